@@ -1,0 +1,150 @@
+//! [`ActiveSet`]: which motors are optimisation variables, the rest locked at given values.
+
+use crate::error::{KinematicsError, Result};
+use crate::fk::PoseBuffer;
+use crate::model::{RobotModel, check_vector};
+
+/// A selection of motors as variables (the *active values*), every other motor locked. It maps
+/// an active vector straight to joint values (couplings and locked motors folded into one sparse
+/// affine map) and runs forward kinematics. `Send + Sync`; share it between threads.
+///
+/// ```
+/// # use trm_kinematics::RobotModel;
+/// let urdf = r#"<robot name="r"><link name="a"/><link name="b"/>
+///   <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+///   <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
+/// let model = RobotModel::from_urdf_str(urdf, "<doc>")?;
+/// let active = model.active_set(&["j"], &model.neutral_motors())?;
+/// let mut poses = model.pose_buffer();
+/// active.forward(&[0.5], &mut poses)?;
+/// # Ok::<(), trm_kinematics::KinematicsError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ActiveSet {
+    model: RobotModel,
+    active: Vec<usize>,
+    locked: Vec<f64>,
+    /// Per joint: constant part and range into `terms`.
+    rows: Vec<(f64, u32, u32)>,
+    terms: Vec<(u32, f64)>,
+}
+
+impl RobotModel {
+    /// Makes the motors named in `selection` (motor or group names, in that order) the
+    /// variables; every other motor is locked at its value in `locked` (a full motor vector,
+    /// e.g. [`RobotModel::posture`] or [`RobotModel::neutral_motors`]).
+    pub fn active_set<S: AsRef<str>>(&self, selection: &[S], locked: &[f64]) -> Result<ActiveSet> {
+        let active = self.select_motors(selection)?;
+        ActiveSet::new(self.clone(), active, locked)
+    }
+
+    /// Every motor active, in motor order.
+    pub fn all_active(&self) -> ActiveSet {
+        ActiveSet::new(self.clone(), (0..self.motors().len()).collect(), &self.neutral_motors())
+            .expect("the neutral posture is valid")
+    }
+}
+
+impl ActiveSet {
+    /// An active set from motor indices and a full motor vector for the locked ones.
+    pub fn new(model: RobotModel, active: Vec<usize>, locked: &[f64]) -> Result<Self> {
+        let motors = model.motors();
+        check_vector("locked motor values", locked, motors.len(), |i| &motors[i].name)?;
+        if let Some(&bad) = active.iter().find(|&&m| m >= motors.len()) {
+            return Err(KinematicsError::WrongLength { what: "active motor index", expected: motors.len(), got: bad });
+        }
+        let mut position = vec![None; motors.len()];
+        for (k, &m) in active.iter().enumerate() {
+            position[m] = Some(k as u32);
+        }
+        let mut rows = Vec::with_capacity(model.num_joints());
+        let mut terms = Vec::new();
+        for c in model.couplings() {
+            let mut constant = c.offset;
+            let start = terms.len() as u32;
+            for &(m, f) in &c.terms {
+                match position[m] {
+                    Some(k) => terms.push((k, f)),
+                    None => constant += f * locked[m],
+                }
+            }
+            rows.push((constant, start, terms.len() as u32));
+        }
+        Ok(ActiveSet { model, active, locked: locked.to_vec(), rows, terms })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &RobotModel {
+        &self.model
+    }
+
+    /// Number of active motors (the optimisation dimension).
+    pub fn len(&self) -> usize {
+        self.active.len()
+    }
+
+    /// Whether no motor is active.
+    pub fn is_empty(&self) -> bool {
+        self.active.is_empty()
+    }
+
+    /// Motor indices of the active values, in order.
+    pub fn motor_indices(&self) -> &[usize] {
+        &self.active
+    }
+
+    /// Names of the active motors.
+    pub fn names(&self) -> impl ExactSizeIterator<Item = &str> {
+        self.active.iter().map(|&m| self.model.motors()[m].name.as_str())
+    }
+
+    /// Lower and upper limits of the active motors (box bounds for an optimiser).
+    pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        let m = self.model.motors();
+        (self.active.iter().map(|&i| m[i].limits.lower).collect(), self.active.iter().map(|&i| m[i].limits.upper).collect())
+    }
+
+    /// Active values taken from a full motor vector.
+    pub fn from_motors(&self, motors: &[f64]) -> Vec<f64> {
+        self.active.iter().map(|&m| motors[m]).collect()
+    }
+
+    /// The full motor vector for active values `q` (locked motors at their locked values).
+    pub fn to_motors(&self, q: &[f64]) -> Vec<f64> {
+        let mut motors = self.locked.clone();
+        for (&m, &v) in self.active.iter().zip(q) {
+            motors[m] = v;
+        }
+        motors
+    }
+
+    /// Joint values for active values `q`, without checks.
+    #[inline]
+    pub fn joint_values_unchecked(&self, q: &[f64], joints: &mut [f64]) {
+        for (value, &(constant, start, end)) in joints.iter_mut().zip(&self.rows) {
+            let mut v = constant;
+            for &(k, f) in &self.terms[start as usize..end as usize] {
+                v += f * q[k as usize];
+            }
+            *value = v;
+        }
+    }
+
+    /// Forward kinematics of active values `q` into `buffer` (made by
+    /// [`RobotModel::pose_buffer`]). Checks the length and that every value is finite; values
+    /// outside the limits are allowed (optimisers may probe there).
+    pub fn forward(&self, q: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
+        check_vector("active motor values", q, self.active.len(), |i| &self.model.motors()[self.active[i]].name)?;
+        self.model.check_buffer(buffer)?;
+        self.forward_unchecked(q, buffer);
+        Ok(())
+    }
+
+    /// [`ActiveSet::forward`] without checks, for the hot path. Panics on a wrong-sized `q` or
+    /// buffer; NaN in `q` gives NaN poses.
+    #[inline]
+    pub fn forward_unchecked(&self, q: &[f64], buffer: &mut PoseBuffer) {
+        self.joint_values_unchecked(q, &mut buffer.joint_values);
+        self.model.forward_buffered_unchecked(buffer);
+    }
+}

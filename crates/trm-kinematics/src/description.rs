@@ -1,0 +1,118 @@
+//! The model description: a RON file beside a URDF that says what the URDF cannot — which motors
+//! drive which joints (linear couplings), named frames, motor groups and named postures.
+//!
+//! The format is documented in `models/README.md`. A minimal description:
+//!
+//! ```ron
+//! (
+//!     urdf: "planar_arm.urdf",
+//!     frames: [(name: "tool", link: "link3", xyz: (0.1, 0.0, 0.0))],
+//!     groups: [(name: "arm", members: ["joint1", "joint2", "joint3"])],
+//!     postures: [(name: "home", values: {"joint2": 0.5})],
+//! )
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+/// Everything a model description file holds. All angles are radians, lengths metres.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelDescription {
+    /// The URDF, relative to the description file.
+    pub urdf: PathBuf,
+    /// Motors that drive coupled joints. A movable joint that no coupling names (and that has no
+    /// `<mimic>`) is driven by a motor of its own, with the joint's name and limits.
+    #[serde(default)]
+    pub motors: Vec<MotorSpec>,
+    /// Joints driven by a linear combination of motors.
+    #[serde(default)]
+    pub couplings: Vec<CouplingSpec>,
+    /// Named frames: a link plus a fixed offset.
+    #[serde(default)]
+    pub frames: Vec<FrameSpec>,
+    /// Named groups of motors, usable to select active motors.
+    #[serde(default)]
+    pub groups: Vec<GroupSpec>,
+    /// Named postures in motor space.
+    #[serde(default)]
+    pub postures: Vec<PostureSpec>,
+}
+
+/// A motor declared for couplings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorSpec {
+    /// Unique motor name.
+    pub name: String,
+    /// Lowest motor position.
+    pub lower: f64,
+    /// Highest motor position.
+    pub upper: f64,
+    /// Largest motor speed; unlimited when absent.
+    #[serde(default)]
+    pub velocity: Option<f64>,
+}
+
+/// `joint = Σ factor · motor + offset`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSpec {
+    /// URDF name of the driven joint.
+    pub joint: String,
+    /// `(motor name, factor)` terms; empty for a joint held at `offset`.
+    pub motors: Vec<(String, f64)>,
+    /// Constant term.
+    #[serde(default)]
+    pub offset: f64,
+}
+
+/// A named frame rigidly attached to a link.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSpec {
+    /// Unique name, distinct from every link name.
+    pub name: String,
+    /// The link (or an earlier named frame) it is attached to.
+    pub link: String,
+    /// Offset translation, in the link frame.
+    #[serde(default)]
+    pub xyz: [f64; 3],
+    /// Offset rotation as URDF roll-pitch-yaw.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+/// A named list of motors (or of other, earlier groups).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroupSpec {
+    /// Unique group name.
+    pub name: String,
+    /// Motor names or earlier group names.
+    pub members: Vec<String>,
+}
+
+/// A named posture: motor values by name. Motors left out take 0 clamped into their limits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PostureSpec {
+    /// Unique posture name.
+    pub name: String,
+    /// Motor values by motor name.
+    pub values: BTreeMap<String, f64>,
+}
+
+impl ModelDescription {
+    /// Parses RON text; `origin` names the file in errors.
+    pub fn from_ron(text: &str, origin: &str) -> crate::Result<Self> {
+        ron::from_str(text).map_err(|e| crate::KinematicsError::MalformedDescription {
+            origin: origin.to_string(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })
+    }
+}

@@ -1,0 +1,170 @@
+//! The error type of this crate.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// What kind of name a lookup failed on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NameKind {
+    /// A URDF link.
+    Link,
+    /// A URDF joint.
+    Joint,
+    /// A motor (an optimisation variable before active-joint selection).
+    Motor,
+    /// A link or a named frame.
+    Frame,
+    /// A motor group.
+    Group,
+    /// A motor or a group of motors.
+    MotorOrGroup,
+    /// A named posture.
+    Posture,
+}
+
+impl fmt::Display for NameKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            NameKind::Link => "link",
+            NameKind::Joint => "joint",
+            NameKind::Motor => "motor",
+            NameKind::Frame => "link or frame",
+            NameKind::Group => "group",
+            NameKind::MotorOrGroup => "motor or group",
+            NameKind::Posture => "posture",
+        })
+    }
+}
+
+/// Everything that can go wrong while loading or using a robot model.
+#[derive(Debug, thiserror::Error)]
+pub enum KinematicsError {
+    /// A file could not be read.
+    #[error("{}: cannot read file: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// The URDF is not well-formed XML or does not follow the URDF schema.
+    #[error(
+        "{origin}: malformed URDF: {message}\n  fix: the file must be well-formed XML with one <robot name=\"…\"> element holding <link> and <joint> elements"
+    )]
+    MalformedUrdf {
+        /// The file (or `<string>`) the URDF came from.
+        origin: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A model description (RON) could not be parsed.
+    #[error("{origin}:{line}:{column}: malformed model description: {message}\n  fix: see models/README.md for the format")]
+    MalformedDescription {
+        /// The file (or `<string>`) the description came from.
+        origin: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The parser's message.
+        message: String,
+    },
+    /// The model parses but is not a valid kinematic tree or description.
+    #[error("{origin}{}: {element}: {problem}\n  fix: {fix}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    InvalidModel {
+        /// The file (or `<string>`) the model came from.
+        origin: String,
+        /// The line of the offending element, when it could be found.
+        line: Option<usize>,
+        /// The offending element, e.g. `<joint name="r_elbow">`.
+        element: String,
+        /// What is wrong.
+        problem: String,
+        /// What to do about it.
+        fix: String,
+    },
+    /// A name lookup failed.
+    #[error("unknown {kind} `{name}`{}", suggest(suggestions))]
+    UnknownName {
+        /// What was looked up.
+        kind: NameKind,
+        /// The name given.
+        name: String,
+        /// The closest existing names, best first.
+        suggestions: Vec<String>,
+    },
+    /// A vector had the wrong number of entries.
+    #[error("{what}: expected {expected} values, got {got}")]
+    WrongLength {
+        /// Which vector.
+        what: &'static str,
+        /// Entries expected.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// A value was NaN or infinite.
+    #[error("{what}: entry {index} (`{name}`) is {value}; all values must be finite")]
+    NonFinite {
+        /// Which vector.
+        what: &'static str,
+        /// Position of the entry.
+        index: usize,
+        /// Name of the entry.
+        name: String,
+        /// The value.
+        value: f64,
+    },
+}
+
+fn suggest(suggestions: &[String]) -> String {
+    if suggestions.is_empty() {
+        String::new()
+    } else {
+        format!("; did you mean {}?", suggestions.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", "))
+    }
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = KinematicsError> = std::result::Result<T, E>;
+
+/// Up to three names from `candidates` closest to `name` (Jaro-Winkler and substring match).
+pub fn closest_names<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+    let lower = name.to_lowercase();
+    let mut scored: Vec<(f64, &str)> = candidates
+        .into_iter()
+        .map(|c| {
+            let cl = c.to_lowercase();
+            let mut score = strsim::jaro_winkler(&lower, &cl);
+            if !lower.is_empty() && (cl.contains(&lower) || lower.contains(&cl)) {
+                score += 0.2;
+            }
+            (score, c)
+        })
+        .filter(|(s, _)| *s > 0.75)
+        .collect();
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+    scored.into_iter().take(3).map(|(_, c)| c.to_string()).collect()
+}
+
+/// An [`KinematicsError::UnknownName`] with suggestions drawn from `candidates`.
+pub(crate) fn unknown<'a>(kind: NameKind, name: &str, candidates: impl IntoIterator<Item = &'a str>) -> KinematicsError {
+    KinematicsError::UnknownName { kind, name: name.to_string(), suggestions: closest_names(name, candidates) }
+}
+
+/// 1-based line of the first `<tag ... name="name"` in `source`, if any.
+pub(crate) fn line_of_element(source: &str, tag: &str, name: &str) -> Option<usize> {
+    let open = format!("<{tag}");
+    let needles = [format!("name=\"{name}\""), format!("name='{name}'")];
+    let mut search_from = 0;
+    while let Some(rel) = source[search_from..].find(&open) {
+        let start = search_from + rel;
+        let end = source[start..].find('>').map_or(source.len(), |e| start + e);
+        let head = &source[start..end];
+        if needles.iter().any(|n| head.contains(n.as_str())) {
+            return Some(source[..start].matches('\n').count() + 1);
+        }
+        search_from = start + open.len();
+    }
+    None
+}

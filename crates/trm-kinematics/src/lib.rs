@@ -1,0 +1,43 @@
+//! Robot models for trm: URDF link trees, motors with linear couplings, active-joint selection,
+//! named frames and allocation-free forward kinematics.
+//!
+//! Start with [`RobotModel::load`] (a `.urdf`, or a `.ron` [model description](ModelDescription)
+//! that adds couplings, frames, groups and postures to a URDF), choose the variables with
+//! [`RobotModel::active_set`], and pose the robot with [`ActiveSet::forward`] into a reusable
+//! [`PoseBuffer`]:
+//!
+//! ```
+//! use trm_kinematics::RobotModel;
+//!
+//! let urdf = r#"<robot name="arm">
+//!   <link name="base"/><link name="upper"/><link name="tool"/>
+//!   <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+//!     <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+//!   <joint name="tip" type="fixed"><origin xyz="1 0 0"/><parent link="upper"/><child link="tool"/></joint>
+//! </robot>"#;
+//! let model = RobotModel::from_urdf_str(urdf, "<example>")?;
+//! let active = model.all_active();
+//! let mut poses = model.pose_buffer();
+//! active.forward(&[std::f64::consts::FRAC_PI_2], &mut poses)?;
+//! let tool = poses.pose(model.frame_id("tool")?);
+//! assert!((tool.translation.y - 1.0).abs() < 1e-12);
+//! # Ok::<(), trm_kinematics::KinematicsError>(())
+//! ```
+//!
+//! World frame = the URDF root link. Joint, motor and active vectors are explained on
+//! [`RobotModel`]. Mesh files are never opened: kinematics needs none.
+
+mod active;
+mod description;
+mod error;
+mod fk;
+mod model;
+mod tree;
+
+pub use active::ActiveSet;
+pub use description::{CouplingSpec, FrameSpec, GroupSpec, ModelDescription, MotorSpec, PostureSpec};
+pub use error::{KinematicsError, NameKind, Result, closest_names};
+pub use fk::PoseBuffer;
+pub use model::{Coupling, FrameId, Motor, NamedFrame, RobotModel};
+pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
+pub use nalgebra;

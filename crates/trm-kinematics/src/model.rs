@@ -1,0 +1,662 @@
+//! [`RobotModel`]: a URDF tree plus motors, couplings, named frames, groups and postures.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use nalgebra::Isometry3;
+
+use crate::description::ModelDescription;
+use crate::error::{KinematicsError, NameKind, Result, unknown};
+use crate::fk::{Motion, PoseBuffer, Step};
+use crate::tree::{Ctx, JointKind, Limits, Tree, pose_from_xyz_rpy};
+
+/// Index of a pose in a [`PoseBuffer`]: a link (`0..num_links`) or a named frame after them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FrameId(pub(crate) usize);
+
+impl FrameId {
+    /// Position in the pose buffer.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+/// A motor: one optimisation variable, driving one or more joints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Motor {
+    /// Unique name (for an uncoupled joint, the joint's name).
+    pub name: String,
+    /// Position limits, and velocity limit (∞ when unknown). Continuous joints get [−π, π].
+    pub limits: Limits,
+}
+
+/// `joint value = offset + Σ factor · motor[index]` for one movable joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coupling {
+    /// `(motor index, factor)` terms.
+    pub terms: Vec<(usize, f64)>,
+    /// Constant term.
+    pub offset: f64,
+}
+
+/// A named frame: a link plus a fixed offset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedFrame {
+    /// Unique name.
+    pub name: String,
+    /// The link it is attached to.
+    pub link: usize,
+    /// Pose of the frame in the link frame.
+    pub local_offset: Isometry3<f64>,
+}
+
+#[derive(Debug)]
+struct ModelData {
+    origin: String,
+    tree: Tree,
+    motors: Vec<Motor>,
+    couplings: Vec<Coupling>,
+    frames: Vec<NamedFrame>,
+    groups: Vec<(String, Vec<usize>)>,
+    postures: Vec<(String, Vec<f64>)>,
+    steps: Vec<Step>,
+}
+
+/// A robot: the URDF link tree, the motors that drive its joints, named frames, motor groups and
+/// named postures. Cheap to clone (shared), `Send + Sync`.
+///
+/// Three vector spaces appear in the API:
+/// * **joint values**: one per movable URDF joint, in [`RobotModel::joint_names`] order;
+/// * **motor values**: one per motor, in [`RobotModel::motors`] order; joints follow motors
+///   through the linear [`Coupling`]s;
+/// * **active values**: the motors an [`crate::ActiveSet`] makes variables, the rest locked.
+#[derive(Debug, Clone)]
+pub struct RobotModel {
+    data: Arc<ModelData>,
+}
+
+impl TryFrom<&urdf_rs::Robot> for RobotModel {
+    type Error = KinematicsError;
+    fn try_from(robot: &urdf_rs::Robot) -> Result<Self> {
+        Self::build(robot, &ModelDescription::default(), &Ctx { origin: "<urdf>", source: None }, None)
+    }
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|source| KinematicsError::Io { path: path.to_path_buf(), source })
+}
+
+fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
+    urdf_rs::read_from_string(text)
+        .map_err(|e| KinematicsError::MalformedUrdf { origin: origin.to_string(), message: e.to_string() })
+}
+
+impl RobotModel {
+    /// Loads a model from a `.urdf` file or a `.ron` model description (which names its URDF).
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron")) {
+            Self::from_description_file(path)
+        } else {
+            Self::from_urdf_file(path)
+        }
+    }
+
+    /// Loads a plain URDF file: every movable joint is a motor (mimic joints follow their leader).
+    /// Mesh files are never opened.
+    pub fn from_urdf_file(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        Self::from_urdf_str(&read(path)?, &path.display().to_string())
+    }
+
+    /// Parses URDF text; `origin` names the text in errors (a file name or `<string>`).
+    pub fn from_urdf_str(urdf: &str, origin: &str) -> Result<Self> {
+        Self::from_parts(urdf, origin, &ModelDescription::default(), None)
+    }
+
+    /// Loads a model description (RON) and the URDF it names (relative to the description).
+    pub fn from_description_file(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = read(path)?;
+        let origin = path.display().to_string();
+        let description = ModelDescription::from_ron(&text, &origin)?;
+        let urdf_path = path.parent().unwrap_or(Path::new(".")).join(&description.urdf);
+        let urdf = read(&urdf_path)?;
+        Self::from_parts(&urdf, &urdf_path.display().to_string(), &description, Some((&text, &origin)))
+    }
+
+    /// Builds a model from URDF text and a description; `origin` names the URDF in errors and
+    /// `description_text` is the description's `(text, origin)` when it came from a file.
+    pub fn from_parts(
+        urdf: &str,
+        origin: &str,
+        description: &ModelDescription,
+        description_text: Option<(&str, &str)>,
+    ) -> Result<Self> {
+        let robot = parse_urdf(urdf, origin)?;
+        Self::build(&robot, description, &Ctx { origin, source: Some(urdf) }, description_text)
+    }
+
+    fn build(
+        robot: &urdf_rs::Robot,
+        desc: &ModelDescription,
+        ctx: &Ctx,
+        desc_text: Option<(&str, &str)>,
+    ) -> Result<Self> {
+        let tree = Tree::from_urdf(robot, ctx)?;
+        let dctx = DescCtx { origin: desc_text.map_or("<description>", |d| d.1), text: desc_text.map(|d| d.0) };
+        let (motors, couplings) = resolve_motors(&tree, desc, &dctx)?;
+        let frames = resolve_frames(&tree, desc, &dctx)?;
+        let groups = resolve_groups(&motors, desc, &dctx)?;
+        let postures = resolve_postures(&motors, desc, &dctx)?;
+        let steps = compile_steps(&tree, &frames);
+        Ok(RobotModel {
+            data: Arc::new(ModelData {
+                origin: ctx.origin.to_string(),
+                tree,
+                motors,
+                couplings,
+                frames,
+                groups,
+                postures,
+                steps,
+            }),
+        })
+    }
+
+    /// Where the model was loaded from (the URDF file name, or `<string>`).
+    pub fn origin(&self) -> &str {
+        &self.data.origin
+    }
+
+    /// The robot name from the URDF.
+    pub fn name(&self) -> &str {
+        &self.data.tree.name
+    }
+
+    /// The link tree.
+    pub fn tree(&self) -> &Tree {
+        &self.data.tree
+    }
+
+    /// Number of links.
+    pub fn num_links(&self) -> usize {
+        self.data.tree.links.len()
+    }
+
+    /// Number of movable joints (the length of a joint-value vector).
+    pub fn num_joints(&self) -> usize {
+        self.data.tree.movable.len()
+    }
+
+    /// Names of the movable joints, in joint-value order.
+    pub fn joint_names(&self) -> impl ExactSizeIterator<Item = &str> {
+        self.data.tree.movable.iter().map(|&j| self.data.tree.joints[j].name.as_str())
+    }
+
+    /// The movable joint at coordinate `i`.
+    pub fn joint(&self, i: usize) -> &crate::tree::Joint {
+        &self.data.tree.joints[self.data.tree.movable[i]]
+    }
+
+    /// Coordinate (joint-value index) of the movable joint `name`.
+    pub fn joint_index(&self, name: &str) -> Result<usize> {
+        self.data
+            .tree
+            .joint_index(name)
+            .and_then(|j| self.data.tree.joints[j].coordinate)
+            .ok_or_else(|| unknown(NameKind::Joint, name, self.joint_names()))
+    }
+
+    /// Motors, in motor-value order.
+    pub fn motors(&self) -> &[Motor] {
+        &self.data.motors
+    }
+
+    /// Index of the motor `name`.
+    pub fn motor_index(&self, name: &str) -> Result<usize> {
+        self.data
+            .motors
+            .iter()
+            .position(|m| m.name == name)
+            .ok_or_else(|| unknown(NameKind::Motor, name, self.data.motors.iter().map(|m| m.name.as_str())))
+    }
+
+    /// The coupling of every movable joint, in joint-value order.
+    pub fn couplings(&self) -> &[Coupling] {
+        &self.data.couplings
+    }
+
+    /// Whether some joint is driven by anything other than exactly one motor of its own.
+    pub fn is_coupled(&self) -> bool {
+        self.data.motors.len() != self.num_joints()
+            || self.data.couplings.iter().any(|c| c.offset != 0.0 || c.terms.len() != 1 || c.terms[0].1 != 1.0)
+    }
+
+    /// Named frames (not including links).
+    pub fn named_frames(&self) -> &[NamedFrame] {
+        &self.data.frames
+    }
+
+    /// The pose-buffer index of a link or named frame.
+    pub fn frame_id(&self, name: &str) -> Result<FrameId> {
+        if let Some(i) = self.data.tree.link_index(name) {
+            return Ok(FrameId(i));
+        }
+        if let Some(i) = self.data.frames.iter().position(|f| f.name == name) {
+            return Ok(FrameId(self.num_links() + i));
+        }
+        Err(unknown(NameKind::Frame, name, self.frame_names()))
+    }
+
+    /// Names of all links then all named frames, in pose-buffer order.
+    pub fn frame_names(&self) -> impl Iterator<Item = &str> {
+        let links = self.data.tree.links.iter().map(|l| l.name.as_str());
+        links.chain(self.data.frames.iter().map(|f| f.name.as_str()))
+    }
+
+    /// Number of poses a [`PoseBuffer`] holds (links + named frames).
+    pub fn num_frames(&self) -> usize {
+        self.num_links() + self.data.frames.len()
+    }
+
+    /// Motor groups, in declaration order.
+    pub fn groups(&self) -> impl Iterator<Item = (&str, &[usize])> {
+        self.data.groups.iter().map(|(n, m)| (n.as_str(), m.as_slice()))
+    }
+
+    /// Motor indices of group `name`.
+    pub fn group(&self, name: &str) -> Result<&[usize]> {
+        self.data
+            .groups
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, m)| m.as_slice())
+            .ok_or_else(|| unknown(NameKind::Group, name, self.data.groups.iter().map(|(n, _)| n.as_str())))
+    }
+
+    /// Motor indices for a list of motor and group names, in the given order, without repeats.
+    pub fn select_motors<S: AsRef<str>>(&self, names: &[S]) -> Result<Vec<usize>> {
+        let mut out = Vec::new();
+        for name in names {
+            let name = name.as_ref();
+            let found: Vec<usize> = if let Ok(g) = self.group(name) {
+                g.to_vec()
+            } else if let Ok(m) = self.motor_index(name) {
+                vec![m]
+            } else {
+                let candidates = self.data.groups.iter().map(|(n, _)| n.as_str());
+                let candidates = candidates.chain(self.data.motors.iter().map(|m| m.name.as_str()));
+                return Err(unknown(NameKind::MotorOrGroup, name, candidates));
+            };
+            for m in found {
+                if !out.contains(&m) {
+                    out.push(m);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Names of the named postures.
+    pub fn posture_names(&self) -> impl Iterator<Item = &str> {
+        self.data.postures.iter().map(|(n, _)| n.as_str())
+    }
+
+    /// Motor values of the named posture.
+    pub fn posture(&self, name: &str) -> Result<&[f64]> {
+        self.data
+            .postures
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+            .ok_or_else(|| unknown(NameKind::Posture, name, self.posture_names()))
+    }
+
+    /// The zero motor vector clamped into the motor limits (the default locked values).
+    pub fn neutral_motors(&self) -> Vec<f64> {
+        self.data.motors.iter().map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper)).collect()
+    }
+
+    /// A pose buffer sized for this model.
+    pub fn pose_buffer(&self) -> PoseBuffer {
+        PoseBuffer::new(self.num_joints(), self.num_frames())
+    }
+
+    /// Joint values from motor values, through the couplings.
+    pub fn motors_to_joints(&self, motors: &[f64], joints: &mut [f64]) -> Result<()> {
+        check_vector("motor values", motors, self.data.motors.len(), |i| &self.data.motors[i].name)?;
+        if joints.len() != self.num_joints() {
+            return Err(KinematicsError::WrongLength {
+                what: "joint values",
+                expected: self.num_joints(),
+                got: joints.len(),
+            });
+        }
+        for (value, c) in joints.iter_mut().zip(&self.data.couplings) {
+            *value = c.offset + c.terms.iter().map(|&(m, f)| f * motors[m]).sum::<f64>();
+        }
+        Ok(())
+    }
+
+    /// Forward kinematics from joint values: the world pose (world = root link) of every link
+    /// and named frame into `buffer`.
+    pub fn forward_joints(&self, joints: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
+        check_vector("joint values", joints, self.num_joints(), |i| &self.joint(i).name)?;
+        self.check_buffer(buffer)?;
+        buffer.joint_values.copy_from_slice(joints);
+        self.forward_buffered_unchecked(buffer);
+        Ok(())
+    }
+
+    /// Forward kinematics from motor values (every motor, in [`RobotModel::motors`] order).
+    pub fn forward_motors(&self, motors: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
+        self.check_buffer(buffer)?;
+        self.motors_to_joints(motors, &mut buffer.joint_values)?;
+        self.forward_buffered_unchecked(buffer);
+        Ok(())
+    }
+
+    pub(crate) fn check_buffer(&self, buffer: &PoseBuffer) -> Result<()> {
+        if buffer.poses.len() != self.num_frames() || buffer.joint_values.len() != self.num_joints() {
+            return Err(KinematicsError::WrongLength {
+                what: "pose buffer (make it with RobotModel::pose_buffer)",
+                expected: self.num_frames(),
+                got: buffer.poses.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Runs the FK pass on the joint values already in `buffer`.
+    pub(crate) fn forward_buffered_unchecked(&self, buffer: &mut PoseBuffer) {
+        crate::fk::run_steps(&self.data.steps, &buffer.joint_values, &mut buffer.poses);
+    }
+}
+
+/// Checks length and finiteness of a vector; `name(i)` names entry `i` in errors.
+pub(crate) fn check_vector<'a>(
+    what: &'static str,
+    values: &[f64],
+    expected: usize,
+    name: impl Fn(usize) -> &'a str,
+) -> Result<()> {
+    if values.len() != expected {
+        return Err(KinematicsError::WrongLength { what, expected, got: values.len() });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(KinematicsError::NonFinite { what, index, name: name(index).to_string(), value: values[index] });
+    }
+    Ok(())
+}
+
+struct DescCtx<'a> {
+    origin: &'a str,
+    text: Option<&'a str>,
+}
+
+impl DescCtx<'_> {
+    fn invalid(&self, element: String, quoted: &str, problem: impl Into<String>, fix: impl Into<String>) -> KinematicsError {
+        let needle = format!("\"{quoted}\"");
+        let line = self
+            .text
+            .and_then(|t| t.lines().position(|l| l.contains(&needle) && !l.trim_start().starts_with("//")))
+            .map(|i| i + 1);
+        KinematicsError::InvalidModel {
+            origin: self.origin.to_string(),
+            line,
+            element,
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+}
+
+fn suggestion_fix<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>, otherwise: &str) -> String {
+    let near = crate::error::closest_names(name, candidates);
+    if near.is_empty() { otherwise.to_string() } else { format!("did you mean `{}`?", near.join("`, `")) }
+}
+
+fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result<(Vec<Motor>, Vec<Coupling>)> {
+    let joint_names: Vec<&str> = tree.movable.iter().map(|&j| tree.joints[j].name.as_str()).collect();
+    // Declared motors.
+    let mut declared: HashMap<&str, (usize, &crate::description::MotorSpec)> = HashMap::new();
+    for (i, m) in desc.motors.iter().enumerate() {
+        let element = format!("motor \"{}\"", m.name);
+        if !(m.lower.is_finite() && m.upper.is_finite()) || m.velocity.is_some_and(|v| v.is_nan() || v <= 0.0) {
+            return Err(ctx.invalid(element, &m.name, "has a non-finite limit or a non-positive velocity", "write finite limits and a positive velocity"));
+        }
+        if m.lower > m.upper {
+            return Err(ctx.invalid(element, &m.name, format!("lower {} is above upper {}", m.lower, m.upper), "swap the limits"));
+        }
+        if declared.insert(m.name.as_str(), (i, m)).is_some() {
+            return Err(ctx.invalid(element, &m.name, "is declared twice", "give every motor a unique name"));
+        }
+    }
+    // Couplings by joint.
+    let mut coupled: HashMap<&str, &crate::description::CouplingSpec> = HashMap::new();
+    for c in &desc.couplings {
+        let element = format!("coupling of joint \"{}\"", c.joint);
+        let Some(j) = tree.joint_index(&c.joint) else {
+            return Err(ctx.invalid(element, &c.joint, "names no joint of the URDF", suggestion_fix(&c.joint, joint_names.iter().copied(), "name a movable URDF joint")));
+        };
+        if !tree.joints[j].kind.is_movable() {
+            return Err(ctx.invalid(element, &c.joint, "names a fixed joint", "couple only movable joints"));
+        }
+        if tree.joints[j].mimic.is_some() {
+            return Err(ctx.invalid(element, &c.joint, "names a joint that already has a <mimic>", "remove the <mimic> or the coupling"));
+        }
+        if !c.offset.is_finite() || c.motors.iter().any(|(_, f)| !f.is_finite()) {
+            return Err(ctx.invalid(element, &c.joint, "has a non-finite factor or offset", "write finite numbers"));
+        }
+        if coupled.insert(c.joint.as_str(), c).is_some() {
+            return Err(ctx.invalid(element, &c.joint, "is coupled twice", "give one coupling per joint"));
+        }
+    }
+    // Independent joints own a motor named like them.
+    let own_motor = |j: usize| {
+        let joint = &tree.joints[j];
+        joint.mimic.is_none() && !coupled.contains_key(joint.name.as_str())
+    };
+    for &j in &tree.movable {
+        let name = tree.joints[j].name.as_str();
+        if own_motor(j) && declared.contains_key(name) {
+            return Err(ctx.invalid(
+                format!("motor \"{name}\""),
+                name,
+                "has the name of an uncoupled joint, which is already a motor of its own",
+                "rename the motor, or add a coupling for the joint",
+            ));
+        }
+    }
+    let mut motors: Vec<Motor> = Vec::new();
+    let mut index_of: HashMap<String, usize> = HashMap::new();
+    let mut motor_index = |name: &str, motors: &mut Vec<Motor>, make: &dyn Fn() -> Motor| -> usize {
+        *index_of.entry(name.to_string()).or_insert_with(|| {
+            motors.push(make());
+            motors.len() - 1
+        })
+    };
+    let mut couplings: Vec<Option<Coupling>> = vec![None; tree.movable.len()];
+    // First pass: independent and coupled joints, in joint order; second pass: mimics.
+    for (coord, &j) in tree.movable.iter().enumerate() {
+        let joint = &tree.joints[j];
+        if joint.mimic.is_some() {
+            continue;
+        }
+        if let Some(c) = coupled.get(joint.name.as_str()) {
+            let mut terms = Vec::new();
+            for (mname, factor) in &c.motors {
+                let m = if let Some(&(_, spec)) = declared.get(mname.as_str()) {
+                    motor_index(mname, &mut motors, &|| Motor {
+                        name: spec.name.clone(),
+                        limits: Limits {
+                            lower: spec.lower,
+                            upper: spec.upper,
+                            velocity: spec.velocity.unwrap_or(f64::INFINITY),
+                            effort: f64::INFINITY,
+                        },
+                    })
+                } else if let Some(other) = tree.joint_index(mname).filter(|&o| tree.joints[o].kind.is_movable() && own_motor(o)) {
+                    let other = &tree.joints[other];
+                    motor_index(mname, &mut motors, &|| own_motor_of(other))
+                } else {
+                    let candidates = desc.motors.iter().map(|m| m.name.as_str()).chain(joint_names.iter().copied());
+                    return Err(ctx.invalid(
+                        format!("coupling of joint \"{}\"", joint.name),
+                        mname,
+                        format!("names motor `{mname}`, which is neither declared in `motors` nor an uncoupled joint"),
+                        suggestion_fix(mname, candidates, "declare the motor in `motors`"),
+                    ));
+                };
+                terms.push((m, *factor));
+            }
+            couplings[coord] = Some(Coupling { terms, offset: c.offset });
+        } else {
+            let m = motor_index(&joint.name, &mut motors, &|| own_motor_of(joint));
+            couplings[coord] = Some(Coupling { terms: vec![(m, 1.0)], offset: 0.0 });
+        }
+    }
+    for (coord, &j) in tree.movable.iter().enumerate() {
+        let Some(mimic) = &tree.joints[j].mimic else { continue };
+        let leader = tree.joints[tree.joint_index(&mimic.leader).expect("checked by Tree")].coordinate.expect("movable");
+        let lc = couplings[leader].clone().expect("leaders are resolved in the first pass");
+        couplings[coord] = Some(Coupling {
+            terms: lc.terms.iter().map(|&(m, f)| (m, f * mimic.multiplier)).collect(),
+            offset: lc.offset * mimic.multiplier + mimic.offset,
+        });
+    }
+    for m in &desc.motors {
+        if !index_of.contains_key(&m.name) {
+            return Err(ctx.invalid(format!("motor \"{}\"", m.name), &m.name, "drives no joint", "use it in a coupling or remove it"));
+        }
+    }
+    let couplings: Vec<Coupling> = couplings.into_iter().map(|c| c.expect("every movable joint resolved")).collect();
+    // Explicit couplings must keep their joints within the URDF limits over the motor box.
+    for (coord, c) in couplings.iter().enumerate() {
+        let joint = &tree.joints[tree.movable[coord]];
+        if !coupled.contains_key(joint.name.as_str()) || joint.kind == JointKind::Continuous {
+            continue;
+        }
+        let (mut lo, mut hi) = (c.offset, c.offset);
+        for &(m, f) in &c.terms {
+            let (a, b) = (f * motors[m].limits.lower, f * motors[m].limits.upper);
+            lo += a.min(b);
+            hi += a.max(b);
+        }
+        let tol = 1e-9;
+        if lo < joint.limits.lower - tol || hi > joint.limits.upper + tol {
+            return Err(ctx.invalid(
+                format!("coupling of joint \"{}\"", joint.name),
+                &joint.name,
+                format!(
+                    "drives the joint over [{lo:.6}, {hi:.6}], outside its URDF limits [{:.6}, {:.6}]",
+                    joint.limits.lower, joint.limits.upper
+                ),
+                "narrow the motor limits or correct the factors/offset",
+            ));
+        }
+    }
+    Ok((motors, couplings))
+}
+
+fn own_motor_of(joint: &crate::tree::Joint) -> Motor {
+    let mut limits = joint.limits;
+    if joint.kind == JointKind::Continuous {
+        limits.lower = -std::f64::consts::PI;
+        limits.upper = std::f64::consts::PI;
+    }
+    Motor { name: joint.name.clone(), limits }
+}
+
+fn resolve_frames(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<NamedFrame>> {
+    let mut frames: Vec<NamedFrame> = Vec::new();
+    for f in &desc.frames {
+        let element = format!("frame \"{}\"", f.name);
+        if tree.link_index(&f.name).is_some() || frames.iter().any(|g| g.name == f.name) {
+            return Err(ctx.invalid(element, &f.name, "has the name of a link or another frame", "give the frame a unique name"));
+        }
+        if f.xyz.iter().chain(&f.rpy).any(|v| !v.is_finite()) {
+            return Err(ctx.invalid(element, &f.name, "has a non-finite offset", "write finite numbers"));
+        }
+        let offset = pose_from_xyz_rpy(f.xyz, f.rpy);
+        let (link, local_offset) = if let Some(l) = tree.link_index(&f.link) {
+            (l, offset)
+        } else if let Some(g) = frames.iter().find(|g| g.name == f.link) {
+            (g.link, g.local_offset * offset)
+        } else {
+            let candidates = tree.links.iter().map(|l| l.name.as_str()).chain(frames.iter().map(|g| g.name.as_str()));
+            return Err(ctx.invalid(element, &f.link, format!("is attached to `{}`, which is no link or earlier frame", f.link), suggestion_fix(&f.link, candidates, "name an existing link")));
+        };
+        frames.push(NamedFrame { name: f.name.clone(), link, local_offset });
+    }
+    Ok(frames)
+}
+
+fn resolve_groups(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<(String, Vec<usize>)>> {
+    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+    for g in &desc.groups {
+        let element = format!("group \"{}\"", g.name);
+        if groups.iter().any(|(n, _)| *n == g.name) {
+            return Err(ctx.invalid(element, &g.name, "is declared twice", "give every group a unique name"));
+        }
+        let mut members = Vec::new();
+        for name in &g.members {
+            let found: Vec<usize> = if let Some((_, m)) = groups.iter().find(|(n, _)| n == name) {
+                m.clone()
+            } else if let Some(i) = motors.iter().position(|m| &m.name == name) {
+                vec![i]
+            } else {
+                let candidates = motors.iter().map(|m| m.name.as_str()).chain(groups.iter().map(|(n, _)| n.as_str()));
+                return Err(ctx.invalid(element, name, format!("member `{name}` is no motor or earlier group"), suggestion_fix(name, candidates, "list motor names")));
+            };
+            for m in found {
+                if !members.contains(&m) {
+                    members.push(m);
+                }
+            }
+        }
+        groups.push((g.name.clone(), members));
+    }
+    Ok(groups)
+}
+
+fn resolve_postures(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<(String, Vec<f64>)>> {
+    let mut postures: Vec<(String, Vec<f64>)> = Vec::new();
+    for p in &desc.postures {
+        let element = format!("posture \"{}\"", p.name);
+        if postures.iter().any(|(n, _)| *n == p.name) {
+            return Err(ctx.invalid(element, &p.name, "is declared twice", "give every posture a unique name"));
+        }
+        let mut values: Vec<f64> = motors.iter().map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper)).collect();
+        for (name, &v) in &p.values {
+            let Some(i) = motors.iter().position(|m| &m.name == name) else {
+                return Err(ctx.invalid(element, name, format!("sets `{name}`, which is no motor"), suggestion_fix(name, motors.iter().map(|m| m.name.as_str()), "use motor names (see `cargo xtask model-info`)")));
+            };
+            let l = &motors[i].limits;
+            if !v.is_finite() || v < l.lower - 1e-12 || v > l.upper + 1e-12 {
+                return Err(ctx.invalid(element, name, format!("sets `{name}` to {v}, outside its limits [{}, {}]", l.lower, l.upper), "choose a value within the motor limits"));
+            }
+            values[i] = v.clamp(l.lower, l.upper);
+        }
+        postures.push((p.name.clone(), values));
+    }
+    Ok(postures)
+}
+
+fn compile_steps(tree: &Tree, frames: &[NamedFrame]) -> Vec<Step> {
+    let mut steps = Vec::with_capacity(tree.joints.len() + frames.len());
+    for joint in &tree.joints {
+        let motion = match (joint.kind, joint.coordinate) {
+            (JointKind::Revolute | JointKind::Continuous, Some(c)) => Motion::Revolute { axis: joint.axis, coordinate: c },
+            (JointKind::Prismatic, Some(c)) => Motion::Prismatic { axis: joint.axis.into_inner(), coordinate: c },
+            _ => Motion::Fixed,
+        };
+        steps.push(Step { parent: joint.parent, local_origin: joint.local_origin, motion });
+    }
+    for f in frames {
+        steps.push(Step { parent: f.link, local_origin: f.local_offset, motion: Motion::Fixed });
+    }
+    steps
+}

@@ -1,0 +1,58 @@
+//! The robot models shipped in `models/`, embedded in the binary so that every crate, test,
+//! bench and command can load them from anywhere.
+//!
+//! ```
+//! let icub = trm_models::icub_upper_body();
+//! assert_eq!(icub.motors().len(), 41);
+//! ```
+//!
+//! The iCub files are derived from robotology/icub-models (CC-BY-SA-4.0, © Istituto Italiano
+//! di Tecnologia); see `models/icub-visuomanip/NOTICE.md`.
+
+use trm_kinematics::{ModelDescription, RobotModel};
+
+/// models/icub_upper_body.urdf: the iCub upper body with primitive collision proxies.
+pub const ICUB_UPPER_BODY_URDF: &str = include_str!("../../../models/icub_upper_body.urdf");
+/// models/icub_upper_body.ron: its 41 motors, couplings, frames, groups and postures.
+pub const ICUB_UPPER_BODY_RON: &str = include_str!("../../../models/icub_upper_body.ron");
+/// The official iCubGazeboV2_5_visuomanip URDF (75 revolute joints), unchanged.
+pub const ICUB_OFFICIAL_URDF: &str = include_str!("../../../models/icub-visuomanip/model.urdf");
+/// The official iCubGenova04 URDF (32 revolute joints), unchanged.
+pub const ICUB_GENOVA04_URDF: &str = include_str!("../../../models/icub-genova04/model.urdf");
+/// models/planar_arm.urdf: a three-link planar arm.
+pub const PLANAR_ARM_URDF: &str = include_str!("../../../models/planar_arm.urdf");
+/// models/branched_tree.urdf: a small tree with continuous, prismatic, mimic and fixed joints.
+pub const BRANCHED_TREE_URDF: &str = include_str!("../../../models/branched_tree.urdf");
+
+/// The 41-motor iCub upper body (the default model of trm).
+pub fn icub_upper_body() -> RobotModel {
+    let description = ModelDescription::from_ron(ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")
+        .expect("the shipped description parses (checked by tests)");
+    RobotModel::from_parts(
+        ICUB_UPPER_BODY_URDF,
+        "models/icub_upper_body.urdf",
+        &description,
+        Some((ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")),
+    )
+    .expect("the shipped model is valid (checked by tests)")
+}
+
+/// The official 75-joint iCub URDF, every joint its own motor.
+pub fn icub_official() -> RobotModel {
+    RobotModel::from_urdf_str(ICUB_OFFICIAL_URDF, "models/icub-visuomanip/model.urdf").expect("the official URDF loads")
+}
+
+/// The official iCubGenova04 URDF.
+pub fn icub_genova04() -> RobotModel {
+    RobotModel::from_urdf_str(ICUB_GENOVA04_URDF, "models/icub-genova04/model.urdf").expect("the official URDF loads")
+}
+
+/// The three-link planar arm.
+pub fn planar_arm() -> RobotModel {
+    RobotModel::from_urdf_str(PLANAR_ARM_URDF, "models/planar_arm.urdf").expect("the planar arm loads")
+}
+
+/// The small branched tree.
+pub fn branched_tree() -> RobotModel {
+    RobotModel::from_urdf_str(BRANCHED_TREE_URDF, "models/branched_tree.urdf").expect("the branched tree loads")
+}

@@ -1,0 +1,105 @@
+//! `cargo xtask fk [MODEL] --configs IN.json --out OUT.json`.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use serde_json::{Map, Value, json};
+
+/// Arguments of `fk`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
+    model: Option<PathBuf>,
+    /// Input: {"joint_names": [...], "samples": [{"q": [...]}, ...]} (URDF joint names, radians).
+    #[arg(long)]
+    configs: PathBuf,
+    /// Output file: the input plus, per sample, "links": {"<link>": {"p": [x,y,z], "R": [[...],[...],[...]]}}
+    /// (and "frames" for named frames). Printed to stdout when absent.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// The input file.
+#[derive(Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Configs {
+    joint_names: Vec<String>,
+    samples: Vec<Sample>,
+}
+
+#[derive(Deserialize, Serialize)]
+struct Sample {
+    q: Vec<f64>,
+}
+
+fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
+    let r = p.rotation.to_rotation_matrix();
+    let m = r.matrix();
+    json!({
+        "p": [p.translation.x, p.translation.y, p.translation.z],
+        "R": [[m[(0, 0)], m[(0, 1)], m[(0, 2)]], [m[(1, 0)], m[(1, 1)], m[(1, 2)]], [m[(2, 0)], m[(2, 1)], m[(2, 2)]]],
+    })
+}
+
+/// Computes and writes the poses.
+pub fn run(args: &Args) -> Result<()> {
+    let model = crate::load_model(args.model.as_deref())?;
+    let text = std::fs::read_to_string(&args.configs).with_context(|| format!("reading {}", args.configs.display()))?;
+    let configs: Configs = serde_json::from_str(&text).with_context(|| {
+        format!("{}: expected {{\"joint_names\": [...], \"samples\": [{{\"q\": [...]}}]}}", args.configs.display())
+    })?;
+    let columns: Vec<usize> = configs
+        .joint_names
+        .iter()
+        .map(|n| model.joint_index(n))
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{}: joint_names", args.configs.display()))?;
+    let given: Vec<bool> = (0..model.num_joints()).map(|j| columns.contains(&j)).collect();
+    let missing: Vec<&str> = model.joint_names().enumerate().filter(|(j, _)| !given[*j]).map(|(_, n)| n).collect();
+    if !missing.is_empty() {
+        eprintln!("note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}", missing.len(), missing.join(", "));
+    }
+    let mut buffer = model.pose_buffer();
+    let mut joints = vec![0.0; model.num_joints()];
+    let mut samples_out = Vec::with_capacity(configs.samples.len());
+    for (s, sample) in configs.samples.iter().enumerate() {
+        if sample.q.len() != columns.len() {
+            bail!("{}: sample {s} has {} values for {} joint_names", args.configs.display(), sample.q.len(), columns.len());
+        }
+        joints.iter_mut().for_each(|v| *v = 0.0);
+        for (&j, &v) in columns.iter().zip(&sample.q) {
+            joints[j] = v;
+        }
+        for j in 0..model.num_joints() {
+            if let (false, Some(m)) = (given[j], &model.joint(j).mimic) {
+                let leader = model.joint_index(&m.leader)?;
+                joints[j] = m.multiplier * joints[leader] + m.offset;
+            }
+        }
+        model.forward_joints(&joints, &mut buffer).with_context(|| format!("{}: sample {s}", args.configs.display()))?;
+        let mut links = Map::new();
+        let mut frames = Map::new();
+        for (i, name) in model.frame_names().enumerate() {
+            let target = if i < model.num_links() { &mut links } else { &mut frames };
+            target.insert(name.to_string(), pose_json(&buffer.poses()[i]));
+        }
+        let mut out = Map::new();
+        out.insert("q".into(), json!(sample.q));
+        out.insert("links".into(), Value::Object(links));
+        if !frames.is_empty() {
+            out.insert("frames".into(), Value::Object(frames));
+        }
+        samples_out.push(Value::Object(out));
+    }
+    let result = json!({ "model": model.origin(), "joint_names": configs.joint_names, "samples": samples_out });
+    let text = serde_json::to_string_pretty(&result)?;
+    match &args.out {
+        Some(path) => {
+            crate::write_atomic(path, text.as_bytes())?;
+            eprintln!("wrote {} samples × {} links to {}", configs.samples.len(), model.num_links(), path.display());
+        }
+        None => println!("{text}"),
+    }
+    Ok(())
+}

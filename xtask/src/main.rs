@@ -1,0 +1,75 @@
+//! `cargo xtask <command>`: the commands people run with trm. `cargo xtask --help` lists them.
+
+mod fk;
+mod gen_icub;
+mod model_info;
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use trm_kinematics::RobotModel;
+
+#[derive(Parser)]
+#[command(name = "cargo xtask", about = "trm: task-relevant roadmaps for high-DOF robots", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a model's joints, motors with limits, couplings, links, frames, groups and postures.
+    ModelInfo(model_info::Args),
+    /// Forward kinematics of joint configurations read from JSON (world poses of every link).
+    Fk(fk::Args),
+    /// Regenerate models/icub_upper_body.{urdf,ron} from the official iCub files in models/.
+    GenIcub,
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::ModelInfo(args) => model_info::run(&args),
+        Command::Fk(args) => fk::run(&args),
+        Command::GenIcub => gen_icub::run(&models_dir()),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// The repository's models/ directory.
+fn models_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    dir.canonicalize().unwrap_or(dir)
+}
+
+/// Loads `path` (a .urdf or .ron model description), or the embedded iCub upper body when absent.
+fn load_model(path: Option<&Path>) -> Result<RobotModel> {
+    match path {
+        None => Ok(trm_models::icub_upper_body()),
+        Some(p) => Ok(RobotModel::load(p)?),
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
+/// crash never leaves a half-written file.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let name = path.file_name().context("output path has no file name")?.to_string_lossy();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("writing {}", path.display()))
+}

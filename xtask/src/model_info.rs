@@ -1,0 +1,125 @@
+//! `cargo xtask model-info [MODEL]`.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use trm_kinematics::{JointKind, RobotModel};
+
+/// Arguments of `model-info`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
+    model: Option<PathBuf>,
+    /// Also list every link with its parent joint.
+    #[arg(long)]
+    links: bool,
+}
+
+fn deg(x: f64) -> String {
+    if x.is_finite() { format!("{:.1}", x.to_degrees()) } else { format!("{x}") }
+}
+
+fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
+    let c = &model.couplings()[coordinate];
+    let mut parts: Vec<String> = c
+        .terms
+        .iter()
+        .map(|&(m, f)| if f == 1.0 { model.motors()[m].name.clone() } else { format!("{f:.4}·{}", model.motors()[m].name) })
+        .collect();
+    if c.offset != 0.0 || parts.is_empty() {
+        parts.push(format!("{:.4}", c.offset));
+    }
+    parts.join(" + ")
+}
+
+/// Prints the report.
+pub fn run(args: &Args) -> Result<()> {
+    let model = crate::load_model(args.model.as_deref())?;
+    let tree = model.tree();
+    let fixed = tree.joints.len() - model.num_joints();
+    println!("model `{}` from {}", model.name(), model.origin());
+    println!(
+        "  {} links, {} joints ({} movable, {} fixed), {} motors, {} named frames",
+        model.num_links(),
+        tree.joints.len(),
+        model.num_joints(),
+        fixed,
+        model.motors().len(),
+        model.named_frames().len()
+    );
+    println!("  root (world frame): {}", tree.links[0].name);
+
+    println!("\nmotors ({}), limits in degrees (rad for prismatic):", model.motors().len());
+    println!("  {:>3}  {:<28} {:>9} {:>9}  drives", "#", "name", "lower", "upper");
+    for (i, m) in model.motors().iter().enumerate() {
+        let driven: Vec<&str> = model
+            .couplings()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.terms.iter().any(|&(k, _)| k == i))
+            .map(|(j, _)| model.joint(j).name.as_str())
+            .collect();
+        let driven = if driven.len() == 1 && driven[0] == m.name { String::from("(itself)") } else { driven.join(", ") };
+        println!("  {i:>3}  {:<28} {:>9} {:>9}  {driven}", m.name, deg(m.limits.lower), deg(m.limits.upper));
+    }
+
+    println!("\nmovable joints ({}):", model.num_joints());
+    println!("  {:>3}  {:<28} {:<10} {:>9} {:>9}  value", "#", "name", "type", "lower", "upper");
+    for j in 0..model.num_joints() {
+        let joint = model.joint(j);
+        let kind = match joint.kind {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+        };
+        println!(
+            "  {j:>3}  {:<28} {kind:<10} {:>9} {:>9}  {}",
+            joint.name,
+            deg(joint.limits.lower),
+            deg(joint.limits.upper),
+            coupling_formula(&model, j)
+        );
+    }
+    if model.is_coupled() {
+        println!("  (value: the joint as a function of the motors, angles in rad)");
+    }
+
+    if args.links {
+        println!("\nlinks ({}), parent joint → link:", model.num_links());
+        for link in &tree.links {
+            match link.parent_joint {
+                Some(j) => println!("  {:<28} ← {} ({})", link.name, tree.joints[j].name, tree.links[tree.joints[j].parent].name),
+                None => println!("  {:<28} (root)", link.name),
+            }
+        }
+    } else {
+        println!("\nlinks: {} (list them with --links)", model.num_links());
+    }
+
+    if !model.named_frames().is_empty() {
+        println!("\nnamed frames ({}):", model.named_frames().len());
+        for f in model.named_frames() {
+            let t = f.local_offset.translation.vector;
+            let (r, p, y) = f.local_offset.rotation.euler_angles();
+            println!(
+                "  {:<22} on {:<22} xyz ({:.4}, {:.4}, {:.4})  rpy ({:.4}, {:.4}, {:.4})",
+                f.name, tree.links[f.link].name, t.x, t.y, t.z, r, p, y
+            );
+        }
+    }
+    let groups: Vec<_> = model.groups().collect();
+    if !groups.is_empty() {
+        println!("\ngroups:");
+        for (name, members) in groups {
+            let names: Vec<&str> = members.iter().map(|&m| model.motors()[m].name.as_str()).collect();
+            println!("  {name:<12} ({:>2}) {}", members.len(), names.join(" "));
+        }
+    }
+    let postures: Vec<&str> = model.posture_names().collect();
+    if !postures.is_empty() {
+        println!("\npostures: {}", postures.join(", "));
+    }
+    println!("\ncollision bodies: not modelled yet (see the collision issue)");
+    Ok(())
+}
