@@ -45,9 +45,13 @@ fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
 /// Computes and writes the poses.
 pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(args.model.as_deref())?;
-    let text = std::fs::read_to_string(&args.configs).with_context(|| format!("reading {}", args.configs.display()))?;
+    let text = std::fs::read_to_string(&args.configs)
+        .with_context(|| format!("reading {}", args.configs.display()))?;
     let configs: Configs = serde_json::from_str(&text).with_context(|| {
-        format!("{}: expected {{\"joint_names\": [...], \"samples\": [{{\"q\": [...]}}]}}", args.configs.display())
+        format!(
+            "{}: expected {{\"joint_names\": [...], \"samples\": [{{\"q\": [...]}}]}}",
+            args.configs.display()
+        )
     })?;
     let columns: Vec<usize> = configs
         .joint_names
@@ -55,17 +59,33 @@ pub fn run(args: &Args) -> Result<()> {
         .map(|n| model.joint_index(n))
         .collect::<Result<_, _>>()
         .with_context(|| format!("{}: joint_names", args.configs.display()))?;
-    let given: Vec<bool> = (0..model.num_joints()).map(|j| columns.contains(&j)).collect();
-    let missing: Vec<&str> = model.joint_names().enumerate().filter(|(j, _)| !given[*j]).map(|(_, n)| n).collect();
+    let given: Vec<bool> = (0..model.num_joints())
+        .map(|j| columns.contains(&j))
+        .collect();
+    let missing: Vec<&str> = model
+        .joint_names()
+        .enumerate()
+        .filter(|(j, _)| !given[*j])
+        .map(|(_, n)| n)
+        .collect();
     if !missing.is_empty() {
-        eprintln!("note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}", missing.len(), missing.join(", "));
+        eprintln!(
+            "note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}",
+            missing.len(),
+            missing.join(", ")
+        );
     }
     let mut buffer = model.pose_buffer();
     let mut joints = vec![0.0; model.num_joints()];
     let mut samples_out = Vec::with_capacity(configs.samples.len());
     for (s, sample) in configs.samples.iter().enumerate() {
         if sample.q.len() != columns.len() {
-            bail!("{}: sample {s} has {} values for {} joint_names", args.configs.display(), sample.q.len(), columns.len());
+            bail!(
+                "{}: sample {s} has {} values for {} joint_names",
+                args.configs.display(),
+                sample.q.len(),
+                columns.len()
+            );
         }
         joints.iter_mut().for_each(|v| *v = 0.0);
         for (&j, &v) in columns.iter().zip(&sample.q) {
@@ -77,11 +97,17 @@ pub fn run(args: &Args) -> Result<()> {
                 joints[j] = m.multiplier * joints[leader] + m.offset;
             }
         }
-        model.forward_joints(&joints, &mut buffer).with_context(|| format!("{}: sample {s}", args.configs.display()))?;
+        model
+            .forward_joints(&joints, &mut buffer)
+            .with_context(|| format!("{}: sample {s}", args.configs.display()))?;
         let mut links = Map::new();
         let mut frames = Map::new();
         for (i, name) in model.frame_names().enumerate() {
-            let target = if i < model.num_links() { &mut links } else { &mut frames };
+            let target = if i < model.num_links() {
+                &mut links
+            } else {
+                &mut frames
+            };
             target.insert(name.to_string(), pose_json(&buffer.poses()[i]));
         }
         let mut out = Map::new();
@@ -97,7 +123,12 @@ pub fn run(args: &Args) -> Result<()> {
     match &args.out {
         Some(path) => {
             crate::write_atomic(path, text.as_bytes())?;
-            eprintln!("wrote {} samples × {} links to {}", configs.samples.len(), model.num_links(), path.display());
+            eprintln!(
+                "wrote {} samples × {} links to {}",
+                configs.samples.len(),
+                model.num_links(),
+                path.display()
+            );
         }
         None => println!("{text}"),
     }

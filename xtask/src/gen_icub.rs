@@ -46,24 +46,57 @@ struct Extents {
 }
 
 fn read_extents(path: &Path) -> Result<BTreeMap<String, Extents>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().context("empty extents file")?.split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).with_context(|| format!("{}: no column {name}", path.display()));
-    let cols = ["aabb_min_x", "aabb_min_y", "aabb_min_z", "aabb_max_x", "aabb_max_y", "aabb_max_z", "capsule_ax", "capsule_ay", "capsule_az", "capsule_bx", "capsule_by", "capsule_bz", "capsule_r"];
+    let header: Vec<&str> = lines
+        .next()
+        .context("empty extents file")?
+        .split(',')
+        .collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .with_context(|| format!("{}: no column {name}", path.display()))
+    };
+    let cols = [
+        "aabb_min_x",
+        "aabb_min_y",
+        "aabb_min_z",
+        "aabb_max_x",
+        "aabb_max_y",
+        "aabb_max_z",
+        "capsule_ax",
+        "capsule_ay",
+        "capsule_az",
+        "capsule_bx",
+        "capsule_by",
+        "capsule_bz",
+        "capsule_r",
+    ];
     let idx: Vec<usize> = cols.iter().map(|c| col(c)).collect::<Result<_>>()?;
     let mut out = BTreeMap::new();
     for (n, line) in lines.enumerate() {
         let fields: Vec<&str> = line.split(',').collect();
         if fields.len() != header.len() {
-            bail!("{}:{}: expected {} fields", path.display(), n + 2, header.len());
+            bail!(
+                "{}:{}: expected {} fields",
+                path.display(),
+                n + 2,
+                header.len()
+            );
         }
         if fields[idx[6]].is_empty() {
             continue; // primitive rows (feet) carry no capsule
         }
         let v: Vec<f64> = idx
             .iter()
-            .map(|&i| fields[i].parse::<f64>().with_context(|| format!("{}:{}: bad number {}", path.display(), n + 2, fields[i])))
+            .map(|&i| {
+                fields[i].parse::<f64>().with_context(|| {
+                    format!("{}:{}: bad number {}", path.display(), n + 2, fields[i])
+                })
+            })
             .collect::<Result<_>>()?;
         out.insert(
             fields[0].to_string(),
@@ -95,8 +128,12 @@ fn round6(x: f64) -> f64 {
 fn collision_xml(link: &str, e: &Extents) -> String {
     let (xyz, rpy, geometry);
     if BOX_LINKS.contains(&link) {
-        let c: Vec<f64> = (0..3).map(|i| round6((e.aabb_min[i] + e.aabb_max[i]) / 2.0)).collect();
-        let s: Vec<f64> = (0..3).map(|i| round6(e.aabb_max[i] - e.aabb_min[i])).collect();
+        let c: Vec<f64> = (0..3)
+            .map(|i| round6((e.aabb_min[i] + e.aabb_max[i]) / 2.0))
+            .collect();
+        let s: Vec<f64> = (0..3)
+            .map(|i| round6(e.aabb_max[i] - e.aabb_min[i]))
+            .collect();
         xyz = [c[0], c[1], c[2]];
         rpy = [0.0; 3];
         geometry = format!("<box size=\"{}\"/>", v3([s[0], s[1], s[2]]));
@@ -110,11 +147,16 @@ fn collision_xml(link: &str, e: &Extents) -> String {
             rpy = [0.0; 3];
             geometry = format!("<sphere radius=\"{}\"/>", f(e.capsule_r));
         } else {
-            let q = UnitQuaternion::rotation_between(&Vector3::z(), &d)
-                .unwrap_or_else(|| UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI));
+            let q = UnitQuaternion::rotation_between(&Vector3::z(), &d).unwrap_or_else(|| {
+                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+            });
             let (r, p, y) = q.euler_angles();
             rpy = [round6(r), round6(p), round6(y)];
-            geometry = format!("<capsule radius=\"{}\" length=\"{}\"/>", f(e.capsule_r), f(round6(d.norm())));
+            geometry = format!(
+                "<capsule radius=\"{}\" length=\"{}\"/>",
+                f(e.capsule_r),
+                f(round6(d.norm()))
+            );
         }
     }
     format!(
@@ -132,7 +174,10 @@ fn upper_body_urdf(robot: &urdf_rs::Robot, extents: &BTreeMap<String, Extents>) 
     while changed {
         changed = false;
         for j in &robot.joints {
-            if kept.contains(j.parent.link.as_str()) && !LEG_ROOTS.contains(&j.child.link.as_str()) && kept.insert(&j.child.link) {
+            if kept.contains(j.parent.link.as_str())
+                && !LEG_ROOTS.contains(&j.child.link.as_str())
+                && kept.insert(&j.child.link)
+            {
                 changed = true;
             }
         }
@@ -145,33 +190,63 @@ fn upper_body_urdf(robot: &urdf_rs::Robot, extents: &BTreeMap<String, Extents>) 
     s.push_str("     Kinematics and inertials unchanged; legs removed; collision meshes replaced by primitives enclosing them\n");
     s.push_str("     (capsules, or boxes for flat parts); arm and neck limits narrowed to the simulator's. Licence: CC-BY-SA-4.0. -->\n");
     let _ = writeln!(s, "<robot name=\"icub_upper_body\">");
-    for link in robot.links.iter().filter(|l| kept.contains(l.name.as_str())) {
+    for link in robot
+        .links
+        .iter()
+        .filter(|l| kept.contains(l.name.as_str()))
+    {
         let _ = writeln!(s, "  <link name=\"{}\">", link.name);
         let i = &link.inertial;
         if i.mass.value > 0.0 {
-            let _ = writeln!(s, "    <inertial>\n      <origin xyz=\"{}\" rpy=\"{}\"/>\n      <mass value=\"{}\"/>", v3(*i.origin.xyz), v3(*i.origin.rpy), f(i.mass.value));
+            let _ = writeln!(
+                s,
+                "    <inertial>\n      <origin xyz=\"{}\" rpy=\"{}\"/>\n      <mass value=\"{}\"/>",
+                v3(*i.origin.xyz),
+                v3(*i.origin.rpy),
+                f(i.mass.value)
+            );
             let t = &i.inertia;
             let _ = writeln!(
                 s,
                 "      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>\n    </inertial>",
-                f(t.ixx), f(t.ixy), f(t.ixz), f(t.iyy), f(t.iyz), f(t.izz)
+                f(t.ixx),
+                f(t.ixy),
+                f(t.ixz),
+                f(t.iyy),
+                f(t.iyz),
+                f(t.izz)
             );
         }
         if !link.collision.is_empty() {
-            let e = extents.get(&link.name).with_context(|| format!("no collision extents for link {}", link.name))?;
+            let e = extents
+                .get(&link.name)
+                .with_context(|| format!("no collision extents for link {}", link.name))?;
             s.push_str(&collision_xml(&link.name, e));
         }
         s.push_str("  </link>\n");
     }
-    for j in robot.joints.iter().filter(|j| kept.contains(j.parent.link.as_str()) && kept.contains(j.child.link.as_str())) {
+    for j in robot
+        .joints
+        .iter()
+        .filter(|j| kept.contains(j.parent.link.as_str()) && kept.contains(j.child.link.as_str()))
+    {
         let kind = match j.joint_type {
             urdf_rs::JointType::Revolute => "revolute",
             urdf_rs::JointType::Fixed => "fixed",
             ref other => bail!("joint {} has unexpected type {other:?}", j.name),
         };
         let _ = writeln!(s, "  <joint name=\"{}\" type=\"{kind}\">", j.name);
-        let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"{}\"/>", v3(*j.origin.xyz), v3(*j.origin.rpy));
-        let _ = writeln!(s, "    <parent link=\"{}\"/>\n    <child link=\"{}\"/>", j.parent.link, j.child.link);
+        let _ = writeln!(
+            s,
+            "    <origin xyz=\"{}\" rpy=\"{}\"/>",
+            v3(*j.origin.xyz),
+            v3(*j.origin.rpy)
+        );
+        let _ = writeln!(
+            s,
+            "    <parent link=\"{}\"/>\n    <child link=\"{}\"/>",
+            j.parent.link, j.child.link
+        );
         if kind == "revolute" {
             let _ = writeln!(s, "    <axis xyz=\"{}\"/>", v3(*j.axis.xyz));
             let (mut lower, mut upper) = (j.limit.lower, j.limit.upper);
@@ -179,7 +254,14 @@ fn upper_body_urdf(robot: &urdf_rs::Robot, extents: &BTreeMap<String, Extents>) 
                 lower = lower.max(lo.to_radians());
                 upper = upper.min(hi.to_radians());
             }
-            let _ = writeln!(s, "    <limit lower=\"{}\" upper=\"{}\" effort=\"{}\" velocity=\"{}\"/>", f(lower), f(upper), f(j.limit.effort), f(j.limit.velocity));
+            let _ = writeln!(
+                s,
+                "    <limit lower=\"{}\" upper=\"{}\" effort=\"{}\" velocity=\"{}\"/>",
+                f(lower),
+                f(upper),
+                f(j.limit.effort),
+                f(j.limit.velocity)
+            );
         }
         s.push_str("  </joint>\n");
     }
@@ -190,17 +272,26 @@ fn upper_body_urdf(robot: &urdf_rs::Robot, extents: &BTreeMap<String, Extents>) 
 /// The model description (motors, couplings, frames, groups, postures) text.
 fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
     let mut s = String::new();
-    s.push_str("// GENERATED by `cargo xtask gen-icub`; do not edit by hand. Format: models/README.md.\n");
+    s.push_str(
+        "// GENERATED by `cargo xtask gen-icub`; do not edit by hand. Format: models/README.md.\n",
+    );
     s.push_str("// The 41 motors of the iCub upper body: torso 3, arms 2x7, hands 2x9, neck 3, eyes 3. Radians.\n");
     s.push_str("// Hand and eye couplings as in the iCub simulator (gz-sim couplingICubHandMk2 / couplingICubEye).\n");
     s.push_str("(\n    urdf: \"icub_upper_body.urdf\",\n    motors: [\n");
     for side in ["l", "r"] {
         for (name, lo, hi) in HAND_MOTORS {
-            let _ = writeln!(s, "        (name: \"{side}_{name}\", lower: {}, upper: {}), // [{lo}, {hi}] deg", f(lo.to_radians()), f(hi.to_radians()));
+            let _ = writeln!(
+                s,
+                "        (name: \"{side}_{name}\", lower: {}, upper: {}), // [{lo}, {hi}] deg",
+                f(lo.to_radians()),
+                f(hi.to_radians())
+            );
         }
     }
     s.push_str("        (name: \"eyes_version\", lower: -0.5235987755982988, upper: 0.5235987755982988), // [-30, 30] deg\n");
-    s.push_str("        (name: \"eyes_vergence\", lower: 0, upper: 0.8726646259971648), // [0, 50] deg\n");
+    s.push_str(
+        "        (name: \"eyes_vergence\", lower: 0, upper: 0.8726646259971648), // [0, 50] deg\n",
+    );
     s.push_str("    ],\n    couplings: [\n");
     let deg20 = 20f64.to_radians();
     for side in ["l", "r"] {
@@ -227,47 +318,103 @@ fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
             }
         }
         for (joint, terms, offset) in rows {
-            let terms: Vec<String> = terms.iter().map(|(n, k)| format!("(\"{n}\", {})", f(*k))).collect();
-            let offset = if offset == 0.0 { String::new() } else { format!(", offset: {}", f(offset)) };
-            let _ = writeln!(s, "        (joint: \"{joint}\", motors: [{}]{offset}),", terms.join(", "));
+            let terms: Vec<String> = terms
+                .iter()
+                .map(|(n, k)| format!("(\"{n}\", {})", f(*k)))
+                .collect();
+            let offset = if offset == 0.0 {
+                String::new()
+            } else {
+                format!(", offset: {}", f(offset))
+            };
+            let _ = writeln!(
+                s,
+                "        (joint: \"{joint}\", motors: [{}]{offset}),",
+                terms.join(", ")
+            );
         }
     }
     s.push_str("        (joint: \"l_eye_pan_joint\", motors: [(\"eyes_version\", 1), (\"eyes_vergence\", 0.5)]),\n");
     s.push_str("        (joint: \"r_eye_pan_joint\", motors: [(\"eyes_version\", 1), (\"eyes_vergence\", -0.5)]),\n");
     s.push_str("    ],\n    frames: [\n");
     for side in ["l", "r"] {
-        let palm = extents.get(&format!("{side}_hand")).context("no palm extents")?;
-        let c: Vec<f64> = (0..3).map(|i| round6((palm.aabb_min[i] + palm.aabb_max[i]) / 2.0)).collect();
-        let _ = writeln!(s, "        // centre of the palm's bounding box, axes of {side}_hand");
-        let _ = writeln!(s, "        (name: \"{side}_palm_center\", link: \"{side}_hand\", xyz: ({}, {}, {})),", f(c[0]), f(c[1]), f(c[2]));
+        let palm = extents
+            .get(&format!("{side}_hand"))
+            .context("no palm extents")?;
+        let c: Vec<f64> = (0..3)
+            .map(|i| round6((palm.aabb_min[i] + palm.aabb_max[i]) / 2.0))
+            .collect();
+        let _ = writeln!(
+            s,
+            "        // centre of the palm's bounding box, axes of {side}_hand"
+        );
+        let _ = writeln!(
+            s,
+            "        (name: \"{side}_palm_center\", link: \"{side}_hand\", xyz: ({}, {}, {})),",
+            f(c[0]),
+            f(c[1]),
+            f(c[2])
+        );
         for finger in FINGERS {
             let link = format!("{side}_hand_{finger}_3");
-            let e = extents.get(&link).with_context(|| format!("no extents for {link}"))?;
+            let e = extents
+                .get(&link)
+                .with_context(|| format!("no extents for {link}"))?;
             let (a, b) = (Vector3::from(e.capsule_a), Vector3::from(e.capsule_b));
             let (near, far) = if a.norm() < b.norm() { (a, b) } else { (b, a) };
             let tip = far + (far - near).normalize() * e.capsule_r;
             let _ = writeln!(
                 s,
                 "        (name: \"{side}_{finger}_fingertip\", link: \"{link}\", xyz: ({}, {}, {})),",
-                f(round6(tip.x)), f(round6(tip.y)), f(round6(tip.z))
+                f(round6(tip.x)),
+                f(round6(tip.y)),
+                f(round6(tip.z))
             );
         }
-        let _ = writeln!(s, "        (name: \"{side}_gaze\", link: \"{side}_eye\"), // z: optical axis of the {side} camera");
+        let _ = writeln!(
+            s,
+            "        (name: \"{side}_gaze\", link: \"{side}_eye\"), // z: optical axis of the {side} camera"
+        );
     }
     s.push_str("        // between the eyes, z forward at zero version\n");
-    s.push_str("        (name: \"gaze\", link: \"eyes_tilt_frame\", rpy: (0, -1.5707963267948966, 0)),\n");
+    s.push_str(
+        "        (name: \"gaze\", link: \"eyes_tilt_frame\", rpy: (0, -1.5707963267948966, 0)),\n",
+    );
     s.push_str("    ],\n    groups: [\n");
-    s.push_str("        (name: \"torso\", members: [\"torso_pitch\", \"torso_roll\", \"torso_yaw\"]),\n");
+    s.push_str(
+        "        (name: \"torso\", members: [\"torso_pitch\", \"torso_roll\", \"torso_yaw\"]),\n",
+    );
     for (side, word) in [("l", "left"), ("r", "right")] {
-        let arm: Vec<String> = ["shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow", "wrist_prosup", "wrist_pitch", "wrist_yaw"]
+        let arm: Vec<String> = [
+            "shoulder_pitch",
+            "shoulder_roll",
+            "shoulder_yaw",
+            "elbow",
+            "wrist_prosup",
+            "wrist_pitch",
+            "wrist_yaw",
+        ]
+        .iter()
+        .map(|n| format!("\"{side}_{n}\""))
+        .collect();
+        let _ = writeln!(
+            s,
+            "        (name: \"{word}_arm\", members: [{}]),",
+            arm.join(", ")
+        );
+        let hand: Vec<String> = HAND_MOTORS
             .iter()
-            .map(|n| format!("\"{side}_{n}\""))
+            .map(|(n, _, _)| format!("\"{side}_{n}\""))
             .collect();
-        let _ = writeln!(s, "        (name: \"{word}_arm\", members: [{}]),", arm.join(", "));
-        let hand: Vec<String> = HAND_MOTORS.iter().map(|(n, _, _)| format!("\"{side}_{n}\"")).collect();
-        let _ = writeln!(s, "        (name: \"{word}_hand\", members: [{}]),", hand.join(", "));
+        let _ = writeln!(
+            s,
+            "        (name: \"{word}_hand\", members: [{}]),",
+            hand.join(", ")
+        );
     }
-    s.push_str("        (name: \"neck\", members: [\"neck_pitch\", \"neck_roll\", \"neck_yaw\"]),\n");
+    s.push_str(
+        "        (name: \"neck\", members: [\"neck_pitch\", \"neck_roll\", \"neck_yaw\"]),\n",
+    );
     s.push_str("        (name: \"eyes\", members: [\"eyes_tilt\", \"eyes_version\", \"eyes_vergence\"]),\n");
     s.push_str("        (name: \"arms\", members: [\"left_arm\", \"right_arm\"]),\n");
     s.push_str("        (name: \"hands\", members: [\"left_hand\", \"right_hand\"]),\n");
@@ -275,8 +422,14 @@ fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
     s.push_str("        (name: \"upper_body\", members: [\"torso\", \"left_arm\", \"left_hand\", \"right_arm\", \"right_hand\", \"neck\", \"eyes\"]),\n");
     s.push_str("    ],\n    postures: [\n");
     s.push_str("        // arms forward with bent elbows, hands open, head straight (the iCub home pose)\n        (name: \"home\", values: {\n");
-    let home_deg: [(&str, f64); 6] =
-        [("shoulder_pitch", -30.0), ("shoulder_roll", 30.0), ("elbow", 45.0), ("hand_finger", 30.0), ("thumb_oppose", 30.0), ("thumb_proximal", 10.0)];
+    let home_deg: [(&str, f64); 6] = [
+        ("shoulder_pitch", -30.0),
+        ("shoulder_roll", 30.0),
+        ("elbow", 45.0),
+        ("hand_finger", 30.0),
+        ("thumb_oppose", 30.0),
+        ("thumb_proximal", 10.0),
+    ];
     let mut entries: Vec<(String, f64)> = Vec::new();
     for side in ["l", "r"] {
         for (n, d) in home_deg {
@@ -294,9 +447,13 @@ fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
 /// The generated (urdf, ron) texts from the files under `models/`.
 pub fn generate(models: &Path) -> Result<(String, String)> {
     let official = models.join("icub-visuomanip/model.urdf");
-    let robot = urdf_rs::read_file(&official).with_context(|| format!("reading {}", official.display()))?;
+    let robot =
+        urdf_rs::read_file(&official).with_context(|| format!("reading {}", official.display()))?;
     let extents = read_extents(&models.join("icub-visuomanip/collision-extents.csv"))?;
-    Ok((upper_body_urdf(&robot, &extents)?, description_ron(&extents)?))
+    Ok((
+        upper_body_urdf(&robot, &extents)?,
+        description_ron(&extents)?,
+    ))
 }
 
 /// Writes models/icub_upper_body.{urdf,ron} (atomically) and checks they load.

@@ -12,7 +12,11 @@ use clap::{Parser, Subcommand};
 use trm_kinematics::RobotModel;
 
 #[derive(Parser)]
-#[command(name = "cargo xtask", about = "trm: task-relevant roadmaps for high-DOF robots", version)]
+#[command(
+    name = "cargo xtask",
+    about = "trm: task-relevant roadmaps for high-DOF robots",
+    version
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -58,9 +62,15 @@ fn load_model(path: Option<&Path>) -> Result<RobotModel> {
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
 /// crash never leaves a half-written file.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let name = path.file_name().context("output path has no file name")?.to_string_lossy();
+    let name = path
+        .file_name()
+        .context("output path has no file name")?
+        .to_string_lossy();
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
     let result = (|| {
         let mut file = std::fs::File::create(&tmp)?;

@@ -16,7 +16,11 @@ pub struct Args {
 }
 
 fn deg(x: f64) -> String {
-    if x.is_finite() { format!("{:.1}", x.to_degrees()) } else { format!("{x}") }
+    if x.is_finite() {
+        format!("{:.1}", x.to_degrees())
+    } else {
+        format!("{x}")
+    }
 }
 
 fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
@@ -24,7 +28,13 @@ fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
     let mut parts: Vec<String> = c
         .terms
         .iter()
-        .map(|&(m, f)| if f == 1.0 { model.motors()[m].name.clone() } else { format!("{f:.4}·{}", model.motors()[m].name) })
+        .map(|&(m, f)| {
+            if f == 1.0 {
+                model.motors()[m].name.clone()
+            } else {
+                format!("{f:.4}·{}", model.motors()[m].name)
+            }
+        })
         .collect();
     if c.offset != 0.0 || parts.is_empty() {
         parts.push(format!("{:.4}", c.offset));
@@ -49,8 +59,14 @@ pub fn run(args: &Args) -> Result<()> {
     );
     println!("  root (world frame): {}", tree.links[0].name);
 
-    println!("\nmotors ({}), limits in degrees (rad for prismatic):", model.motors().len());
-    println!("  {:>3}  {:<28} {:>9} {:>9}  drives", "#", "name", "lower", "upper");
+    println!(
+        "\nmotors ({}), limits in degrees (rad for prismatic):",
+        model.motors().len()
+    );
+    println!(
+        "  {:>3}  {:<28} {:>9} {:>9}  drives",
+        "#", "name", "lower", "upper"
+    );
     for (i, m) in model.motors().iter().enumerate() {
         let driven: Vec<&str> = model
             .couplings()
@@ -59,12 +75,24 @@ pub fn run(args: &Args) -> Result<()> {
             .filter(|(_, c)| c.terms.iter().any(|&(k, _)| k == i))
             .map(|(j, _)| model.joint(j).name.as_str())
             .collect();
-        let driven = if driven.len() == 1 && driven[0] == m.name { String::from("(itself)") } else { driven.join(", ") };
-        println!("  {i:>3}  {:<28} {:>9} {:>9}  {driven}", m.name, deg(m.limits.lower), deg(m.limits.upper));
+        let driven = if driven.len() == 1 && driven[0] == m.name {
+            String::from("(itself)")
+        } else {
+            driven.join(", ")
+        };
+        println!(
+            "  {i:>3}  {:<28} {:>9} {:>9}  {driven}",
+            m.name,
+            deg(m.limits.lower),
+            deg(m.limits.upper)
+        );
     }
 
     println!("\nmovable joints ({}):", model.num_joints());
-    println!("  {:>3}  {:<28} {:<10} {:>9} {:>9}  value", "#", "name", "type", "lower", "upper");
+    println!(
+        "  {:>3}  {:<28} {:<10} {:>9} {:>9}  value",
+        "#", "name", "type", "lower", "upper"
+    );
     for j in 0..model.num_joints() {
         let joint = model.joint(j);
         let kind = match joint.kind {
@@ -89,7 +117,10 @@ pub fn run(args: &Args) -> Result<()> {
         println!("\nlinks ({}), parent joint → link:", model.num_links());
         for link in &tree.links {
             match link.parent_joint {
-                Some(j) => println!("  {:<28} ← {} ({})", link.name, tree.joints[j].name, tree.links[tree.joints[j].parent].name),
+                Some(j) => println!(
+                    "  {:<28} ← {} ({})",
+                    link.name, tree.joints[j].name, tree.links[tree.joints[j].parent].name
+                ),
                 None => println!("  {:<28} (root)", link.name),
             }
         }
@@ -112,7 +143,10 @@ pub fn run(args: &Args) -> Result<()> {
     if !groups.is_empty() {
         println!("\ngroups:");
         for (name, members) in groups {
-            let names: Vec<&str> = members.iter().map(|&m| model.motors()[m].name.as_str()).collect();
+            let names: Vec<&str> = members
+                .iter()
+                .map(|&m| model.motors()[m].name.as_str())
+                .collect();
             println!("  {name:<12} ({:>2}) {}", members.len(), names.join(" "));
         }
     }

@@ -1,7 +1,7 @@
 //! [`ActiveSet`]: which motors are optimisation variables, the rest locked at given values.
 
 use crate::error::{KinematicsError, Result};
-use crate::fk::PoseBuffer;
+use crate::fk::{AffineRow, Plan, PoseBuffer};
 use crate::model::{RobotModel, check_vector};
 
 /// A selection of motors as variables (the *active values*), every other motor locked. It maps
@@ -27,6 +27,7 @@ pub struct ActiveSet {
     /// Per joint: constant part and range into `terms`.
     rows: Vec<(f64, u32, u32)>,
     terms: Vec<(u32, f64)>,
+    plan: Plan,
 }
 
 impl RobotModel {
@@ -40,8 +41,12 @@ impl RobotModel {
 
     /// Every motor active, in motor order.
     pub fn all_active(&self) -> ActiveSet {
-        ActiveSet::new(self.clone(), (0..self.motors().len()).collect(), &self.neutral_motors())
-            .expect("the neutral posture is valid")
+        ActiveSet::new(
+            self.clone(),
+            (0..self.motors().len()).collect(),
+            &self.neutral_motors(),
+        )
+        .expect("the neutral posture is valid")
     }
 }
 
@@ -49,9 +54,15 @@ impl ActiveSet {
     /// An active set from motor indices and a full motor vector for the locked ones.
     pub fn new(model: RobotModel, active: Vec<usize>, locked: &[f64]) -> Result<Self> {
         let motors = model.motors();
-        check_vector("locked motor values", locked, motors.len(), |i| &motors[i].name)?;
+        check_vector("locked motor values", locked, motors.len(), |i| {
+            &motors[i].name
+        })?;
         if let Some(&bad) = active.iter().find(|&&m| m >= motors.len()) {
-            return Err(KinematicsError::WrongLength { what: "active motor index", expected: motors.len(), got: bad });
+            return Err(KinematicsError::WrongLength {
+                what: "active motor index",
+                expected: motors.len(),
+                got: bad,
+            });
         }
         let mut position = vec![None; motors.len()];
         for (k, &m) in active.iter().enumerate() {
@@ -70,7 +81,39 @@ impl ActiveSet {
             }
             rows.push((constant, start, terms.len() as u32));
         }
-        Ok(ActiveSet { model, active, locked: locked.to_vec(), rows, terms })
+        let affine: Vec<(f64, Vec<(usize, f64)>)> = rows
+            .iter()
+            .map(|&(c, s, e)| {
+                (
+                    c,
+                    terms[s as usize..e as usize]
+                        .iter()
+                        .map(|&(k, f)| (k as usize, f))
+                        .collect(),
+                )
+            })
+            .collect();
+        let affine_rows: Vec<AffineRow> = affine
+            .iter()
+            .map(|(c, t)| AffineRow {
+                constant: *c,
+                terms: t,
+            })
+            .collect();
+        let frames: Vec<_> = model
+            .named_frames()
+            .iter()
+            .map(|f| (f.link, f.local_offset))
+            .collect();
+        let plan = Plan::compile(model.tree(), &frames, &affine_rows);
+        Ok(ActiveSet {
+            model,
+            active,
+            locked: locked.to_vec(),
+            rows,
+            terms,
+            plan,
+        })
     }
 
     /// The model.
@@ -95,13 +138,18 @@ impl ActiveSet {
 
     /// Names of the active motors.
     pub fn names(&self) -> impl ExactSizeIterator<Item = &str> {
-        self.active.iter().map(|&m| self.model.motors()[m].name.as_str())
+        self.active
+            .iter()
+            .map(|&m| self.model.motors()[m].name.as_str())
     }
 
     /// Lower and upper limits of the active motors (box bounds for an optimiser).
     pub fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
         let m = self.model.motors();
-        (self.active.iter().map(|&i| m[i].limits.lower).collect(), self.active.iter().map(|&i| m[i].limits.upper).collect())
+        (
+            self.active.iter().map(|&i| m[i].limits.lower).collect(),
+            self.active.iter().map(|&i| m[i].limits.upper).collect(),
+        )
     }
 
     /// Active values taken from a full motor vector.
@@ -116,6 +164,12 @@ impl ActiveSet {
             motors[m] = v;
         }
         motors
+    }
+
+    /// Number of distinct joint values one FK pass computes (joints held constant by locked
+    /// motors are folded away; joints that always share a value share one computation).
+    pub fn num_distinct_joint_values(&self) -> usize {
+        self.plan.num_slots()
     }
 
     /// Joint values for active values `q`, without checks.
@@ -134,7 +188,9 @@ impl ActiveSet {
     /// [`RobotModel::pose_buffer`]). Checks the length and that every value is finite; values
     /// outside the limits are allowed (optimisers may probe there).
     pub fn forward(&self, q: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
-        check_vector("active motor values", q, self.active.len(), |i| &self.model.motors()[self.active[i]].name)?;
+        check_vector("active motor values", q, self.active.len(), |i| {
+            &self.model.motors()[self.active[i]].name
+        })?;
         self.model.check_buffer(buffer)?;
         self.forward_unchecked(q, buffer);
         Ok(())
@@ -144,7 +200,6 @@ impl ActiveSet {
     /// buffer; NaN in `q` gives NaN poses.
     #[inline]
     pub fn forward_unchecked(&self, q: &[f64], buffer: &mut PoseBuffer) {
-        self.joint_values_unchecked(q, &mut buffer.joint_values);
-        self.model.forward_buffered_unchecked(buffer);
+        self.plan.run(q, buffer);
     }
 }

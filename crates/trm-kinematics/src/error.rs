@@ -58,7 +58,9 @@ pub enum KinematicsError {
         message: String,
     },
     /// A model description (RON) could not be parsed.
-    #[error("{origin}:{line}:{column}: malformed model description: {message}\n  fix: see models/README.md for the format")]
+    #[error(
+        "{origin}:{line}:{column}: malformed model description: {message}\n  fix: see models/README.md for the format"
+    )]
     MalformedDescription {
         /// The file (or `<string>`) the description came from.
         origin: String,
@@ -121,7 +123,14 @@ fn suggest(suggestions: &[String]) -> String {
     if suggestions.is_empty() {
         String::new()
     } else {
-        format!("; did you mean {}?", suggestions.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", "))
+        format!(
+            "; did you mean {}?",
+            suggestions
+                .iter()
+                .map(|s| format!("`{s}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     }
 }
 
@@ -144,12 +153,24 @@ pub fn closest_names<'a>(name: &str, candidates: impl IntoIterator<Item = &'a st
         .filter(|(s, _)| *s > 0.75)
         .collect();
     scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(b.1)));
-    scored.into_iter().take(3).map(|(_, c)| c.to_string()).collect()
+    scored
+        .into_iter()
+        .take(3)
+        .map(|(_, c)| c.to_string())
+        .collect()
 }
 
 /// An [`KinematicsError::UnknownName`] with suggestions drawn from `candidates`.
-pub(crate) fn unknown<'a>(kind: NameKind, name: &str, candidates: impl IntoIterator<Item = &'a str>) -> KinematicsError {
-    KinematicsError::UnknownName { kind, name: name.to_string(), suggestions: closest_names(name, candidates) }
+pub(crate) fn unknown<'a>(
+    kind: NameKind,
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> KinematicsError {
+    KinematicsError::UnknownName {
+        kind,
+        name: name.to_string(),
+        suggestions: closest_names(name, candidates),
+    }
 }
 
 /// 1-based line of the first `<tag ... name="name"` in `source`, if any.
@@ -159,7 +180,9 @@ pub(crate) fn line_of_element(source: &str, tag: &str, name: &str) -> Option<usi
     let mut search_from = 0;
     while let Some(rel) = source[search_from..].find(&open) {
         let start = search_from + rel;
-        let end = source[start..].find('>').map_or(source.len(), |e| start + e);
+        let end = source[start..]
+            .find('>')
+            .map_or(source.len(), |e| start + e);
         let head = &source[start..end];
         if needles.iter().any(|n| head.contains(n.as_str())) {
             return Some(source[..start].matches('\n').count() + 1);

@@ -1,36 +1,243 @@
 //! Forward kinematics: one pass over the links in topological order into a caller-owned buffer.
+//!
+//! A [`Plan`] is compiled once per model (joint values as input) and once per
+//! [`crate::ActiveSet`] (active motor values as input). Compilation folds joints whose value does
+//! not depend on the input into fixed transforms and gives joints with the same value (coupled
+//! finger phalanges) one shared *slot*, so each distinct angle costs one `sin_cos`.
 
-use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use crate::model::FrameId;
+use crate::tree::{JointKind, Tree};
 
-/// How a step moves its child relative to the joint frame.
+/// One link or named frame: `pose[k + 1] = pose[parent] · local`, where, with the slot's
+/// `(s, c, d)` — the sine and cosine of half the angle for revolute joints, the displacement for
+/// prismatic ones, `(0, 1, 0)` for fixed transforms —
+/// `local.rotation = c·rotation + s·axis_quat` (= rotation ⊗ (c, s·axis)) and
+/// `local.translation = translation + d·axis_in_parent`. Every step runs the same branch-free code.
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum Motion {
-    Fixed,
-    Revolute { axis: Unit<Vector3<f64>>, coordinate: usize },
-    Prismatic { axis: Vector3<f64>, coordinate: usize },
+struct Step {
+    parent: u32,
+    child: u32,
+    slot: u32,
+    rotation: Quaternion<f64>,
+    axis_quat: Quaternion<f64>,
+    translation: Vector3<f64>,
+    axis_in_parent: Vector3<f64>,
 }
 
-/// One link (or named frame) of the FK pass: `pose[k + 1] = pose[parent] · origin · motion(q)`.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Step {
-    pub parent: usize,
-    pub local_origin: Isometry3<f64>,
-    pub motion: Motion,
+impl Step {
+    fn fixed(parent: usize, origin: Isometry3<f64>) -> Step {
+        Step {
+            parent: parent as u32,
+            child: 0,
+            slot: 0,
+            rotation: *origin.rotation.quaternion(),
+            axis_quat: Quaternion::new(0.0, 0.0, 0.0, 0.0),
+            translation: origin.translation.vector,
+            axis_in_parent: Vector3::zeros(),
+        }
+    }
 }
 
-/// Caller-owned scratch for forward kinematics: the joint values of the last pass and the world
-/// pose of every link and named frame (index = [`FrameId::index`]). Reuse it: FK does not allocate.
+/// A compiled FK pass: an affine map from an input vector to slot values, and the steps.
+#[derive(Debug, Clone)]
+pub(crate) struct Plan {
+    /// Per slot: constant and range into `terms`.
+    rows: Vec<(f64, u32, u32)>,
+    /// `(input index, factor)`.
+    terms: Vec<(u32, f64)>,
+    /// Whether a slot is a revolute angle (needs its half-angle sine and cosine). Slot 0 is
+    /// the constant `(0, 1, 0)` of fixed transforms.
+    revolute: Vec<bool>,
+    steps: Vec<Step>,
+}
+
+/// `joint value = constant + Σ factor · input[index]`, per movable joint.
+pub(crate) struct AffineRow<'a> {
+    pub constant: f64,
+    pub terms: &'a [(usize, f64)],
+}
+
+impl Plan {
+    /// Compiles the FK of `tree` plus named frames `(link, offset)`, with each movable joint's
+    /// value given by `rows[coordinate]` over some input vector.
+    pub fn compile(tree: &Tree, frames: &[(usize, Isometry3<f64>)], rows: &[AffineRow]) -> Plan {
+        let mut plan = Plan {
+            rows: vec![(0.0, 0, 0)],
+            terms: Vec::new(),
+            revolute: vec![false],
+            steps: Vec::new(),
+        };
+        let mut slot_of: Vec<(f64, Vec<(usize, u64)>, bool, u32)> = Vec::new();
+        for joint in &tree.joints {
+            let origin = joint.local_origin;
+            let motion = match (joint.kind, joint.coordinate) {
+                (JointKind::Fixed, _) | (_, None) => None,
+                (kind, Some(c)) => {
+                    let row = &rows[c];
+                    let revolute = kind != JointKind::Prismatic;
+                    if row.terms.iter().all(|&(_, f)| f == 0.0) {
+                        // Constant: fold into the origin.
+                        let local = joint_transform(joint.kind, &joint.axis, row.constant);
+                        plan.steps.push(Step::fixed(joint.parent, origin * local));
+                        continue;
+                    }
+                    let key: Vec<(usize, u64)> =
+                        row.terms.iter().map(|&(k, f)| (k, f.to_bits())).collect();
+                    let slot = match slot_of.iter().find(|s| {
+                        s.0.to_bits() == row.constant.to_bits() && s.1 == key && s.2 == revolute
+                    }) {
+                        Some(s) => s.3,
+                        None => {
+                            let slot = plan.rows.len() as u32;
+                            let start = plan.terms.len() as u32;
+                            plan.terms
+                                .extend(row.terms.iter().map(|&(k, f)| (k as u32, f)));
+                            plan.rows
+                                .push((row.constant, start, plan.terms.len() as u32));
+                            plan.revolute.push(revolute);
+                            slot_of.push((row.constant, key, revolute, slot));
+                            slot
+                        }
+                    };
+                    Some((revolute, slot))
+                }
+            };
+            let mut step = Step::fixed(joint.parent, origin);
+            match motion {
+                None => {}
+                Some((true, slot)) => {
+                    let a = joint.axis;
+                    step.slot = slot;
+                    step.axis_quat =
+                        origin.rotation.quaternion() * Quaternion::new(0.0, a.x, a.y, a.z);
+                }
+                Some((false, slot)) => {
+                    step.slot = slot;
+                    step.axis_in_parent = origin.rotation * joint.axis.into_inner();
+                }
+            }
+            plan.steps.push(step);
+        }
+        for &(link, offset) in frames {
+            plan.steps.push(Step::fixed(link, offset));
+        }
+        // Step k poses entry k + 1. Run the steps level by level (breadth-first): steps of one
+        // level are independent, so the processor overlaps them instead of waiting on each
+        // parent pose in long chains (fingers).
+        let mut depth = vec![0u32; plan.steps.len() + 1];
+        for (k, step) in plan.steps.iter_mut().enumerate() {
+            step.child = k as u32 + 1;
+            depth[k + 1] = depth[step.parent as usize] + 1;
+        }
+        plan.steps.sort_by_key(|s| depth[s.child as usize]);
+        plan
+    }
+
+    /// Number of distinct joint values the pass computes.
+    pub fn num_slots(&self) -> usize {
+        self.rows.len() - 1
+    }
+
+    /// Runs the pass on `input` into `buffer`. Lengths must have been checked.
+    #[inline]
+    pub fn run(&self, input: &[f64], buffer: &mut PoseBuffer) {
+        let slots = &mut buffer.slots[..self.rows.len()];
+        for ((out, &(constant, start, end)), &revolute) in
+            slots.iter_mut().zip(&self.rows).zip(&self.revolute)
+        {
+            let mut v = constant;
+            for &(k, f) in &self.terms[start as usize..end as usize] {
+                v += f * input[k as usize];
+            }
+            *out = if revolute {
+                let (s, c) = (0.5 * v).sin_cos();
+                [s, c, 0.0]
+            } else {
+                [0.0, 1.0, v]
+            };
+        }
+        let slots = &buffer.slots;
+        let poses = &mut buffer.poses;
+        poses[0] = Isometry3::identity();
+        for step in &self.steps {
+            let parent = poses[step.parent as usize];
+            let [s, c, d] = slots[step.slot as usize];
+            let (r, b) = (&step.rotation, &step.axis_quat);
+            let local = Quaternion::new(
+                c * r.w + s * b.w,
+                c * r.i + s * b.i,
+                c * r.j + s * b.j,
+                c * r.k + s * b.k,
+            );
+            let translation = step.translation + step.axis_in_parent * d;
+            let pr = parent.rotation.quaternion();
+            poses[step.child as usize] = Isometry3::from_parts(
+                Translation3::from(rotate(pr, &translation) + parent.translation.vector),
+                UnitQuaternion::new_unchecked(multiply(pr, &local)),
+            );
+        }
+    }
+}
+
+/// The motion of a joint at a given value.
+fn joint_transform(
+    kind: JointKind,
+    axis: &nalgebra::Unit<Vector3<f64>>,
+    value: f64,
+) -> Isometry3<f64> {
+    match kind {
+        JointKind::Prismatic => Isometry3::from_parts(
+            Translation3::from(axis.into_inner() * value),
+            UnitQuaternion::identity(),
+        ),
+        JointKind::Fixed => Isometry3::identity(),
+        _ => Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(axis, value),
+        ),
+    }
+}
+
+#[inline(always)]
+fn multiply(a: &Quaternion<f64>, b: &Quaternion<f64>) -> Quaternion<f64> {
+    Quaternion::new(
+        a.w * b.w - a.i * b.i - a.j * b.j - a.k * b.k,
+        a.w * b.i + a.i * b.w + a.j * b.k - a.k * b.j,
+        a.w * b.j - a.i * b.k + a.j * b.w + a.k * b.i,
+        a.w * b.k + a.i * b.j - a.j * b.i + a.k * b.w,
+    )
+}
+
+/// Rotates `v` by the unit quaternion `q`: `v + w·t + u×t` with `t = 2 u×v`.
+#[inline(always)]
+fn rotate(q: &Quaternion<f64>, v: &Vector3<f64>) -> Vector3<f64> {
+    let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+    let tx = 2.0 * (y * v.z - z * v.y);
+    let ty = 2.0 * (z * v.x - x * v.z);
+    let tz = 2.0 * (x * v.y - y * v.x);
+    Vector3::new(
+        v.x + w * tx + (y * tz - z * ty),
+        v.y + w * ty + (z * tx - x * tz),
+        v.z + w * tz + (x * ty - y * tx),
+    )
+}
+
+/// Caller-owned scratch for forward kinematics: the world pose of every link and named frame
+/// (index = [`FrameId::index`]). Reuse it: FK does not allocate.
 #[derive(Debug, Clone)]
 pub struct PoseBuffer {
-    pub(crate) joint_values: Vec<f64>,
+    pub(crate) slots: Vec<[f64; 3]>,
     pub(crate) poses: Vec<Isometry3<f64>>,
 }
 
 impl PoseBuffer {
     pub(crate) fn new(num_joints: usize, num_frames: usize) -> Self {
-        PoseBuffer { joint_values: vec![0.0; num_joints], poses: vec![Isometry3::identity(); num_frames] }
+        PoseBuffer {
+            slots: vec![[0.0, 1.0, 0.0]; num_joints + 1],
+            poses: vec![Isometry3::identity(); num_frames],
+        }
     }
 
     /// World pose of a link or named frame.
@@ -42,25 +249,5 @@ impl PoseBuffer {
     /// World poses of all links then all named frames.
     pub fn poses(&self) -> &[Isometry3<f64>] {
         &self.poses
-    }
-
-    /// Joint values (one per movable joint) of the last pass.
-    pub fn joint_values(&self) -> &[f64] {
-        &self.joint_values
-    }
-}
-
-/// The FK pass. `poses[0]` (the root) stays the identity.
-#[inline]
-pub(crate) fn run_steps(steps: &[Step], q: &[f64], poses: &mut [Isometry3<f64>]) {
-    debug_assert_eq!(poses.len(), steps.len() + 1);
-    poses[0] = Isometry3::identity();
-    for (k, step) in steps.iter().enumerate() {
-        let base = poses[step.parent] * step.local_origin;
-        poses[k + 1] = match step.motion {
-            Motion::Fixed => base,
-            Motion::Revolute { axis, coordinate } => base * UnitQuaternion::from_axis_angle(&axis, q[coordinate]),
-            Motion::Prismatic { axis, coordinate } => base * Translation3::from(axis * q[coordinate]),
-        };
     }
 }

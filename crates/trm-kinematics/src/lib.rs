@@ -35,9 +35,11 @@ mod model;
 mod tree;
 
 pub use active::ActiveSet;
-pub use description::{CouplingSpec, FrameSpec, GroupSpec, ModelDescription, MotorSpec, PostureSpec};
+pub use description::{
+    CouplingSpec, FrameSpec, GroupSpec, ModelDescription, MotorSpec, PostureSpec,
+};
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use fk::PoseBuffer;
 pub use model::{Coupling, FrameId, Motor, NamedFrame, RobotModel};
-pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use nalgebra;
+pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};

@@ -8,7 +8,7 @@ use nalgebra::Isometry3;
 
 use crate::description::ModelDescription;
 use crate::error::{KinematicsError, NameKind, Result, unknown};
-use crate::fk::{Motion, PoseBuffer, Step};
+use crate::fk::{AffineRow, Plan, PoseBuffer};
 use crate::tree::{Ctx, JointKind, Limits, Tree, pose_from_xyz_rpy};
 
 /// Index of a pose in a [`PoseBuffer`]: a link (`0..num_links`) or a named frame after them.
@@ -60,7 +60,10 @@ struct ModelData {
     frames: Vec<NamedFrame>,
     groups: Vec<(String, Vec<usize>)>,
     postures: Vec<(String, Vec<f64>)>,
-    steps: Vec<Step>,
+    /// FK over joint values.
+    joint_plan: Plan,
+    /// FK over motor values.
+    motor_plan: Plan,
 }
 
 /// A robot: the URDF link tree, the motors that drive its joints, named frames, motor groups and
@@ -79,24 +82,40 @@ pub struct RobotModel {
 impl TryFrom<&urdf_rs::Robot> for RobotModel {
     type Error = KinematicsError;
     fn try_from(robot: &urdf_rs::Robot) -> Result<Self> {
-        Self::build(robot, &ModelDescription::default(), &Ctx { origin: "<urdf>", source: None }, None)
+        Self::build(
+            robot,
+            &ModelDescription::default(),
+            &Ctx {
+                origin: "<urdf>",
+                source: None,
+            },
+            None,
+        )
     }
 }
 
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|source| KinematicsError::Io { path: path.to_path_buf(), source })
+    std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
-    urdf_rs::read_from_string(text)
-        .map_err(|e| KinematicsError::MalformedUrdf { origin: origin.to_string(), message: e.to_string() })
+    urdf_rs::read_from_string(text).map_err(|e| KinematicsError::MalformedUrdf {
+        origin: origin.to_string(),
+        message: e.to_string(),
+    })
 }
 
 impl RobotModel {
     /// Loads a model from a `.urdf` file or a `.ron` model description (which names its URDF).
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron")) {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ron"))
+        {
             Self::from_description_file(path)
         } else {
             Self::from_urdf_file(path)
@@ -121,9 +140,17 @@ impl RobotModel {
         let text = read(path)?;
         let origin = path.display().to_string();
         let description = ModelDescription::from_ron(&text, &origin)?;
-        let urdf_path = path.parent().unwrap_or(Path::new(".")).join(&description.urdf);
+        let urdf_path = path
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(&description.urdf);
         let urdf = read(&urdf_path)?;
-        Self::from_parts(&urdf, &urdf_path.display().to_string(), &description, Some((&text, &origin)))
+        Self::from_parts(
+            &urdf,
+            &urdf_path.display().to_string(),
+            &description,
+            Some((&text, &origin)),
+        )
     }
 
     /// Builds a model from URDF text and a description; `origin` names the URDF in errors and
@@ -135,7 +162,15 @@ impl RobotModel {
         description_text: Option<(&str, &str)>,
     ) -> Result<Self> {
         let robot = parse_urdf(urdf, origin)?;
-        Self::build(&robot, description, &Ctx { origin, source: Some(urdf) }, description_text)
+        Self::build(
+            &robot,
+            description,
+            &Ctx {
+                origin,
+                source: Some(urdf),
+            },
+            description_text,
+        )
     }
 
     fn build(
@@ -145,12 +180,33 @@ impl RobotModel {
         desc_text: Option<(&str, &str)>,
     ) -> Result<Self> {
         let tree = Tree::from_urdf(robot, ctx)?;
-        let dctx = DescCtx { origin: desc_text.map_or("<description>", |d| d.1), text: desc_text.map(|d| d.0) };
+        let dctx = DescCtx {
+            origin: desc_text.map_or("<description>", |d| d.1),
+            text: desc_text.map(|d| d.0),
+        };
         let (motors, couplings) = resolve_motors(&tree, desc, &dctx)?;
         let frames = resolve_frames(&tree, desc, &dctx)?;
         let groups = resolve_groups(&motors, desc, &dctx)?;
         let postures = resolve_postures(&motors, desc, &dctx)?;
-        let steps = compile_steps(&tree, &frames);
+        let frame_offsets: Vec<_> = frames.iter().map(|f| (f.link, f.local_offset)).collect();
+        let identity: Vec<[(usize, f64); 1]> =
+            (0..tree.movable.len()).map(|c| [(c, 1.0)]).collect();
+        let joint_rows: Vec<AffineRow> = identity
+            .iter()
+            .map(|t| AffineRow {
+                constant: 0.0,
+                terms: t,
+            })
+            .collect();
+        let joint_plan = Plan::compile(&tree, &frame_offsets, &joint_rows);
+        let motor_rows: Vec<AffineRow> = couplings
+            .iter()
+            .map(|c| AffineRow {
+                constant: c.offset,
+                terms: &c.terms,
+            })
+            .collect();
+        let motor_plan = Plan::compile(&tree, &frame_offsets, &motor_rows);
         Ok(RobotModel {
             data: Arc::new(ModelData {
                 origin: ctx.origin.to_string(),
@@ -160,7 +216,8 @@ impl RobotModel {
                 frames,
                 groups,
                 postures,
-                steps,
+                joint_plan,
+                motor_plan,
             }),
         })
     }
@@ -192,7 +249,11 @@ impl RobotModel {
 
     /// Names of the movable joints, in joint-value order.
     pub fn joint_names(&self) -> impl ExactSizeIterator<Item = &str> {
-        self.data.tree.movable.iter().map(|&j| self.data.tree.joints[j].name.as_str())
+        self.data
+            .tree
+            .movable
+            .iter()
+            .map(|&j| self.data.tree.joints[j].name.as_str())
     }
 
     /// The movable joint at coordinate `i`.
@@ -220,7 +281,13 @@ impl RobotModel {
             .motors
             .iter()
             .position(|m| m.name == name)
-            .ok_or_else(|| unknown(NameKind::Motor, name, self.data.motors.iter().map(|m| m.name.as_str())))
+            .ok_or_else(|| {
+                unknown(
+                    NameKind::Motor,
+                    name,
+                    self.data.motors.iter().map(|m| m.name.as_str()),
+                )
+            })
     }
 
     /// The coupling of every movable joint, in joint-value order.
@@ -231,7 +298,11 @@ impl RobotModel {
     /// Whether some joint is driven by anything other than exactly one motor of its own.
     pub fn is_coupled(&self) -> bool {
         self.data.motors.len() != self.num_joints()
-            || self.data.couplings.iter().any(|c| c.offset != 0.0 || c.terms.len() != 1 || c.terms[0].1 != 1.0)
+            || self
+                .data
+                .couplings
+                .iter()
+                .any(|c| c.offset != 0.0 || c.terms.len() != 1 || c.terms[0].1 != 1.0)
     }
 
     /// Named frames (not including links).
@@ -263,7 +334,10 @@ impl RobotModel {
 
     /// Motor groups, in declaration order.
     pub fn groups(&self) -> impl Iterator<Item = (&str, &[usize])> {
-        self.data.groups.iter().map(|(n, m)| (n.as_str(), m.as_slice()))
+        self.data
+            .groups
+            .iter()
+            .map(|(n, m)| (n.as_str(), m.as_slice()))
     }
 
     /// Motor indices of group `name`.
@@ -273,7 +347,13 @@ impl RobotModel {
             .iter()
             .find(|(n, _)| n == name)
             .map(|(_, m)| m.as_slice())
-            .ok_or_else(|| unknown(NameKind::Group, name, self.data.groups.iter().map(|(n, _)| n.as_str())))
+            .ok_or_else(|| {
+                unknown(
+                    NameKind::Group,
+                    name,
+                    self.data.groups.iter().map(|(n, _)| n.as_str()),
+                )
+            })
     }
 
     /// Motor indices for a list of motor and group names, in the given order, without repeats.
@@ -316,7 +396,11 @@ impl RobotModel {
 
     /// The zero motor vector clamped into the motor limits (the default locked values).
     pub fn neutral_motors(&self) -> Vec<f64> {
-        self.data.motors.iter().map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper)).collect()
+        self.data
+            .motors
+            .iter()
+            .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+            .collect()
     }
 
     /// A pose buffer sized for this model.
@@ -326,7 +410,9 @@ impl RobotModel {
 
     /// Joint values from motor values, through the couplings.
     pub fn motors_to_joints(&self, motors: &[f64], joints: &mut [f64]) -> Result<()> {
-        check_vector("motor values", motors, self.data.motors.len(), |i| &self.data.motors[i].name)?;
+        check_vector("motor values", motors, self.data.motors.len(), |i| {
+            &self.data.motors[i].name
+        })?;
         if joints.len() != self.num_joints() {
             return Err(KinematicsError::WrongLength {
                 what: "joint values",
@@ -343,23 +429,26 @@ impl RobotModel {
     /// Forward kinematics from joint values: the world pose (world = root link) of every link
     /// and named frame into `buffer`.
     pub fn forward_joints(&self, joints: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
-        check_vector("joint values", joints, self.num_joints(), |i| &self.joint(i).name)?;
+        check_vector("joint values", joints, self.num_joints(), |i| {
+            &self.joint(i).name
+        })?;
         self.check_buffer(buffer)?;
-        buffer.joint_values.copy_from_slice(joints);
-        self.forward_buffered_unchecked(buffer);
+        self.data.joint_plan.run(joints, buffer);
         Ok(())
     }
 
     /// Forward kinematics from motor values (every motor, in [`RobotModel::motors`] order).
     pub fn forward_motors(&self, motors: &[f64], buffer: &mut PoseBuffer) -> Result<()> {
+        check_vector("motor values", motors, self.data.motors.len(), |i| {
+            &self.data.motors[i].name
+        })?;
         self.check_buffer(buffer)?;
-        self.motors_to_joints(motors, &mut buffer.joint_values)?;
-        self.forward_buffered_unchecked(buffer);
+        self.data.motor_plan.run(motors, buffer);
         Ok(())
     }
 
     pub(crate) fn check_buffer(&self, buffer: &PoseBuffer) -> Result<()> {
-        if buffer.poses.len() != self.num_frames() || buffer.joint_values.len() != self.num_joints() {
+        if buffer.poses.len() != self.num_frames() || buffer.slots.len() != self.num_joints() + 1 {
             return Err(KinematicsError::WrongLength {
                 what: "pose buffer (make it with RobotModel::pose_buffer)",
                 expected: self.num_frames(),
@@ -367,11 +456,6 @@ impl RobotModel {
             });
         }
         Ok(())
-    }
-
-    /// Runs the FK pass on the joint values already in `buffer`.
-    pub(crate) fn forward_buffered_unchecked(&self, buffer: &mut PoseBuffer) {
-        crate::fk::run_steps(&self.data.steps, &buffer.joint_values, &mut buffer.poses);
     }
 }
 
@@ -383,10 +467,19 @@ pub(crate) fn check_vector<'a>(
     name: impl Fn(usize) -> &'a str,
 ) -> Result<()> {
     if values.len() != expected {
-        return Err(KinematicsError::WrongLength { what, expected, got: values.len() });
+        return Err(KinematicsError::WrongLength {
+            what,
+            expected,
+            got: values.len(),
+        });
     }
     if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-        return Err(KinematicsError::NonFinite { what, index, name: name(index).to_string(), value: values[index] });
+        return Err(KinematicsError::NonFinite {
+            what,
+            index,
+            name: name(index).to_string(),
+            value: values[index],
+        });
     }
     Ok(())
 }
@@ -397,11 +490,20 @@ struct DescCtx<'a> {
 }
 
 impl DescCtx<'_> {
-    fn invalid(&self, element: String, quoted: &str, problem: impl Into<String>, fix: impl Into<String>) -> KinematicsError {
+    fn invalid(
+        &self,
+        element: String,
+        quoted: &str,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> KinematicsError {
         let needle = format!("\"{quoted}\"");
         let line = self
             .text
-            .and_then(|t| t.lines().position(|l| l.contains(&needle) && !l.trim_start().starts_with("//")))
+            .and_then(|t| {
+                t.lines()
+                    .position(|l| l.contains(&needle) && !l.trim_start().starts_with("//"))
+            })
             .map(|i| i + 1);
         KinematicsError::InvalidModel {
             origin: self.origin.to_string(),
@@ -413,25 +515,58 @@ impl DescCtx<'_> {
     }
 }
 
-fn suggestion_fix<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>, otherwise: &str) -> String {
+fn suggestion_fix<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+    otherwise: &str,
+) -> String {
     let near = crate::error::closest_names(name, candidates);
-    if near.is_empty() { otherwise.to_string() } else { format!("did you mean `{}`?", near.join("`, `")) }
+    if near.is_empty() {
+        otherwise.to_string()
+    } else {
+        format!("did you mean `{}`?", near.join("`, `"))
+    }
 }
 
-fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result<(Vec<Motor>, Vec<Coupling>)> {
-    let joint_names: Vec<&str> = tree.movable.iter().map(|&j| tree.joints[j].name.as_str()).collect();
+fn resolve_motors(
+    tree: &Tree,
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<(Vec<Motor>, Vec<Coupling>)> {
+    let joint_names: Vec<&str> = tree
+        .movable
+        .iter()
+        .map(|&j| tree.joints[j].name.as_str())
+        .collect();
     // Declared motors.
     let mut declared: HashMap<&str, (usize, &crate::description::MotorSpec)> = HashMap::new();
     for (i, m) in desc.motors.iter().enumerate() {
         let element = format!("motor \"{}\"", m.name);
-        if !(m.lower.is_finite() && m.upper.is_finite()) || m.velocity.is_some_and(|v| v.is_nan() || v <= 0.0) {
-            return Err(ctx.invalid(element, &m.name, "has a non-finite limit or a non-positive velocity", "write finite limits and a positive velocity"));
+        if !(m.lower.is_finite() && m.upper.is_finite())
+            || m.velocity.is_some_and(|v| v.is_nan() || v <= 0.0)
+        {
+            return Err(ctx.invalid(
+                element,
+                &m.name,
+                "has a non-finite limit or a non-positive velocity",
+                "write finite limits and a positive velocity",
+            ));
         }
         if m.lower > m.upper {
-            return Err(ctx.invalid(element, &m.name, format!("lower {} is above upper {}", m.lower, m.upper), "swap the limits"));
+            return Err(ctx.invalid(
+                element,
+                &m.name,
+                format!("lower {} is above upper {}", m.lower, m.upper),
+                "swap the limits",
+            ));
         }
         if declared.insert(m.name.as_str(), (i, m)).is_some() {
-            return Err(ctx.invalid(element, &m.name, "is declared twice", "give every motor a unique name"));
+            return Err(ctx.invalid(
+                element,
+                &m.name,
+                "is declared twice",
+                "give every motor a unique name",
+            ));
         }
     }
     // Couplings by joint.
@@ -439,19 +574,48 @@ fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
     for c in &desc.couplings {
         let element = format!("coupling of joint \"{}\"", c.joint);
         let Some(j) = tree.joint_index(&c.joint) else {
-            return Err(ctx.invalid(element, &c.joint, "names no joint of the URDF", suggestion_fix(&c.joint, joint_names.iter().copied(), "name a movable URDF joint")));
+            return Err(ctx.invalid(
+                element,
+                &c.joint,
+                "names no joint of the URDF",
+                suggestion_fix(
+                    &c.joint,
+                    joint_names.iter().copied(),
+                    "name a movable URDF joint",
+                ),
+            ));
         };
         if !tree.joints[j].kind.is_movable() {
-            return Err(ctx.invalid(element, &c.joint, "names a fixed joint", "couple only movable joints"));
+            return Err(ctx.invalid(
+                element,
+                &c.joint,
+                "names a fixed joint",
+                "couple only movable joints",
+            ));
         }
         if tree.joints[j].mimic.is_some() {
-            return Err(ctx.invalid(element, &c.joint, "names a joint that already has a <mimic>", "remove the <mimic> or the coupling"));
+            return Err(ctx.invalid(
+                element,
+                &c.joint,
+                "names a joint that already has a <mimic>",
+                "remove the <mimic> or the coupling",
+            ));
         }
         if !c.offset.is_finite() || c.motors.iter().any(|(_, f)| !f.is_finite()) {
-            return Err(ctx.invalid(element, &c.joint, "has a non-finite factor or offset", "write finite numbers"));
+            return Err(ctx.invalid(
+                element,
+                &c.joint,
+                "has a non-finite factor or offset",
+                "write finite numbers",
+            ));
         }
         if coupled.insert(c.joint.as_str(), c).is_some() {
-            return Err(ctx.invalid(element, &c.joint, "is coupled twice", "give one coupling per joint"));
+            return Err(ctx.invalid(
+                element,
+                &c.joint,
+                "is coupled twice",
+                "give one coupling per joint",
+            ));
         }
     }
     // Independent joints own a motor named like them.
@@ -472,12 +636,13 @@ fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
     }
     let mut motors: Vec<Motor> = Vec::new();
     let mut index_of: HashMap<String, usize> = HashMap::new();
-    let mut motor_index = |name: &str, motors: &mut Vec<Motor>, make: &dyn Fn() -> Motor| -> usize {
-        *index_of.entry(name.to_string()).or_insert_with(|| {
-            motors.push(make());
-            motors.len() - 1
-        })
-    };
+    let mut motor_index =
+        |name: &str, motors: &mut Vec<Motor>, make: &dyn Fn() -> Motor| -> usize {
+            *index_of.entry(name.to_string()).or_insert_with(|| {
+                motors.push(make());
+                motors.len() - 1
+            })
+        };
     let mut couplings: Vec<Option<Coupling>> = vec![None; tree.movable.len()];
     // First pass: independent and coupled joints, in joint order; second pass: mimics.
     for (coord, &j) in tree.movable.iter().enumerate() {
@@ -498,11 +663,18 @@ fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
                             effort: f64::INFINITY,
                         },
                     })
-                } else if let Some(other) = tree.joint_index(mname).filter(|&o| tree.joints[o].kind.is_movable() && own_motor(o)) {
+                } else if let Some(other) = tree
+                    .joint_index(mname)
+                    .filter(|&o| tree.joints[o].kind.is_movable() && own_motor(o))
+                {
                     let other = &tree.joints[other];
                     motor_index(mname, &mut motors, &|| own_motor_of(other))
                 } else {
-                    let candidates = desc.motors.iter().map(|m| m.name.as_str()).chain(joint_names.iter().copied());
+                    let candidates = desc
+                        .motors
+                        .iter()
+                        .map(|m| m.name.as_str())
+                        .chain(joint_names.iter().copied());
                     return Err(ctx.invalid(
                         format!("coupling of joint \"{}\"", joint.name),
                         mname,
@@ -512,27 +684,51 @@ fn resolve_motors(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
                 };
                 terms.push((m, *factor));
             }
-            couplings[coord] = Some(Coupling { terms, offset: c.offset });
+            couplings[coord] = Some(Coupling {
+                terms,
+                offset: c.offset,
+            });
         } else {
             let m = motor_index(&joint.name, &mut motors, &|| own_motor_of(joint));
-            couplings[coord] = Some(Coupling { terms: vec![(m, 1.0)], offset: 0.0 });
+            couplings[coord] = Some(Coupling {
+                terms: vec![(m, 1.0)],
+                offset: 0.0,
+            });
         }
     }
     for (coord, &j) in tree.movable.iter().enumerate() {
-        let Some(mimic) = &tree.joints[j].mimic else { continue };
-        let leader = tree.joints[tree.joint_index(&mimic.leader).expect("checked by Tree")].coordinate.expect("movable");
-        let lc = couplings[leader].clone().expect("leaders are resolved in the first pass");
+        let Some(mimic) = &tree.joints[j].mimic else {
+            continue;
+        };
+        let leader = tree.joints[tree.joint_index(&mimic.leader).expect("checked by Tree")]
+            .coordinate
+            .expect("movable");
+        let lc = couplings[leader]
+            .clone()
+            .expect("leaders are resolved in the first pass");
         couplings[coord] = Some(Coupling {
-            terms: lc.terms.iter().map(|&(m, f)| (m, f * mimic.multiplier)).collect(),
+            terms: lc
+                .terms
+                .iter()
+                .map(|&(m, f)| (m, f * mimic.multiplier))
+                .collect(),
             offset: lc.offset * mimic.multiplier + mimic.offset,
         });
     }
     for m in &desc.motors {
         if !index_of.contains_key(&m.name) {
-            return Err(ctx.invalid(format!("motor \"{}\"", m.name), &m.name, "drives no joint", "use it in a coupling or remove it"));
+            return Err(ctx.invalid(
+                format!("motor \"{}\"", m.name),
+                &m.name,
+                "drives no joint",
+                "use it in a coupling or remove it",
+            ));
         }
     }
-    let couplings: Vec<Coupling> = couplings.into_iter().map(|c| c.expect("every movable joint resolved")).collect();
+    let couplings: Vec<Coupling> = couplings
+        .into_iter()
+        .map(|c| c.expect("every movable joint resolved"))
+        .collect();
     // Explicit couplings must keep their joints within the URDF limits over the motor box.
     for (coord, c) in couplings.iter().enumerate() {
         let joint = &tree.joints[tree.movable[coord]];
@@ -567,7 +763,10 @@ fn own_motor_of(joint: &crate::tree::Joint) -> Motor {
         limits.lower = -std::f64::consts::PI;
         limits.upper = std::f64::consts::PI;
     }
-    Motor { name: joint.name.clone(), limits }
+    Motor {
+        name: joint.name.clone(),
+        limits,
+    }
 }
 
 fn resolve_frames(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<NamedFrame>> {
@@ -575,10 +774,20 @@ fn resolve_frames(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
     for f in &desc.frames {
         let element = format!("frame \"{}\"", f.name);
         if tree.link_index(&f.name).is_some() || frames.iter().any(|g| g.name == f.name) {
-            return Err(ctx.invalid(element, &f.name, "has the name of a link or another frame", "give the frame a unique name"));
+            return Err(ctx.invalid(
+                element,
+                &f.name,
+                "has the name of a link or another frame",
+                "give the frame a unique name",
+            ));
         }
         if f.xyz.iter().chain(&f.rpy).any(|v| !v.is_finite()) {
-            return Err(ctx.invalid(element, &f.name, "has a non-finite offset", "write finite numbers"));
+            return Err(ctx.invalid(
+                element,
+                &f.name,
+                "has a non-finite offset",
+                "write finite numbers",
+            ));
         }
         let offset = pose_from_xyz_rpy(f.xyz, f.rpy);
         let (link, local_offset) = if let Some(l) = tree.link_index(&f.link) {
@@ -586,20 +795,45 @@ fn resolve_frames(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result
         } else if let Some(g) = frames.iter().find(|g| g.name == f.link) {
             (g.link, g.local_offset * offset)
         } else {
-            let candidates = tree.links.iter().map(|l| l.name.as_str()).chain(frames.iter().map(|g| g.name.as_str()));
-            return Err(ctx.invalid(element, &f.link, format!("is attached to `{}`, which is no link or earlier frame", f.link), suggestion_fix(&f.link, candidates, "name an existing link")));
+            let candidates = tree
+                .links
+                .iter()
+                .map(|l| l.name.as_str())
+                .chain(frames.iter().map(|g| g.name.as_str()));
+            return Err(ctx.invalid(
+                element,
+                &f.link,
+                format!(
+                    "is attached to `{}`, which is no link or earlier frame",
+                    f.link
+                ),
+                suggestion_fix(&f.link, candidates, "name an existing link"),
+            ));
         };
-        frames.push(NamedFrame { name: f.name.clone(), link, local_offset });
+        frames.push(NamedFrame {
+            name: f.name.clone(),
+            link,
+            local_offset,
+        });
     }
     Ok(frames)
 }
 
-fn resolve_groups(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<(String, Vec<usize>)>> {
+fn resolve_groups(
+    motors: &[Motor],
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<Vec<(String, Vec<usize>)>> {
     let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
     for g in &desc.groups {
         let element = format!("group \"{}\"", g.name);
         if groups.iter().any(|(n, _)| *n == g.name) {
-            return Err(ctx.invalid(element, &g.name, "is declared twice", "give every group a unique name"));
+            return Err(ctx.invalid(
+                element,
+                &g.name,
+                "is declared twice",
+                "give every group a unique name",
+            ));
         }
         let mut members = Vec::new();
         for name in &g.members {
@@ -608,8 +842,16 @@ fn resolve_groups(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> R
             } else if let Some(i) = motors.iter().position(|m| &m.name == name) {
                 vec![i]
             } else {
-                let candidates = motors.iter().map(|m| m.name.as_str()).chain(groups.iter().map(|(n, _)| n.as_str()));
-                return Err(ctx.invalid(element, name, format!("member `{name}` is no motor or earlier group"), suggestion_fix(name, candidates, "list motor names")));
+                let candidates = motors
+                    .iter()
+                    .map(|m| m.name.as_str())
+                    .chain(groups.iter().map(|(n, _)| n.as_str()));
+                return Err(ctx.invalid(
+                    element,
+                    name,
+                    format!("member `{name}` is no motor or earlier group"),
+                    suggestion_fix(name, candidates, "list motor names"),
+                ));
             };
             for m in found {
                 if !members.contains(&m) {
@@ -622,41 +864,54 @@ fn resolve_groups(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> R
     Ok(groups)
 }
 
-fn resolve_postures(motors: &[Motor], desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<(String, Vec<f64>)>> {
+fn resolve_postures(
+    motors: &[Motor],
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<Vec<(String, Vec<f64>)>> {
     let mut postures: Vec<(String, Vec<f64>)> = Vec::new();
     for p in &desc.postures {
         let element = format!("posture \"{}\"", p.name);
         if postures.iter().any(|(n, _)| *n == p.name) {
-            return Err(ctx.invalid(element, &p.name, "is declared twice", "give every posture a unique name"));
+            return Err(ctx.invalid(
+                element,
+                &p.name,
+                "is declared twice",
+                "give every posture a unique name",
+            ));
         }
-        let mut values: Vec<f64> = motors.iter().map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper)).collect();
+        let mut values: Vec<f64> = motors
+            .iter()
+            .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+            .collect();
         for (name, &v) in &p.values {
             let Some(i) = motors.iter().position(|m| &m.name == name) else {
-                return Err(ctx.invalid(element, name, format!("sets `{name}`, which is no motor"), suggestion_fix(name, motors.iter().map(|m| m.name.as_str()), "use motor names (see `cargo xtask model-info`)")));
+                return Err(ctx.invalid(
+                    element,
+                    name,
+                    format!("sets `{name}`, which is no motor"),
+                    suggestion_fix(
+                        name,
+                        motors.iter().map(|m| m.name.as_str()),
+                        "use motor names (see `cargo xtask model-info`)",
+                    ),
+                ));
             };
             let l = &motors[i].limits;
             if !v.is_finite() || v < l.lower - 1e-12 || v > l.upper + 1e-12 {
-                return Err(ctx.invalid(element, name, format!("sets `{name}` to {v}, outside its limits [{}, {}]", l.lower, l.upper), "choose a value within the motor limits"));
+                return Err(ctx.invalid(
+                    element,
+                    name,
+                    format!(
+                        "sets `{name}` to {v}, outside its limits [{}, {}]",
+                        l.lower, l.upper
+                    ),
+                    "choose a value within the motor limits",
+                ));
             }
             values[i] = v.clamp(l.lower, l.upper);
         }
         postures.push((p.name.clone(), values));
     }
     Ok(postures)
-}
-
-fn compile_steps(tree: &Tree, frames: &[NamedFrame]) -> Vec<Step> {
-    let mut steps = Vec::with_capacity(tree.joints.len() + frames.len());
-    for joint in &tree.joints {
-        let motion = match (joint.kind, joint.coordinate) {
-            (JointKind::Revolute | JointKind::Continuous, Some(c)) => Motion::Revolute { axis: joint.axis, coordinate: c },
-            (JointKind::Prismatic, Some(c)) => Motion::Prismatic { axis: joint.axis.into_inner(), coordinate: c },
-            _ => Motion::Fixed,
-        };
-        steps.push(Step { parent: joint.parent, local_origin: joint.local_origin, motion });
-    }
-    for f in frames {
-        steps.push(Step { parent: f.link, local_origin: f.local_offset, motion: Motion::Fixed });
-    }
-    steps
 }

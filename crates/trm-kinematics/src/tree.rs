@@ -112,7 +112,13 @@ pub(crate) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    pub fn invalid(&self, tag: &str, name: &str, problem: impl Into<String>, fix: impl Into<String>) -> KinematicsError {
+    pub fn invalid(
+        &self,
+        tag: &str,
+        name: &str,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> KinematicsError {
         KinematicsError::InvalidModel {
             origin: self.origin.to_string(),
             line: self.source.and_then(|s| line_of_element(s, tag, name)),
@@ -125,7 +131,12 @@ impl Ctx<'_> {
 
 fn check_finite(ctx: &Ctx, tag: &str, name: &str, what: &str, values: &[f64]) -> Result<()> {
     if values.iter().any(|v| !v.is_finite()) {
-        return Err(ctx.invalid(tag, name, format!("{what} {values:?} is not finite"), "write finite numbers"));
+        return Err(ctx.invalid(
+            tag,
+            name,
+            format!("{what} {values:?} is not finite"),
+            "write finite numbers",
+        ));
     }
     Ok(())
 }
@@ -142,12 +153,22 @@ impl Tree {
     /// Builds and validates the tree. `source` (the URDF text), when given, lets errors name lines.
     pub(crate) fn from_urdf(robot: &urdf_rs::Robot, ctx: &Ctx) -> Result<Tree> {
         if robot.links.is_empty() {
-            return Err(ctx.invalid("robot", &robot.name, "has no <link>", "add at least one <link>"));
+            return Err(ctx.invalid(
+                "robot",
+                &robot.name,
+                "has no <link>",
+                "add at least one <link>",
+            ));
         }
         let mut link_index: HashMap<&str, usize> = HashMap::new();
         for (i, l) in robot.links.iter().enumerate() {
             if link_index.insert(l.name.as_str(), i).is_some() {
-                return Err(ctx.invalid("link", &l.name, "is defined twice", "give every <link> a unique name"));
+                return Err(ctx.invalid(
+                    "link",
+                    &l.name,
+                    "is defined twice",
+                    "give every <link> a unique name",
+                ));
             }
         }
         let mut joint_names: HashMap<&str, ()> = HashMap::new();
@@ -155,11 +176,19 @@ impl Tree {
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
         for (j, joint) in robot.joints.iter().enumerate() {
             if joint_names.insert(joint.name.as_str(), ()).is_some() {
-                return Err(ctx.invalid("joint", &joint.name, "is defined twice", "give every <joint> a unique name"));
+                return Err(ctx.invalid(
+                    "joint",
+                    &joint.name,
+                    "is defined twice",
+                    "give every <joint> a unique name",
+                ));
             }
             let find = |link: &str, role: &str| {
                 link_index.get(link).copied().ok_or_else(|| {
-                    let near = crate::error::closest_names(link, robot.links.iter().map(|l| l.name.as_str()));
+                    let near = crate::error::closest_names(
+                        link,
+                        robot.links.iter().map(|l| l.name.as_str()),
+                    );
                     ctx.invalid(
                         "joint",
                         &joint.name,
@@ -167,7 +196,10 @@ impl Tree {
                         if near.is_empty() {
                             format!("add <link name=\"{link}\"/> or correct the <{role}> element")
                         } else {
-                            format!("did you mean `{}`? otherwise add <link name=\"{link}\"/>", near.join("`, `"))
+                            format!(
+                                "did you mean `{}`? otherwise add <link name=\"{link}\"/>",
+                                near.join("`, `")
+                            )
                         },
                     )
                 })
@@ -175,7 +207,12 @@ impl Tree {
             let parent = find(&joint.parent.link, "parent")?;
             let child = find(&joint.child.link, "child")?;
             if parent == child {
-                return Err(ctx.invalid("joint", &joint.name, "connects a link to itself", "use two different links"));
+                return Err(ctx.invalid(
+                    "joint",
+                    &joint.name,
+                    "connects a link to itself",
+                    "use two different links",
+                ));
             }
             if let Some(previous) = parent_of[child] {
                 return Err(ctx.invalid(
@@ -191,11 +228,21 @@ impl Tree {
             parent_of[child] = Some(j);
             children[parent].push(j);
         }
-        let roots: Vec<usize> = (0..robot.links.len()).filter(|&i| parent_of[i].is_none()).collect();
+        let roots: Vec<usize> = (0..robot.links.len())
+            .filter(|&i| parent_of[i].is_none())
+            .collect();
         if roots.len() != 1 {
-            let names: Vec<&str> = roots.iter().map(|&i| robot.links[i].name.as_str()).collect();
+            let names: Vec<&str> = roots
+                .iter()
+                .map(|&i| robot.links[i].name.as_str())
+                .collect();
             return Err(if roots.is_empty() {
-                ctx.invalid("robot", &robot.name, "has no root link: the joints form a cycle", "break the cycle")
+                ctx.invalid(
+                    "robot",
+                    &robot.name,
+                    "has no root link: the joints form a cycle",
+                    "break the cycle",
+                )
             } else {
                 ctx.invalid(
                     "robot",
@@ -216,7 +263,9 @@ impl Tree {
         }
         if order.len() != robot.links.len() {
             let reached: std::collections::HashSet<usize> = order.iter().copied().collect();
-            let lost = (0..robot.links.len()).find(|i| !reached.contains(i)).unwrap_or(0);
+            let lost = (0..robot.links.len())
+                .find(|i| !reached.contains(i))
+                .unwrap_or(0);
             return Err(ctx.invalid(
                 "link",
                 &robot.links[lost].name,
@@ -239,7 +288,8 @@ impl Tree {
                 parent_joint: parent_joint.map(|_| new - 1),
             });
             if let Some(uj) = parent_joint {
-                let mut joint = convert_joint(uj, new_index[link_index[uj.parent.link.as_str()]], new, ctx)?;
+                let mut joint =
+                    convert_joint(uj, new_index[link_index[uj.parent.link.as_str()]], new, ctx)?;
                 if joint.kind.is_movable() {
                     joint.coordinate = Some(movable.len());
                     movable.push(joints.len());
@@ -247,7 +297,12 @@ impl Tree {
                 joints.push(joint);
             }
         }
-        let tree = Tree { name: robot.name.clone(), links, joints, movable };
+        let tree = Tree {
+            name: robot.name.clone(),
+            links,
+            joints,
+            movable,
+        };
         tree.check_mimics(ctx)?;
         Ok(tree)
     }
@@ -256,22 +311,37 @@ impl Tree {
         for joint in &self.joints {
             let Some(mimic) = &joint.mimic else { continue };
             let Some(leader) = self.joints.iter().find(|j| j.name == mimic.leader) else {
-                let near = crate::error::closest_names(&mimic.leader, self.joints.iter().map(|j| j.name.as_str()));
+                let near = crate::error::closest_names(
+                    &mimic.leader,
+                    self.joints.iter().map(|j| j.name.as_str()),
+                );
                 return Err(ctx.invalid(
                     "joint",
                     &joint.name,
                     format!("<mimic joint=\"{}\"> names no joint", mimic.leader),
-                    if near.is_empty() { "name an existing joint".into() } else { format!("did you mean `{}`?", near.join("`, `")) },
+                    if near.is_empty() {
+                        "name an existing joint".into()
+                    } else {
+                        format!("did you mean `{}`?", near.join("`, `"))
+                    },
                 ));
             };
             if !leader.kind.is_movable() {
-                return Err(ctx.invalid("joint", &joint.name, format!("mimics the fixed joint `{}`", leader.name), "mimic a movable joint"));
+                return Err(ctx.invalid(
+                    "joint",
+                    &joint.name,
+                    format!("mimics the fixed joint `{}`", leader.name),
+                    "mimic a movable joint",
+                ));
             }
             if leader.mimic.is_some() {
                 return Err(ctx.invalid(
                     "joint",
                     &joint.name,
-                    format!("mimics `{}`, which itself mimics another joint", leader.name),
+                    format!(
+                        "mimics `{}`, which itself mimics another joint",
+                        leader.name
+                    ),
                     "make every mimic joint follow an independent joint",
                 ));
             }
@@ -315,7 +385,12 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
     let axis_vec = Vector3::from(axis_raw);
     let axis = if kind.is_movable() {
         if axis_vec.norm() < 1e-12 {
-            return Err(ctx.invalid("joint", name, "has a zero <axis>", "give a non-zero axis, e.g. <axis xyz=\"0 0 1\"/>"));
+            return Err(ctx.invalid(
+                "joint",
+                name,
+                "has a zero <axis>",
+                "give a non-zero axis, e.g. <axis xyz=\"0 0 1\"/>",
+            ));
         }
         Unit::new_normalize(axis_vec)
     } else {
@@ -326,12 +401,21 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
         JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
         JointKind::Fixed => (0.0, 0.0),
         _ => {
-            check_finite(ctx, "joint", name, "<limit lower upper>", &[l.lower, l.upper])?;
+            check_finite(
+                ctx,
+                "joint",
+                name,
+                "<limit lower upper>",
+                &[l.lower, l.upper],
+            )?;
             if l.lower > l.upper {
                 return Err(ctx.invalid(
                     "joint",
                     name,
-                    format!("<limit lower=\"{}\" upper=\"{}\">: lower is above upper", l.lower, l.upper),
+                    format!(
+                        "<limit lower=\"{}\" upper=\"{}\">: lower is above upper",
+                        l.lower, l.upper
+                    ),
                     "swap the two values",
                 ));
             }
@@ -342,7 +426,10 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
         return Err(ctx.invalid(
             "joint",
             name,
-            format!("<limit velocity=\"{}\" effort=\"{}\"> must be non-negative numbers", l.velocity, l.effort),
+            format!(
+                "<limit velocity=\"{}\" effort=\"{}\"> must be non-negative numbers",
+                l.velocity, l.effort
+            ),
             "write non-negative velocity and effort limits",
         ));
     }
@@ -351,8 +438,18 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
         Some(m) if kind.is_movable() => {
             let multiplier = m.multiplier.unwrap_or(1.0);
             let offset = m.offset.unwrap_or(0.0);
-            check_finite(ctx, "joint", name, "<mimic multiplier offset>", &[multiplier, offset])?;
-            Some(Mimic { leader: m.joint.clone(), multiplier, offset })
+            check_finite(
+                ctx,
+                "joint",
+                name,
+                "<mimic multiplier offset>",
+                &[multiplier, offset],
+            )?;
+            Some(Mimic {
+                leader: m.joint.clone(),
+                multiplier,
+                offset,
+            })
         }
         _ => None,
     };
@@ -363,7 +460,12 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
         child,
         local_origin: pose_from_xyz_rpy(xyz, rpy),
         axis,
-        limits: Limits { lower, upper, velocity: positive_or_inf(l.velocity), effort: positive_or_inf(l.effort) },
+        limits: Limits {
+            lower,
+            upper,
+            velocity: positive_or_inf(l.velocity),
+            effort: positive_or_inf(l.effort),
+        },
         mimic,
         coordinate: None,
     })

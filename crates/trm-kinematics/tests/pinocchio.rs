@@ -32,11 +32,22 @@ fn repo() -> PathBuf {
 
 /// Largest position and rotation-entry error over every link of every sample.
 fn max_errors(fixture_name: &str) -> (f64, f64, usize) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(fixture_name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(fixture_name);
     let fixture: Fixture = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let model = RobotModel::from_urdf_file(repo().join(&fixture.urdf)).unwrap();
-    assert_eq!(fixture.joint_names.len(), model.num_joints(), "{}: movable joint count", fixture.urdf);
-    let columns: Vec<usize> = fixture.joint_names.iter().map(|n| model.joint_index(n).unwrap()).collect();
+    assert_eq!(
+        fixture.joint_names.len(),
+        model.num_joints(),
+        "{}: movable joint count",
+        fixture.urdf
+    );
+    let columns: Vec<usize> = fixture
+        .joint_names
+        .iter()
+        .map(|n| model.joint_index(n).unwrap())
+        .collect();
     let mut buffer = model.pose_buffer();
     let mut q = vec![0.0; model.num_joints()];
     let (mut ep, mut er, mut compared) = (0.0f64, 0.0f64, 0);
@@ -45,7 +56,12 @@ fn max_errors(fixture_name: &str) -> (f64, f64, usize) {
             q[c] = v;
         }
         model.forward_joints(&q, &mut buffer).unwrap();
-        assert_eq!(sample.links.len(), model.num_links(), "{}: every link has a reference pose", fixture.urdf);
+        assert_eq!(
+            sample.links.len(),
+            model.num_links(),
+            "{}: every link has a reference pose",
+            fixture.urdf
+        );
         for (name, expected) in &sample.links {
             let pose = buffer.pose(model.frame_id(name).unwrap());
             let r = pose.rotation.to_rotation_matrix();
@@ -65,7 +81,10 @@ fn check(fixture: &str) {
     let (ep, er, n) = max_errors(fixture);
     assert!(n > 0);
     eprintln!("{fixture}: max position error {ep:e} m, rotation entry error {er:e} over {n} poses");
-    assert!(ep < 1e-9 && er < 1e-9, "{fixture}: max position error {ep:e} m, rotation entry error {er:e} over {n} poses");
+    assert!(
+        ep < 1e-9 && er < 1e-9,
+        "{fixture}: max position error {ep:e} m, rotation entry error {er:e} over {n} poses"
+    );
 }
 
 #[test]

@@ -39,20 +39,24 @@ pub fn icub_upper_body() -> RobotModel {
 
 /// The official 75-joint iCub URDF, every joint its own motor.
 pub fn icub_official() -> RobotModel {
-    RobotModel::from_urdf_str(ICUB_OFFICIAL_URDF, "models/icub-visuomanip/model.urdf").expect("the official URDF loads")
+    RobotModel::from_urdf_str(ICUB_OFFICIAL_URDF, "models/icub-visuomanip/model.urdf")
+        .expect("the official URDF loads")
 }
 
 /// The official iCubGenova04 URDF.
 pub fn icub_genova04() -> RobotModel {
-    RobotModel::from_urdf_str(ICUB_GENOVA04_URDF, "models/icub-genova04/model.urdf").expect("the official URDF loads")
+    RobotModel::from_urdf_str(ICUB_GENOVA04_URDF, "models/icub-genova04/model.urdf")
+        .expect("the official URDF loads")
 }
 
 /// The three-link planar arm.
 pub fn planar_arm() -> RobotModel {
-    RobotModel::from_urdf_str(PLANAR_ARM_URDF, "models/planar_arm.urdf").expect("the planar arm loads")
+    RobotModel::from_urdf_str(PLANAR_ARM_URDF, "models/planar_arm.urdf")
+        .expect("the planar arm loads")
 }
 
 /// The small branched tree.
 pub fn branched_tree() -> RobotModel {
-    RobotModel::from_urdf_str(BRANCHED_TREE_URDF, "models/branched_tree.urdf").expect("the branched tree loads")
+    RobotModel::from_urdf_str(BRANCHED_TREE_URDF, "models/branched_tree.urdf")
+        .expect("the branched tree loads")
 }
