@@ -22,7 +22,6 @@ pub struct Args {
 
 /// The input file.
 #[derive(Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
 pub struct Configs {
     joint_names: Vec<String>,
     samples: Vec<Sample>,
@@ -133,4 +132,83 @@ pub fn run(args: &Args) -> Result<()> {
         None => println!("{text}"),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `fk` on the Pinocchio fixture's inputs reproduces its poses (the fixture is both a valid
+    /// input file and the expected output).
+    #[test]
+    fn fk_command_reproduces_pinocchio_poses_of_the_official_urdf() {
+        let root = crate::models_dir().join("..");
+        let fixture =
+            root.join("crates/trm-kinematics/tests/fixtures/icub_visuomanip.pinocchio.json");
+        let expected: Value =
+            serde_json::from_str(&std::fs::read_to_string(&fixture).unwrap()).unwrap();
+        let dir = std::env::temp_dir().join(format!("trm-fk-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let input = dir.join("in.json");
+        let configs = json!({"joint_names": expected["joint_names"], "samples": expected["samples"].as_array().unwrap().iter().map(|s| json!({"q": s["q"]})).collect::<Vec<_>>()});
+        std::fs::write(&input, configs.to_string()).unwrap();
+        let out = dir.join("out.json");
+        let args = Args {
+            model: Some(crate::models_dir().join("icub-visuomanip/model.urdf")),
+            configs: input,
+            out: Some(out.clone()),
+        };
+        run(&args).unwrap();
+        let got: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let mut worst = 0.0f64;
+        for (g, e) in got["samples"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(expected["samples"].as_array().unwrap())
+        {
+            let links = e["links"].as_object().unwrap();
+            assert_eq!(g["links"].as_object().unwrap().len(), links.len());
+            for (name, pose) in links {
+                let a = &g["links"][name];
+                for i in 0..3 {
+                    worst = worst
+                        .max((a["p"][i].as_f64().unwrap() - pose["p"][i].as_f64().unwrap()).abs());
+                    for j in 0..3 {
+                        worst = worst.max(
+                            (a["R"][i][j].as_f64().unwrap() - pose["R"][i][j].as_f64().unwrap())
+                                .abs(),
+                        );
+                    }
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(worst < 1e-9, "worst difference {worst:e}");
+    }
+
+    #[test]
+    fn fk_rejects_unknown_joint_names_with_a_suggestion() {
+        let dir = std::env::temp_dir().join(format!("trm-fk-bad-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let input = dir.join("in.json");
+        std::fs::write(
+            &input,
+            r#"{"joint_names": ["r_elbw"], "samples": [{"q": [0.1]}]}"#,
+        )
+        .unwrap();
+        let err = run(&Args {
+            model: None,
+            configs: input,
+            out: Some(dir.join("out.json")),
+        })
+        .unwrap_err();
+        let text = format!("{err:#}");
+        assert!(
+            text.contains("r_elbow") && text.contains("in.json"),
+            "{text}"
+        );
+        assert!(!dir.join("out.json").exists(), "no output on error");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

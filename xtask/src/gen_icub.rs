@@ -8,6 +8,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use nalgebra::{UnitQuaternion, Vector3};
+use trm_kinematics::CouplingSpec;
 
 /// Links whose collision proxy is their mesh's bounding box (flat parts a capsule fits badly).
 const BOX_LINKS: &[&str] = &["root_link", "chest", "l_hand", "r_hand", "neck_1", "head"];
@@ -295,30 +296,41 @@ fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
     s.push_str("    ],\n    couplings: [\n");
     let deg20 = 20f64.to_radians();
     for side in ["l", "r"] {
-        let j = |finger: &str, k: u32| format!("{side}_hand_{finger}_{k}_joint");
-        let m = |name: &str| format!("{side}_{name}");
-        let mut rows: Vec<(String, Vec<(String, f64)>, f64)> = vec![
-            (j("thumb", 0), vec![(m("thumb_oppose"), 1.0)], 0.0),
-            (j("thumb", 1), vec![(m("thumb_proximal"), 1.0)], 0.0),
-            (j("thumb", 2), vec![(m("thumb_distal"), 0.5)], 0.0),
-            (j("thumb", 3), vec![(m("thumb_distal"), 0.5)], 0.0),
-            (j("index", 0), vec![(m("hand_finger"), 1.0 / 3.0)], -deg20),
-            (j("index", 1), vec![(m("index_proximal"), 1.0)], 0.0),
-            (j("index", 2), vec![(m("index_distal"), 0.5)], 0.0),
-            (j("index", 3), vec![(m("index_distal"), 0.5)], 0.0),
-            (j("middle", 0), vec![], 0.0),
-            (j("middle", 1), vec![(m("middle_proximal"), 1.0)], 0.0),
-            (j("middle", 2), vec![(m("middle_distal"), 0.5)], 0.0),
-            (j("middle", 3), vec![(m("middle_distal"), 0.5)], 0.0),
+        let row = |finger: &str, k: u32, terms: &[(&str, f64)], offset: f64| CouplingSpec {
+            joint: format!("{side}_hand_{finger}_{k}_joint"),
+            motors: terms
+                .iter()
+                .map(|(name, factor)| (format!("{side}_{name}"), *factor))
+                .collect(),
+            offset,
+        };
+        let mut rows = vec![
+            row("thumb", 0, &[("thumb_oppose", 1.0)], 0.0),
+            row("thumb", 1, &[("thumb_proximal", 1.0)], 0.0),
+            row("thumb", 2, &[("thumb_distal", 0.5)], 0.0),
+            row("thumb", 3, &[("thumb_distal", 0.5)], 0.0),
+            row("index", 0, &[("hand_finger", 1.0 / 3.0)], -deg20),
+            row("index", 1, &[("index_proximal", 1.0)], 0.0),
+            row("index", 2, &[("index_distal", 0.5)], 0.0),
+            row("index", 3, &[("index_distal", 0.5)], 0.0),
+            row("middle", 0, &[], 0.0),
+            row("middle", 1, &[("middle_proximal", 1.0)], 0.0),
+            row("middle", 2, &[("middle_distal", 0.5)], 0.0),
+            row("middle", 3, &[("middle_distal", 0.5)], 0.0),
         ];
         for finger in ["ring", "little"] {
-            rows.push((j(finger, 0), vec![(m("hand_finger"), -1.0 / 3.0)], deg20));
+            rows.push(row(finger, 0, &[("hand_finger", -1.0 / 3.0)], deg20));
             for k in 1..=3 {
-                rows.push((j(finger, k), vec![(m("pinky"), 1.0 / 3.0)], 0.0));
+                rows.push(row(finger, k, &[("pinky", 1.0 / 3.0)], 0.0));
             }
         }
-        for (joint, terms, offset) in rows {
-            let terms: Vec<String> = terms
+        for CouplingSpec {
+            joint,
+            motors,
+            offset,
+        } in rows
+        {
+            let terms: Vec<String> = motors
                 .iter()
                 .map(|(n, k)| format!("(\"{n}\", {})", f(*k)))
                 .collect();
@@ -470,4 +482,19 @@ pub fn run(models: &Path) -> Result<()> {
         model.motors().len()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn committed_icub_model_files_are_up_to_date() {
+        let models = crate::models_dir();
+        let (urdf, ron) = super::generate(&models).unwrap();
+        let committed_urdf = std::fs::read_to_string(models.join("icub_upper_body.urdf")).unwrap();
+        let committed_ron = std::fs::read_to_string(models.join("icub_upper_body.ron")).unwrap();
+        assert!(
+            urdf == committed_urdf && ron == committed_ron,
+            "models/icub_upper_body.* are stale: run `cargo xtask gen-icub`"
+        );
+    }
 }

@@ -25,21 +25,33 @@ fn deg(x: f64) -> String {
 
 fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
     let c = &model.couplings()[coordinate];
-    let mut parts: Vec<String> = c
-        .terms
-        .iter()
-        .map(|&(m, f)| {
-            if f == 1.0 {
-                model.motors()[m].name.clone()
-            } else {
-                format!("{f:.4}·{}", model.motors()[m].name)
-            }
-        })
-        .collect();
-    if c.offset != 0.0 || parts.is_empty() {
-        parts.push(format!("{:.4}", c.offset));
+    let mut text = String::new();
+    for &(m, f) in &c.terms {
+        let name = &model.motors()[m].name;
+        let factor = if f.abs() == 1.0 {
+            String::new()
+        } else {
+            format!("{:.4}·", f.abs())
+        };
+        let sign = match (text.is_empty(), f < 0.0) {
+            (true, false) => "",
+            (true, true) => "-",
+            (false, false) => " + ",
+            (false, true) => " - ",
+        };
+        text = format!("{text}{sign}{factor}{name}");
     }
-    parts.join(" + ")
+    if text.is_empty() {
+        format!("{:.4} (constant)", c.offset)
+    } else if c.offset != 0.0 {
+        format!(
+            "{text} {} {:.4}",
+            if c.offset < 0.0 { "-" } else { "+" },
+            c.offset.abs()
+        )
+    } else {
+        text
+    }
 }
 
 /// Prints the report.

@@ -5,6 +5,8 @@
 //! not depend on the input into fixed transforms and gives joints with the same value (coupled
 //! finger phalanges) one shared *slot*, so each distinct angle costs one `sin_cos`.
 
+use std::collections::HashMap;
+
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use crate::model::FrameId;
@@ -53,6 +55,10 @@ pub(crate) struct Plan {
     steps: Vec<Step>,
 }
 
+/// Identifies joints that always share a value: (constant bits, (input, factor bits) terms,
+/// revolute).
+type SlotKey = (u64, Vec<(usize, u64)>, bool);
+
 /// `joint value = constant + Σ factor · input[index]`, per movable joint.
 pub(crate) struct AffineRow<'a> {
     pub constant: f64,
@@ -69,7 +75,7 @@ impl Plan {
             revolute: vec![false],
             steps: Vec::new(),
         };
-        let mut slot_of: Vec<(f64, Vec<(usize, u64)>, bool, u32)> = Vec::new();
+        let mut slot_of: HashMap<SlotKey, u32> = HashMap::new();
         for joint in &tree.joints {
             let origin = joint.local_origin;
             let motion = match (joint.kind, joint.coordinate) {
@@ -85,22 +91,17 @@ impl Plan {
                     }
                     let key: Vec<(usize, u64)> =
                         row.terms.iter().map(|&(k, f)| (k, f.to_bits())).collect();
-                    let slot = match slot_of.iter().find(|s| {
-                        s.0.to_bits() == row.constant.to_bits() && s.1 == key && s.2 == revolute
-                    }) {
-                        Some(s) => s.3,
-                        None => {
-                            let slot = plan.rows.len() as u32;
+                    let slot = *slot_of
+                        .entry((row.constant.to_bits(), key, revolute))
+                        .or_insert_with(|| {
                             let start = plan.terms.len() as u32;
                             plan.terms
                                 .extend(row.terms.iter().map(|&(k, f)| (k as u32, f)));
                             plan.rows
                                 .push((row.constant, start, plan.terms.len() as u32));
                             plan.revolute.push(revolute);
-                            slot_of.push((row.constant, key, revolute, slot));
-                            slot
-                        }
-                    };
+                            plan.rows.len() as u32 - 1
+                        });
                     Some((revolute, slot))
                 }
             };
