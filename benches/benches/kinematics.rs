@@ -31,6 +31,25 @@ fn forward_kinematics(c: &mut Criterion) {
             })
         });
     }
+    // The usual optimisation setting: a few motors active, the rest locked (folded into constants).
+    let model = trm_models::icub_upper_body();
+    let home = model.posture("home").expect("home posture");
+    let arm = model
+        .active_set(&["torso", "right_arm"], home)
+        .expect("groups exist");
+    let samples = random_configurations(&arm, 64, 7);
+    let mut buffer = model.pose_buffer();
+    let mut k = 0;
+    group.bench_function(
+        BenchmarkId::new("unchecked", "icub_upper_body_torso_right_arm_10_motors"),
+        |b| {
+            b.iter(|| {
+                k = (k + 1) % samples.len();
+                arm.forward_unchecked(black_box(&samples[k]), &mut buffer);
+                black_box(buffer.poses()[1].translation.x)
+            })
+        },
+    );
     group.finish();
 }
 

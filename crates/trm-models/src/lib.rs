@@ -60,3 +60,15 @@ pub fn branched_tree() -> RobotModel {
     RobotModel::from_urdf_str(BRANCHED_TREE_URDF, "models/branched_tree.urdf")
         .expect("the branched tree loads")
 }
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_embedded_model_loads() {
+        assert_eq!(super::icub_upper_body().num_joints(), 63);
+        assert_eq!(super::icub_official().num_joints(), 75);
+        assert_eq!(super::icub_genova04().num_joints(), 32);
+        assert_eq!(super::planar_arm().num_joints(), 3);
+        assert_eq!(super::branched_tree().num_joints(), 6);
+    }
+}
