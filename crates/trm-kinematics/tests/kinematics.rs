@@ -460,3 +460,28 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn official_full_body_icub_arm_moves_with_the_legs_locked() {
+    let model = RobotModel::load(models().join("icub-visuomanip/model.urdf")).unwrap();
+    let mut locked = model.neutral_motors();
+    locked[model.motor_index("l_knee").unwrap()] = -1.0;
+    let arm = model
+        .active_set(&["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"], &locked)
+        .unwrap();
+    let mut buffer = model.pose_buffer();
+    arm.forward(&[-0.5, 0.4, 1.0], &mut buffer).unwrap();
+    let motors = arm.to_motors(&[-0.5, 0.4, 1.0]);
+    assert_eq!(motors[model.motor_index("l_knee").unwrap()], -1.0);
+    let mut reference = model.pose_buffer();
+    model.forward_motors(&motors, &mut reference).unwrap();
+    for name in ["r_hand", "l_foot", "head"] {
+        let id = model.frame_id(name).unwrap();
+        assert!(
+            (buffer.pose(id).translation.vector - reference.pose(id).translation.vector).norm()
+                < 1e-14,
+            "{name}"
+        );
+    }
+    assert_eq!(arm.num_distinct_joint_values(), 3);
+}
