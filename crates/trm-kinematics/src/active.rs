@@ -24,9 +24,8 @@ pub struct ActiveSet {
     model: RobotModel,
     active: Vec<usize>,
     locked: Vec<f64>,
-    /// Per joint: constant part and range into `terms`.
-    rows: Vec<(f64, u32, u32)>,
-    terms: Vec<(u32, f64)>,
+    /// Per joint: constant (offset plus locked motors) and `(active index, factor)` terms.
+    rows: Vec<(f64, Vec<(usize, f64)>)>,
     plan: Plan,
 }
 
@@ -66,34 +65,25 @@ impl ActiveSet {
         }
         let mut position = vec![None; motors.len()];
         for (k, &m) in active.iter().enumerate() {
-            position[m] = Some(k as u32);
+            position[m] = Some(k);
         }
-        let mut rows = Vec::with_capacity(model.num_joints());
-        let mut terms = Vec::new();
-        for c in model.couplings() {
-            let mut constant = c.offset;
-            let start = terms.len() as u32;
-            for &(m, f) in &c.terms {
-                match position[m] {
-                    Some(k) => terms.push((k, f)),
-                    None => constant += f * locked[m],
-                }
-            }
-            rows.push((constant, start, terms.len() as u32));
-        }
-        let affine: Vec<(f64, Vec<(usize, f64)>)> = rows
+        // Per joint: locked motors folded into the constant, active terms by active index.
+        let rows: Vec<(f64, Vec<(usize, f64)>)> = model
+            .couplings()
             .iter()
-            .map(|&(c, s, e)| {
-                (
-                    c,
-                    terms[s as usize..e as usize]
-                        .iter()
-                        .map(|&(k, f)| (k as usize, f))
-                        .collect(),
-                )
+            .map(|c| {
+                let mut constant = c.offset;
+                let mut terms = Vec::new();
+                for &(m, f) in &c.terms {
+                    match position[m] {
+                        Some(k) => terms.push((k, f)),
+                        None => constant += f * locked[m],
+                    }
+                }
+                (constant, terms)
             })
             .collect();
-        let affine_rows: Vec<AffineRow> = affine
+        let affine_rows: Vec<AffineRow> = rows
             .iter()
             .map(|(c, t)| AffineRow {
                 constant: *c,
@@ -111,7 +101,6 @@ impl ActiveSet {
             active,
             locked: locked.to_vec(),
             rows,
-            terms,
             plan,
         })
     }
@@ -175,10 +164,10 @@ impl ActiveSet {
     /// Joint values for active values `q`, without checks.
     #[inline]
     pub fn joint_values_unchecked(&self, q: &[f64], joints: &mut [f64]) {
-        for (value, &(constant, start, end)) in joints.iter_mut().zip(&self.rows) {
-            let mut v = constant;
-            for &(k, f) in &self.terms[start as usize..end as usize] {
-                v += f * q[k as usize];
+        for (value, (constant, terms)) in joints.iter_mut().zip(&self.rows) {
+            let mut v = *constant;
+            for &(k, f) in terms {
+                v += f * q[k];
             }
             *value = v;
         }
