@@ -36,6 +36,12 @@ const HAND_MOTORS: [(&str, f64, f64); 9] = [
     ("pinky", 0.0, 270.0),
 ];
 const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "little"];
+/// Capsules shortened at their end nearest the link origin (metres): the fitted forearm capsule
+/// reaches back over the elbow hinge into the upper arm's at every elbow angle, which would
+/// force the upper-arm/forearm pair out of checking; elbow_1 covers the hinge instead.
+const CAPSULE_TRIMS: &[(&str, f64)] = &[("l_forearm", 0.045), ("r_forearm", 0.045)];
+/// Random configurations sampled to find never/always colliding link pairs.
+const ACM_SAMPLES: usize = 100_000;
 
 /// One row of collision-extents.csv (link frame, metres).
 struct Extents {
@@ -139,8 +145,13 @@ fn collision_xml(link: &str, e: &Extents) -> String {
         rpy = [0.0; 3];
         geometry = format!("<box size=\"{}\"/>", v3([s[0], s[1], s[2]]));
     } else {
-        let a = Vector3::from(e.capsule_a);
-        let b = Vector3::from(e.capsule_b);
+        let (mut a, mut b) = (Vector3::from(e.capsule_a), Vector3::from(e.capsule_b));
+        if let Some((_, trim)) = CAPSULE_TRIMS.iter().find(|(l, _)| *l == link) {
+            if a.norm() > b.norm() {
+                std::mem::swap(&mut a, &mut b);
+            }
+            a += (b - a).normalize() * *trim;
+        }
         let d = b - a;
         let c = (a + b) / 2.0;
         xyz = [round6(c.x), round6(c.y), round6(c.z)];
@@ -452,7 +463,68 @@ fn description_ron(extents: &BTreeMap<String, Extents>) -> Result<String> {
     for (n, d) in entries {
         let _ = writeln!(s, "            \"{n}\": {}, // {d} deg", f(d.to_radians()));
     }
-    s.push_str("        }),\n        // every motor at 0 clamped into its limits\n        (name: \"zero\", values: {}),\n    ],\n)\n");
+    s.push_str("        }),\n        // every motor at 0 clamped into its limits\n        (name: \"zero\", values: {}),\n    ],\n");
+    Ok(s)
+}
+
+/// The `disabled_collisions` section: every pair within one hand (grasp contacts are the hand's
+/// own business, so fingers may close onto the palm and each other), then the pairs MoveIt's
+/// rules disable (colliding at home, never or always colliding in random samples).
+fn disabled_collisions(urdf: &str, ron_head: &str) -> Result<String> {
+    let robot = urdf_rs::read_from_string(urdf)?;
+    let with_geometry: Vec<&str> = robot
+        .links
+        .iter()
+        .filter(|l| !l.collision.is_empty())
+        .map(|l| l.name.as_str())
+        .collect();
+    let mut s = String::from(
+        "    // Link pairs left out of collision checking (links joined by a joint are always left out).\n",
+    );
+    s.push_str("    // `user`: contacts within one hand; the rest from `generate_acm`");
+    let _ = writeln!(s, " ({ACM_SAMPLES} random configurations, seed 0).");
+    s.push_str("    disabled_collisions: [\n");
+    for side in ["l", "r"] {
+        let hand: Vec<&str> = with_geometry
+            .iter()
+            .copied()
+            .filter(|l| l.starts_with(&format!("{side}_hand")))
+            .collect();
+        for (i, a) in hand.iter().enumerate() {
+            for b in &hand[i + 1..] {
+                let _ = writeln!(s, "        (a: \"{a}\", b: \"{b}\", reason: user),");
+            }
+        }
+    }
+    let head = format!("{ron_head}{s}    ],\n)\n");
+    let description = trm_kinematics::ModelDescription::from_ron(&head, "<generated>")?;
+    let model =
+        trm_kinematics::RobotModel::from_parts(urdf, "<generated>", &description, None)?;
+    let collision = trm_collision::CollisionModel::new(&model)?;
+    let report = trm_collision::generate_acm(
+        &collision,
+        &trm_collision::AcmSettings {
+            samples: ACM_SAMPLES,
+            seed: 0,
+            ..Default::default()
+        },
+    )?;
+    let names: Vec<&str> = model.tree().links.iter().map(|l| l.name.as_str()).collect();
+    for ([a, b], reason) in report.acm.disabled_pairs() {
+        if !matches!(
+            reason,
+            trm_kinematics::DisableReason::Adjacent | trm_kinematics::DisableReason::User
+        ) {
+            let _ = writeln!(
+                s,
+                "        (a: \"{}\", b: \"{}\", reason: {}),",
+                names[a],
+                names[b],
+                reason.as_str()
+            );
+        }
+    }
+    s.push_str("    ],\n");
     Ok(s)
 }
 
@@ -462,10 +534,10 @@ pub fn generate(models: &Path) -> Result<(String, String)> {
     let robot =
         urdf_rs::read_file(&official).with_context(|| format!("reading {}", official.display()))?;
     let extents = read_extents(&models.join("icub-visuomanip/collision-extents.csv"))?;
-    Ok((
-        upper_body_urdf(&robot, &extents)?,
-        description_ron(&extents)?,
-    ))
+    let urdf = upper_body_urdf(&robot, &extents)?;
+    let head = description_ron(&extents)?;
+    let collisions = disabled_collisions(&urdf, &head)?;
+    Ok((urdf, format!("{head}{collisions})\n")))
 }
 
 /// Writes models/icub_upper_body.{urdf,ron} (atomically) and checks they load.

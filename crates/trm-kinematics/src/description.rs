@@ -39,6 +39,55 @@ pub struct ModelDescription {
     /// Named postures in motor space.
     #[serde(default)]
     pub postures: Vec<PostureSpec>,
+    /// Link pairs collision checking skips (as SRDF `<disable_collisions>`), usually written by
+    /// `cargo xtask gen-acm`. Links joined by a joint are always skipped and need no entry.
+    #[serde(default)]
+    pub disabled_collisions: Vec<DisabledCollisionSpec>,
+    /// Link pairs that are always checked, overriding every automatic or listed exclusion
+    /// (adjacency included).
+    #[serde(default)]
+    pub enabled_collisions: Vec<(String, String)>,
+}
+
+/// Why a link pair is left out of collision checking (the reasons of MoveIt's setup assistant).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DisableReason {
+    /// The links are joined by a joint (directly, or through links without geometry).
+    Adjacent,
+    /// The pair collides at the model's default posture.
+    Default,
+    /// The pair collided in (almost) every random sample.
+    Always,
+    /// The pair collided in none of the random samples.
+    Never,
+    /// Disabled by hand.
+    User,
+}
+
+impl DisableReason {
+    /// The lower-case name used in files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DisableReason::Adjacent => "adjacent",
+            DisableReason::Default => "default",
+            DisableReason::Always => "always",
+            DisableReason::Never => "never",
+            DisableReason::User => "user",
+        }
+    }
+}
+
+/// A link pair excluded from collision checking.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DisabledCollisionSpec {
+    /// First link.
+    pub a: String,
+    /// Second link.
+    pub b: String,
+    /// Why the pair is excluded.
+    pub reason: DisableReason,
 }
 
 /// A motor declared for couplings.

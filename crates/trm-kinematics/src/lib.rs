@@ -36,10 +36,12 @@ mod tree;
 
 pub use active::ActiveSet;
 pub use description::{
-    CouplingSpec, FrameSpec, GroupSpec, ModelDescription, MotorSpec, PostureSpec,
+    CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,
+    MotorSpec, PostureSpec,
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use fk::PoseBuffer;
-pub use model::{Coupling, FrameId, Motor, NamedFrame, RobotModel};
+pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
+pub use urdf_rs;
 pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};

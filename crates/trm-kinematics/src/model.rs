@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use nalgebra::Isometry3;
 
-use crate::description::ModelDescription;
+use crate::description::{DisableReason, ModelDescription};
 use crate::error::{KinematicsError, NameKind, Result, unknown};
 use crate::fk::{AffineRow, Plan, PoseBuffer};
 use crate::tree::{Ctx, JointKind, Limits, Tree, pose_from_xyz_rpy};
@@ -51,6 +51,15 @@ pub struct NamedFrame {
     pub local_offset: Isometry3<f64>,
 }
 
+/// A link pair excluded from collision checking, resolved to link indices (`links[0] < links[1]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DisabledCollision {
+    /// The two links, by index into [`Tree::links`].
+    pub links: [usize; 2],
+    /// Why the pair is excluded.
+    pub reason: DisableReason,
+}
+
 #[derive(Debug)]
 struct ModelData {
     origin: String,
@@ -60,6 +69,8 @@ struct ModelData {
     frames: Vec<NamedFrame>,
     groups: Vec<(String, Vec<usize>)>,
     postures: Vec<(String, Vec<f64>)>,
+    disabled_collisions: Vec<DisabledCollision>,
+    enabled_collisions: Vec<[usize; 2]>,
     /// FK over joint values.
     joint_plan: Plan,
     /// FK over motor values.
@@ -188,6 +199,7 @@ impl RobotModel {
         let frames = resolve_frames(&tree, desc, &dctx)?;
         let groups = resolve_groups(&motors, desc, &dctx)?;
         let postures = resolve_postures(&motors, desc, &dctx)?;
+        let (disabled_collisions, enabled_collisions) = resolve_collision_pairs(&tree, desc, &dctx)?;
         let frame_offsets: Vec<_> = frames.iter().map(|f| (f.link, f.local_offset)).collect();
         let identity: Vec<[(usize, f64); 1]> =
             (0..tree.movable.len()).map(|c| [(c, 1.0)]).collect();
@@ -216,6 +228,8 @@ impl RobotModel {
                 frames,
                 groups,
                 postures,
+                disabled_collisions,
+                enabled_collisions,
                 joint_plan,
                 motor_plan,
             }),
@@ -392,6 +406,16 @@ impl RobotModel {
             .find(|(n, _)| n == name)
             .map(|(_, v)| v.as_slice())
             .ok_or_else(|| unknown(NameKind::Posture, name, self.posture_names()))
+    }
+
+    /// Link pairs the description excludes from collision checking.
+    pub fn disabled_collisions(&self) -> &[DisabledCollision] {
+        &self.data.disabled_collisions
+    }
+
+    /// Link pairs the description forces collision checking to test (`[a, b]` link indices).
+    pub fn enabled_collisions(&self) -> &[[usize; 2]] {
+        &self.data.enabled_collisions
     }
 
     /// The zero motor vector clamped into the motor limits (the default locked values).
@@ -862,6 +886,54 @@ fn resolve_groups(
         groups.push((g.name.clone(), members));
     }
     Ok(groups)
+}
+
+type CollisionPairs = (Vec<DisabledCollision>, Vec<[usize; 2]>);
+
+fn resolve_collision_pairs(
+    tree: &Tree,
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<CollisionPairs> {
+    let link = |name: &str, element: &str| {
+        tree.link_index(name).ok_or_else(|| {
+            ctx.invalid(
+                element.to_string(),
+                name,
+                format!("`{name}` is no link of the URDF"),
+                suggestion_fix(
+                    name,
+                    tree.links.iter().map(|l| l.name.as_str()),
+                    "use link names",
+                ),
+            )
+        })
+    };
+    let pair = |a: &str, b: &str, element: &str| -> Result<[usize; 2]> {
+        let (i, j) = (link(a, element)?, link(b, element)?);
+        if i == j {
+            return Err(ctx.invalid(
+                element.to_string(),
+                a,
+                "names the same link twice",
+                "name two different links",
+            ));
+        }
+        Ok([i.min(j), i.max(j)])
+    };
+    let mut disabled = Vec::new();
+    for d in &desc.disabled_collisions {
+        let links = pair(&d.a, &d.b, "disabled_collisions entry")?;
+        disabled.push(DisabledCollision {
+            links,
+            reason: d.reason,
+        });
+    }
+    let mut enabled = Vec::new();
+    for (a, b) in &desc.enabled_collisions {
+        enabled.push(pair(a, b, "enabled_collisions entry")?);
+    }
+    Ok((disabled, enabled))
 }
 
 fn resolve_postures(

@@ -55,6 +55,10 @@ pub struct Link {
     pub parent: Option<usize>,
     /// Index of the joint that connects the parent to this link.
     pub parent_joint: Option<usize>,
+    /// The link's URDF `<collision>` elements, as written (mesh files are not opened here).
+    pub collisions: Vec<urdf_rs::Collision>,
+    /// Line of the `<link>` element in the URDF text, when known.
+    pub line: Option<usize>,
 }
 
 /// A URDF joint `<mimic>` element: `value = multiplier · leader + offset`.
@@ -286,6 +290,10 @@ impl Tree {
                 name: robot.links[old].name.clone(),
                 parent: parent_joint.map(|j| new_index[link_index[j.parent.link.as_str()]]),
                 parent_joint: parent_joint.map(|_| new - 1),
+                collisions: robot.links[old].collision.clone(),
+                line: ctx
+                    .source
+                    .and_then(|src| line_of_element(src, "link", &robot.links[old].name)),
             });
             if let Some(uj) = parent_joint {
                 let mut joint =

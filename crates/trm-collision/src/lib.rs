@@ -1,0 +1,48 @@
+//! Self- and world-collision checking for trm robot models.
+//!
+//! A [`CollisionModel`] turns every URDF `<collision>` element of a
+//! [`RobotModel`](trm_kinematics::RobotModel) into a convex body (boxes, cylinders, spheres,
+//! capsules; meshes become their convex hull) and skips the link pairs its
+//! [`AllowedCollisionMatrix`] disables. Per configuration: forward kinematics into a
+//! [`PoseBuffer`](trm_kinematics::PoseBuffer), [`CollisionModel::place`], then count, test or
+//! measure — without allocating:
+//!
+//! ```
+//! use trm_collision::{CollisionModel, Shape, World};
+//! use trm_kinematics::nalgebra::Isometry3;
+//!
+//! let robot = trm_models::icub_upper_body();
+//! let collision = CollisionModel::new(&robot)?;
+//! let mut poses = robot.pose_buffer();
+//! robot.forward_motors(robot.posture("home")?, &mut poses)?;
+//! let mut placed = collision.placed_bodies();
+//! collision.place(&poses, &mut placed);
+//! assert_eq!(collision.count_self(&placed), 0);
+//!
+//! let mut world = World::new();
+//! world.add("table", Shape::Box { size: [0.6, 1.0, 0.05] }, Isometry3::translation(-0.3, 0.0, 0.0))?;
+//! assert!(collision.count_world(&placed, &world) > 0); // the table cuts through the torso
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Round shapes (spheres, capsules) are tested analytically (segment distance minus radii);
+//! everything else goes through parry. Every pair test starts with a bounding-sphere reject.
+//! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
+
+mod acm;
+mod error;
+mod generate;
+pub mod mesh;
+mod model;
+mod query;
+mod shape;
+mod world;
+
+pub use acm::AllowedCollisionMatrix;
+pub use error::{CollisionError, Result};
+pub use generate::{AcmReport, AcmSettings, generate_acm};
+pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
+pub use query::{CollidingPair, CollisionCount, Other, PairDistance};
+pub use shape::{Shape, ShapeProblem};
+pub use trm_kinematics::DisableReason;
+pub use world::{ObjectSpec, World, WorldObject, WorldSpec};

@@ -1,0 +1,106 @@
+//! Mesh files: `package://` and relative URIs resolved as ROS does, meshes loaded with
+//! `mesh-loader` (STL, COLLADA, OBJ) and reduced to their convex hull.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Point3;
+use parry3d_f64::shape::ConvexPolyhedron;
+
+/// Where a mesh URI may live, in the order they are tried.
+///
+/// * `package://NAME/REST`: for every directory `D` of `package_paths`, `D/NAME/REST`, then
+///   `D/REST` when `D` itself is named `NAME` (as `ROS_PACKAGE_PATH` entries work);
+/// * `file:///ABS` or an absolute path: that path;
+/// * a relative path: relative to the URDF's directory, when known.
+pub fn mesh_candidates(uri: &str, urdf_dir: Option<&Path>, package_paths: &[PathBuf]) -> Vec<PathBuf> {
+    if let Some(rest) = uri.strip_prefix("package://") {
+        let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
+        let mut out = Vec::new();
+        for dir in package_paths {
+            out.push(dir.join(package).join(inner));
+            if dir.file_name().is_some_and(|n| n == package) {
+                out.push(dir.join(inner));
+            }
+        }
+        return out;
+    }
+    let path = Path::new(uri.strip_prefix("file://").unwrap_or(uri));
+    if path.is_absolute() {
+        vec![path.to_path_buf()]
+    } else {
+        urdf_dir.map(|d| vec![d.join(path)]).unwrap_or_default()
+    }
+}
+
+/// The first existing candidate of [`mesh_candidates`], or every path tried.
+pub fn resolve_mesh(
+    uri: &str,
+    urdf_dir: Option<&Path>,
+    package_paths: &[PathBuf],
+) -> Result<PathBuf, Vec<PathBuf>> {
+    let candidates = mesh_candidates(uri, urdf_dir, package_paths);
+    candidates
+        .iter()
+        .find(|p| p.is_file())
+        .cloned()
+        .ok_or(candidates)
+}
+
+/// Loads a mesh file, scales it and returns the vertices of its convex hull.
+pub fn convex_hull_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<[f64; 3]>, String> {
+    let scene = mesh_loader::Loader::default()
+        .load(path)
+        .map_err(|e| e.to_string())?;
+    let points: Vec<Point3<f64>> = scene
+        .meshes
+        .iter()
+        .flat_map(|m| m.vertices.iter())
+        .map(|v| {
+            Point3::new(
+                f64::from(v[0]) * scale[0],
+                f64::from(v[1]) * scale[1],
+                f64::from(v[2]) * scale[2],
+            )
+        })
+        .collect();
+    if points.is_empty() {
+        return Err("the file holds no vertices".to_string());
+    }
+    if points.iter().any(|p| !p.coords.iter().all(|c| c.is_finite())) {
+        return Err("the file holds non-finite vertices".to_string());
+    }
+    let flat = || "the mesh is flat: its convex hull has no volume".to_string();
+    if !crate::shape::spans_volume(&points) {
+        return Err(flat());
+    }
+    let hull = ConvexPolyhedron::from_convex_hull(&points).ok_or_else(flat)?;
+    Ok(hull.points().iter().map(|p| [p.x, p.y, p.z]).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn package_uris_follow_ros_rules() {
+        let paths = [PathBuf::from("/opt/share"), PathBuf::from("/ws/iCub")];
+        let c = mesh_candidates("package://iCub/meshes/a.stl", None, &paths);
+        assert_eq!(
+            c,
+            [
+                PathBuf::from("/opt/share/iCub/meshes/a.stl"),
+                PathBuf::from("/ws/iCub/iCub/meshes/a.stl"),
+                PathBuf::from("/ws/iCub/meshes/a.stl"),
+            ]
+        );
+        assert_eq!(
+            mesh_candidates("meshes/b.dae", Some(Path::new("/robots/x")), &paths),
+            [PathBuf::from("/robots/x/meshes/b.dae")]
+        );
+        assert_eq!(
+            mesh_candidates("file:///abs/c.obj", None, &[]),
+            [PathBuf::from("/abs/c.obj")]
+        );
+        assert!(mesh_candidates("rel.stl", None, &[]).is_empty());
+    }
+}

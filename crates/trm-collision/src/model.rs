@@ -1,0 +1,370 @@
+//! The collision model of a robot: one body per URDF `<collision>` element, the allowed-collision
+//! matrix, and the flat list of body pairs the queries walk.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use nalgebra::Isometry3;
+use trm_kinematics::{PoseBuffer, RobotModel, pose_from_xyz_rpy};
+
+use crate::acm::AllowedCollisionMatrix;
+use crate::error::{CollisionError, Result, unknown};
+use crate::mesh::{convex_hull_of_mesh, resolve_mesh};
+use crate::shape::{Compiled, Placed, Shape, from_urdf};
+
+/// How to turn a URDF's `<collision>` elements into bodies.
+#[derive(Debug, Clone, Default)]
+pub struct CollisionOptions {
+    /// Directories searched for `package://NAME/...` mesh URIs (like `ROS_PACKAGE_PATH`).
+    pub package_paths: Vec<PathBuf>,
+    /// Directory relative mesh paths are resolved against; by default the URDF's directory
+    /// when the model was loaded from a file.
+    pub urdf_dir: Option<PathBuf>,
+}
+
+/// One collision body: a convex shape rigidly attached to a link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Unique name: the link name, or `link#k` for the k-th of several elements of one link.
+    pub name: String,
+    /// Index of the link in [`trm_kinematics::Tree::links`].
+    pub link: usize,
+    /// The shape, in its own frame.
+    pub shape: Shape,
+    /// Pose of the shape frame in the link frame.
+    pub local: Isometry3<f64>,
+}
+
+/// Two bodies to test, and where the next link pair starts (so a link pair is counted once).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodyPair {
+    pub a: u32,
+    pub b: u32,
+    pub next: u32,
+}
+
+#[derive(Debug)]
+struct Inner {
+    robot: RobotModel,
+    bodies: Vec<Body>,
+    compiled: Vec<Compiled>,
+    acm: AllowedCollisionMatrix,
+    pairs: Vec<BodyPair>,
+    link_pairs: usize,
+    /// Per body: index of the first body of the next link (bodies are sorted by link).
+    next_link: Vec<u32>,
+}
+
+/// The collision geometry of a robot with its allowed-collision matrix. Cheap to clone,
+/// `Send + Sync`. Build it once, then per configuration: forward kinematics into a
+/// [`PoseBuffer`], [`CollisionModel::place`] into a [`PlacedBodies`], then query.
+#[derive(Debug, Clone)]
+pub struct CollisionModel {
+    inner: Arc<Inner>,
+}
+
+/// World-frame geometry of every body for one configuration (a reusable scratch buffer).
+#[derive(Debug, Clone)]
+pub struct PlacedBodies {
+    pub(crate) placed: Vec<Placed>,
+}
+
+impl PlacedBodies {
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.placed.len()
+    }
+
+    /// True for a robot without collision geometry.
+    pub fn is_empty(&self) -> bool {
+        self.placed.is_empty()
+    }
+}
+
+fn link_dir(origin: &str) -> Option<PathBuf> {
+    let path = Path::new(origin);
+    path.is_file()
+        .then(|| path.parent().map(Path::to_path_buf))
+        .flatten()
+}
+
+impl CollisionModel {
+    /// Bodies from the URDF's `<collision>` elements (meshes found relative to the URDF) and
+    /// the allowed-collision matrix of the model description
+    /// ([`AllowedCollisionMatrix::from_model`]).
+    pub fn new(robot: &RobotModel) -> Result<Self> {
+        Self::with_options(robot, &CollisionOptions::default())
+    }
+
+    /// As [`CollisionModel::new`], with mesh search paths.
+    pub fn with_options(robot: &RobotModel, options: &CollisionOptions) -> Result<Self> {
+        let bodies = bodies_from_urdf(robot, options)?;
+        let has = has_geometry(robot.num_links(), &bodies);
+        let acm = AllowedCollisionMatrix::from_model(robot, &has);
+        Self::from_bodies(robot, bodies, acm)
+    }
+
+    /// A collision model from bodies of your own (e.g. simplified proxies) and a matrix.
+    pub fn from_bodies(
+        robot: &RobotModel,
+        mut bodies: Vec<Body>,
+        acm: AllowedCollisionMatrix,
+    ) -> Result<Self> {
+        if acm.num_links() != robot.num_links() {
+            return Err(CollisionError::InvalidValue {
+                what: "allowed-collision matrix".into(),
+                problem: format!(
+                    "covers {} links but the robot has {}",
+                    acm.num_links(),
+                    robot.num_links()
+                ),
+            });
+        }
+        bodies.sort_by_key(|b| b.link);
+        let mut compiled = Vec::with_capacity(bodies.len());
+        for (i, b) in bodies.iter().enumerate() {
+            if b.link >= robot.num_links() {
+                return Err(CollisionError::InvalidValue {
+                    what: format!("body `{}`", b.name),
+                    problem: format!("link index {} out of range", b.link),
+                });
+            }
+            if bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(CollisionError::InvalidValue {
+                    what: format!("body `{}`", b.name),
+                    problem: "the name is used twice".into(),
+                });
+            }
+            let element = format!("body `{}`", b.name);
+            compiled.push(b.shape.compile(&b.local).ok_or_else(|| {
+                let p = b.shape.check().err().unwrap_or_else(|| crate::ShapeProblem {
+                    problem: "unusable shape".into(),
+                    fix: "use another shape".into(),
+                });
+                CollisionError::InvalidShape {
+                    origin: robot.origin().to_string(),
+                    line: None,
+                    element,
+                    problem: p.problem,
+                    fix: p.fix,
+                }
+            })?);
+        }
+        let next_link: Vec<u32> = (0..bodies.len())
+            .map(|i| {
+                (i + 1..bodies.len())
+                    .find(|&j| bodies[j].link != bodies[i].link)
+                    .unwrap_or(bodies.len()) as u32
+            })
+            .collect();
+        let (pairs, link_pairs) = body_pairs(&bodies, &acm);
+        Ok(CollisionModel {
+            inner: Arc::new(Inner {
+                robot: robot.clone(),
+                bodies,
+                compiled,
+                acm,
+                pairs,
+                link_pairs,
+                next_link,
+            }),
+        })
+    }
+
+    /// The same bodies with another allowed-collision matrix.
+    pub fn with_acm(&self, acm: AllowedCollisionMatrix) -> Result<Self> {
+        Self::from_bodies(&self.inner.robot, self.inner.bodies.clone(), acm)
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> &RobotModel {
+        &self.inner.robot
+    }
+
+    /// The bodies, sorted by link.
+    pub fn bodies(&self) -> &[Body] {
+        &self.inner.bodies
+    }
+
+    /// Index of the body with this name.
+    pub fn body_index(&self, name: &str) -> Result<usize> {
+        self.inner
+            .bodies
+            .iter()
+            .position(|b| b.name == name)
+            .ok_or_else(|| {
+                unknown(
+                    "collision body",
+                    name,
+                    self.inner.bodies.iter().map(|b| b.name.as_str()),
+                )
+            })
+    }
+
+    /// The allowed-collision matrix in use.
+    pub fn acm(&self) -> &AllowedCollisionMatrix {
+        &self.inner.acm
+    }
+
+    /// Per link: whether it has at least one body.
+    pub fn has_geometry(&self) -> Vec<bool> {
+        has_geometry(self.inner.robot.num_links(), &self.inner.bodies)
+    }
+
+    /// Number of link pairs self-collision checking tests.
+    pub fn num_checked_link_pairs(&self) -> usize {
+        self.inner.link_pairs
+    }
+
+    /// Number of body pairs self-collision checking tests.
+    pub fn num_checked_body_pairs(&self) -> usize {
+        self.inner.pairs.len()
+    }
+
+    /// A scratch buffer for [`CollisionModel::place`].
+    pub fn placed_bodies(&self) -> PlacedBodies {
+        PlacedBodies {
+            placed: vec![Placed::default(); self.inner.bodies.len()],
+        }
+    }
+
+    /// Moves every body to the world pose of its link (no allocation).
+    ///
+    /// # Panics
+    /// If the buffers do not belong to this model (wrong lengths).
+    pub fn place(&self, poses: &PoseBuffer, out: &mut PlacedBodies) {
+        let links = poses.poses();
+        for ((b, c), p) in self
+            .inner
+            .bodies
+            .iter()
+            .zip(&self.inner.compiled)
+            .zip(out.placed.iter_mut())
+        {
+            c.place(&links[b.link], p);
+        }
+    }
+
+    pub(crate) fn compiled(&self) -> &[Compiled] {
+        &self.inner.compiled
+    }
+
+    pub(crate) fn pairs(&self) -> &[BodyPair] {
+        &self.inner.pairs
+    }
+
+    pub(crate) fn next_link(&self) -> &[u32] {
+        &self.inner.next_link
+    }
+}
+
+fn has_geometry(links: usize, bodies: &[Body]) -> Vec<bool> {
+    let mut has = vec![false; links];
+    for b in bodies {
+        has[b.link] = true;
+    }
+    has
+}
+
+/// Checked body pairs grouped by link pair, and the number of link pairs.
+fn body_pairs(bodies: &[Body], acm: &AllowedCollisionMatrix) -> (Vec<BodyPair>, usize) {
+    let mut groups: Vec<([usize; 2], Vec<(u32, u32)>)> = Vec::new();
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let (la, lb) = (bodies[i].link, bodies[j].link);
+            if !acm.is_checked(la, lb) {
+                continue;
+            }
+            let key = [la.min(lb), la.max(lb)];
+            match groups.iter_mut().rev().find(|(k, _)| *k == key) {
+                Some((_, v)) => v.push((i as u32, j as u32)),
+                None => groups.push((key, vec![(i as u32, j as u32)])),
+            }
+        }
+    }
+    let mut pairs = Vec::new();
+    for (_, members) in &groups {
+        let next = (pairs.len() + members.len()) as u32;
+        pairs.extend(members.iter().map(|&(a, b)| BodyPair { a, b, next }));
+    }
+    (pairs, groups.len())
+}
+
+fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Vec<Body>> {
+    let urdf_dir = options
+        .urdf_dir
+        .clone()
+        .or_else(|| link_dir(robot.origin()));
+    let mut bodies = Vec::new();
+    for (index, link) in robot.tree().links.iter().enumerate() {
+        let several = link.collisions.len() > 1;
+        for (k, c) in link.collisions.iter().enumerate() {
+            let element = if several {
+                format!("<collision> {} of <link name=\"{}\">", k + 1, link.name)
+            } else {
+                format!("<collision> of <link name=\"{}\">", link.name)
+            };
+            let invalid = |problem: String, fix: String| CollisionError::InvalidShape {
+                origin: robot.origin().to_string(),
+                line: link.line,
+                element: element.clone(),
+                problem,
+                fix,
+            };
+            let (xyz, rpy) = (c.origin.xyz.0, c.origin.rpy.0);
+            if xyz.iter().chain(&rpy).any(|v| !v.is_finite()) {
+                return Err(invalid(
+                    "its <origin> is not finite".into(),
+                    "write finite numbers".into(),
+                ));
+            }
+            let shape = match from_urdf(&c.geometry) {
+                Some(s) => s,
+                None => {
+                    let trm_kinematics::urdf_rs::Geometry::Mesh { filename, scale } = &c.geometry
+                    else {
+                        unreachable!("from_urdf converts every geometry but meshes")
+                    };
+                    let path = resolve_mesh(filename, urdf_dir.as_deref(), &options.package_paths)
+                        .map_err(|tried| CollisionError::MeshNotFound {
+                            origin: robot.origin().to_string(),
+                            line: link.line,
+                            element: element.clone(),
+                            uri: filename.clone(),
+                            tried,
+                            fix: if filename.starts_with("package://") {
+                                "add the directory that holds the package to the package \
+                                 paths (--package-path, ROS_PACKAGE_PATH)"
+                                    .into()
+                            } else {
+                                "check the path (relative paths start at the URDF's directory)"
+                                    .into()
+                            },
+                        })?;
+                    let scale = scale.map_or([1.0; 3], |s| s.0);
+                    let points = convex_hull_of_mesh(&path, scale).map_err(|message| {
+                        CollisionError::MeshUnreadable {
+                            path: path.clone(),
+                            origin: robot.origin().to_string(),
+                            element: element.clone(),
+                            message,
+                        }
+                    })?;
+                    Shape::Convex { points }
+                }
+            };
+            shape.check().map_err(|p| invalid(p.problem, p.fix))?;
+            bodies.push(Body {
+                name: if several {
+                    format!("{}#{}", link.name, k + 1)
+                } else {
+                    link.name.clone()
+                },
+                link: index,
+                shape,
+                local: pose_from_xyz_rpy(xyz, rpy),
+            });
+        }
+    }
+    Ok(bodies)
+}

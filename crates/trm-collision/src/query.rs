@@ -1,0 +1,248 @@
+//! Queries on placed bodies: colliding-pair counts, early-exit checks, pair lists, distances.
+
+use crate::model::{CollisionModel, PlacedBodies};
+use crate::shape::{bounds_apart, intersects, signed_distance};
+use crate::world::World;
+
+/// Colliding pairs of one configuration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CollisionCount {
+    /// Colliding link pairs of the robot with itself.
+    pub self_pairs: usize,
+    /// Colliding (link, world object) pairs.
+    pub world_pairs: usize,
+}
+
+impl CollisionCount {
+    /// Both counts together.
+    pub fn total(&self) -> usize {
+        self.self_pairs + self.world_pairs
+    }
+}
+
+/// What a body touched.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Other {
+    /// Another body of the robot.
+    Body(String),
+    /// A world object.
+    Object(String),
+}
+
+/// A colliding pair, for debugging and reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollidingPair {
+    /// The robot body.
+    pub body: String,
+    /// What it collides with.
+    pub other: Other,
+    /// Signed distance (≤ 0: minus the penetration depth).
+    pub distance: f64,
+}
+
+/// The closest pair of bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairDistance {
+    /// First body index.
+    pub a: usize,
+    /// Second body index.
+    pub b: usize,
+    /// Signed distance (negative when they overlap).
+    pub distance: f64,
+}
+
+impl CollisionModel {
+    /// Calls `hit(k)` for every checked body pair `k` that collides; when `hit` returns true,
+    /// the rest of that link pair is skipped. Returns early when `hit` asks to stop (`None`).
+    #[inline]
+    fn walk_self(&self, placed: &PlacedBodies, mut hit: impl FnMut(usize) -> Option<bool>) {
+        let (pairs, compiled, p) = (self.pairs(), self.compiled(), &placed.placed);
+        let mut k = 0;
+        while k < pairs.len() {
+            let pair = pairs[k];
+            let (a, b) = (pair.a as usize, pair.b as usize);
+            if !bounds_apart(&p[a], &p[b]) && intersects(&compiled[a], &p[a], &compiled[b], &p[b])
+            {
+                match hit(k) {
+                    None => return,
+                    Some(true) => {
+                        k = pair.next as usize;
+                        continue;
+                    }
+                    Some(false) => {}
+                }
+            }
+            k += 1;
+        }
+    }
+
+    /// As [`CollisionModel::walk_self`], over (link, object) pairs: `hit(body, object)`.
+    #[inline]
+    fn walk_world(
+        &self,
+        placed: &PlacedBodies,
+        world: &World,
+        mut hit: impl FnMut(usize, usize) -> Option<bool>,
+    ) {
+        let (compiled, next, p) = (self.compiled(), self.next_link(), &placed.placed);
+        for (o, object) in world.objects().iter().enumerate() {
+            let mut i = 0;
+            while i < p.len() {
+                if !bounds_apart(&p[i], &object.placed)
+                    && intersects(&compiled[i], &p[i], &object.compiled, &object.placed)
+                {
+                    match hit(i, o) {
+                        None => return,
+                        Some(true) => {
+                            i = next[i] as usize;
+                            continue;
+                        }
+                        Some(false) => {}
+                    }
+                }
+                i += 1;
+            }
+        }
+    }
+
+    /// Number of colliding link pairs of the robot with itself (checked pairs only).
+    pub fn count_self(&self, placed: &PlacedBodies) -> usize {
+        let mut n = 0;
+        self.walk_self(placed, |_| {
+            n += 1;
+            Some(true)
+        });
+        n
+    }
+
+    /// Whether any checked link pair collides; stops at the first.
+    pub fn any_self_collision(&self, placed: &PlacedBodies) -> bool {
+        let mut any = false;
+        self.walk_self(placed, |_| {
+            any = true;
+            None
+        });
+        any
+    }
+
+    /// Number of colliding (link, world object) pairs.
+    pub fn count_world(&self, placed: &PlacedBodies, world: &World) -> usize {
+        let mut n = 0;
+        self.walk_world(placed, world, |_, _| {
+            n += 1;
+            Some(true)
+        });
+        n
+    }
+
+    /// Whether any link touches any world object; stops at the first.
+    pub fn any_world_collision(&self, placed: &PlacedBodies, world: &World) -> bool {
+        let mut any = false;
+        self.walk_world(placed, world, |_, _| {
+            any = true;
+            None
+        });
+        any
+    }
+
+    /// Self and world counts.
+    pub fn count(&self, placed: &PlacedBodies, world: &World) -> CollisionCount {
+        CollisionCount {
+            self_pairs: self.count_self(placed),
+            world_pairs: self.count_world(placed, world),
+        }
+    }
+
+    /// Whether the configuration collides with itself or the world (world first: it is
+    /// usually the cheaper and likelier test).
+    pub fn is_colliding(&self, placed: &PlacedBodies, world: &World) -> bool {
+        self.any_world_collision(placed, world) || self.any_self_collision(placed)
+    }
+
+    /// Every colliding body pair (self pairs first, then world), with signed distances.
+    pub fn colliding_pairs(&self, placed: &PlacedBodies, world: &World) -> Vec<CollidingPair> {
+        let (bodies, compiled, p) = (self.bodies(), self.compiled(), &placed.placed);
+        let mut out = Vec::new();
+        let pairs = self.pairs();
+        self.walk_self(placed, |k| {
+            let (a, b) = (pairs[k].a as usize, pairs[k].b as usize);
+            out.push(CollidingPair {
+                body: bodies[a].name.clone(),
+                other: Other::Body(bodies[b].name.clone()),
+                distance: signed_distance(&compiled[a], &p[a], &compiled[b], &p[b]),
+            });
+            Some(false)
+        });
+        self.walk_world(placed, world, |i, o| {
+            let object = &world.objects()[o];
+            out.push(CollidingPair {
+                body: bodies[i].name.clone(),
+                other: Other::Object(object.name().to_string()),
+                distance: signed_distance(&compiled[i], &p[i], &object.compiled, &object.placed),
+            });
+            Some(false)
+        });
+        out
+    }
+
+    /// Signed distance between bodies `a` and `b` (whether or not their pair is checked).
+    ///
+    /// # Panics
+    /// If an index is out of range.
+    pub fn body_distance(&self, placed: &PlacedBodies, a: usize, b: usize) -> f64 {
+        let (c, p) = (self.compiled(), &placed.placed);
+        signed_distance(&c[a], &p[a], &c[b], &p[b])
+    }
+
+    /// Signed distance between body `body` and world object `object`.
+    ///
+    /// # Panics
+    /// If an index is out of range.
+    pub fn object_distance(
+        &self,
+        placed: &PlacedBodies,
+        body: usize,
+        world: &World,
+        object: usize,
+    ) -> f64 {
+        let o = &world.objects()[object];
+        signed_distance(
+            &self.compiled()[body],
+            &placed.placed[body],
+            &o.compiled,
+            &o.placed,
+        )
+    }
+
+    /// The closest checked body pair (bounding spheres prune pairs that cannot beat the best so
+    /// far); `None` when no pair is checked.
+    pub fn min_self_distance(&self, placed: &PlacedBodies) -> Option<PairDistance> {
+        let (c, p) = (self.compiled(), &placed.placed);
+        let mut best: Option<PairDistance> = None;
+        for pair in self.pairs() {
+            let (a, b) = (pair.a as usize, pair.b as usize);
+            let lower = (p[a].center - p[b].center).norm() - p[a].bound - p[b].bound;
+            if best.is_some_and(|best| lower >= best.distance) {
+                continue;
+            }
+            let distance = signed_distance(&c[a], &p[a], &c[b], &p[b]);
+            if best.is_none_or(|best| distance < best.distance) {
+                best = Some(PairDistance { a, b, distance });
+            }
+        }
+        best
+    }
+}
+
+impl CollisionModel {
+    /// `[a, b]` body indices of every colliding checked body pair.
+    pub(crate) fn colliding_pair_indices(&self, placed: &PlacedBodies) -> Vec<[usize; 2]> {
+        let pairs = self.pairs();
+        let mut out = Vec::new();
+        self.walk_self(placed, |k| {
+            out.push([pairs[k].a as usize, pairs[k].b as usize]);
+            Some(false)
+        });
+        out
+    }
+}
