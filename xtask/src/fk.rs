@@ -23,13 +23,16 @@ pub struct Args {
 /// The input file.
 #[derive(Deserialize, Serialize)]
 pub struct Configs {
-    joint_names: Vec<String>,
-    samples: Vec<Sample>,
+    /// URDF joint names, one per column of `q`.
+    pub joint_names: Vec<String>,
+    /// The configurations.
+    pub samples: Vec<Sample>,
 }
 
 #[derive(Deserialize, Serialize)]
-struct Sample {
-    q: Vec<f64>,
+pub struct Sample {
+    /// Values of `joint_names`, radians (metres for prismatic joints).
+    pub q: Vec<f64>,
 }
 
 fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
@@ -41,15 +44,18 @@ fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
     })
 }
 
-/// Computes and writes the poses.
-pub fn run(args: &Args) -> Result<()> {
-    let model = crate::load_model(args.model.as_deref())?;
-    let text = std::fs::read_to_string(&args.configs)
-        .with_context(|| format!("reading {}", args.configs.display()))?;
+/// Reads a configurations file: the parsed file and, per sample, the full joint vector (joints
+/// not named are 0; mimic joints not named follow their leader).
+pub fn read_configurations(
+    model: &trm_kinematics::RobotModel,
+    path: &std::path::Path,
+) -> Result<(Configs, Vec<Vec<f64>>)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let configs: Configs = serde_json::from_str(&text).with_context(|| {
         format!(
             "{}: expected {{\"joint_names\": [...], \"samples\": [{{\"q\": [...]}}]}}",
-            args.configs.display()
+            path.display()
         )
     })?;
     let columns: Vec<usize> = configs
@@ -57,7 +63,7 @@ pub fn run(args: &Args) -> Result<()> {
         .iter()
         .map(|n| model.joint_index(n))
         .collect::<Result<_, _>>()
-        .with_context(|| format!("{}: joint_names", args.configs.display()))?;
+        .with_context(|| format!("{}: joint_names", path.display()))?;
     let given: Vec<bool> = (0..model.num_joints())
         .map(|j| columns.contains(&j))
         .collect();
@@ -74,19 +80,17 @@ pub fn run(args: &Args) -> Result<()> {
             missing.join(", ")
         );
     }
-    let mut buffer = model.pose_buffer();
-    let mut joints = vec![0.0; model.num_joints()];
-    let mut samples_out = Vec::with_capacity(configs.samples.len());
+    let mut all = Vec::with_capacity(configs.samples.len());
     for (s, sample) in configs.samples.iter().enumerate() {
         if sample.q.len() != columns.len() {
             bail!(
                 "{}: sample {s} has {} values for {} joint_names",
-                args.configs.display(),
+                path.display(),
                 sample.q.len(),
                 columns.len()
             );
         }
-        joints.iter_mut().for_each(|v| *v = 0.0);
+        let mut joints = vec![0.0; model.num_joints()];
         for (&j, &v) in columns.iter().zip(&sample.q) {
             joints[j] = v;
         }
@@ -96,8 +100,20 @@ pub fn run(args: &Args) -> Result<()> {
                 joints[j] = m.multiplier * joints[leader] + m.offset;
             }
         }
+        all.push(joints);
+    }
+    Ok((configs, all))
+}
+
+/// Computes and writes the poses.
+pub fn run(args: &Args) -> Result<()> {
+    let model = crate::load_model(args.model.as_deref())?;
+    let (configs, all) = read_configurations(&model, &args.configs)?;
+    let mut buffer = model.pose_buffer();
+    let mut samples_out = Vec::with_capacity(configs.samples.len());
+    for (s, (sample, joints)) in configs.samples.iter().zip(&all).enumerate() {
         model
-            .forward_joints(&joints, &mut buffer)
+            .forward_joints(joints, &mut buffer)
             .with_context(|| format!("{}: sample {s}", args.configs.display()))?;
         let mut links = Map::new();
         let mut frames = Map::new();

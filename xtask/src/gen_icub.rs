@@ -498,8 +498,7 @@ fn disabled_collisions(urdf: &str, ron_head: &str) -> Result<String> {
     }
     let head = format!("{ron_head}{s}    ],\n)\n");
     let description = trm_kinematics::ModelDescription::from_ron(&head, "<generated>")?;
-    let model =
-        trm_kinematics::RobotModel::from_parts(urdf, "<generated>", &description, None)?;
+    let model = trm_kinematics::RobotModel::from_parts(urdf, "<generated>", &description, None)?;
     let collision = trm_collision::CollisionModel::new(&model)?;
     let report = trm_collision::generate_acm(
         &collision,

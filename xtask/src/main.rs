@@ -1,6 +1,8 @@
 //! `cargo xtask <command>`: the commands people run with trm. `cargo xtask --help` lists them.
 
+mod collide;
 mod fk;
+mod gen_acm;
 mod gen_icub;
 mod model_info;
 
@@ -28,6 +30,10 @@ enum Command {
     ModelInfo(model_info::Args),
     /// Forward kinematics of joint configurations read from JSON (world poses of every link).
     Fk(fk::Args),
+    /// Colliding pairs and minimum self-distance of joint configurations read from JSON.
+    Collide(collide::Args),
+    /// Generate a model's allowed-collision matrix (the description's `disabled_collisions`).
+    GenAcm(gen_acm::Args),
     /// Regenerate models/icub_upper_body.{urdf,ron} from the official iCub files in models/.
     GenIcub,
 }
@@ -37,6 +43,8 @@ fn main() {
     let result = match cli.command {
         Command::ModelInfo(args) => model_info::run(&args),
         Command::Fk(args) => fk::run(&args),
+        Command::Collide(args) => collide::run(&args),
+        Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
     };
     if let Err(e) = result {
@@ -56,6 +64,32 @@ fn load_model(path: Option<&Path>) -> Result<RobotModel> {
     match path {
         None => Ok(trm_models::icub_upper_body()),
         Some(p) => Ok(RobotModel::load(p)?),
+    }
+}
+
+/// Where mesh files are looked for.
+#[derive(clap::Args, Default)]
+pub struct MeshArgs {
+    /// A directory searched for `package://NAME/...` meshes (repeatable); the directories of
+    /// ROS_PACKAGE_PATH are searched after these.
+    #[arg(long = "package-path", value_name = "DIR")]
+    package_paths: Vec<PathBuf>,
+}
+
+impl MeshArgs {
+    /// The model's collision model, meshes found through the package paths.
+    fn collision_model(&self, model: &RobotModel) -> Result<trm_collision::CollisionModel> {
+        let mut package_paths = self.package_paths.clone();
+        if let Some(ros) = std::env::var_os("ROS_PACKAGE_PATH") {
+            package_paths.extend(std::env::split_paths(&ros));
+        }
+        let options = trm_collision::CollisionOptions {
+            package_paths,
+            ..Default::default()
+        };
+        Ok(trm_collision::CollisionModel::with_options(
+            model, &options,
+        )?)
     }
 }
 

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use trm_collision::{CollisionModel, Shape};
 use trm_kinematics::{JointKind, RobotModel};
 
 /// Arguments of `model-info`.
@@ -13,6 +14,11 @@ pub struct Args {
     /// Also list every link with its parent joint.
     #[arg(long)]
     links: bool,
+    /// Also list every disabled collision pair.
+    #[arg(long)]
+    collisions: bool,
+    #[command(flatten)]
+    meshes: crate::MeshArgs,
 }
 
 fn deg(x: f64) -> String {
@@ -166,6 +172,63 @@ pub fn run(args: &Args) -> Result<()> {
     if !postures.is_empty() {
         println!("\npostures: {}", postures.join(", "));
     }
-    println!("\ncollision bodies: not modelled yet (see the collision issue)");
+    match args.meshes.collision_model(&model) {
+        Ok(collision) => print_collision(&collision, args.collisions),
+        Err(e) => println!("\ncollision bodies: cannot be built: {e:#}"),
+    }
     Ok(())
+}
+
+fn shape_text(shape: &Shape) -> String {
+    match shape {
+        Shape::Sphere { radius } => format!("sphere r {radius:.4}"),
+        Shape::Box { size } => format!("box {:.4} × {:.4} × {:.4}", size[0], size[1], size[2]),
+        Shape::Cylinder { radius, length } => format!("cylinder r {radius:.4} l {length:.4}"),
+        Shape::Capsule { radius, length } => format!("capsule r {radius:.4} l {length:.4}"),
+        Shape::Convex { points } => format!("convex hull of {} points", points.len()),
+    }
+}
+
+fn print_collision(collision: &CollisionModel, list_pairs: bool) {
+    let model = collision.robot();
+    let links = &model.tree().links;
+    println!("\ncollision bodies ({}):", collision.bodies().len());
+    for b in collision.bodies() {
+        let t = b.local.translation.vector;
+        println!(
+            "  {:<22} on {:<22} {:<36} at ({:.4}, {:.4}, {:.4})",
+            b.name,
+            links[b.link].name,
+            shape_text(&b.shape),
+            t.x,
+            t.y,
+            t.z
+        );
+    }
+    let mut by_reason: std::collections::BTreeMap<&str, Vec<[usize; 2]>> = Default::default();
+    for (pair, reason) in collision.acm().disabled_pairs() {
+        by_reason.entry(reason.as_str()).or_default().push(pair);
+    }
+    let has = collision.has_geometry();
+    let summary: Vec<String> = by_reason
+        .iter()
+        .map(|(r, pairs)| {
+            let with_geometry = pairs.iter().filter(|[a, b]| has[*a] && has[*b]).count();
+            format!("{with_geometry} {r}")
+        })
+        .collect();
+    println!(
+        "\ncollision pairs: {} link pairs checked; disabled: {} (pairs of links with bodies)",
+        collision.num_checked_link_pairs(),
+        summary.join(", ")
+    );
+    if list_pairs {
+        for (reason, pairs) in &by_reason {
+            for [a, b] in pairs.iter().filter(|[a, b]| has[*a] && has[*b]) {
+                println!("  {reason:<8} {:<22} {}", links[*a].name, links[*b].name);
+            }
+        }
+    } else {
+        println!("  (list them with --collisions)");
+    }
 }

@@ -24,7 +24,12 @@ impl AllowedCollisionMatrix {
     pub fn adjacent(model: &RobotModel, has_geometry: &[bool]) -> Self {
         let tree = model.tree();
         let mut acm = Self::all_checked(tree.links.len());
-        for (i, _) in tree.links.iter().enumerate().filter(|(i, _)| has_geometry[*i]) {
+        for (i, _) in tree
+            .links
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| has_geometry[*i])
+        {
             let mut up = tree.links[i].parent;
             while let Some(p) = up {
                 if has_geometry[p] {

@@ -30,9 +30,14 @@ pub enum CollisionError {
     },
     /// A mesh file named by a `<mesh filename>` could not be found.
     #[error(
-        "{origin}{}: {element}: mesh `{uri}` not found (tried {}); fix: {fix}",
+        "{origin}{}: {element}: mesh `{uri}` not found (tried {}); fix: {}",
         line.map(|l| format!(":{l}")).unwrap_or_default(),
-        if tried.is_empty() { "nothing".to_string() } else { tried.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ") }
+        if tried.is_empty() { "nothing".to_string() } else { tried.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ") },
+        if uri.starts_with("package://") {
+            "add the directory that holds the package to the package paths (--package-path, ROS_PACKAGE_PATH)"
+        } else {
+            "check the path (relative paths start at the URDF's directory)"
+        }
     )]
     MeshNotFound {
         /// The URDF.
@@ -45,8 +50,6 @@ pub enum CollisionError {
         uri: String,
         /// Every path that was tried.
         tried: Vec<PathBuf>,
-        /// How to fix it.
-        fix: String,
     },
     /// A mesh file exists but could not be read or holds no usable geometry.
     #[error("mesh {path}: {message} (referenced by {element} in {origin})")]

@@ -12,7 +12,11 @@ use parry3d_f64::shape::ConvexPolyhedron;
 ///   `D/REST` when `D` itself is named `NAME` (as `ROS_PACKAGE_PATH` entries work);
 /// * `file:///ABS` or an absolute path: that path;
 /// * a relative path: relative to the URDF's directory, when known.
-pub fn mesh_candidates(uri: &str, urdf_dir: Option<&Path>, package_paths: &[PathBuf]) -> Vec<PathBuf> {
+pub fn mesh_candidates(
+    uri: &str,
+    urdf_dir: Option<&Path>,
+    package_paths: &[PathBuf],
+) -> Vec<PathBuf> {
     if let Some(rest) = uri.strip_prefix("package://") {
         let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
         let mut out = Vec::new();
@@ -66,7 +70,10 @@ pub fn convex_hull_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<[f64; 3]>
     if points.is_empty() {
         return Err("the file holds no vertices".to_string());
     }
-    if points.iter().any(|p| !p.coords.iter().all(|c| c.is_finite())) {
+    if points
+        .iter()
+        .any(|p| !p.coords.iter().all(|c| c.is_finite()))
+    {
         return Err("the file holds non-finite vertices".to_string());
     }
     let flat = || "the mesh is flat: its convex hull has no volume".to_string();

@@ -137,10 +137,14 @@ impl CollisionModel {
             }
             let element = format!("body `{}`", b.name);
             compiled.push(b.shape.compile(&b.local).ok_or_else(|| {
-                let p = b.shape.check().err().unwrap_or_else(|| crate::ShapeProblem {
-                    problem: "unusable shape".into(),
-                    fix: "use another shape".into(),
-                });
+                let p = b
+                    .shape
+                    .check()
+                    .err()
+                    .unwrap_or_else(|| crate::ShapeProblem {
+                        problem: "unusable shape".into(),
+                        fix: "use another shape".into(),
+                    });
                 CollisionError::InvalidShape {
                     origin: robot.origin().to_string(),
                     line: None,
@@ -268,22 +272,21 @@ fn has_geometry(links: usize, bodies: &[Body]) -> Vec<bool> {
 
 /// Checked body pairs grouped by link pair, and the number of link pairs.
 fn body_pairs(bodies: &[Body], acm: &AllowedCollisionMatrix) -> (Vec<BodyPair>, usize) {
-    let mut groups: Vec<([usize; 2], Vec<(u32, u32)>)> = Vec::new();
+    let mut groups: std::collections::BTreeMap<[usize; 2], Vec<(u32, u32)>> = Default::default();
     for i in 0..bodies.len() {
         for j in i + 1..bodies.len() {
             let (la, lb) = (bodies[i].link, bodies[j].link);
             if !acm.is_checked(la, lb) {
                 continue;
             }
-            let key = [la.min(lb), la.max(lb)];
-            match groups.iter_mut().rev().find(|(k, _)| *k == key) {
-                Some((_, v)) => v.push((i as u32, j as u32)),
-                None => groups.push((key, vec![(i as u32, j as u32)])),
-            }
+            groups
+                .entry([la.min(lb), la.max(lb)])
+                .or_default()
+                .push((i as u32, j as u32));
         }
     }
     let mut pairs = Vec::new();
-    for (_, members) in &groups {
+    for members in groups.values() {
         let next = (pairs.len() + members.len()) as u32;
         pairs.extend(members.iter().map(|&(a, b)| BodyPair { a, b, next }));
     }
@@ -332,14 +335,6 @@ fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Ve
                             element: element.clone(),
                             uri: filename.clone(),
                             tried,
-                            fix: if filename.starts_with("package://") {
-                                "add the directory that holds the package to the package \
-                                 paths (--package-path, ROS_PACKAGE_PATH)"
-                                    .into()
-                            } else {
-                                "check the path (relative paths start at the URDF's directory)"
-                                    .into()
-                            },
                         })?;
                     let scale = scale.map_or([1.0; 3], |s| s.0);
                     let points = convex_hull_of_mesh(&path, scale).map_err(|message| {

@@ -61,8 +61,7 @@ impl CollisionModel {
         while k < pairs.len() {
             let pair = pairs[k];
             let (a, b) = (pair.a as usize, pair.b as usize);
-            if !bounds_apart(&p[a], &p[b]) && intersects(&compiled[a], &p[a], &compiled[b], &p[b])
-            {
+            if !bounds_apart(&p[a], &p[b]) && intersects(&compiled[a], &p[a], &compiled[b], &p[b]) {
                 match hit(k) {
                     None => return,
                     Some(true) => {

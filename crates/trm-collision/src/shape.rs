@@ -1,6 +1,6 @@
 //! Shapes, their compiled hot-path form, and the pairwise tests between placed shapes.
 
-use nalgebra::{Isometry3, Point3, Translation3};
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 use parry3d_f64::query;
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
 use parry3d_f64::shape::{Ball, Capsule, SegmentPointLocation, Shape as ParryShape, SharedShape};
@@ -156,12 +156,17 @@ impl Shape {
             _ => {
                 let shape = self.to_parry()?;
                 let sphere = shape.compute_local_bounding_sphere();
+                let half_extents = match self {
+                    Shape::Box { size } => Some(Vector3::from(*size) / 2.0),
+                    _ => None,
+                };
                 Compiled {
                     center: local * sphere.center,
                     bound: sphere.radius,
                     geometry: Geometry::General {
                         local: *local,
                         shape,
+                        half_extents,
                     },
                 }
             }
@@ -216,10 +221,12 @@ pub(crate) enum Geometry {
         b: Point3<f64>,
         radius: f64,
     },
-    /// Any other convex shape at `local`: tested by parry.
+    /// Any other convex shape at `local`: tested by parry, except boxes (`half_extents`)
+    /// against round shapes, which are tested analytically.
     General {
         local: Isometry3<f64>,
         shape: SharedShape,
+        half_extents: Option<Vector3<f64>>,
     },
 }
 
@@ -327,6 +334,77 @@ fn segment_distance_squared(
     (point_on(a1, b1, l1) - point_on(a2, b2, l2)).norm_squared()
 }
 
+/// Squared distance between the segment of a placed round shape and a placed box.
+#[inline]
+fn round_box_distance_squared(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> f64 {
+    let a = cuboid.iso.inverse_transform_point(&round.a);
+    let b = cuboid.iso.inverse_transform_point(&round.b);
+    segment_box_distance_squared(&a, &b, half)
+}
+
+/// Squared distance between the segment `[a, b]` and the box `|x_i| ≤ h_i`, exactly: the squared
+/// distance is convex and piecewise quadratic along the segment, with pieces separated where the
+/// segment crosses a face plane; each piece is minimised in closed form.
+pub(crate) fn segment_box_distance_squared(
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    h: &Vector3<f64>,
+) -> f64 {
+    let d = b - a;
+    let excess = |t: f64| {
+        let p = a + d * t;
+        (0..3)
+            .map(|i| {
+                let e = p[i].abs() - h[i];
+                if e > 0.0 { e * e } else { 0.0 }
+            })
+            .sum::<f64>()
+    };
+    let mut ts = [0.0f64; 8];
+    ts[1] = 1.0;
+    let mut n = 2;
+    for i in 0..3 {
+        if d[i] != 0.0 {
+            for side in [-h[i], h[i]] {
+                let t = (side - a[i]) / d[i];
+                if t > 0.0 && t < 1.0 {
+                    ts[n] = t;
+                    n += 1;
+                }
+            }
+        }
+    }
+    let ts = &mut ts[..n];
+    ts.sort_unstable_by(f64::total_cmp);
+    let mut best = f64::INFINITY;
+    for w in ts.windows(2) {
+        let (t0, t1) = (w[0], w[1]);
+        let mid = a + d * (0.5 * (t0 + t1));
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..3 {
+            let bound = if mid[i] > h[i] {
+                h[i]
+            } else if mid[i] < -h[i] {
+                -h[i]
+            } else {
+                continue;
+            };
+            num += (bound - a[i]) * d[i];
+            den += d[i] * d[i];
+        }
+        let t = if den > 0.0 {
+            (num / den).clamp(t0, t1)
+        } else {
+            0.5 * (t0 + t1)
+        };
+        best = best.min(excess(t));
+        if best == 0.0 {
+            break;
+        }
+    }
+    best
+}
+
 /// True when the bounding spheres of two placed shapes are disjoint.
 #[inline(always)]
 pub(crate) fn bounds_apart(p: &Placed, q: &Placed) -> bool {
@@ -342,6 +420,20 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
             let r = r1 + r2;
             segment_distance_squared(&p1.a, &p1.b, &p2.a, &p2.b) <= r * r
         }
+        (
+            Geometry::Round { radius, .. },
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+        ) => round_box_distance_squared(p1, p2, h) <= radius * radius,
+        (
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+            Geometry::Round { radius, .. },
+        ) => round_box_distance_squared(p2, p1, h) <= radius * radius,
         (Geometry::Round { radius, .. }, Geometry::General { shape, .. }) => {
             let (iso, round) = Compiled::round_as_parry(p1, *radius);
             parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref())
@@ -373,6 +465,28 @@ pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Pl
         (&c1.geometry, &c2.geometry)
     {
         return segment_distance_squared(&p1.a, &p1.b, &p2.a, &p2.b).sqrt() - r1 - r2;
+    }
+    let round_box = match (&c1.geometry, &c2.geometry) {
+        (
+            Geometry::Round { radius, .. },
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+        ) => Some((round_box_distance_squared(p1, p2, h), *radius)),
+        (
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+            Geometry::Round { radius, .. },
+        ) => Some((round_box_distance_squared(p2, p1, h), *radius)),
+        _ => None,
+    };
+    if let Some((squared, radius)) = round_box {
+        if squared > 0.0 {
+            return squared.sqrt() - radius;
+        }
     }
     let own = |c: &Compiled, p: &Placed| -> (Isometry3<f64>, Option<RoundShape>) {
         match &c.geometry {
@@ -426,7 +540,6 @@ pub(crate) fn from_urdf(geometry: &trm_kinematics::urdf_rs::Geometry) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector3;
 
     fn placed(shape: &Shape, pose: Isometry3<f64>) -> (Compiled, Placed) {
         let c = shape.compile(&Isometry3::identity()).unwrap();
@@ -506,6 +619,36 @@ mod tests {
         assert!((signed_distance(&c1, &p1, &c3, &p3) - 0.15).abs() < 1e-9);
         assert!(intersects(&c1, &p1, &c2, &p2));
         assert!(!intersects(&c1, &p1, &c3, &p3));
+    }
+
+    #[test]
+    fn segment_box_distance_matches_parry() {
+        let cuboid = Shape::Box {
+            size: [0.3, 0.2, 0.1],
+        };
+        let parry_box = cuboid.to_parry().unwrap();
+        let h = Vector3::new(0.15, 0.1, 0.05);
+        let mut state = 12345u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 0.8 - 0.4
+        };
+        for _ in 0..2000 {
+            let a = Point3::new(uniform(), uniform(), uniform());
+            let b = Point3::new(uniform(), uniform(), uniform());
+            let ours = segment_box_distance_squared(&a, &b, &h).sqrt();
+            let segment = parry3d_f64::shape::Segment::new(a, b);
+            let theirs = query::distance(
+                &Isometry3::identity(),
+                &segment,
+                &Isometry3::identity(),
+                parry_box.as_ref(),
+            )
+            .unwrap();
+            assert!((ours - theirs).abs() < 1e-9, "{a} {b}: {ours} vs {theirs}");
+        }
     }
 
     #[test]

@@ -95,15 +95,15 @@ impl World {
             world
                 .add(&o.name, o.shape.clone(), pose_from_xyz_rpy(o.xyz, o.rpy))
                 .map_err(|e| match e {
-                    CollisionError::InvalidShape {
-                        problem, fix, ..
-                    } => CollisionError::InvalidShape {
-                        origin: origin.to_string(),
-                        line: None,
-                        element: format!("object \"{}\"", o.name),
-                        problem,
-                        fix,
-                    },
+                    CollisionError::InvalidShape { problem, fix, .. } => {
+                        CollisionError::InvalidShape {
+                            origin: origin.to_string(),
+                            line: None,
+                            element: format!("object \"{}\"", o.name),
+                            problem,
+                            fix,
+                        }
+                    }
                     other => other,
                 })?;
         }
@@ -156,21 +156,19 @@ impl World {
             return Err(CollisionError::DuplicateObject(name.to_string()));
         }
         check_pose(&format!("world object `{name}`"), &pose)?;
-        let compiled = shape
-            .compile(&Isometry3::identity())
-            .ok_or_else(|| {
-                let p = shape.check().err().unwrap_or_else(|| crate::ShapeProblem {
-                    problem: "unusable shape".into(),
-                    fix: "use another shape".into(),
-                });
-                CollisionError::InvalidShape {
-                    origin: "<world>".into(),
-                    line: None,
-                    element: format!("object \"{name}\""),
-                    problem: p.problem,
-                    fix: p.fix,
-                }
-            })?;
+        let compiled = shape.compile(&Isometry3::identity()).ok_or_else(|| {
+            let p = shape.check().err().unwrap_or_else(|| crate::ShapeProblem {
+                problem: "unusable shape".into(),
+                fix: "use another shape".into(),
+            });
+            CollisionError::InvalidShape {
+                origin: "<world>".into(),
+                line: None,
+                element: format!("object \"{name}\""),
+                problem: p.problem,
+                fix: p.fix,
+            }
+        })?;
         let mut placed = Placed::default();
         compiled.place(&pose, &mut placed);
         self.objects.push(WorldObject {
@@ -248,18 +246,32 @@ mod tests {
         assert_eq!(world.len(), 2);
         let again = World::from_spec(&world.to_spec(), "again").unwrap();
         assert!((again.object("ball").unwrap().pose().rotation.angle() - 1.0).abs() < 1e-12);
-        world.set_pose("ball", Isometry3::translation(1.0, 0.0, 0.0)).unwrap();
+        world
+            .set_pose("ball", Isometry3::translation(1.0, 0.0, 0.0))
+            .unwrap();
         assert_eq!(world.object("ball").unwrap().pose().translation.x, 1.0);
-        let e = world.set_pose("bal", Isometry3::identity()).unwrap_err().to_string();
+        let e = world
+            .set_pose("bal", Isometry3::identity())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("did you mean `ball`"), "{e}");
         assert!(matches!(
-            world.add("table", Shape::Sphere { radius: 1.0 }, Isometry3::identity()),
+            world.add(
+                "table",
+                Shape::Sphere { radius: 1.0 },
+                Isometry3::identity()
+            ),
             Err(CollisionError::DuplicateObject(_))
         ));
         let bad = r#"(objects: [(name: "b", shape: Sphere(radius: -1.0))])"#;
         let e = World::from_ron(bad, "w.ron").unwrap_err().to_string();
-        assert!(e.starts_with("w.ron: object \"b\": sphere radius -1"), "{e}");
-        let e = World::from_ron("(objects: [(nme: \"x\")])", "w.ron").unwrap_err().to_string();
+        assert!(
+            e.starts_with("w.ron: object \"b\": sphere radius -1"),
+            "{e}"
+        );
+        let e = World::from_ron("(objects: [(nme: \"x\")])", "w.ron")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("w.ron:1:"), "{e}");
         world.remove("ball").unwrap();
         assert_eq!(world.len(), 1);

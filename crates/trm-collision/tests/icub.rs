@@ -94,7 +94,12 @@ fn fingers_close_fully_without_counting_as_collisions() {
         q[*m] = icub.robot.motors()[*m].limits.upper;
     }
     icub.pose(&q);
-    assert_eq!(icub.collision.count_self(&icub.placed), 0, "{:?}", icub.self_pairs());
+    assert_eq!(
+        icub.collision.count_self(&icub.placed),
+        0,
+        "{:?}",
+        icub.self_pairs()
+    );
 }
 
 #[test]
@@ -109,7 +114,10 @@ fn crossed_forearms_collide() {
     }
     icub.pose(&q);
     let pairs = icub.self_pairs();
-    assert!(pairs.contains(&("r_forearm".into(), "l_forearm".into())), "{pairs:?}");
+    assert!(
+        pairs.contains(&("r_forearm".into(), "l_forearm".into())),
+        "{pairs:?}"
+    );
     assert!(icub.collision.any_self_collision(&icub.placed));
     // the same arms opened sideways are free
     for side in ["l", "r"] {
@@ -212,12 +220,15 @@ fn a_hand_inside_a_table_collides_with_it_and_a_lowered_table_does_not() {
     let count = icub.collision.count_world(&icub.placed, &world);
     assert!(count > 0);
     let pairs = icub.collision.colliding_pairs(&icub.placed, &world);
-    assert!(pairs
-        .iter()
-        .any(|p| p.body == "r_hand" && p.other == Other::Object("table".into()) && p.distance < 0.0));
+    assert!(pairs.iter().any(|p| p.body == "r_hand"
+        && p.other == Other::Object("table".into())
+        && p.distance < 0.0));
     assert!(icub.collision.is_colliding(&icub.placed, &world));
     world
-        .set_pose("table", Isometry3::translation(palm.x, palm.y, palm.z - 0.3))
+        .set_pose(
+            "table",
+            Isometry3::translation(palm.x, palm.y, palm.z - 0.3),
+        )
         .unwrap();
     assert_eq!(icub.collision.count_world(&icub.placed, &world), 0);
     let gap = icub.collision.object_distance(

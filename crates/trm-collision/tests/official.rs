@@ -8,7 +8,11 @@ use trm_collision::{AcmSettings, CollisionError, CollisionModel, CollisionOption
 
 fn meshes() -> Option<std::path::PathBuf> {
     let dir = std::path::PathBuf::from(std::env::var_os("TRM_ICUB_MESHES")?);
-    assert!(dir.join("iCub/meshes").is_dir(), "TRM_ICUB_MESHES={} holds no iCub/meshes", dir.display());
+    assert!(
+        dir.join("iCub/meshes").is_dir(),
+        "TRM_ICUB_MESHES={} holds no iCub/meshes",
+        dir.display()
+    );
     Some(dir)
 }
 
@@ -18,7 +22,10 @@ fn without_mesh_paths_the_official_urdf_reports_the_missing_mesh() {
     let e = CollisionModel::new(&robot).unwrap_err();
     assert!(matches!(e, CollisionError::MeshNotFound { .. }), "{e}");
     let text = e.to_string();
-    assert!(text.contains("package://iCub/meshes/") && text.contains("--package-path"), "{text}");
+    assert!(
+        text.contains("package://iCub/meshes/") && text.contains("--package-path"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -32,27 +39,48 @@ fn the_official_urdfs_with_their_meshes_can_be_collision_checked() {
         ..Default::default()
     };
     // iCubGenova04's meshes are all in icub-models; the visuomanip hands' COLLADA meshes are not.
-    for robot in [trm_models::icub_genova04()] {
-        let collision = CollisionModel::with_options(&robot, &options).unwrap();
-        assert!(collision.bodies().len() >= 39, "{}", collision.bodies().len());
-        // A generated matrix leaves the zero posture free, and random postures are classified
-        // the same way by every query.
-        let report = generate_acm(
-            &collision,
-            &AcmSettings {
-                samples: 300,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let checked = collision.with_acm(report.acm).unwrap();
-        let mut poses = robot.pose_buffer();
-        let mut placed = checked.placed_bodies();
-        robot
-            .forward_motors(&robot.neutral_motors(), &mut poses)
-            .unwrap();
-        checked.place(&poses, &mut placed);
-        assert_eq!(checked.count_self(&placed), 0);
-        assert!(checked.min_self_distance(&placed).unwrap().distance > 0.0);
+    let robot = trm_models::icub_genova04();
+    let collision = CollisionModel::with_options(&robot, &options).unwrap();
+    assert!(
+        collision.bodies().len() >= 39,
+        "{}",
+        collision.bodies().len()
+    );
+    // A generated matrix leaves the neutral posture free; crossing the forearms collides.
+    let report = generate_acm(
+        &collision,
+        &AcmSettings {
+            samples: 300,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let checked = collision.with_acm(report.acm).unwrap();
+    let mut poses = robot.pose_buffer();
+    let mut placed = checked.placed_bodies();
+    let mut q = robot.neutral_motors();
+    robot.forward_motors(&q, &mut poses).unwrap();
+    checked.place(&poses, &mut placed);
+    assert_eq!(checked.count_self(&placed), 0);
+    assert!(checked.min_self_distance(&placed).unwrap().distance > 0.0);
+    for side in ["l", "r"] {
+        for (motor, degrees) in [
+            ("shoulder_pitch", -50.0),
+            ("shoulder_roll", 10.0),
+            ("shoulder_yaw", 60.0),
+            ("elbow", 90.0),
+        ] {
+            q[robot.motor_index(&format!("{side}_{motor}")).unwrap()] = f64::to_radians(degrees);
+        }
     }
+    robot.forward_motors(&q, &mut poses).unwrap();
+    checked.place(&poses, &mut placed);
+    let pairs = checked.colliding_pairs(&placed, &trm_collision::World::new());
+    assert!(
+        pairs
+            .iter()
+            .any(|p| p.body == "r_forearm"
+                && p.other == trm_collision::Other::Body("l_forearm".into())),
+        "{pairs:?}"
+    );
 }

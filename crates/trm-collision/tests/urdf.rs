@@ -117,7 +117,11 @@ fn generated_matrices_are_reproducible_and_respect_forced_pairs() {
         robot.tree().link_index("tool").unwrap(),
     );
     assert!(a.acm.is_checked(base, tool));
-    assert!(a.collision_counts.iter().any(|(p, n)| *p == [base, tool] && *n > 0));
+    assert!(
+        a.collision_counts
+            .iter()
+            .any(|(p, n)| *p == [base, tool] && *n > 0)
+    );
     // a forced pair stays checked even if it is adjacent
     let description = ModelDescription::from_ron(
         r#"(urdf: "arm.urdf", enabled_collisions: [("upper", "tool")],
@@ -145,8 +149,14 @@ fn a_missing_mesh_names_the_file_the_element_and_every_path_tried() {
     let e = CollisionModel::with_options(&model(&urdf), &options).unwrap_err();
     assert!(matches!(e, CollisionError::MeshNotFound { .. }));
     let text = e.to_string();
-    assert!(text.starts_with("arm.urdf:5: <collision> of <link name=\"tool\">"), "{text}");
-    assert!(text.contains("demo_pkg/meshes/nope.stl") && text.contains("package paths"), "{text}");
+    assert!(
+        text.starts_with("arm.urdf:5: <collision> of <link name=\"tool\">"),
+        "{text}"
+    );
+    assert!(
+        text.contains("demo_pkg/meshes/nope.stl") && text.contains("package paths"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -166,9 +176,14 @@ fn degenerate_shapes_name_the_file_line_and_link() {
     for (geometry, says) in [
         (r#"<sphere radius="0"/>"#, "sphere radius 0"),
         (r#"<box size="0.1 -0.1 0.1"/>"#, "box size -0.1"),
-        (r#"<capsule radius="0.1" length="-1"/>"#, "capsule length -1"),
+        (
+            r#"<capsule radius="0.1" length="-1"/>"#,
+            "capsule length -1",
+        ),
     ] {
-        let e = CollisionModel::new(&model(&arm(geometry))).unwrap_err().to_string();
+        let e = CollisionModel::new(&model(&arm(geometry)))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("arm.urdf:5: <collision> of <link name=\"tool\">: ") && e.contains(says),
             "{e}"
@@ -187,5 +202,8 @@ fn unknown_links_in_the_collision_lists_are_named_with_suggestions() {
     let e = RobotModel::from_parts(&urdf, "arm.urdf", &description, Some(("(urdf: \"arm.urdf\",\n disabled_collisions: [(a: \"base\", b: \"tol\", reason: never)])", "arm.ron")))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("arm.ron:2") && e.contains("did you mean `tool`"), "{e}");
+    assert!(
+        e.contains("arm.ron:2") && e.contains("did you mean `tool`"),
+        "{e}"
+    );
 }

@@ -43,5 +43,5 @@ pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use fk::PoseBuffer;
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
-pub use urdf_rs;
 pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
+pub use urdf_rs;

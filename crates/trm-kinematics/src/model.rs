@@ -199,7 +199,8 @@ impl RobotModel {
         let frames = resolve_frames(&tree, desc, &dctx)?;
         let groups = resolve_groups(&motors, desc, &dctx)?;
         let postures = resolve_postures(&motors, desc, &dctx)?;
-        let (disabled_collisions, enabled_collisions) = resolve_collision_pairs(&tree, desc, &dctx)?;
+        let (disabled_collisions, enabled_collisions) =
+            resolve_collision_pairs(&tree, desc, &dctx)?;
         let frame_offsets: Vec<_> = frames.iter().map(|f| (f.link, f.local_offset)).collect();
         let identity: Vec<[(usize, f64); 1]> =
             (0..tree.movable.len()).map(|c| [(c, 1.0)]).collect();
