@@ -14,7 +14,7 @@ pub struct Args {
     /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
     model: Option<PathBuf>,
     /// Random configurations sampled within the motor limits.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = 1_000_000)]
     samples: usize,
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]

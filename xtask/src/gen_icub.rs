@@ -41,7 +41,7 @@ const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "little"];
 /// force the upper-arm/forearm pair out of checking; elbow_1 covers the hinge instead.
 const CAPSULE_TRIMS: &[(&str, f64)] = &[("l_forearm", 0.045), ("r_forearm", 0.045)];
 /// Random configurations sampled to find never/always colliding link pairs.
-const ACM_SAMPLES: usize = 100_000;
+const ACM_SAMPLES: usize = 1_000_000;
 
 /// One row of collision-extents.csv (link frame, metres).
 struct Extents {

@@ -2,16 +2,21 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use trm_kinematics::DisableReason;
 
 use crate::acm::AllowedCollisionMatrix;
 use crate::error::{CollisionError, Result};
 use crate::model::CollisionModel;
 
+/// Samples drawn from one random stream (the unit of parallel work).
+const SAMPLES_PER_CHUNK: usize = 4096;
+
 /// Settings of [`generate_acm`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct AcmSettings {
-    /// Random configurations sampled uniformly within the motor limits.
+    /// Random configurations sampled uniformly within the motor limits (MoveIt uses 10 000;
+    /// a 41-DOF robot needs far more before rare contacts show up, hence the default).
     pub samples: usize,
     /// Seed of the sampler (ChaCha8).
     pub seed: u64,
@@ -25,7 +30,7 @@ pub struct AcmSettings {
 impl Default for AcmSettings {
     fn default() -> Self {
         AcmSettings {
-            samples: 10_000,
+            samples: 1_000_000,
             seed: 0,
             always_fraction: 0.95,
             default_posture: None,
@@ -88,30 +93,39 @@ pub fn generate_acm(model: &CollisionModel, settings: &AcmSettings) -> Result<Ac
 
     let probe = model.with_acm(acm.clone())?;
     let n = robot.num_links();
-    let mut counts = vec![0usize; n * n];
-    let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
-    let mut q = vec![0.0; robot.motors().len()];
-    let mut seen = vec![false; n * n];
-    let mut touched: Vec<usize> = Vec::new();
-    for _ in 0..settings.samples {
-        for (v, m) in q.iter_mut().zip(robot.motors()) {
-            *v = rng.random_range(m.limits.lower..=m.limits.upper);
-        }
-        robot.forward_motors(&q, &mut poses)?;
-        probe.place(&poses, &mut placed);
-        for hit in probe.colliding_pair_indices(&placed) {
-            let (a, b) = (link(hit[0]), link(hit[1]));
-            let key = a.min(b) * n + a.max(b);
-            if !seen[key] {
-                seen[key] = true;
-                touched.push(key);
-                counts[key] += 1;
+    // Fixed-size chunks, each with its own ChaCha stream: the counts depend on the seed only,
+    // not on the number of threads.
+    let chunks = settings.samples.div_ceil(SAMPLES_PER_CHUNK);
+    let counts = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| -> Result<Vec<usize>> {
+            let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+            rng.set_stream(chunk as u64);
+            let mut counts = vec![0usize; n * n];
+            let mut poses = robot.pose_buffer();
+            let mut placed = probe.placed_bodies();
+            let mut q = vec![0.0; robot.motors().len()];
+            let todo = SAMPLES_PER_CHUNK.min(settings.samples - chunk * SAMPLES_PER_CHUNK);
+            for _ in 0..todo {
+                for (v, m) in q.iter_mut().zip(robot.motors()) {
+                    *v = rng.random_range(m.limits.lower..=m.limits.upper);
+                }
+                robot.forward_motors(&q, &mut poses)?;
+                probe.place(&poses, &mut placed);
+                for hit in probe.colliding_pair_indices(&placed) {
+                    let (a, b) = (link(hit[0]), link(hit[1]));
+                    counts[a.min(b) * n + a.max(b)] += 1;
+                }
             }
-        }
-        for key in touched.drain(..) {
-            seen[key] = false;
-        }
-    }
+            Ok(counts)
+        })
+        .try_reduce(
+            || vec![0usize; n * n],
+            |mut total, part| {
+                total.iter_mut().zip(part).for_each(|(t, p)| *t += p);
+                Ok(total)
+            },
+        )?;
     let mut collision_counts = Vec::new();
     for a in 0..n {
         for b in a + 1..n {

@@ -234,13 +234,13 @@ impl CollisionModel {
 }
 
 impl CollisionModel {
-    /// `[a, b]` body indices of every colliding checked body pair.
+    /// `[a, b]` body indices of one colliding body pair per colliding checked link pair.
     pub(crate) fn colliding_pair_indices(&self, placed: &PlacedBodies) -> Vec<[usize; 2]> {
         let pairs = self.pairs();
         let mut out = Vec::new();
         self.walk_self(placed, |k| {
             out.push([pairs[k].a as usize, pairs[k].b as usize]);
-            Some(false)
+            Some(true)
         });
         out
     }

@@ -104,13 +104,20 @@ fn generated_matrices_are_reproducible_and_respect_forced_pairs() {
     let robot = model(&urdf);
     let c = CollisionModel::new(&robot).unwrap();
     let settings = AcmSettings {
-        samples: 2000,
+        samples: 10_000,
         seed: 7,
         ..Default::default()
     };
-    let a = generate_acm(&c, &settings).unwrap();
-    let b = generate_acm(&c, &settings).unwrap();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| generate_acm(&c, &settings).unwrap())
+    };
+    let (a, b) = (on(1), on(2));
     assert_eq!(a.acm, b.acm);
+    assert_eq!(a.collision_counts, b.collision_counts);
     // base/tool do meet when the arm folds back: the pair stays checked
     let (base, tool) = (
         robot.tree().link_index("base").unwrap(),
