@@ -1,0 +1,97 @@
+//! The hot path does not allocate: a counting global allocator sees no allocation during
+//! thousands of forward-kinematics passes (checked and unchecked, motor and joint inputs) and
+//! collision queries (placing bodies, self and world counts, early-exit checks, distances).
+//! It lives here, in the crate that depends on every library, so one allocator covers them all.
+
+// A global allocator can only be written with `unsafe`; it forwards to the system allocator.
+#![allow(unsafe_code)]
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    /// Allocations made by this thread (tests run on parallel threads).
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|n| n.set(n.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn forward_kinematics_never_allocates() {
+    let model = trm_models::icub_upper_body();
+    let all = model.all_active();
+    let arm = model
+        .active_set(&["right_arm"], model.posture("home").unwrap())
+        .unwrap();
+    let mut buffer = model.pose_buffer();
+    let mut q41 = model.posture("home").unwrap().to_vec();
+    let mut q7 = arm.from_motors(&q41);
+    let mut joints = vec![0.1; model.num_joints()];
+    let before = allocations();
+    for k in 0..2000 {
+        let x = k as f64 * 1e-4;
+        q41[5] = x;
+        q7[3] = x;
+        joints[7] = x;
+        all.forward(&q41, &mut buffer).unwrap();
+        all.forward_unchecked(&q41, &mut buffer);
+        arm.forward(&q7, &mut buffer).unwrap();
+        model.forward_joints(&joints, &mut buffer).unwrap();
+        model.forward_motors(&q41, &mut buffer).unwrap();
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "FK allocated {} times", after - before);
+}
+
+#[test]
+fn collision_queries_never_allocate() {
+    let model = trm_models::icub_upper_body();
+    let collision = trm_collision::CollisionModel::new(&model).unwrap();
+    let world =
+        trm_collision::World::from_ron(include_str!("../../specs/worlds/table.ron"), "table.ron")
+            .unwrap();
+    let mut buffer = model.pose_buffer();
+    let mut placed = collision.placed_bodies();
+    let mut q = model.posture("home").unwrap().to_vec();
+    let elbow = model.motor_index("r_elbow").unwrap();
+    let (hand, table) = (collision.body_index("r_hand").unwrap(), 0);
+    let mut total = 0usize;
+    let before = allocations();
+    for k in 0..2000 {
+        q[elbow] = 0.3 + k as f64 * 7e-4;
+        model.forward_motors(&q, &mut buffer).unwrap();
+        collision.place(&buffer, &mut placed);
+        total += collision.count_self(&placed);
+        total += collision.count(&placed, &world).total();
+        total += usize::from(collision.is_colliding(&placed, &world));
+        total += usize::from(collision.any_self_collision(&placed));
+        let d = collision.min_self_distance(&placed).unwrap().distance
+            + collision.object_distance(&placed, hand, &world, table);
+        total += usize::from(d > 0.0);
+    }
+    let after = allocations();
+    assert!(total > 0);
+    assert_eq!(
+        after - before,
+        0,
+        "collision queries allocated {} times",
+        after - before
+    );
+}
