@@ -1,0 +1,457 @@
+//! What every optimiser shares: the ask/tell trait, start settings, box bounds, stopping rules
+//! and the bookkeeping behind `stop()`.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{OptimError, Result, invalid};
+
+/// Why an optimiser stopped. `stop()` returns every reason that fired.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum StopReason {
+    /// The evaluation budget is spent.
+    MaxEvaluations,
+    /// The generation budget is spent.
+    MaxGenerations,
+    /// The best value reached the target.
+    TargetReached,
+    /// The best value did not improve for the configured number of evaluations.
+    NoImprovement,
+    /// The search distribution (or simplex) became smaller than `tol_x` in every direction.
+    TolX,
+    /// The recent best values and the last population's values span less than `tol_fun`.
+    TolFun,
+    /// Parallel E-TRM's rule: the mean of the last `recent` fitness values at the distribution
+    /// centre exceeds the mean of the last `window`.
+    CentreStagnation,
+    /// A fitness value was NaN or −∞ (+∞ is allowed: it ranks last).
+    InvalidFitness,
+    /// The distribution degenerated numerically (e.g. a covariance lost positive definiteness).
+    Degenerate,
+}
+
+/// Stopping rules; `None` disables a rule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StopOptions {
+    /// Stop after this many evaluations.
+    pub max_evaluations: Option<u64>,
+    /// Stop after this many generations (`tell` calls).
+    pub max_generations: Option<u64>,
+    /// Stop once the best value is ≤ this.
+    pub target: Option<f64>,
+    /// Stop when the best value has not improved for this many evaluations.
+    pub no_improvement_evaluations: Option<u64>,
+    /// Stop when every standard deviation of the search distribution is below this.
+    pub tol_x: Option<f64>,
+    /// Stop when recent best values and the last generation span less than this.
+    pub tol_fun: Option<f64>,
+    /// Parallel E-TRM's rule `(recent, window)`, usually `(20, 40)`: stagnation when the mean of
+    /// the last `recent` centre values exceeds the mean of the last `window`. Needs centre values
+    /// ([`Optimizer::record_centre_fitness`]; `minimize` evaluates the centre when it is set).
+    pub centre_stagnation: Option<(usize, usize)>,
+}
+
+impl Default for StopOptions {
+    fn default() -> Self {
+        StopOptions {
+            max_evaluations: None,
+            max_generations: None,
+            target: None,
+            no_improvement_evaluations: None,
+            tol_x: Some(1e-12),
+            tol_fun: Some(1e-12),
+            centre_stagnation: None,
+        }
+    }
+}
+
+impl StopOptions {
+    fn check(&self) -> Result<()> {
+        if let Some((recent, window)) = self.centre_stagnation {
+            if recent == 0 || window <= recent {
+                return Err(invalid(
+                    "centre_stagnation",
+                    format!("({recent}, {window}) needs 0 < recent < window"),
+                ));
+            }
+        }
+        for (field, v) in [("tol_x", self.tol_x), ("tol_fun", self.tol_fun)] {
+            if v.is_some_and(|v| !(v >= 0.0)) {
+                return Err(invalid(field, "must be ≥ 0"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Box bounds, e.g. joint limits. Every algorithm samples from its own (unbounded) distribution
+/// and clamps candidates into the box before handing them out; the fitness is that of the
+/// clamped point. The distributions themselves are not truncated, so a mean can sit on a bound.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Bounds {
+    /// Lower bounds.
+    pub lower: Vec<f64>,
+    /// Upper bounds.
+    pub upper: Vec<f64>,
+}
+
+impl Bounds {
+    /// Checked bounds (`lower ≤ upper`, not NaN; infinite sides allowed).
+    pub fn new(lower: Vec<f64>, upper: Vec<f64>) -> Result<Self> {
+        if lower.len() != upper.len() {
+            return Err(invalid("bounds", "lower and upper differ in length"));
+        }
+        if let Some(i) = (0..lower.len()).find(|&i| !(lower[i] <= upper[i])) {
+            return Err(invalid(
+                "bounds",
+                format!(
+                    "dimension {i}: lower {} is not ≤ upper {}",
+                    lower[i], upper[i]
+                ),
+            ));
+        }
+        Ok(Bounds { lower, upper })
+    }
+
+    /// Clamps `x` into the box.
+    #[inline]
+    pub fn clamp(&self, x: &mut [f64]) {
+        for ((v, l), u) in x.iter_mut().zip(&self.lower).zip(&self.upper) {
+            *v = v.clamp(*l, *u);
+        }
+    }
+}
+
+/// Initial step size: one for all coordinates, or one per coordinate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum StepSize {
+    /// The same standard deviation for every coordinate.
+    Scalar(f64),
+    /// One standard deviation per coordinate.
+    PerDimension(Vec<f64>),
+}
+
+impl StepSize {
+    /// The per-coordinate values for dimension `d`, checked positive and finite.
+    pub fn per_dimension(&self, d: usize) -> Result<Vec<f64>> {
+        let v = match self {
+            StepSize::Scalar(s) => vec![*s; d],
+            StepSize::PerDimension(v) => v.clone(),
+        };
+        if v.len() != d {
+            return Err(invalid(
+                "step size",
+                format!("{} values for dimension {d}", v.len()),
+            ));
+        }
+        if v.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(invalid(
+                "step size",
+                "every value must be positive and finite",
+            ));
+        }
+        Ok(v)
+    }
+}
+
+impl From<f64> for StepSize {
+    fn from(s: f64) -> Self {
+        StepSize::Scalar(s)
+    }
+}
+
+/// Settings every algorithm takes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Start {
+    /// Initial mean (or point).
+    pub mean: Vec<f64>,
+    /// Initial step size.
+    pub step: StepSize,
+    /// Optional box.
+    #[serde(default)]
+    pub bounds: Option<Bounds>,
+    /// Stopping rules.
+    #[serde(default)]
+    pub stop: StopOptions,
+}
+
+impl Start {
+    /// A start at `mean` with step `step`, no bounds, default stopping rules.
+    pub fn new(mean: Vec<f64>, step: impl Into<StepSize>) -> Self {
+        Start {
+            mean,
+            step: step.into(),
+            bounds: None,
+            stop: StopOptions::default(),
+        }
+    }
+
+    /// Adds box bounds.
+    pub fn with_bounds(mut self, bounds: Bounds) -> Self {
+        self.bounds = Some(bounds);
+        self
+    }
+
+    /// Replaces the stopping rules.
+    pub fn with_stop(mut self, stop: StopOptions) -> Self {
+        self.stop = stop;
+        self
+    }
+
+    /// Checks the settings and returns the per-coordinate steps.
+    pub(crate) fn check(&self) -> Result<Vec<f64>> {
+        let d = self.mean.len();
+        if d == 0 {
+            return Err(invalid("mean", "dimension 0"));
+        }
+        if self.mean.iter().any(|v| !v.is_finite()) {
+            return Err(invalid("mean", "not finite"));
+        }
+        if let Some(b) = &self.bounds {
+            if b.lower.len() != d {
+                return Err(invalid(
+                    "bounds",
+                    format!("{} bounds for dimension {d}", b.lower.len()),
+                ));
+            }
+        }
+        self.stop.check()?;
+        self.step.per_dimension(d)
+    }
+}
+
+/// Bookkeeping shared by all algorithms: counts, the best point, and the histories the stopping
+/// rules read. Allocated once.
+#[derive(Debug, Clone)]
+pub struct State {
+    stop: StopOptions,
+    bounds: Option<Bounds>,
+    evaluations: u64,
+    generations: u64,
+    best_x: Vec<f64>,
+    best_f: f64,
+    best_at: u64,
+    invalid: bool,
+    degenerate: bool,
+    /// Best value of each recent generation (ring buffer) for TolFun.
+    history: Vec<f64>,
+    history_len: usize,
+    last_range: f64,
+    /// Recent centre values (ring buffer) for the centre-stagnation rule.
+    centre: Vec<f64>,
+    centre_len: usize,
+    pending: usize,
+}
+
+impl State {
+    /// Bookkeeping for dimension `d` and `lambda` candidates per generation.
+    pub(crate) fn new(start: &Start, lambda: usize) -> Self {
+        let d = start.mean.len();
+        let history = 10 + (30 * d).div_ceil(lambda.max(1));
+        State {
+            stop: start.stop.clone(),
+            bounds: start.bounds.clone(),
+            evaluations: 0,
+            generations: 0,
+            best_x: start.mean.clone(),
+            best_f: f64::INFINITY,
+            best_at: 0,
+            invalid: false,
+            degenerate: false,
+            history: vec![f64::INFINITY; history],
+            history_len: 0,
+            last_range: f64::INFINITY,
+            centre: vec![0.0; start.stop.centre_stagnation.map_or(0, |c| c.1)],
+            centre_len: 0,
+            pending: 0,
+        }
+    }
+
+    /// Clamps a candidate into the bounds, if any.
+    #[inline]
+    pub(crate) fn clamp(&self, x: &mut [f64]) {
+        if let Some(b) = &self.bounds {
+            b.clamp(x);
+        }
+    }
+
+    pub(crate) fn asked(&mut self, n: usize) {
+        self.pending = n;
+    }
+
+    /// Records a generation's values for its candidates; returns an error on a count mismatch.
+    pub(crate) fn told(&mut self, candidates: &[Vec<f64>], fitness: &[f64]) -> Result<()> {
+        if self.pending == 0 {
+            return Err(OptimError::NoPendingAsk);
+        }
+        if fitness.len() != self.pending || candidates.len() < fitness.len() {
+            return Err(OptimError::WrongFitnessCount {
+                expected: self.pending,
+                got: fitness.len(),
+            });
+        }
+        self.pending = 0;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (x, &f) in candidates.iter().zip(fitness) {
+            self.evaluations += 1;
+            if f.is_nan() || f == f64::NEG_INFINITY {
+                self.invalid = true;
+                continue;
+            }
+            lo = lo.min(f);
+            hi = hi.max(f);
+            if f < self.best_f {
+                self.best_f = f;
+                self.best_x.copy_from_slice(x);
+                self.best_at = self.evaluations;
+            }
+        }
+        self.generations += 1;
+        let n = self.history.len();
+        self.history[(self.generations as usize - 1) % n] = lo;
+        self.history_len = (self.history_len + 1).min(n);
+        self.last_range = hi - lo;
+        Ok(())
+    }
+
+    pub(crate) fn set_degenerate(&mut self) {
+        self.degenerate = true;
+    }
+
+    pub(crate) fn record_centre(&mut self, x: &[f64], f: f64) {
+        self.evaluations += 1;
+        if f.is_nan() || f == f64::NEG_INFINITY {
+            self.invalid = true;
+        } else if f < self.best_f {
+            self.best_f = f;
+            self.best_x.copy_from_slice(x);
+            self.best_at = self.evaluations;
+        }
+        let n = self.centre.len();
+        if n > 0 {
+            self.centre[self.centre_len % n] = f;
+            self.centre_len += 1;
+        }
+    }
+
+    /// Every stopping reason that holds, given the distribution's largest standard deviation.
+    pub(crate) fn reasons(&self, spread: f64) -> Vec<StopReason> {
+        let s = &self.stop;
+        let mut out = Vec::new();
+        if s.max_evaluations.is_some_and(|m| self.evaluations >= m) {
+            out.push(StopReason::MaxEvaluations);
+        }
+        if s.max_generations.is_some_and(|m| self.generations >= m) {
+            out.push(StopReason::MaxGenerations);
+        }
+        if s.target.is_some_and(|t| self.best_f <= t) {
+            out.push(StopReason::TargetReached);
+        }
+        if s.no_improvement_evaluations
+            .is_some_and(|n| self.evaluations >= self.best_at + n)
+        {
+            out.push(StopReason::NoImprovement);
+        }
+        if s.tol_x.is_some_and(|t| spread < t) {
+            out.push(StopReason::TolX);
+        }
+        if let Some(t) = s.tol_fun {
+            let full = self.history_len == self.history.len();
+            let (lo, hi) = self.history[..self.history_len]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            if full && hi - lo < t && self.last_range < t {
+                out.push(StopReason::TolFun);
+            }
+        }
+        if let Some((recent, window)) = s.centre_stagnation {
+            if self.centre_len >= window {
+                let mean_last = |k: usize| {
+                    (0..k)
+                        .map(|i| self.centre[(self.centre_len - 1 - i) % window])
+                        .sum::<f64>()
+                        / k as f64
+                };
+                if mean_last(recent) > mean_last(window) {
+                    out.push(StopReason::CentreStagnation);
+                }
+            }
+        }
+        if self.invalid {
+            out.push(StopReason::InvalidFitness);
+        }
+        if self.degenerate {
+            out.push(StopReason::Degenerate);
+        }
+        out
+    }
+
+    /// Evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    /// Generations (`tell` calls) so far.
+    pub fn generations(&self) -> u64 {
+        self.generations
+    }
+
+    /// The best point so far (the start mean before any evaluation).
+    pub fn best_x(&self) -> &[f64] {
+        &self.best_x
+    }
+
+    /// The best value so far (+∞ before any evaluation).
+    pub fn best_f(&self) -> f64 {
+        self.best_f
+    }
+
+    /// The evaluation (1-based count) at which the best value was found.
+    pub fn best_at(&self) -> u64 {
+        self.best_at
+    }
+
+    /// The stopping rules in force.
+    pub fn stop_options(&self) -> &StopOptions {
+        &self.stop
+    }
+}
+
+/// An ask/tell optimiser minimising a function of `dim()` variables.
+///
+/// Each generation: `ask` hands out candidates (reused buffers: no allocation), the caller
+/// evaluates them in any order or in parallel, `tell` takes their values in the same order.
+/// NaN or −∞ values are recorded as [`StopReason::InvalidFitness`], never a panic.
+pub trait Optimizer {
+    /// The algorithm's short name.
+    fn name(&self) -> &'static str;
+    /// Number of variables.
+    fn dim(&self) -> usize;
+    /// Candidates of the next generation.
+    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>];
+    /// Values of the candidates of the last `ask`, in order.
+    fn tell(&mut self, fitness: &[f64]) -> Result<()>;
+    /// The centre of the search distribution (the current point for single-point methods).
+    fn mean(&self) -> &[f64];
+    /// The largest standard deviation of the search distribution (for TolX).
+    fn spread(&self) -> f64;
+    /// Counts, best point and stopping histories.
+    fn state(&self) -> &State;
+    /// Mutable bookkeeping (for [`Optimizer::record_centre_fitness`]).
+    fn state_mut(&mut self) -> &mut State;
+
+    /// Every stopping reason that holds now (empty: go on).
+    fn stop(&self) -> Vec<StopReason> {
+        self.state().reasons(self.spread())
+    }
+
+    /// Records the fitness `f` of the distribution centre `centre` (a copy of [`Optimizer::mean`])
+    /// for the centre-stagnation rule; it counts as an evaluation.
+    fn record_centre_fitness(&mut self, centre: &[f64], f: f64) {
+        self.state_mut().record_centre(centre, f);
+    }
+}

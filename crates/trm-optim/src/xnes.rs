@@ -1,0 +1,203 @@
+//! xNES, the exponential natural evolution strategy (Glasmachers, Schaul, Sun, Wierstra and
+//! Schmidhuber, "Exponential natural evolution strategies", GECCO 2010): the search distribution
+//! N(μ, σ²BBᵀ) with det B = 1 follows the natural gradient of the expected rank-based utility;
+//! B is updated multiplicatively through a matrix exponential.
+
+use nalgebra::{DMatrix, DVector};
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::core::{Optimizer, Start, State};
+use crate::error::{Result, invalid};
+use crate::linalg::{expm_small, fill_normal, rank};
+
+/// xNES settings; `None` = the paper's default.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct XnesOptions {
+    /// Population size λ (default 4 + ⌊3 ln d⌋).
+    pub population: Option<usize>,
+    /// Learning rate of the mean (default 1).
+    pub eta_mean: Option<f64>,
+    /// Learning rate of the step size (default 3(3 + ln d)/(5 d √d)).
+    pub eta_sigma: Option<f64>,
+    /// Learning rate of the shape matrix B (default as `eta_sigma`).
+    pub eta_b: Option<f64>,
+}
+
+/// Rank-based utilities of the NES papers: max(0, ln(λ/2 + 1) − ln k), normalised, minus 1/λ.
+pub(crate) fn nes_utilities(lambda: usize) -> Vec<f64> {
+    let raw: Vec<f64> = (1..=lambda)
+        .map(|k| ((lambda as f64 / 2.0 + 1.0).ln() - (k as f64).ln()).max(0.0))
+        .collect();
+    let total: f64 = raw.iter().sum();
+    raw.iter()
+        .map(|r| r / total - 1.0 / lambda as f64)
+        .collect()
+}
+
+/// Default NES population size 4 + ⌊3 ln d⌋.
+pub(crate) fn default_population(d: usize) -> usize {
+    4 + (3.0 * (d as f64).ln()).floor() as usize
+}
+
+/// The xNES optimiser.
+#[derive(Debug, Clone)]
+pub struct Xnes {
+    state: State,
+    lambda: usize,
+    eta_mean: f64,
+    eta_sigma: f64,
+    eta_b: f64,
+    utilities: Vec<f64>,
+    mean: DVector<f64>,
+    sigma: f64,
+    b: DMatrix<f64>,
+    /// Samples z (d × λ), and their images B z.
+    z: DMatrix<f64>,
+    bz: DMatrix<f64>,
+    candidates: Vec<Vec<f64>>,
+    order: Vec<usize>,
+    grad_mean: DVector<f64>,
+    step: DVector<f64>,
+    g: DMatrix<f64>,
+    e: DMatrix<f64>,
+    t1: DMatrix<f64>,
+    t2: DMatrix<f64>,
+    mean_slice: Vec<f64>,
+}
+
+impl Xnes {
+    /// A new search. A per-dimension step makes B diagonal with σ their geometric mean.
+    pub fn new(start: &Start, options: &XnesOptions) -> Result<Self> {
+        let steps = start.check()?;
+        let d = steps.len();
+        let lambda = options.population.unwrap_or_else(|| default_population(d));
+        if lambda < 2 {
+            return Err(invalid("population", "xNES needs at least 2 candidates"));
+        }
+        let default_eta = 3.0 * (3.0 + (d as f64).ln()) / (5.0 * d as f64 * (d as f64).sqrt());
+        let eta_mean = options.eta_mean.unwrap_or(1.0);
+        let eta_sigma = options.eta_sigma.unwrap_or(default_eta);
+        let eta_b = options.eta_b.unwrap_or(default_eta);
+        for (field, v) in [
+            ("eta_mean", eta_mean),
+            ("eta_sigma", eta_sigma),
+            ("eta_b", eta_b),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(field, "must be positive and finite"));
+            }
+        }
+        let sigma = (steps.iter().map(|s| s.ln()).sum::<f64>() / d as f64).exp();
+        let b = DMatrix::from_diagonal(&DVector::from_iterator(d, steps.iter().map(|s| s / sigma)));
+        Ok(Xnes {
+            state: State::new(start, lambda),
+            lambda,
+            eta_mean,
+            eta_sigma,
+            eta_b,
+            utilities: nes_utilities(lambda),
+            mean: DVector::from_column_slice(&start.mean),
+            sigma,
+            b,
+            z: DMatrix::zeros(d, lambda),
+            bz: DMatrix::zeros(d, lambda),
+            candidates: vec![vec![0.0; d]; lambda],
+            order: Vec::with_capacity(lambda),
+            grad_mean: DVector::zeros(d),
+            step: DVector::zeros(d),
+            g: DMatrix::zeros(d, d),
+            e: DMatrix::zeros(d, d),
+            t1: DMatrix::zeros(d, d),
+            t2: DMatrix::zeros(d, d),
+            mean_slice: start.mean.clone(),
+        })
+    }
+
+    /// Current global step size σ.
+    pub fn sigma(&self) -> f64 {
+        self.sigma
+    }
+
+    /// Population size λ.
+    pub fn population(&self) -> usize {
+        self.lambda
+    }
+}
+
+impl Optimizer for Xnes {
+    fn name(&self) -> &'static str {
+        "xnes"
+    }
+
+    fn dim(&self) -> usize {
+        self.mean.len()
+    }
+
+    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+        fill_normal(rng, self.z.as_mut_slice());
+        self.bz.gemm(1.0, &self.b, &self.z, 0.0);
+        for (k, x) in self.candidates.iter_mut().enumerate() {
+            for (i, v) in x.iter_mut().enumerate() {
+                *v = self.mean[i] + self.sigma * self.bz[(i, k)];
+            }
+            self.state.clamp(x);
+        }
+        self.state.asked(self.lambda);
+        &self.candidates
+    }
+
+    fn tell(&mut self, fitness: &[f64]) -> Result<()> {
+        self.state.told(&self.candidates, fitness)?;
+        rank(fitness, &mut self.order);
+        let d = self.mean.len();
+        // Natural gradients: G_δ = Σ u_k z_k, G_M = Σ u_k (z_k z_kᵀ − I) (Σ u_k = 0).
+        self.grad_mean.fill(0.0);
+        self.g.fill(0.0);
+        for (rank_k, &k) in self.order.iter().enumerate() {
+            let u = self.utilities[rank_k];
+            let zk = self.z.column(k);
+            self.grad_mean.axpy(u, &zk, 1.0);
+            self.g.ger(u, &zk, &zk, 1.0);
+        }
+        let g_sigma = self.g.trace() / d as f64;
+        for i in 0..d {
+            self.g[(i, i)] -= g_sigma;
+        }
+        // μ ← μ + η_μ σ B G_δ
+        self.step.gemv(1.0, &self.b, &self.grad_mean, 0.0);
+        self.mean.axpy(self.eta_mean * self.sigma, &self.step, 1.0);
+        self.sigma *= (0.5 * self.eta_sigma * g_sigma).exp();
+        // B ← B exp(η_B/2 G_B)
+        self.g *= 0.5 * self.eta_b;
+        expm_small(&self.g, &mut self.e, &mut self.t1, &mut self.t2);
+        self.t1.gemm(1.0, &self.b, &self.e, 0.0);
+        std::mem::swap(&mut self.b, &mut self.t1);
+        if !(self.sigma.is_finite() && self.sigma > 0.0) || self.b.iter().any(|v| !v.is_finite()) {
+            self.state.set_degenerate();
+        }
+        self.mean_slice.copy_from_slice(self.mean.as_slice());
+        Ok(())
+    }
+
+    fn mean(&self) -> &[f64] {
+        &self.mean_slice
+    }
+
+    fn spread(&self) -> f64 {
+        let d = self.mean.len();
+        let max_row = (0..d)
+            .map(|i| self.b.row(i).norm_squared())
+            .fold(0.0, f64::max);
+        self.sigma * max_row.sqrt()
+    }
+
+    fn state(&self) -> &State {
+        &self.state
+    }
+
+    fn state_mut(&mut self) -> &mut State {
+        &mut self.state
+    }
+}
