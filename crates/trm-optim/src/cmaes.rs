@@ -18,6 +18,10 @@ pub struct CmaesOptions {
     pub population: Option<usize>,
     /// Use negative recombination weights for the covariance update (default true).
     pub active: Option<bool>,
+    /// Generations between eigendecompositions of C. Default: the tutorial's lazy rule
+    /// (after λ/((c₁ + c_μ) d · 10) evaluations), which at d = 41, λ = 30 means every
+    /// generation; larger values trade a slightly stale B, D for speed (O(d³) → O(d²)).
+    pub eigen_interval: Option<u64>,
 }
 
 /// The CMA-ES optimiser.
@@ -43,12 +47,15 @@ pub struct Cmaes {
     p_c: DVector<f64>,
     z: DMatrix<f64>,
     y: DMatrix<f64>,
+    /// Scratch: D Z (columns) in `ask`, W° Yᵀ (rows) in `tell`.
+    wyt: DMatrix<f64>,
     candidates: Vec<Vec<f64>>,
     order: Vec<usize>,
     step_y: DVector<f64>,
     step_z: DVector<f64>,
     bz: DVector<f64>,
     eigen_at: u64,
+    eigen_interval: Option<u64>,
     mean_slice: Vec<f64>,
 }
 
@@ -123,12 +130,14 @@ impl Cmaes {
             p_c: DVector::zeros(n),
             z: DMatrix::zeros(n, lambda),
             y: DMatrix::zeros(n, lambda),
+            wyt: DMatrix::zeros(n.max(lambda), n.max(lambda)),
             candidates: vec![vec![0.0; n]; lambda],
             order: Vec::with_capacity(lambda),
             step_y: DVector::zeros(n),
             step_z: DVector::zeros(n),
             bz: DVector::zeros(n),
             eigen_at: 0,
+            eigen_interval: options.eigen_interval.map(|g| g.max(1)),
             mean_slice: start.mean.clone(),
         })
     }
@@ -180,21 +189,26 @@ impl Optimizer for Cmaes {
 
     fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
         let n = self.mean.len();
-        let gap = self.lambda as f64 / (self.c_1 + self.c_mu) / n as f64 / 10.0;
+        let gap = match self.eigen_interval {
+            Some(g) => (g * self.lambda as u64) as f64 - 0.5,
+            None => self.lambda as f64 / (self.c_1 + self.c_mu) / n as f64 / 10.0,
+        };
         if (self.state.evaluations() - self.eigen_at) as f64 > gap {
             self.decompose();
         }
         fill_normal(rng, self.z.as_mut_slice());
-        // y = B D z
+        // Y = B (D Z)
         for k in 0..self.lambda {
             for i in 0..n {
-                self.step_z[i] = self.d[i] * self.z[(i, k)];
+                self.wyt[(i, k)] = self.d[i] * self.z[(i, k)];
             }
-            self.bz.gemv(1.0, &self.b, &self.step_z, 0.0);
-            self.y.set_column(k, &self.bz);
+        }
+        self.y
+            .gemm(1.0, &self.b, &self.wyt.view((0, 0), (n, self.lambda)), 0.0);
+        for k in 0..self.lambda {
             let x = &mut self.candidates[k];
             for i in 0..n {
-                x[i] = self.mean[i] + self.sigma * self.bz[i];
+                x[i] = self.mean[i] + self.sigma * self.y[(i, k)];
             }
             self.state.clamp(x);
         }
@@ -236,20 +250,25 @@ impl Optimizer for Cmaes {
         let decay = 1.0 + self.c_1 * delta - self.c_1 - self.c_mu * weight_sum;
         self.c *= decay;
         self.c.ger(self.c_1, &self.p_c, &self.p_c, 1.0);
+        // rank-μ update C += c_μ Y W° Yᵀ, as one product Y (W° Yᵀ)
         for (r, &k) in self.order.iter().enumerate() {
             let w = self.weights[r];
-            if w == 0.0 {
-                continue;
-            }
             // for negative weights, w° = w n / ‖C^{-1/2} y‖² and C^{-1/2} y = B z
-            let w = if w > 0.0 {
+            let w = if w >= 0.0 {
                 w
             } else {
                 w * nf / self.z.column(k).norm_squared().max(1e-300)
             };
-            let yk = self.y.column(k);
-            self.c.ger(self.c_mu * w, &yk, &yk, 1.0);
+            for i in 0..n {
+                self.wyt[(k, i)] = w * self.y[(i, k)];
+            }
         }
+        self.c.gemm(
+            self.c_mu,
+            &self.y,
+            &self.wyt.view((0, 0), (self.lambda, n)),
+            1.0,
+        );
         self.sigma *= ((cs / self.d_sigma) * (ps_norm / self.chi_n - 1.0)).exp();
         if !(self.sigma.is_finite() && self.sigma > 0.0) {
             self.state.set_degenerate();

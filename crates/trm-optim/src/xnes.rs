@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
 use crate::error::{Result, invalid};
-use crate::linalg::{expm_small, fill_normal, rank};
+use crate::linalg::{ExpmScratch, expm, fill_normal, rank};
 
 /// xNES settings; `None` = the paper's default.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -56,6 +56,7 @@ pub struct Xnes {
     /// Samples z (d × λ), and their images B z.
     z: DMatrix<f64>,
     bz: DMatrix<f64>,
+    uzt: DMatrix<f64>,
     candidates: Vec<Vec<f64>>,
     order: Vec<usize>,
     grad_mean: DVector<f64>,
@@ -63,7 +64,7 @@ pub struct Xnes {
     g: DMatrix<f64>,
     e: DMatrix<f64>,
     t1: DMatrix<f64>,
-    t2: DMatrix<f64>,
+    expm_scratch: ExpmScratch,
     mean_slice: Vec<f64>,
 }
 
@@ -103,6 +104,7 @@ impl Xnes {
             b,
             z: DMatrix::zeros(d, lambda),
             bz: DMatrix::zeros(d, lambda),
+            uzt: DMatrix::zeros(lambda, d),
             candidates: vec![vec![0.0; d]; lambda],
             order: Vec::with_capacity(lambda),
             grad_mean: DVector::zeros(d),
@@ -110,7 +112,7 @@ impl Xnes {
             g: DMatrix::zeros(d, d),
             e: DMatrix::zeros(d, d),
             t1: DMatrix::zeros(d, d),
-            t2: DMatrix::zeros(d, d),
+            expm_scratch: ExpmScratch::new(d),
             mean_slice: start.mean.clone(),
         })
     }
@@ -153,13 +155,23 @@ impl Optimizer for Xnes {
         rank(fitness, &mut self.order);
         let d = self.mean.len();
         // Natural gradients: G_δ = Σ u_k z_k, G_M = Σ u_k (z_k z_kᵀ − I) (Σ u_k = 0).
-        self.grad_mean.fill(0.0);
-        self.g.fill(0.0);
+        // U Zᵀ (λ × d), then G_M = Z (U Zᵀ) and G_δ = (U Zᵀ)ᵀ 1
         for (rank_k, &k) in self.order.iter().enumerate() {
             let u = self.utilities[rank_k];
-            let zk = self.z.column(k);
-            self.grad_mean.axpy(u, &zk, 1.0);
-            self.g.ger(u, &zk, &zk, 1.0);
+            for i in 0..d {
+                self.uzt[(k, i)] = u * self.z[(i, k)];
+            }
+        }
+        self.g.gemm(1.0, &self.z, &self.uzt, 0.0);
+        for j in 0..d {
+            for i in 0..j {
+                let v = 0.5 * (self.g[(i, j)] + self.g[(j, i)]);
+                self.g[(i, j)] = v;
+                self.g[(j, i)] = v;
+            }
+        }
+        for i in 0..d {
+            self.grad_mean[i] = self.uzt.column(i).sum();
         }
         let g_sigma = self.g.trace() / d as f64;
         for i in 0..d {
@@ -171,7 +183,7 @@ impl Optimizer for Xnes {
         self.sigma *= (0.5 * self.eta_sigma * g_sigma).exp();
         // B ← B exp(η_B/2 G_B)
         self.g *= 0.5 * self.eta_b;
-        expm_small(&self.g, &mut self.e, &mut self.t1, &mut self.t2);
+        expm(&self.g, &mut self.e, &mut self.expm_scratch);
         self.t1.gemm(1.0, &self.b, &self.e, 0.0);
         std::mem::swap(&mut self.b, &mut self.t1);
         if !(self.sigma.is_finite() && self.sigma > 0.0) || self.b.iter().any(|v| !v.is_finite()) {
