@@ -1,6 +1,7 @@
 //! The hot path does not allocate: a counting global allocator sees no allocation during
 //! thousands of forward-kinematics passes (checked and unchecked, motor and joint inputs) and
-//! collision queries (placing bodies, self and world counts, early-exit checks, distances).
+//! collision queries (placing bodies, self and world counts, early-exit checks, distances), and
+//! optimiser generations (ask/tell) after the first.
 //! It lives here, in the crate that depends on every library, so one allocator covers them all.
 
 // A global allocator can only be written with `unsafe`; it forwards to the system allocator.
@@ -94,4 +95,55 @@ fn collision_queries_never_allocate() {
         "collision queries allocated {} times",
         after - before
     );
+}
+
+#[test]
+fn optimiser_generations_never_allocate() {
+    use rand::SeedableRng;
+    let start = trm_optim::Start::new(vec![0.3; 12], 0.2).with_stop(trm_optim::StopOptions {
+        tol_x: None,
+        tol_fun: None,
+        ..Default::default()
+    });
+    // Our own buffers are reused everywhere. The exceptions are inside nalgebra: its matrix
+    // products (through matrixmultiply) allocate packing buffers, one per product (xNES makes
+    // 8 per generation, CMA-ES 3), and CMA-ES's eigendecomposition allocates its result.
+    for (algo, products) in [
+        ("xnes", 10), // 8 products, plus squarings of larger exponentials
+        ("snes", 0),
+        ("oneplusone", 0),
+        ("sir", 0),
+        ("sird", 0),
+        ("mh", 0),
+        ("simplex", 0),
+    ] {
+        let mut o = trm_optim::by_name(algo, &start, None).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let mut fitness = vec![0.0; 400];
+        let mut step = |o: &mut Box<dyn trm_optim::Optimizer + Send>, fitness: &mut Vec<f64>| {
+            let n = {
+                let xs = o.ask(&mut rng);
+                for (f, x) in fitness.iter_mut().zip(xs) {
+                    *f = x.iter().map(|v| v * v).sum();
+                }
+                xs.len()
+            };
+            o.tell(&fitness[..n]).unwrap();
+            let _ = o.stop();
+        };
+        for _ in 0..3 {
+            step(&mut o, &mut fitness);
+        }
+        let before = allocations();
+        for _ in 0..200 {
+            step(&mut o, &mut fitness);
+        }
+        let after = allocations();
+        // `stop()` returns a Vec of reasons: empty while running, so no allocation
+        assert!(
+            after - before <= 200 * products,
+            "{algo} allocated {} times in 200 generations",
+            after - before
+        );
+    }
 }

@@ -5,6 +5,7 @@ mod fk;
 mod gen_acm;
 mod gen_icub;
 mod model_info;
+mod optimise;
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -36,6 +37,8 @@ enum Command {
     GenAcm(gen_acm::Args),
     /// Regenerate models/icub_upper_body.{urdf,ron} from the official iCub files in models/.
     GenIcub,
+    /// Run an optimiser on a test function several times: evaluations to target and a summary.
+    Optimise(optimise::Args),
 }
 
 fn main() {
@@ -46,6 +49,7 @@ fn main() {
         Command::Collide(args) => collide::run(&args),
         Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
+        Command::Optimise(args) => optimise::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

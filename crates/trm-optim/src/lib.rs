@@ -39,6 +39,7 @@
 // Numeric kernels index several arrays in step, and `!(x > 0.0)` deliberately catches NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod algorithms;
 pub mod cmaes;
 mod core;
 mod error;
@@ -52,6 +53,7 @@ pub mod sir;
 pub mod snes;
 pub mod xnes;
 
+pub use algorithms::{ALGORITHMS, by_name};
 pub use cmaes::{Cmaes, CmaesOptions};
 pub use core::{Bounds, Optimizer, Start, State, StepSize, StopOptions, StopReason};
 pub use error::{OptimError, Result};

@@ -6,17 +6,11 @@ use rand_chacha::ChaCha8Rng;
 use trm_optim::functions::TestFunction;
 use trm_optim::*;
 
-fn optimiser(algo: &str, start: &Start) -> Box<dyn Optimizer> {
+fn optimiser(algo: &str, start: &Start) -> Box<dyn Optimizer + Send> {
     match algo {
-        "xnes" => Box::new(Xnes::new(start, &XnesOptions::default()).unwrap()),
-        "snes" => Box::new(Snes::new(start, &SnesOptions::default()).unwrap()),
-        "cmaes" => Box::new(Cmaes::new(start, &CmaesOptions::default()).unwrap()),
-        "oneplusone" => Box::new(OnePlusOne::new(start, &OnePlusOneOptions::default()).unwrap()),
-        "simplex" => Box::new(NelderMead::new(start, &SimplexOptions::default()).unwrap()),
-        "sir" => Box::new(Sir::new(start, &SirOptions::default()).unwrap()),
-        "sird" => Box::new(Sir::new(start, &SirOptions::direct()).unwrap()),
+        // a colder chain than the default, so the random walk follows the slope
         "mh" => Box::new(MetropolisHastings::new(start, &MhOptions { temperature: 0.01 }).unwrap()),
-        _ => unreachable!(),
+        _ => by_name(algo, start, None).unwrap(),
     }
 }
 

@@ -18,36 +18,10 @@ const ALGOS: [&str; 8] = [
     "mh",
 ];
 
-fn optimiser(algo: &str, start: &Start) -> Box<dyn Optimizer> {
-    match algo {
-        "xnes" => Box::new(Xnes::new(start, &XnesOptions::default()).unwrap()),
-        "snes" => Box::new(Snes::new(start, &SnesOptions::default()).unwrap()),
-        "cmaes" => Box::new(Cmaes::new(start, &CmaesOptions::default()).unwrap()),
-        "oneplusone" => Box::new(OnePlusOne::new(start, &OnePlusOneOptions::default()).unwrap()),
-        "simplex" => Box::new(NelderMead::new(start, &SimplexOptions::default()).unwrap()),
-        "sir" => Box::new(
-            Sir::new(
-                start,
-                &SirOptions {
-                    particles: 20,
-                    ..Default::default()
-                },
-            )
-            .unwrap(),
-        ),
-        "sird" => Box::new(
-            Sir::new(
-                start,
-                &SirOptions {
-                    particles: 20,
-                    ..SirOptions::direct()
-                },
-            )
-            .unwrap(),
-        ),
-        "mh" => Box::new(MetropolisHastings::new(start, &MhOptions::default()).unwrap()),
-        _ => unreachable!(),
-    }
+fn optimiser(algo: &str, start: &Start) -> Box<dyn Optimizer + Send> {
+    // small particle sets keep the tests fast
+    let particles = algo.starts_with("sir").then_some(20);
+    by_name(algo, start, particles).unwrap()
 }
 
 fn budget(n: u64) -> StopOptions {
