@@ -1,0 +1,278 @@
+//! Cost functions h_i(p, q, w) ≥ 0 (Table I of Stollenga et al., IROS 2013, with the parameters
+//! the paper describes). Implement [`Cost`] to add your own.
+
+use trm_kinematics::FrameId;
+use trm_kinematics::nalgebra::Vector3;
+
+use crate::context::{Anchor, Context};
+
+/// A cost term. `eval` must return a value ≥ 0 (NaN marks an invalid candidate).
+pub trait Cost: Send + Sync + std::fmt::Debug {
+    /// A short label for breakdowns, e.g. `position r_palm_center`.
+    fn label(&self) -> String;
+    /// Whether the term reads the placed collision bodies.
+    fn needs_collision(&self) -> bool {
+        false
+    }
+    /// The cost of one candidate.
+    fn eval(&self, ctx: &Context) -> f64;
+}
+
+#[inline]
+fn masked_norm(v: Vector3<f64>, mask: [bool; 3]) -> f64 {
+    (0..3)
+        .filter(|&i| mask[i])
+        .map(|i| v[i] * v[i])
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// ‖W (q − q*)‖ over the active values, W diagonal (e.g. the torso costlier than the arms).
+#[derive(Debug, Clone)]
+pub struct HomePosture {
+    /// q* for the active values.
+    pub home: Vec<f64>,
+    /// Per-value weights.
+    pub weights: Vec<f64>,
+}
+
+impl Cost for HomePosture {
+    fn label(&self) -> String {
+        "home posture".into()
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        ctx.q
+            .iter()
+            .zip(&self.home)
+            .zip(&self.weights)
+            .map(|((q, h), w)| (w * (q - h)).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+/// The number of colliding pairs: self (checked link pairs) and/or with world objects.
+#[derive(Debug, Clone)]
+pub struct Collision {
+    /// Count the robot's own pairs.
+    pub self_collision: bool,
+    /// Count (link, object) pairs.
+    pub world: bool,
+}
+
+impl Cost for Collision {
+    fn label(&self) -> String {
+        "collision".into()
+    }
+    fn needs_collision(&self) -> bool {
+        true
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let mut n = 0;
+        if self.self_collision {
+            n += ctx.collision.count_self(ctx.placed);
+        }
+        if self.world {
+            n += ctx.collision.count_world(ctx.placed, ctx.world);
+        }
+        n as f64
+    }
+}
+
+/// Where a position term pulls a part.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Region {
+    /// A point: a fixed point, another part, or an object.
+    Point(Anchor),
+    /// An axis-aligned box in the world frame (zero cost inside).
+    Box {
+        /// Lower corner.
+        min: [f64; 3],
+        /// Upper corner.
+        max: [f64; 3],
+    },
+    /// A ball around an anchor (zero cost inside).
+    Sphere {
+        /// Centre.
+        center: Anchor,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+/// ‖mask ⊙ (v_part − v*)‖, or the distance to a box or ball (zero inside). Masking an axis
+/// attracts to a plane (one axis off) or a line (two off).
+#[derive(Debug, Clone)]
+pub struct Position {
+    /// The attracted frame.
+    pub part: FrameId,
+    /// Its name, for labels.
+    pub part_name: String,
+    /// The target.
+    pub target: Region,
+    /// Axes that count.
+    pub mask: [bool; 3],
+}
+
+impl Cost for Position {
+    fn label(&self) -> String {
+        format!("position {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let v = ctx.position(&Anchor::Frame(self.part));
+        match &self.target {
+            Region::Point(a) => masked_norm(v - ctx.position(a), self.mask),
+            Region::Box { min, max } => {
+                let outside = Vector3::from_fn(|i, _| {
+                    (min[i] - v[i]).max(0.0) + (v[i] - max[i]).max(0.0)
+                });
+                masked_norm(outside, self.mask)
+            }
+            Region::Sphere { center, radius } => {
+                (masked_norm(v - ctx.position(center), self.mask) - radius).max(0.0)
+            }
+        }
+    }
+}
+
+/// A desired direction for a part's axis.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Direction {
+    /// A fixed unit vector in the world frame.
+    Fixed(Vector3<f64>),
+    /// Another frame's axis (unit, in that frame).
+    Axis(FrameId, Vector3<f64>),
+}
+
+/// (1 − uᵀ u*)/2 ∈ [0, 1]: 0 when the part's axis u points along u*, 1 when opposite.
+#[derive(Debug, Clone)]
+pub struct Orientation {
+    /// The frame.
+    pub part: FrameId,
+    /// Its name, for labels.
+    pub part_name: String,
+    /// The axis, unit, in the frame.
+    pub axis: Vector3<f64>,
+    /// The desired direction.
+    pub target: Direction,
+}
+
+impl Cost for Orientation {
+    fn label(&self) -> String {
+        format!("orientation {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let u = ctx.axis(self.part, &self.axis);
+        let want = match &self.target {
+            Direction::Fixed(d) => *d,
+            Direction::Axis(f, a) => ctx.axis(*f, a),
+        };
+        (1.0 - u.dot(&want)) / 2.0
+    }
+}
+
+/// (1 − uᵀ (v_t − v)/‖v_t − v‖)/2: the part's axis points at the target; plus, optionally,
+/// |‖v_t − v‖ − d| to hold it at distance d.
+#[derive(Debug, Clone)]
+pub struct Pointing {
+    /// The pointing frame.
+    pub part: FrameId,
+    /// Its name, for labels.
+    pub part_name: String,
+    /// The axis, unit, in the frame.
+    pub axis: Vector3<f64>,
+    /// What to point at.
+    pub target: Anchor,
+    /// Optional distance to keep.
+    pub distance: Option<f64>,
+}
+
+impl Cost for Pointing {
+    fn label(&self) -> String {
+        format!("pointing {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let v = ctx.position(&Anchor::Frame(self.part));
+        let to = ctx.position(&self.target) - v;
+        let norm = to.norm();
+        let u = ctx.axis(self.part, &self.axis);
+        let aim = if norm > 0.0 {
+            (1.0 - u.dot(&to) / norm) / 2.0
+        } else {
+            0.0
+        };
+        aim + self.distance.map_or(0.0, |d| (norm - d).abs())
+    }
+}
+
+/// max(0, d − ‖mask ⊙ (v_a − v_b)‖)/d: pushes two anchors apart until they are d apart.
+#[derive(Debug, Clone)]
+pub struct Repel {
+    /// First anchor.
+    pub a: Anchor,
+    /// Second anchor.
+    pub b: Anchor,
+    /// Label text.
+    pub names: String,
+    /// Distance from which repulsion starts.
+    pub min_distance: f64,
+    /// Axes that count.
+    pub mask: [bool; 3],
+}
+
+impl Cost for Repel {
+    fn label(&self) -> String {
+        format!("repel {}", self.names)
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let d = masked_norm(ctx.position(&self.a) - ctx.position(&self.b), self.mask);
+        (self.min_distance - d).max(0.0) / self.min_distance
+    }
+}
+
+/// Σ over active values of how far they enter the margin band inside their limits, in margins:
+/// (max(0, lower + m − q) + max(0, q − upper + m))/m.
+#[derive(Debug, Clone)]
+pub struct JointLimits {
+    /// Lower limits of the active values.
+    pub lower: Vec<f64>,
+    /// Upper limits.
+    pub upper: Vec<f64>,
+    /// Margin (radians).
+    pub margin: f64,
+}
+
+impl Cost for JointLimits {
+    fn label(&self) -> String {
+        "joint limits".into()
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let m = self.margin;
+        ctx.q
+            .iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .map(|(q, (l, u))| ((l + m - q).max(0.0) + (q - u + m).max(0.0)) / m)
+            .sum()
+    }
+}
+
+/// ‖q − q_start‖: minimal displacement from a start posture.
+#[derive(Debug, Clone)]
+pub struct Displacement {
+    /// The start, active values.
+    pub start: Vec<f64>,
+}
+
+impl Cost for Displacement {
+    fn label(&self) -> String {
+        "displacement".into()
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        ctx.q
+            .iter()
+            .zip(&self.start)
+            .map(|(q, s)| (q - s).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+}

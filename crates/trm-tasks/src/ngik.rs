@@ -1,0 +1,86 @@
+//! NGIK: natural-gradient inverse kinematics — minimise the objective over the active motors with
+//! any optimiser of `trm-optim`, evaluating each population in parallel (results do not depend
+//! on the thread count: every candidate's value is a pure function of it).
+
+use std::time::{Duration, Instant};
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use trm_optim::{Bounds, Start, StopOptions, StopReason, by_name, minimize};
+
+use crate::error::Result;
+use crate::objective::{Objective, TermValue};
+use crate::spec::SolverSpec;
+
+/// A solved posture.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Active motor values.
+    pub q: Vec<f64>,
+    /// The full motor vector.
+    pub motors: Vec<f64>,
+    /// Final cost (with noise, if the objective has it).
+    pub cost: f64,
+    /// Per-term values at `q` (without noise).
+    pub breakdown: Vec<TermValue>,
+    /// Evaluations in total.
+    pub evaluations: u64,
+    /// Evaluation at which the best was found.
+    pub best_at: u64,
+    /// Why the search stopped.
+    pub reasons: Vec<StopReason>,
+    /// Free of self- and world collisions (the hard constraint of roadmaps).
+    pub collision_free: bool,
+    /// The task vector at `q` (empty without a task function).
+    pub task: Vec<f64>,
+    /// Wall time of the search.
+    pub wall_time: Duration,
+    /// Best-so-far trace `(evaluations, cost)`.
+    pub trace: Vec<(u64, f64)>,
+}
+
+/// Minimises `objective` from the active values `start` with the solver settings. Candidates
+/// are kept within the motor limits.
+pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Solution> {
+    let (lower, upper) = objective.active().bounds();
+    let settings = Start::new(start.to_vec(), solver.sigma)
+        .with_bounds(Bounds::new(lower, upper)?)
+        .with_stop(StopOptions {
+            max_evaluations: Some(solver.max_evaluations),
+            no_improvement_evaluations: solver.no_improvement,
+            target: solver.target,
+            ..Default::default()
+        });
+    let mut optimizer = by_name(&solver.algo, &settings, solver.population)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(solver.seed);
+    let started = Instant::now();
+    let report = minimize(
+        optimizer.as_mut(),
+        &mut rng,
+        |xs, out| {
+            xs.par_iter()
+                .zip(out.par_iter_mut())
+                .for_each_init(|| objective.scratch(), |scratch, (x, o)| {
+                    *o = objective.eval(x, scratch);
+                });
+        },
+        |_| true,
+    );
+    let wall_time = started.elapsed();
+    let mut scratch = objective.scratch();
+    let (_, breakdown) = objective.breakdown(&report.best_x, &mut scratch);
+    Ok(Solution {
+        motors: objective.active().to_motors(&report.best_x),
+        collision_free: objective.is_collision_free(&report.best_x, &mut scratch),
+        task: objective.task_value(&report.best_x, &mut scratch),
+        q: report.best_x,
+        cost: report.best_f,
+        breakdown,
+        evaluations: report.evaluations,
+        best_at: report.best_at_evaluation,
+        reasons: report.reasons,
+        wall_time,
+        trace: report.trace,
+    })
+}

@@ -1,0 +1,185 @@
+//! Task functions g(p, q, w) → ℝᵐ (Table II of Stollenga et al., IROS 2013, plus the composites
+//! the bimanual maps need). Implement [`TaskFunction`] to add your own.
+
+use trm_kinematics::FrameId;
+use trm_kinematics::nalgebra::Vector3;
+
+use crate::context::{Anchor, Context};
+
+/// A task function.
+pub trait TaskFunction: Send + Sync + std::fmt::Debug {
+    /// Output dimension m.
+    fn dim(&self) -> usize;
+    /// A short label.
+    fn label(&self) -> String;
+    /// Writes g into `out` (length `dim()`).
+    fn eval(&self, ctx: &Context, out: &mut [f64]);
+}
+
+fn write_masked(v: Vector3<f64>, mask: [bool; 3], out: &mut [f64]) {
+    let mut k = 0;
+    for i in 0..3 {
+        if mask[i] {
+            out[k] = v[i];
+            k += 1;
+        }
+    }
+}
+
+fn mask_dim(mask: [bool; 3]) -> usize {
+    mask.iter().filter(|m| **m).count()
+}
+
+/// The position of a part (masked): g = v_part.
+#[derive(Debug, Clone)]
+pub struct PositionTask {
+    /// The frame.
+    pub part: FrameId,
+    /// Its name.
+    pub part_name: String,
+    /// Axes kept.
+    pub mask: [bool; 3],
+}
+
+impl TaskFunction for PositionTask {
+    fn dim(&self) -> usize {
+        mask_dim(self.mask)
+    }
+    fn label(&self) -> String {
+        format!("position {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        write_masked(ctx.position(&Anchor::Frame(self.part)).coords, self.mask, out);
+    }
+}
+
+/// The direction of a part's axis (masked): g = R_part u.
+#[derive(Debug, Clone)]
+pub struct RotationTask {
+    /// The frame.
+    pub part: FrameId,
+    /// Its name.
+    pub part_name: String,
+    /// The axis, unit, in the frame.
+    pub axis: Vector3<f64>,
+    /// Components kept.
+    pub mask: [bool; 3],
+}
+
+impl TaskFunction for RotationTask {
+    fn dim(&self) -> usize {
+        mask_dim(self.mask)
+    }
+    fn label(&self) -> String {
+        format!("rotation {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        write_masked(ctx.axis(self.part, &self.axis), self.mask, out);
+    }
+}
+
+/// ‖v_a − v_b‖.
+#[derive(Debug, Clone)]
+pub struct DistanceTask {
+    /// First anchor.
+    pub a: Anchor,
+    /// Second anchor.
+    pub b: Anchor,
+    /// Label text.
+    pub names: String,
+}
+
+impl TaskFunction for DistanceTask {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn label(&self) -> String {
+        format!("distance {}", self.names)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        out[0] = (ctx.position(&self.a) - ctx.position(&self.b)).norm();
+    }
+}
+
+/// atan2(u₂ᵀ(v_a − v_b), u₁ᵀ(v_a − v_b)): the angle of the vector from b to a projected on the
+/// plane spanned by u₁, u₂ (world frame).
+#[derive(Debug, Clone)]
+pub struct AngleTask {
+    /// First anchor.
+    pub a: Anchor,
+    /// Second anchor.
+    pub b: Anchor,
+    /// Label text.
+    pub names: String,
+    /// First plane axis.
+    pub u1: Vector3<f64>,
+    /// Second plane axis.
+    pub u2: Vector3<f64>,
+}
+
+impl TaskFunction for AngleTask {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn label(&self) -> String {
+        format!("angle {}", self.names)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        let v = ctx.position(&self.a) - ctx.position(&self.b);
+        out[0] = self.u2.dot(&v).atan2(self.u1.dot(&v));
+    }
+}
+
+/// The midpoint of two anchors (masked): bimanual maps.
+#[derive(Debug, Clone)]
+pub struct MidpointTask {
+    /// First anchor.
+    pub a: Anchor,
+    /// Second anchor.
+    pub b: Anchor,
+    /// Label text.
+    pub names: String,
+    /// Axes kept.
+    pub mask: [bool; 3],
+}
+
+impl TaskFunction for MidpointTask {
+    fn dim(&self) -> usize {
+        mask_dim(self.mask)
+    }
+    fn label(&self) -> String {
+        format!("midpoint {}", self.names)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        let m = (ctx.position(&self.a).coords + ctx.position(&self.b).coords) / 2.0;
+        write_masked(m, self.mask, out);
+    }
+}
+
+/// The unit direction of a virtual rod from a to b (masked): bimanual rotation maps.
+#[derive(Debug, Clone)]
+pub struct RodDirectionTask {
+    /// First anchor.
+    pub a: Anchor,
+    /// Second anchor.
+    pub b: Anchor,
+    /// Label text.
+    pub names: String,
+    /// Components kept.
+    pub mask: [bool; 3],
+}
+
+impl TaskFunction for RodDirectionTask {
+    fn dim(&self) -> usize {
+        mask_dim(self.mask)
+    }
+    fn label(&self) -> String {
+        format!("rod direction {}", self.names)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        let v = ctx.position(&self.b) - ctx.position(&self.a);
+        let n = v.norm();
+        let u = if n > 0.0 { v / n } else { Vector3::zeros() };
+        write_masked(u, self.mask, out);
+    }
+}
