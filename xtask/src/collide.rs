@@ -90,14 +90,15 @@ pub fn run(args: &Args) -> Result<()> {
         }));
     }
     if let Some(out) = &args.out {
-        let text = serde_json::to_string_pretty(&json!({
-            "model": model.origin(),
-            "configs": args.configs,
-            "world": args.world,
-            "samples": results,
-        }))?;
-        crate::write_atomic(out, text.as_bytes())?;
-        eprintln!("wrote {}", out.display());
+        crate::write_json(
+            out,
+            &json!({
+                "model": model.origin(),
+                "configs": args.configs,
+                "world": args.world,
+                "samples": results,
+            }),
+        )?;
     }
     Ok(())
 }

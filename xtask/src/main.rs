@@ -1,11 +1,13 @@
 //! `cargo xtask <command>`: the commands people run with trm. `cargo xtask --help` lists them.
 
 mod collide;
+mod compare;
 mod fk;
 mod gen_acm;
 mod gen_icub;
 mod model_info;
 mod optimise;
+mod solve;
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -31,6 +33,8 @@ enum Command {
     ModelInfo(model_info::Args),
     /// Forward kinematics of joint configurations read from JSON (world poses of every link).
     Fk(fk::Args),
+    /// Table III: xNES against SIR, SIRD, MH, Nelder-Mead (and CMA-ES, (1+1)-CMA-ES) on two postures.
+    CompareOptimisers(compare::Args),
     /// Colliding pairs and minimum self-distance of joint configurations read from JSON.
     Collide(collide::Args),
     /// Generate a model's allowed-collision matrix (the description's `disabled_collisions`).
@@ -39,6 +43,8 @@ enum Command {
     GenIcub,
     /// Run an optimiser on a test function several times: evaluations to target and a summary.
     Optimise(optimise::Args),
+    /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
+    Solve(solve::Args),
 }
 
 fn main() {
@@ -47,9 +53,11 @@ fn main() {
         Command::ModelInfo(args) => model_info::run(&args),
         Command::Fk(args) => fk::run(&args),
         Command::Collide(args) => collide::run(&args),
+        Command::CompareOptimisers(args) => compare::run(&args),
         Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
         Command::Optimise(args) => optimise::run(&args),
+        Command::Solve(args) => solve::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
@@ -95,6 +103,13 @@ impl MeshArgs {
             model, &options,
         )?)
     }
+}
+
+/// Writes `value` as pretty JSON to `path` (atomically) and says so on stderr.
+fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    write_atomic(path, serde_json::to_string_pretty(value)?.as_bytes())?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a

@@ -38,9 +38,7 @@ impl Context<'_> {
     pub fn position(&self, anchor: &Anchor) -> Point3<f64> {
         match anchor {
             Anchor::Frame(f) => Point3::from(self.poses.pose(*f).translation.vector),
-            Anchor::Object(o) => {
-                Point3::from(self.world.objects()[*o].pose().translation.vector)
-            }
+            Anchor::Object(o) => Point3::from(self.world.objects()[*o].pose().translation.vector),
             Anchor::Point(p) => Point3::from(*p),
         }
     }

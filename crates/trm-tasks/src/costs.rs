@@ -123,9 +123,8 @@ impl Cost for Position {
         match &self.target {
             Region::Point(a) => masked_norm(v - ctx.position(a), self.mask),
             Region::Box { min, max } => {
-                let outside = Vector3::from_fn(|i, _| {
-                    (min[i] - v[i]).max(0.0) + (v[i] - max[i]).max(0.0)
-                });
+                let outside =
+                    Vector3::from_fn(|i, _| (min[i] - v[i]).max(0.0) + (v[i] - max[i]).max(0.0));
                 masked_norm(outside, self.mask)
             }
             Region::Sphere { center, radius } => {

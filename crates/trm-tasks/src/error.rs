@@ -9,14 +9,12 @@ pub type Result<T, E = TaskError> = std::result::Result<T, E>;
 #[derive(Debug, Error)]
 pub enum TaskError {
     /// A spec file problem, located in the file.
-    #[error("{origin}{}: {field}: {problem}{}", location(*line, *column), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
+    #[error("{origin}{}: {field}: {problem}{}", position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
     Spec {
         /// The spec file.
         origin: String,
-        /// 1-based line, when known.
-        line: Option<usize>,
-        /// 1-based column, when known.
-        column: Option<usize>,
+        /// 1-based (line, column), when known.
+        position: Option<(usize, usize)>,
         /// The field or element.
         field: String,
         /// What is wrong.
@@ -49,12 +47,4 @@ pub enum TaskError {
         /// The reason.
         message: String,
     },
-}
-
-fn location(line: Option<usize>, column: Option<usize>) -> String {
-    match (line, column) {
-        (Some(l), Some(c)) => format!(":{l}:{c}"),
-        (Some(l), None) => format!(":{l}"),
-        _ => String::new(),
-    }
 }

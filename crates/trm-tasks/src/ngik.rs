@@ -41,7 +41,8 @@ pub struct Solution {
 }
 
 /// Minimises `objective` from the active values `start` with the solver settings. Candidates
-/// are kept within the motor limits.
+/// are kept within the motor limits. The start itself is evaluated too (one extra evaluation):
+/// the result is never worse than the start.
 pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Solution> {
     let (lower, upper) = objective.active().bounds();
     let settings = Start::new(start.to_vec(), solver.sigma)
@@ -59,16 +60,29 @@ pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Resul
         optimizer.as_mut(),
         &mut rng,
         |xs, out| {
-            xs.par_iter()
-                .zip(out.par_iter_mut())
-                .for_each_init(|| objective.scratch(), |scratch, (x, o)| {
+            xs.par_iter().zip(out.par_iter_mut()).for_each_init(
+                || objective.scratch(),
+                |scratch, (x, o)| {
                     *o = objective.eval(x, scratch);
-                });
+                },
+            );
         },
         |_| true,
     );
-    let wall_time = started.elapsed();
     let mut scratch = objective.scratch();
+    let mut report = report;
+    let mut clamped = start.to_vec();
+    if let Some(b) = &settings.bounds {
+        b.clamp(&mut clamped);
+    }
+    let start_cost = objective.eval(&clamped, &mut scratch);
+    report.evaluations += 1;
+    if start_cost < report.best_f || report.best_f.is_nan() {
+        report.best_f = start_cost;
+        report.best_x = clamped;
+        report.best_at_evaluation = report.evaluations;
+    }
+    let wall_time = started.elapsed();
     let (_, breakdown) = objective.breakdown(&report.best_x, &mut scratch);
     Ok(Solution {
         motors: objective.active().to_motors(&report.best_x),

@@ -40,9 +40,10 @@ pub struct Spec {
     /// Active motors: motor or group names; empty = every motor.
     #[serde(default)]
     pub active: Vec<String>,
-    /// The start posture (and values of locked motors): a posture name of the model.
-    #[serde(default = "home")]
-    pub start: String,
+    /// The start posture (and values of locked motors): a posture name of the model; by default
+    /// `home` if the model has one, else every motor at 0 clamped into its limits.
+    #[serde(default)]
+    pub start: Option<String>,
     /// Motor values overriding the start posture, by motor name.
     #[serde(default)]
     pub start_values: BTreeMap<String, f64>,
@@ -63,10 +64,6 @@ pub struct Spec {
     /// Roadmap settings (used by `build-map`).
     #[serde(default)]
     pub map: Option<MapSpec>,
-}
-
-fn home() -> String {
-    "home".into()
 }
 
 /// `(weight: a, cost: …)`.
@@ -379,19 +376,28 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn err(&self, field: &str, needle: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskError {
-        let at = locate(self.text, needle);
+    fn err(
+        &self,
+        field: &str,
+        needle: &str,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> TaskError {
         TaskError::Spec {
             origin: self.origin.to_string(),
-            line: at.map(|a| a.0),
-            column: at.map(|a| a.1),
+            position: locate(self.text, needle),
             field: field.to_string(),
             problem: problem.into(),
             fix: fix.into(),
         }
     }
 
-    fn suggest<'a>(&self, name: &str, candidates: impl IntoIterator<Item = &'a str>, otherwise: &str) -> String {
+    fn suggest<'a>(
+        &self,
+        name: &str,
+        candidates: impl IntoIterator<Item = &'a str>,
+        otherwise: &str,
+    ) -> String {
         let near = closest_names(name, candidates);
         if near.is_empty() {
             otherwise.to_string()
@@ -422,21 +428,35 @@ impl Problem {
     fn build(spec: Spec, text: &str, origin: &str, base: &Path) -> Result<Self> {
         let ctx = Ctx { origin, text };
         let robot = load_model(&spec.model, base, &ctx)?;
-        let mut motors = robot.posture(&spec.start).map(<[f64]>::to_vec).map_err(|_| {
-            ctx.err(
-                "start",
-                &format!("\"{}\"", spec.start),
-                format!("`{}` is no posture of the model", spec.start),
-                ctx.suggest(&spec.start, robot.posture_names(), "use a posture of the model description"),
-            )
-        })?;
+        let mut motors = match &spec.start {
+            None => robot
+                .posture("home")
+                .map(<[f64]>::to_vec)
+                .unwrap_or_else(|_| robot.neutral_motors()),
+            Some(start) => robot.posture(start).map(<[f64]>::to_vec).map_err(|_| {
+                ctx.err(
+                    "start",
+                    &format!("\"{start}\""),
+                    format!("`{start}` is no posture of the model"),
+                    ctx.suggest(
+                        start,
+                        robot.posture_names(),
+                        "use a posture of the model description",
+                    ),
+                )
+            })?,
+        };
         for (name, v) in &spec.start_values {
             let i = robot.motor_index(name).map_err(|_| {
                 ctx.err(
                     "start_values",
                     &format!("\"{name}\""),
                     format!("`{name}` is no motor"),
-                    ctx.suggest(name, robot.motors().iter().map(|m| m.name.as_str()), "use motor names"),
+                    ctx.suggest(
+                        name,
+                        robot.motors().iter().map(|m| m.name.as_str()),
+                        "use motor names",
+                    ),
                 )
             })?;
             motors[i] = *v;
@@ -465,9 +485,18 @@ impl Problem {
         let collision = CollisionModel::new(&robot)?;
         let start = active.from_motors(&motors);
         if spec.costs.is_empty() {
-            return Err(ctx.err("costs", "costs", "the list is empty", "add at least one weighted cost term"));
+            return Err(ctx.err(
+                "costs",
+                "costs",
+                "the list is empty",
+                "add at least one weighted cost term",
+            ));
         }
-        let resolver = Resolver { robot: &robot, world: &world, ctx: &ctx };
+        let resolver = Resolver {
+            robot: &robot,
+            world: &world,
+            ctx: &ctx,
+        };
         let mut terms = Vec::new();
         for (k, c) in spec.costs.iter().enumerate() {
             if !(c.weight.is_finite() && c.weight >= 0.0) {
@@ -478,7 +507,10 @@ impl Problem {
                     "weights are non-negative multipliers",
                 ));
             }
-            terms.push((c.weight, resolver.cost(&c.cost, &active, &motors, &start, k)?));
+            terms.push((
+                c.weight,
+                resolver.cost(&c.cost, &active, &motors, &start, k)?,
+            ));
         }
         let task = spec.task.as_ref().map(|t| resolver.task(t)).transpose()?;
         let mut objective = Objective::new(active.clone(), collision, world);
@@ -490,7 +522,12 @@ impl Problem {
         }
         if let Some(n) = &spec.noise {
             if !(n.sigma.is_finite() && n.sigma >= 0.0) {
-                return Err(ctx.err("noise.sigma", "sigma", format!("{} is not a finite number ≥ 0", n.sigma), "give a standard deviation in radians"));
+                return Err(ctx.err(
+                    "noise.sigma",
+                    "sigma",
+                    format!("{} is not a finite number ≥ 0", n.sigma),
+                    "give a standard deviation in radians",
+                ));
             }
             objective.set_noise(n.samples, n.sigma, n.seed)?;
         }
@@ -499,15 +536,29 @@ impl Problem {
                 "solver.algo",
                 &format!("\"{}\"", spec.solver.algo),
                 format!("unknown algorithm `{}`", spec.solver.algo),
-                ctx.suggest(&spec.solver.algo, trm_optim::ALGORITHMS, "use one of trm_optim::ALGORITHMS"),
+                ctx.suggest(
+                    &spec.solver.algo,
+                    trm_optim::ALGORITHMS,
+                    "use one of trm_optim::ALGORITHMS",
+                ),
             ));
         }
         if !(spec.solver.sigma.is_finite() && spec.solver.sigma > 0.0) {
-            return Err(ctx.err("solver.sigma", "sigma", "must be positive", "give an initial step in radians"));
+            return Err(ctx.err(
+                "solver.sigma",
+                "sigma",
+                "must be positive",
+                "give an initial step in radians",
+            ));
         }
         if let Some(m) = &spec.map {
             if !(m.spacing.is_finite() && m.spacing > 0.0) {
-                return Err(ctx.err("map.spacing", "spacing", "must be positive", "give the task-space spacing d"));
+                return Err(ctx.err(
+                    "map.spacing",
+                    "spacing",
+                    "must be positive",
+                    "give the task-space spacing d",
+                ));
             }
         }
         Ok(Problem {
@@ -522,7 +573,10 @@ impl Problem {
 
 fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<RobotModel> {
     let embedded = [
-        ("icub_upper_body", trm_models::icub_upper_body as fn() -> RobotModel),
+        (
+            "icub_upper_body",
+            trm_models::icub_upper_body as fn() -> RobotModel,
+        ),
         ("planar_arm", trm_models::planar_arm),
         ("branched_tree", trm_models::branched_tree),
     ];
@@ -534,8 +588,15 @@ fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<RobotModel> {
         return Err(ctx.err(
             "model",
             &format!("\"{name}\""),
-            format!("`{name}` is neither an embedded model nor a file (looked for {})", path.display()),
-            ctx.suggest(name, embedded.iter().map(|(n, _)| *n), "give a .urdf/.ron path relative to the spec, or icub_upper_body"),
+            format!(
+                "`{name}` is neither an embedded model nor a file (looked for {})",
+                path.display()
+            ),
+            ctx.suggest(
+                name,
+                embedded.iter().map(|(n, _)| *n),
+                "give a .urdf/.ron path relative to the spec, or icub_upper_body",
+            ),
         ));
     }
     Ok(RobotModel::load(path)?)
@@ -554,7 +615,11 @@ impl Resolver<'_> {
                 field,
                 &format!("\"{name}\""),
                 format!("`{name}` is no link or named frame of the model"),
-                self.ctx.suggest(name, self.robot.frame_names(), "use link or frame names (cargo xtask model-info --links)"),
+                self.ctx.suggest(
+                    name,
+                    self.robot.frame_names(),
+                    "use link or frame names (cargo xtask model-info --links)",
+                ),
             )
         })
     }
@@ -573,7 +638,11 @@ impl Resolver<'_> {
                 field,
                 &format!("\"{name}\""),
                 format!("`{name}` is no world object"),
-                self.ctx.suggest(name, self.world.objects().iter().map(|o| o.name()), "add it under world: (objects: [...])"),
+                self.ctx.suggest(
+                    name,
+                    self.world.objects().iter().map(|o| o.name()),
+                    "add it under world: (objects: [...])",
+                ),
             )
         })
     }
@@ -582,7 +651,12 @@ impl Resolver<'_> {
         if v.iter().all(|x| x.is_finite()) {
             Ok(v)
         } else {
-            Err(self.ctx.err(field, field, format!("{v:?} is not finite"), "write finite numbers"))
+            Err(self.ctx.err(
+                field,
+                field,
+                format!("{v:?} is not finite"),
+                "write finite numbers",
+            ))
         }
     }
 
@@ -590,7 +664,12 @@ impl Resolver<'_> {
         let v = Vector3::from(self.finite(v, field)?);
         let n = v.norm();
         if n < 1e-12 {
-            return Err(self.ctx.err(field, field, "the axis is zero", "give a non-zero axis, e.g. (0, 0, 1)"));
+            return Err(self.ctx.err(
+                field,
+                field,
+                "the axis is zero",
+                "give a non-zero axis, e.g. (0, 0, 1)",
+            ));
         }
         Ok(v / n)
     }
@@ -599,7 +678,12 @@ impl Resolver<'_> {
         if m.iter().any(|b| *b) {
             Ok(m)
         } else {
-            Err(self.ctx.err(field, "mask", "masks every axis out", "keep at least one axis"))
+            Err(self.ctx.err(
+                field,
+                "mask",
+                "masks every axis out",
+                "keep at least one axis",
+            ))
         }
     }
 
@@ -607,7 +691,12 @@ impl Resolver<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
-            Err(self.ctx.err(field, name, format!("{v} must be positive"), "give a positive length"))
+            Err(self.ctx.err(
+                field,
+                name,
+                format!("{v} must be positive"),
+                "give a positive length",
+            ))
         }
     }
 
@@ -625,17 +714,42 @@ impl Resolver<'_> {
                 let home_motors = match posture {
                     None => motors.to_vec(),
                     Some(p) => self.robot.posture(p).map(<[f64]>::to_vec).map_err(|_| {
-                        self.ctx.err(&field, &format!("\"{p}\""), format!("`{p}` is no posture"), self.ctx.suggest(p, self.robot.posture_names(), "use a posture of the model"))
+                        self.ctx.err(
+                            &field,
+                            &format!("\"{p}\""),
+                            format!("`{p}` is no posture"),
+                            self.ctx.suggest(
+                                p,
+                                self.robot.posture_names(),
+                                "use a posture of the model",
+                            ),
+                        )
                     })?,
                 };
                 let mut w = vec![1.0; active.len()];
                 for (name, value) in weights {
                     if !(value.is_finite() && *value >= 0.0) {
-                        return Err(self.ctx.err(&field, &format!("\"{name}\""), format!("weight {value} is not a finite number ≥ 0"), "use non-negative weights"));
+                        return Err(self.ctx.err(
+                            &field,
+                            &format!("\"{name}\""),
+                            format!("weight {value} is not a finite number ≥ 0"),
+                            "use non-negative weights",
+                        ));
                     }
                     let members = self.robot.select_motors(&[name]).map_err(|_| {
-                        let candidates = self.robot.motors().iter().map(|m| m.name.as_str()).chain(self.robot.groups().map(|(g, _)| g));
-                        self.ctx.err(&field, &format!("\"{name}\""), format!("`{name}` is no motor or group"), self.ctx.suggest(name, candidates, "use motor or group names"))
+                        let candidates = self
+                            .robot
+                            .motors()
+                            .iter()
+                            .map(|m| m.name.as_str())
+                            .chain(self.robot.groups().map(|(g, _)| g));
+                        self.ctx.err(
+                            &field,
+                            &format!("\"{name}\""),
+                            format!("`{name}` is no motor or group"),
+                            self.ctx
+                                .suggest(name, candidates, "use motor or group names"),
+                        )
                     })?;
                     for m in members {
                         if let Some(i) = active.motor_indices().iter().position(|a| *a == m) {
@@ -643,9 +757,15 @@ impl Resolver<'_> {
                         }
                     }
                 }
-                Box::new(HomePosture { home: active.from_motors(&home_motors), weights: w })
+                Box::new(HomePosture {
+                    home: active.from_motors(&home_motors),
+                    weights: w,
+                })
             }
-            CostKind::Collision { self_collision, world } => Box::new(Collision {
+            CostKind::Collision {
+                self_collision,
+                world,
+            } => Box::new(Collision {
                 self_collision: *self_collision,
                 world: *world,
             }),
@@ -657,7 +777,12 @@ impl Resolver<'_> {
                     TargetSpec::Box { min, max } => {
                         let (min, max) = (self.finite(*min, &field)?, self.finite(*max, &field)?);
                         if (0..3).any(|i| min[i] > max[i]) {
-                            return Err(self.ctx.err(&field, "min", "a box min exceeds its max", "swap the corners"));
+                            return Err(self.ctx.err(
+                                &field,
+                                "min",
+                                "a box min exceeds its max",
+                                "swap the corners",
+                            ));
                         }
                         Region::Box { min, max }
                     }
@@ -684,7 +809,12 @@ impl Resolver<'_> {
                     }
                 },
             }),
-            CostKind::Pointing { part, axis, at, distance } => Box::new(Pointing {
+            CostKind::Pointing {
+                part,
+                axis,
+                at,
+                distance,
+            } => Box::new(Pointing {
                 part: self.frame(part, &field)?,
                 part_name: part.clone(),
                 axis: self.unit(*axis, &field)?,
@@ -694,7 +824,12 @@ impl Resolver<'_> {
                     None => None,
                 },
             }),
-            CostKind::Repel { a, b, min_distance, mask } => Box::new(Repel {
+            CostKind::Repel {
+                a,
+                b,
+                min_distance,
+                mask,
+            } => Box::new(Repel {
                 a: self.anchor(a, &field)?,
                 b: self.anchor(b, &field)?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
@@ -703,9 +838,15 @@ impl Resolver<'_> {
             }),
             CostKind::JointLimits { margin } => {
                 let (lower, upper) = active.bounds();
-                Box::new(JointLimits { lower, upper, margin: self.positive(*margin, &field, "margin")? })
+                Box::new(JointLimits {
+                    lower,
+                    upper,
+                    margin: self.positive(*margin, &field, "margin")?,
+                })
             }
-            CostKind::Displacement => Box::new(Displacement { start: start.to_vec() }),
+            CostKind::Displacement => Box::new(Displacement {
+                start: start.to_vec(),
+            }),
         })
     }
 
@@ -762,21 +903,27 @@ fn anchor_name(a: &AnchorSpec) -> String {
 fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
     use ron::error::Error as E;
     let (problem, fix) = match &e.code {
-        E::NoSuchEnumVariant { expected, found, .. } => (
+        E::NoSuchEnumVariant {
+            expected, found, ..
+        } => (
             format!("unknown variant `{found}`"),
             suggestion(found, expected),
         ),
-        E::NoSuchStructField { expected, found, .. } => (
+        E::NoSuchStructField {
+            expected, found, ..
+        } => (
             format!("unknown field `{found}`"),
             suggestion(found, expected),
         ),
-        E::MissingStructField { field, .. } => (format!("missing field `{field}`"), format!("add `{field}: ...`")),
+        E::MissingStructField { field, .. } => (
+            format!("missing field `{field}`"),
+            format!("add `{field}: ...`"),
+        ),
         other => (other.to_string(), String::new()),
     };
     TaskError::Spec {
         origin: origin.to_string(),
-        line: Some(e.span.start.line),
-        column: Some(e.span.start.col),
+        position: Some((e.span.start.line, e.span.start.col)),
         field: "spec".into(),
         problem,
         fix,
@@ -788,6 +935,10 @@ fn suggestion(found: &str, expected: &[&str]) -> String {
     if near.is_empty() {
         format!("expected one of `{}`", expected.join("`, `"))
     } else {
-        format!("did you mean `{}`? (expected one of `{}`)", near.join("`, `"), expected.join("`, `"))
+        format!(
+            "did you mean `{}`? (expected one of `{}`)",
+            near.join("`, `"),
+            expected.join("`, `")
+        )
     }
 }

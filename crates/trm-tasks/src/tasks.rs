@@ -49,7 +49,11 @@ impl TaskFunction for PositionTask {
         format!("position {}", self.part_name)
     }
     fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        write_masked(ctx.position(&Anchor::Frame(self.part)).coords, self.mask, out);
+        write_masked(
+            ctx.position(&Anchor::Frame(self.part)).coords,
+            self.mask,
+            out,
+        );
     }
 }
 

@@ -1,0 +1,162 @@
+//! Spec files: every example spec loads, mistakes are located and explained, and an infeasible
+//! spec still returns its best posture, marked as not meeting the hard constraint.
+
+use std::path::{Path, PathBuf};
+
+use trm_tasks::{Problem, TaskError, solve};
+
+fn specs_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs")
+}
+
+fn error(text: &str) -> String {
+    match Problem::from_ron(text, "bad.ron", Path::new(".")) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("accepted:\n{text}"),
+    }
+}
+
+#[test]
+fn every_example_spec_loads() {
+    let mut n = 0;
+    let mut stack = vec![specs_dir()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() && !path.ends_with("worlds") {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "ron")
+                && !path.starts_with(specs_dir().join("worlds"))
+            {
+                Problem::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                n += 1;
+            }
+        }
+    }
+    assert!(n >= 3, "{n} specs");
+}
+
+#[test]
+fn unknown_names_are_located_with_suggestions() {
+    let e = error(
+        "(model: \"icub_upper_body\",\n costs: [(weight: 1.0, cost: Positon(part: \"r_hand\", target: Point((0, 0, 0))))])",
+    );
+    assert!(
+        e.starts_with("bad.ron:2:")
+            && e.contains("unknown variant `Positon`")
+            && e.contains("did you mean `Position`"),
+        "{e}"
+    );
+    let e = error(
+        "(model: \"icub_upper_body\", costs: [(weight: 1.0, cost: Displacement)], solvr: ())",
+    );
+    assert!(
+        e.contains("unknown field `solvr`") && e.contains("did you mean `solver`"),
+        "{e}"
+    );
+    let e = error(
+        "(model: \"icub_upper_body\",\n costs: [\n (weight: 1.0, cost: Position(part: \"r_palm_centre\", target: Point((0, 0, 0))))])",
+    );
+    assert!(
+        e.starts_with("bad.ron:3:")
+            && e.contains("r_palm_centre")
+            && e.contains("did you mean `r_palm_center`"),
+        "{e}"
+    );
+    let e = error(
+        "(model: \"icub_upper_body\", active: [\"right_arms\"], costs: [(weight: 1.0, cost: Displacement)])",
+    );
+    assert!(e.contains("did you mean `right_arm`"), "{e}");
+    let e = error("(model: \"icub_upper_bdy\", costs: [(weight: 1.0, cost: Displacement)])");
+    assert!(e.contains("did you mean `icub_upper_body`"), "{e}");
+    let e = error(
+        "(model: \"icub_upper_body\", costs: [(weight: 1.0, cost: Pointing(part: \"gaze\", axis: (0, 0, 1), at: Object(\"bal\")))], world: (objects: [(name: \"ball\", shape: Sphere(radius: 0.05))]))",
+    );
+    assert!(e.contains("did you mean `ball`"), "{e}");
+    let e = error(
+        "(model: \"icub_upper_body\", costs: [(weight: 1.0, cost: Displacement)], solver: (algo: \"xnse\"))",
+    );
+    assert!(e.contains("did you mean `xnes`"), "{e}");
+}
+
+#[test]
+fn bad_values_are_errors() {
+    for (text, says) in [
+        ("(model: \"planar_arm\", costs: [])", "the list is empty"),
+        (
+            "(model: \"planar_arm\", costs: [(weight: -1.0, cost: Displacement)])",
+            "-1 is not a finite number ≥ 0",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: NaN, cost: Displacement)])",
+            "NaN is not a finite number ≥ 0",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Orientation(part: \"tool\", axis: (0, 0, 0), toward: Fixed((1, 0, 0))))])",
+            "the axis is zero",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Position(part: \"tool\", target: Point((0, 0, 0)), mask: (false, false, false)))])",
+            "masks every axis out",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Repel(a: Part(\"tool\"), b: Part(\"base\"), min_distance: 0.0))])",
+            "must be positive",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Position(part: \"tool\", target: Box(min: (1, 0, 0), max: (0, 1, 1))))])",
+            "min exceeds its max",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], start: Some(\"hom\"))",
+            "no posture",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Position(part: \"tool\"))])",
+            "missing field `target`",
+        ),
+    ] {
+        let e = error(text);
+        assert!(e.contains(says), "{text}\n→ {e}");
+    }
+    assert!(matches!(
+        Problem::load("no/such/spec.ron"),
+        Err(TaskError::Io { .. })
+    ));
+}
+
+#[test]
+fn an_infeasible_spec_returns_its_best_posture_marked_as_colliding() {
+    // a box through the robot's torso: no posture avoids it
+    let text = "(model: \"icub_upper_body\", active: [\"right_arm\"],
+        world: (objects: [(name: \"wall\", shape: Box(size: (0.2, 0.2, 0.2)), xyz: (0, 0, 0.1))]),
+        costs: [(weight: 1.0, cost: Collision()), (weight: 1.0, cost: HomePosture())],
+        solver: (max_evaluations: 600, seed: 1))";
+    let p = Problem::from_ron(text, "wall.ron", Path::new(".")).unwrap();
+    let s = solve(&p.objective, &p.start, &p.spec.solver).unwrap();
+    assert!(!s.collision_free);
+    assert!(s.cost >= 1.0);
+    assert_eq!(s.q.len(), 7);
+}
+
+#[test]
+fn ngik_solves_the_reach_example_collision_free() {
+    let p = Problem::load(specs_dir().join("reach_point.ron")).unwrap();
+    let mut solver = p.spec.solver.clone();
+    solver.max_evaluations = 12_000;
+    let s = solve(&p.objective, &p.start, &solver).unwrap();
+    let start = p.objective.eval(&p.start, &mut p.objective.scratch());
+    assert!(s.cost < 0.7 * start, "{} from {start}", s.cost);
+    assert!(s.collision_free);
+    // the palm is within 1 cm of the point above the cup
+    let reach: f64 = s
+        .breakdown
+        .iter()
+        .filter(|t| t.label.starts_with("position"))
+        .map(|t| t.value)
+        .sum();
+    assert!(reach < 0.01, "{:?}", s.breakdown);
+    // the run is reproducible
+    let again = solve(&p.objective, &p.start, &solver).unwrap();
+    assert_eq!(s.q, again.q);
+}
