@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use trm_collision::{CollisionModel, World, WorldSpec};
 use trm_kinematics::nalgebra::Vector3;
-use trm_kinematics::{ActiveSet, FrameId, RobotModel, closest_names};
+use trm_kinematics::{ActiveSet, FrameId, FrameSpec, ModelDescription, RobotModel, closest_names};
 
 use crate::context::Anchor;
 use crate::costs::{
@@ -37,6 +37,9 @@ fn yes() -> bool {
 pub struct Spec {
     /// `icub_upper_body` (embedded) or a `.urdf`/`.ron` model path relative to the spec.
     pub model: String,
+    /// Extra named frames (a link or frame plus an offset), usable as parts in this spec.
+    #[serde(default)]
+    pub frames: Vec<FrameSpec>,
     /// Active motors: motor or group names; empty = every motor.
     #[serde(default)]
     pub active: Vec<String>,
@@ -427,7 +430,8 @@ impl Problem {
 
     fn build(spec: Spec, text: &str, origin: &str, base: &Path) -> Result<Self> {
         let ctx = Ctx { origin, text };
-        let robot = load_model(&spec.model, base, &ctx)?;
+        let (robot, source) = load_model(&spec.model, base, &ctx)?;
+        let robot = with_frames(robot, source, &spec.frames, &ctx)?;
         let mut motors = match &spec.start {
             None => robot
                 .posture("home")
@@ -571,35 +575,130 @@ impl Problem {
     }
 }
 
-fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<RobotModel> {
-    let embedded = [
+/// What a model was built from, so that spec frames can be added: (URDF text, URDF origin,
+/// description).
+type ModelSource = (String, String, ModelDescription);
+
+fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<(RobotModel, ModelSource)> {
+    let embedded: [(&str, &str, &str, Option<&str>); 3] = [
         (
             "icub_upper_body",
-            trm_models::icub_upper_body as fn() -> RobotModel,
+            trm_models::ICUB_UPPER_BODY_URDF,
+            "models/icub_upper_body.urdf",
+            Some(trm_models::ICUB_UPPER_BODY_RON),
         ),
-        ("planar_arm", trm_models::planar_arm),
-        ("branched_tree", trm_models::branched_tree),
+        (
+            "planar_arm",
+            trm_models::PLANAR_ARM_URDF,
+            "models/planar_arm.urdf",
+            None,
+        ),
+        (
+            "branched_tree",
+            trm_models::BRANCHED_TREE_URDF,
+            "models/branched_tree.urdf",
+            None,
+        ),
     ];
-    if let Some((_, f)) = embedded.iter().find(|(n, _)| *n == name) {
-        return Ok(f());
+    let (urdf, origin, description) =
+        if let Some((_, urdf, origin, ron)) = embedded.iter().find(|(n, ..)| *n == name) {
+            let description = match ron {
+                Some(text) => ModelDescription::from_ron(text, "models/icub_upper_body.ron")?,
+                None => ModelDescription::default(),
+            };
+            (urdf.to_string(), origin.to_string(), description)
+        } else {
+            let path: PathBuf = base.join(name);
+            if !path.is_file() {
+                return Err(ctx.err(
+                    "model",
+                    &format!("\"{name}\""),
+                    format!(
+                        "`{name}` is neither an embedded model nor a file (looked for {})",
+                        path.display()
+                    ),
+                    ctx.suggest(
+                        name,
+                        embedded.iter().map(|e| e.0),
+                        "give a .urdf/.ron path relative to the spec, or icub_upper_body",
+                    ),
+                ));
+            }
+            let read = |p: &Path| {
+                std::fs::read_to_string(p).map_err(|e| TaskError::Io {
+                    path: p.display().to_string(),
+                    message: e.to_string(),
+                })
+            };
+            if path.extension().is_some_and(|e| e == "ron") {
+                let text = read(&path)?;
+                let description = ModelDescription::from_ron(&text, &path.display().to_string())?;
+                let urdf_path = path
+                    .parent()
+                    .unwrap_or(Path::new("."))
+                    .join(&description.urdf);
+                (
+                    read(&urdf_path)?,
+                    urdf_path.display().to_string(),
+                    description,
+                )
+            } else {
+                (
+                    read(&path)?,
+                    path.display().to_string(),
+                    ModelDescription::default(),
+                )
+            }
+        };
+    let robot = RobotModel::from_parts(&urdf, &origin, &description, None)?;
+    Ok((robot, (urdf, origin, description)))
+}
+
+/// The model with the spec's extra frames added (checked here, so errors point into the spec).
+fn with_frames(
+    robot: RobotModel,
+    source: ModelSource,
+    frames: &[FrameSpec],
+    ctx: &Ctx,
+) -> Result<RobotModel> {
+    if frames.is_empty() {
+        return Ok(robot);
     }
-    let path: PathBuf = base.join(name);
-    if !path.is_file() {
-        return Err(ctx.err(
-            "model",
-            &format!("\"{name}\""),
-            format!(
-                "`{name}` is neither an embedded model nor a file (looked for {})",
-                path.display()
-            ),
-            ctx.suggest(
-                name,
-                embedded.iter().map(|(n, _)| *n),
-                "give a .urdf/.ron path relative to the spec, or icub_upper_body",
-            ),
-        ));
+    let mut known: Vec<String> = robot.frame_names().map(str::to_string).collect();
+    for f in frames {
+        if known.contains(&f.name) {
+            return Err(ctx.err(
+                "frames",
+                &format!("\"{}\"", f.name),
+                format!("`{}` already names a link or frame", f.name),
+                "choose a new name",
+            ));
+        }
+        if !known.contains(&f.link) {
+            return Err(ctx.err(
+                "frames",
+                &format!("\"{}\"", f.link),
+                format!("`{}` is no link or earlier frame", f.link),
+                ctx.suggest(
+                    &f.link,
+                    known.iter().map(String::as_str),
+                    "attach frames to links or earlier frames",
+                ),
+            ));
+        }
+        if f.xyz.iter().chain(&f.rpy).any(|v| !v.is_finite()) {
+            return Err(ctx.err(
+                "frames",
+                &format!("\"{}\"", f.name),
+                "the offset is not finite",
+                "write finite numbers",
+            ));
+        }
+        known.push(f.name.clone());
     }
-    Ok(RobotModel::load(path)?)
+    let (urdf, origin, mut description) = source;
+    description.frames.extend(frames.iter().cloned());
+    Ok(RobotModel::from_parts(&urdf, &origin, &description, None)?)
 }
 
 struct Resolver<'a> {

@@ -172,3 +172,31 @@ fn ngik_reaches_a_point_with_the_planar_arm() {
     assert!((s.task[0] - 1.2).abs() < 1e-3 && (s.task[1] - 1.1).abs() < 1e-3);
     assert!(s.best_at <= s.evaluations);
 }
+
+/// The catalogue is open in code: a cost of one's own joins the objective like the built-ins.
+#[test]
+fn a_user_defined_cost_plugs_into_the_objective() {
+    #[derive(Debug)]
+    struct TipHeight;
+    impl trm_tasks::Cost for TipHeight {
+        fn label(&self) -> String {
+            "tip height".into()
+        }
+        fn eval(&self, ctx: &trm_tasks::Context) -> f64 {
+            let tool = ctx.robot.frame_id("tool").unwrap();
+            (ctx.poses.pose(tool).translation.z - 0.1).abs()
+        }
+    }
+    let p = arm("(weight: 1.0, cost: Displacement)", "None");
+    let mut objective = trm_tasks::Objective::new(
+        p.objective.active().clone(),
+        p.objective.collision().clone(),
+        p.objective.world().clone(),
+    );
+    objective.add(2.0, Box::new(TipHeight)).unwrap();
+    assert!(objective.add(f64::NAN, Box::new(TipHeight)).is_err());
+    let mut scratch = objective.scratch();
+    assert_eq!(objective.eval(&[0.4, 0.2, 0.1], &mut scratch), 0.0);
+    let (total, terms) = objective.breakdown(&[0.4, 0.2, 0.1], &mut scratch);
+    assert_eq!((total, terms[0].label.as_str()), (0.0, "tip height"));
+}

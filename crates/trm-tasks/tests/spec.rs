@@ -160,3 +160,24 @@ fn ngik_solves_the_reach_example_collision_free() {
     let again = solve(&p.objective, &p.start, &solver).unwrap();
     assert_eq!(s.q, again.q);
 }
+
+#[test]
+fn spec_frames_become_parts() {
+    let text = "(model: \"planar_arm\",
+        frames: [(name: \"tip\", link: \"tool\", xyz: (0.25, 0.0, 0.0))],
+        costs: [(weight: 1.0, cost: Position(part: \"tip\", target: Point((2.55, 0.0, 0.1))))])";
+    let p = Problem::from_ron(text, "frames.ron", Path::new(".")).unwrap();
+    // stretched out, the tool is at x = 2.3: the tip 0.25 further reaches 2.55 exactly
+    let c = p
+        .objective
+        .eval(&[0.0, 0.0, 0.0], &mut p.objective.scratch());
+    assert!(c.abs() < 1e-12, "{c}");
+    let e = error(
+        "(model: \"planar_arm\", frames: [(name: \"tip\", link: \"tol\")], costs: [(weight: 1.0, cost: Displacement)])",
+    );
+    assert!(e.contains("did you mean `tool`"), "{e}");
+    let e = error(
+        "(model: \"planar_arm\", frames: [(name: \"link2\", link: \"tool\")], costs: [(weight: 1.0, cost: Displacement)])",
+    );
+    assert!(e.contains("already names"), "{e}");
+}
