@@ -1,5 +1,6 @@
 //! `cargo xtask <command>`: the commands people run with trm. `cargo xtask --help` lists them.
 
+mod build_map;
 mod collide;
 mod compare;
 mod fk;
@@ -33,6 +34,10 @@ enum Command {
     ModelInfo(model_info::Args),
     /// Forward kinematics of joint configurations read from JSON (world poses of every link).
     Fk(fk::Args),
+    /// Build a task-relevant roadmap from a spec (parallel E-TRM) and save it.
+    BuildMap(build_map::Args),
+    /// Summarise a map file: points, edges, components, extent, spacing, cost, build statistics.
+    MapInfo(build_map::InfoArgs),
     /// Table III: xNES against SIR, SIRD, MH, Nelder-Mead (and CMA-ES, (1+1)-CMA-ES) on two postures.
     CompareOptimisers(compare::Args),
     /// Colliding pairs and minimum self-distance of joint configurations read from JSON.
@@ -52,6 +57,8 @@ fn main() {
     let result = match cli.command {
         Command::ModelInfo(args) => model_info::run(&args),
         Command::Fk(args) => fk::run(&args),
+        Command::BuildMap(args) => build_map::run(&args),
+        Command::MapInfo(args) => build_map::info(&args),
         Command::Collide(args) => collide::run(&args),
         Command::CompareOptimisers(args) => compare::run(&args),
         Command::GenAcm(args) => gen_acm::run(&args),

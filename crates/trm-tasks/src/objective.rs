@@ -188,6 +188,26 @@ impl Objective {
         total / self.noise.len() as f64
     }
 
+    /// h(q) as [`Objective::eval`], and the task vector g(q) at the nominal q written to `task`
+    /// (length of the task function's dimension), from the same forward-kinematics pass when there
+    /// is no noise. Without a task function `task` is left untouched.
+    pub fn eval_with_task(&self, q: &[f64], scratch: &mut Scratch, task: &mut [f64]) -> f64 {
+        let cost =
+            if self.noise.is_empty() && q.len() == self.dim() && !q.iter().any(|v| v.is_nan()) {
+                self.weighted(q, scratch)
+            } else {
+                let c = self.eval(q, scratch);
+                if q.len() == self.dim() {
+                    self.pose(q, scratch, false);
+                }
+                c
+            };
+        if let (Some(t), true) = (&self.task, q.len() == self.dim()) {
+            t.eval(&self.context(q, scratch), task);
+        }
+        cost
+    }
+
     /// Every term's value at `q` (without noise) and the weighted total.
     pub fn breakdown(&self, q: &[f64], scratch: &mut Scratch) -> (f64, Vec<TermValue>) {
         self.pose(q, scratch, true);

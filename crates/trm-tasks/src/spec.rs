@@ -355,6 +355,8 @@ impl Default for MapSpec {
 pub struct Problem {
     /// Where it came from.
     pub origin: String,
+    /// The spec text, verbatim.
+    pub text: String,
     /// The parsed file.
     pub spec: Spec,
     /// The robot.
@@ -567,6 +569,7 @@ impl Problem {
         }
         Ok(Problem {
             origin: origin.to_string(),
+            text: text.to_string(),
             spec,
             robot,
             objective,

@@ -1,0 +1,357 @@
+//! Parallel E-TRM (Stollenga, Schmidhuber and Gomez; Algorithm 2, which with P = 1 is
+//! Algorithm 1, E-TRM): P concurrent xNES searches grow the map, each minimising
+//! h* = h + α_map h_map + α_repel h_repel, one generation at a time for all of them.
+//!
+//! Determinism: P (an algorithm setting) is separate from the thread count (an execution
+//! setting). The searches' candidates are evaluated in parallel, but every random draw comes from
+//! a per-search ChaCha stream or from the master stream in the sequential part, and the map only
+//! changes between generations, in search order: a seed and P give the same map on any number of
+//! threads.
+
+use std::time::Instant;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
+use trm_tasks::Problem;
+use trm_tasks::spec::MapSpec;
+
+use crate::error::{Result, RoadmapError};
+use crate::index::TaskIndex;
+use crate::map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};
+
+/// Execution settings of a build (the algorithm settings are the spec's `map`).
+#[derive(Debug, Clone)]
+pub struct BuildOptions {
+    /// Stop at this many points (overrides the spec's `max_points` when set).
+    pub points: Option<usize>,
+    /// Concurrent searches P (overrides the spec's `searches` when set).
+    pub searches: Option<usize>,
+    /// Seed (overrides the spec's solver seed when set).
+    pub seed: Option<u64>,
+    /// Longest search, in generations (a cap beside the 20/40 convergence rule).
+    pub max_generations: u64,
+    /// Weight of the repulsion between concurrent searches.
+    pub repel_weight: f64,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            points: None,
+            searches: None,
+            seed: None,
+            max_generations: 400,
+            repel_weight: 1.0,
+        }
+    }
+}
+
+/// Progress, reported after each generation that changed the map and at the end.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress {
+    /// Points in the map.
+    pub points: usize,
+    /// Target number of points.
+    pub target: usize,
+    /// Consecutive failed searches.
+    pub failures: usize,
+    /// Evaluations so far.
+    pub evaluations: u64,
+    /// Seconds since the start.
+    pub seconds: f64,
+}
+
+struct Search {
+    xnes: Xnes,
+    rng: ChaCha8Rng,
+    from: Option<usize>,
+    centre_t: Vec<f64>,
+    centre_f: f64,
+}
+
+/// The map under construction: points, their index and the SELECTPROPORTIONAL bookkeeping.
+struct Growing {
+    points: Vec<MapPoint>,
+    index: TaskIndex,
+    neighbours: Vec<usize>,
+    fails: Vec<usize>,
+}
+
+impl Growing {
+    fn add(&mut self, point: MapPoint, radius: f64) {
+        let i = self.points.len();
+        let mut near = 0;
+        for (j, p) in self.points.iter().enumerate() {
+            if dist(&p.t, &point.t) <= radius {
+                self.neighbours[j] += 1;
+                near += 1;
+            }
+        }
+        self.index.add(&point.t);
+        self.points.push(point);
+        self.neighbours.push(near);
+        self.fails.push(0);
+        debug_assert_eq!(self.points.len(), i + 1);
+    }
+
+    /// SELECTPROPORTIONAL: a point with the fewest neighbours + failures, uniformly among ties.
+    fn select(&self, rng: &mut ChaCha8Rng) -> Option<usize> {
+        let score = |i: usize| self.neighbours[i] + self.fails[i];
+        let best = (0..self.points.len()).map(score).min()?;
+        let ties: Vec<usize> = (0..self.points.len())
+            .filter(|&i| score(i) == best)
+            .collect();
+        Some(ties[rng.random_range(0..ties.len())])
+    }
+}
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Builds the map of a spec (it needs a task function and `map` settings, or their defaults).
+pub fn build(
+    problem: &Problem,
+    options: &BuildOptions,
+    mut progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    let objective = &problem.objective;
+    let task = objective.task().ok_or_else(|| {
+        RoadmapError::Unsuitable(format!(
+            "{}: the spec has no task function; add `task: Some(Position(part: \"...\"))`",
+            problem.origin
+        ))
+    })?;
+    let dim = task.dim();
+    let settings: MapSpec = problem.spec.map.clone().unwrap_or_default();
+    let target = options.points.unwrap_or(settings.max_points);
+    let p_searches = options.searches.unwrap_or(settings.searches).max(1);
+    let seed = options.seed.unwrap_or(problem.spec.solver.seed);
+    let d = settings.spacing;
+    let m = dim; // the number of neighbours is tied to the task-space dimension
+    let (lower, upper) = objective.active().bounds();
+    let bounds = Bounds::new(lower, upper)?;
+    let mut master = ChaCha8Rng::seed_from_u64(seed);
+    let mut map = Growing {
+        points: Vec::new(),
+        index: TaskIndex::new(dim),
+        neighbours: Vec::new(),
+        fails: Vec::new(),
+    };
+    let mut searches: Vec<Search> = Vec::new();
+    let mut started_count: u64 = 0;
+    let mut failures = 0usize;
+    let mut total_failures = 0u64;
+    let mut evaluations = 0u64;
+    let started = Instant::now();
+    let stopped_because;
+
+    loop {
+        if map.points.len() >= target {
+            stopped_because = format!("reached {target} points");
+            break;
+        }
+        if failures >= settings.failure_limit {
+            stopped_because = format!(
+                "{failures} consecutive failed searches (k = {})",
+                settings.failure_limit
+            );
+            break;
+        }
+        // start searches: one from home while the map is empty, then up to P
+        let wanted = if map.points.is_empty() {
+            1
+        } else {
+            p_searches.min(map.points.len())
+        };
+        while searches.len() < wanted {
+            let from = map.select(&mut master);
+            let (q0, (lambda, sigma)) = match from {
+                Some(i) => (map.points[i].q.clone(), settings.later_search),
+                None => (problem.start.clone(), settings.first_search),
+            };
+            let start = Start::new(q0, sigma)
+                .with_bounds(bounds.clone())
+                .with_stop(StopOptions {
+                    centre_stagnation: Some((20, 40)),
+                    max_generations: Some(options.max_generations),
+                    tol_x: None,
+                    tol_fun: None,
+                    ..Default::default()
+                });
+            let xnes = Xnes::new(
+                &start,
+                &XnesOptions {
+                    population: Some(lambda),
+                    ..Default::default()
+                },
+            )?;
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream(started_count + 1);
+            started_count += 1;
+            searches.push(Search {
+                xnes,
+                rng,
+                from,
+                centre_t: vec![0.0; dim],
+                centre_f: f64::NAN,
+            });
+        }
+
+        // one generation of every search: ask, evaluate all candidates in parallel, tell
+        let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
+        let have_centres = searches
+            .iter()
+            .map(|s| s.centre_f.is_finite())
+            .collect::<Vec<_>>();
+        // asks in parallel (each search draws from its own stream)
+        let asked: Vec<Vec<Vec<f64>>> = searches
+            .par_iter_mut()
+            .map(|s| s.xnes.ask(&mut s.rng).to_vec())
+            .collect();
+        let jobs: Vec<(usize, &Vec<f64>)> = asked
+            .iter()
+            .enumerate()
+            .flat_map(|(i, xs)| xs.iter().map(move |x| (i, x)))
+            .collect();
+        let h_star = |i: usize,
+                      q: &[f64],
+                      scratch: &mut trm_tasks::Scratch,
+                      t: &mut Vec<f64>,
+                      nn: &mut Vec<(f64, usize)>| {
+            t.resize(dim, 0.0);
+            let mut h = objective.eval_with_task(q, scratch, t);
+            // h_map: construction and smoothness over the m nearest map points
+            map.index.nearest(t, m, nn);
+            let mut h_map = 0.0;
+            for &(dt, j) in nn.iter() {
+                h_map += (d - dt).abs() + settings.smoothness * dist(q, &map.points[j].q);
+            }
+            h += settings.construct_weight * h_map;
+            // h_repel: keep away from the other searches' centres
+            let mut h_rep = 0.0;
+            for (j, c) in centres.iter().enumerate() {
+                if j != i && have_centres[j] {
+                    h_rep += (d - dist(t, c)).max(0.0);
+                }
+            }
+            h + options.repel_weight * h_rep
+        };
+        // every candidate of every search, in parallel
+        let fitness: Vec<f64> = jobs
+            .par_iter()
+            .map_init(
+                || (objective.scratch(), Vec::new(), Vec::new()),
+                |(scratch, t, nn), (i, q)| h_star(*i, q, scratch, t, nn),
+            )
+            .collect();
+        evaluations += jobs.len() as u64;
+        // tells and centre evaluations in parallel, one task per search
+        let mut offsets = Vec::with_capacity(searches.len());
+        let mut offset = 0;
+        for s in &searches {
+            offsets.push(offset);
+            offset += s.xnes.population();
+        }
+        let told: Vec<trm_optim::Result<()>> = searches
+            .par_iter_mut()
+            .enumerate()
+            .map_init(
+                || (objective.scratch(), Vec::new(), Vec::new()),
+                |(scratch, t, nn), (i, s)| {
+                    let n = s.xnes.population();
+                    s.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
+                    let mut q = s.xnes.mean().to_vec();
+                    bounds.clamp(&mut q);
+                    let f = h_star(i, &q, scratch, t, nn);
+                    s.xnes.record_centre_fitness(&q, f);
+                    s.centre_f = f;
+                    s.centre_t.clone_from(t);
+                    Ok(())
+                },
+            )
+            .collect();
+        for r in told {
+            r?;
+        }
+        evaluations += searches.len() as u64;
+
+        // converged searches: CHECK their mean, add it or count a failure (in search order)
+        let mut changed = false;
+        let mut k = 0;
+        while k < searches.len() {
+            if searches[k].xnes.stop().is_empty() {
+                k += 1;
+                continue;
+            }
+            let s = searches.remove(k);
+            let mut q = s.xnes.mean().to_vec();
+            bounds.clamp(&mut q);
+            let mut scratch = objective.scratch();
+            let mut t = vec![0.0; dim];
+            let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
+            let mut nn = Vec::new();
+            map.index.nearest(&t, 1, &mut nn);
+            let outside = nn.first().is_none_or(|(dt, _)| *dt >= d / 2.0);
+            let ok = cost.is_finite() && outside && objective.is_collision_free(&q, &mut scratch);
+            if ok {
+                map.add(MapPoint { q, t, cost }, 1.5 * d);
+                failures = 0;
+                changed = true;
+            } else {
+                failures += 1;
+                total_failures += 1;
+                if let Some(from) = s.from {
+                    map.fails[from] += 1;
+                }
+            }
+        }
+        if changed {
+            progress(&Progress {
+                points: map.points.len(),
+                target,
+                failures,
+                evaluations,
+                seconds: started.elapsed().as_secs_f64(),
+            });
+        }
+    }
+    let build_seconds = started.elapsed().as_secs_f64();
+    progress(&Progress {
+        points: map.points.len(),
+        target,
+        failures,
+        evaluations,
+        seconds: build_seconds,
+    });
+    Ok(Roadmap {
+        format: FORMAT.into(),
+        version: VERSION,
+        software: format!("trm {}", env!("CARGO_PKG_VERSION")),
+        spec_path: problem.origin.clone(),
+        spec: problem.text.clone(),
+        seed,
+        searches: p_searches,
+        settings,
+        active: objective.active().names().map(str::to_string).collect(),
+        task: task.label(),
+        points: map.points,
+        edges: Vec::new(),
+        edge_resolution: 0.0,
+        stats: BuildStats {
+            build_seconds,
+            edge_seconds: 0.0,
+            evaluations,
+            searches_started: started_count,
+            failures: total_failures,
+            stopped_because,
+            threads: rayon::current_num_threads(),
+        },
+    })
+}

@@ -1,0 +1,63 @@
+//! Configuration-space edges: each point to its n nearest neighbours in joint space, kept when
+//! the straight segment between them is collision-free at the given interpolation step.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use trm_tasks::Objective;
+
+use crate::map::Roadmap;
+
+/// Adds edges to `map` (replacing any): `neighbours` per point, segments checked every
+/// `resolution` radians of the largest joint change.
+pub fn connect(map: &mut Roadmap, objective: &Objective, neighbours: usize, resolution: f64) {
+    let started = Instant::now();
+    let points = &map.points;
+    let mut edges: Vec<(usize, usize, f64)> = (0..points.len())
+        .into_par_iter()
+        .map_init(
+            || (objective.scratch(), vec![0.0; objective.dim()]),
+            |(scratch, q), i| {
+                let mut near: Vec<(f64, usize)> = (0..points.len())
+                    .filter(|&j| j != i)
+                    .map(|j| (distance(&points[i].q, &points[j].q), j))
+                    .collect();
+                near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                near.truncate(neighbours);
+                near.into_iter()
+                    .filter(|&(_, j)| {
+                        let (a, b) = (&points[i].q, &points[j].q);
+                        let span = a
+                            .iter()
+                            .zip(b)
+                            .map(|(x, y)| (x - y).abs())
+                            .fold(0.0, f64::max);
+                        let steps = (span / resolution).ceil().max(1.0) as usize;
+                        (1..steps).all(|s| {
+                            let u = s as f64 / steps as f64;
+                            for k in 0..q.len() {
+                                q[k] = a[k] + u * (b[k] - a[k]);
+                            }
+                            objective.is_collision_free(q, scratch)
+                        })
+                    })
+                    .map(|(l, j)| (i.min(j), i.max(j), l))
+                    .collect::<Vec<_>>()
+            },
+        )
+        .flatten()
+        .collect();
+    edges.sort_by_key(|e| (e.0, e.1));
+    edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    map.edges = edges;
+    map.edge_resolution = resolution;
+    map.stats.edge_seconds = started.elapsed().as_secs_f64();
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}

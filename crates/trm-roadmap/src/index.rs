@@ -1,0 +1,146 @@
+//! Task-space nearest neighbours with kiddo kd-trees (dimension 1–6; brute force above).
+
+use kiddo::{KdTree, SquaredEuclidean};
+
+macro_rules! trees {
+    ($($variant:ident => $k:literal),*) => {
+        /// A kd-tree over task vectors, of the task's dimension.
+        #[derive(Debug)]
+        enum Tree {
+            $($variant(Box<KdTree<f64, $k>>),)*
+            /// Dimensions above 6: linear scan.
+            Brute(Vec<Vec<f64>>),
+        }
+
+        impl Tree {
+            fn new(dim: usize) -> Self {
+                match dim {
+                    $($k => Tree::$variant(Box::new(KdTree::new())),)*
+                    _ => Tree::Brute(Vec::new()),
+                }
+            }
+
+            fn add(&mut self, t: &[f64], item: usize) {
+                match self {
+                    $(Tree::$variant(tree) => {
+                        let mut p = [0.0; $k];
+                        p.copy_from_slice(t);
+                        tree.add(&p, item as u64);
+                    })*
+                    Tree::Brute(points) => points.push(t.to_vec()),
+                }
+            }
+
+            fn nearest(&self, t: &[f64], n: usize, out: &mut Vec<(f64, usize)>) {
+                out.clear();
+                match self {
+                    $(Tree::$variant(tree) => {
+                        let mut p = [0.0; $k];
+                        p.copy_from_slice(t);
+                        for nb in tree.nearest_n::<SquaredEuclidean>(&p, n) {
+                            out.push((nb.distance.sqrt(), nb.item as usize));
+                        }
+                    })*
+                    Tree::Brute(points) => {
+                        out.extend(points.iter().enumerate().map(|(i, p)| {
+                            (p.iter().zip(t).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt(), i)
+                        }));
+                        out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                        out.truncate(n);
+                    }
+                }
+            }
+        }
+    };
+}
+
+trees!(D1 => 1, D2 => 2, D3 => 3, D4 => 4, D5 => 5, D6 => 6);
+
+/// The task vectors of a map, indexed for nearest-neighbour queries.
+#[derive(Debug)]
+pub struct TaskIndex {
+    dim: usize,
+    tree: Tree,
+    len: usize,
+}
+
+impl TaskIndex {
+    /// An empty index for task vectors of dimension `dim`.
+    pub fn new(dim: usize) -> Self {
+        TaskIndex {
+            dim,
+            tree: Tree::new(dim),
+            len: 0,
+        }
+    }
+
+    /// Adds a point; its item is its insertion order.
+    pub fn add(&mut self, t: &[f64]) {
+        debug_assert_eq!(t.len(), self.dim);
+        self.tree.add(t, self.len);
+        self.len += 1;
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True without points.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The `n` nearest points to `t` as (distance, item), nearest first.
+    pub fn nearest(&self, t: &[f64], n: usize, out: &mut Vec<(f64, usize)>) {
+        if self.len == 0 || n == 0 {
+            out.clear();
+            return;
+        }
+        self.tree.nearest(t, n.min(self.len), out);
+        out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    #[test]
+    fn nearest_neighbours_equal_brute_force() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        for dim in [1, 2, 3, 6, 7] {
+            let points: Vec<Vec<f64>> = (0..300)
+                .map(|_| (0..dim).map(|_| rng.random::<f64>()).collect())
+                .collect();
+            let mut index = TaskIndex::new(dim);
+            for p in &points {
+                index.add(p);
+            }
+            let mut out = Vec::new();
+            for _ in 0..50 {
+                let q: Vec<f64> = (0..dim).map(|_| rng.random::<f64>()).collect();
+                index.nearest(&q, 4, &mut out);
+                let mut brute: Vec<(f64, usize)> = points
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| {
+                        (
+                            p.iter()
+                                .zip(&q)
+                                .map(|(a, b)| (a - b).powi(2))
+                                .sum::<f64>()
+                                .sqrt(),
+                            i,
+                        )
+                    })
+                    .collect();
+                brute.sort_by(|a, b| a.0.total_cmp(&b.0));
+                for (a, b) in out.iter().zip(&brute[..4]) {
+                    assert!((a.0 - b.0).abs() < 1e-12, "dim {dim}");
+                }
+            }
+        }
+    }
+}

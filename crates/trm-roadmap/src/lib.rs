@@ -1,0 +1,24 @@
+//! Task-relevant roadmaps: maps of postures that evenly cover a task space while satisfying a
+//! task's costs (Stollenga et al., IROS 2013; parallel E-TRM of Stollenga, Schmidhuber and
+//! Gomez). [`build`] grows a map with P concurrent xNES searches, [`connect`] adds
+//! configuration-space edges, and [`Roadmap`] saves and loads map files.
+//!
+//! ```no_run
+//! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
+//! let mut map = trm_roadmap::build(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
+//! trm_roadmap::connect(&mut map, &problem.objective, 8, 0.05);
+//! map.save("reach.map.json".as_ref())?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod build;
+mod edges;
+mod error;
+mod index;
+mod map;
+
+pub use build::{BuildOptions, Progress, build};
+pub use edges::connect;
+pub use error::{Result, RoadmapError};
+pub use index::TaskIndex;
+pub use map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};

@@ -1,0 +1,117 @@
+//! Map construction: spacing, collision-freedom, determinism across thread counts, files.
+
+use std::path::{Path, PathBuf};
+
+use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_tasks::Problem;
+
+fn reach() -> Problem {
+    Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap()
+}
+
+fn small(problem: &Problem, threads: usize) -> Roadmap {
+    let options = BuildOptions {
+        points: Some(25),
+        ..Default::default()
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| {
+            let mut map = build(problem, &options, |_| {}).unwrap();
+            connect(&mut map, &problem.objective, 6, 0.05);
+            map
+        })
+}
+
+fn tmp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("trm-roadmap-{}-{name}", std::process::id()))
+}
+
+#[test]
+fn map_points_are_collision_free_spaced_and_the_same_on_any_thread_count() {
+    let problem = reach();
+    let one = small(&problem, 1);
+    let two = small(&problem, 2);
+    assert_eq!(one.points, two.points);
+    assert_eq!(one.edges, two.edges);
+    assert_eq!(one.points.len(), 25);
+    let d = one.settings.spacing;
+    let mut scratch = problem.objective.scratch();
+    for (i, p) in one.points.iter().enumerate() {
+        assert!(
+            problem.objective.is_collision_free(&p.q, &mut scratch),
+            "point {i} collides"
+        );
+        for (j, o) in one.points.iter().enumerate().skip(i + 1) {
+            let dt: f64 =
+                p.t.iter()
+                    .zip(&o.t)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+            assert!(dt >= d / 2.0 - 1e-12, "points {i} and {j} are {dt} apart");
+        }
+        // the stored task vector is g(q)
+        let g = problem.objective.task_value(&p.q, &mut scratch);
+        assert_eq!(g, p.t);
+    }
+    assert!(!one.edges.is_empty());
+    assert!(
+        one.edges
+            .iter()
+            .all(|&(a, b, _)| a < b && b < one.points.len())
+    );
+}
+
+#[test]
+fn maps_round_trip_through_files_and_bad_files_are_clear_errors() {
+    let problem = reach();
+    let map = small(&problem, 2);
+    let path = tmp("map.json");
+    map.save(&path).unwrap();
+    let back = Roadmap::load(&path).unwrap();
+    assert_eq!(back, map);
+    assert!(back.spec.contains("r_palm_center"));
+    // truncated
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, &text[..text.len() / 2]).unwrap();
+    let e = Roadmap::load(&path).unwrap_err().to_string();
+    assert!(e.contains("truncated"), "{e}");
+    // foreign JSON
+    std::fs::write(&path, "{\"points\": []}").unwrap();
+    let e = Roadmap::load(&path).unwrap_err().to_string();
+    assert!(e.contains("not a trm roadmap"), "{e}");
+    // newer version
+    std::fs::write(&path, text.replacen("\"version\":1", "\"version\":99", 1)).unwrap();
+    let e = Roadmap::load(&path).unwrap_err().to_string();
+    assert!(e.contains("version 99"), "{e}");
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn a_spec_without_a_task_function_cannot_make_a_map() {
+    let text = "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)])";
+    let problem = Problem::from_ron(text, "notask.ron", Path::new(".")).unwrap();
+    let e = build(&problem, &BuildOptions::default(), |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no task function"), "{e}");
+}
+
+#[test]
+fn a_small_map_on_the_planar_arm_covers_its_workspace() {
+    let text = "(model: \"planar_arm\",
+        costs: [(weight: 0.01, cost: Displacement)],
+        task: Some(Position(part: \"tool\", mask: (true, true, false))),
+        map: Some((spacing: 0.2, max_points: 40, construct_weight: 5.0, searches: 2)))";
+    let problem = Problem::from_ron(text, "arm.ron", Path::new(".")).unwrap();
+    let map = build(&problem, &BuildOptions::default(), |_| {}).unwrap();
+    assert_eq!(map.points.len(), 40);
+    let extent = map.extent();
+    assert!(
+        extent[0].1 - extent[0].0 > 0.8 && extent[1].1 - extent[1].0 > 0.8,
+        "{extent:?}"
+    );
+}

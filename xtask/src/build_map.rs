@@ -1,0 +1,171 @@
+//! `cargo xtask build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]`
+//! and `cargo xtask map-info FILE`.
+
+use std::io::IsTerminal as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_tasks::Problem;
+
+/// Arguments of `build-map`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The task spec (with a task function and map settings).
+    spec: PathBuf,
+    /// Output map file (default: target/maps/<spec name>.map.json).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Number of points (default: the spec's map.max_points).
+    #[arg(long)]
+    points: Option<usize>,
+    /// Worker threads (an execution setting: the map does not depend on it).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Concurrent searches P (an algorithm setting; default: the spec's map.searches).
+    #[arg(long)]
+    searches: Option<usize>,
+    /// Seed (default: the spec's solver.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Interpolation step (rad) for checking edges.
+    #[arg(long, default_value_t = 0.05)]
+    edge_resolution: f64,
+}
+
+/// Builds, connects and saves a map.
+pub fn run(args: &Args) -> Result<()> {
+    let problem = Problem::load(&args.spec)?;
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args
+            .spec
+            .file_stem()
+            .map_or("map".into(), |s| s.to_string_lossy().to_string());
+        PathBuf::from("target/maps").join(format!("{stem}.map.json"))
+    });
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    let options = BuildOptions {
+        points: args.points,
+        searches: args.searches,
+        seed: args.seed,
+        ..Default::default()
+    };
+    let tty = std::io::stderr().is_terminal();
+    let mut last_print = 0.0f64;
+    let map = pool.install(|| -> Result<Roadmap> {
+        let mut map = build(&problem, &options, |p| {
+            let rate = p.evaluations as f64 / p.seconds.max(1e-9);
+            let eta = if p.points > 0 {
+                p.seconds / p.points as f64 * (p.target.saturating_sub(p.points)) as f64
+            } else {
+                f64::NAN
+            };
+            let line = format!(
+                "{:>5}/{} points, {} consecutive failures, {} evaluations ({:.0}/s), {:.1} s, ETA {:.0} s",
+                p.points, p.target, p.failures, p.evaluations, rate, p.seconds, eta
+            );
+            if tty {
+                eprint!("\r{line}   ");
+            } else if p.seconds - last_print >= 5.0 || p.points == p.target {
+                eprintln!("{line}");
+                last_print = p.seconds;
+            }
+        })?;
+        if tty {
+            eprintln!();
+        }
+        let neighbours = map.settings.edge_neighbours;
+        connect(&mut map, &problem.objective, neighbours, args.edge_resolution);
+        Ok(map)
+    })?;
+    map.save(&out)
+        .with_context(|| format!("saving {}", out.display()))?;
+    print_summary(&map);
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Arguments of `map-info`.
+#[derive(clap::Args)]
+pub struct InfoArgs {
+    /// A map file written by build-map.
+    map: PathBuf,
+}
+
+/// Prints a map's summary.
+pub fn info(args: &InfoArgs) -> Result<()> {
+    let map = Roadmap::load(&args.map)?;
+    println!(
+        "{} ({}, {})",
+        args.map.display(),
+        map.software,
+        map.spec_path
+    );
+    print_summary(&map);
+    Ok(())
+}
+
+fn print_summary(map: &Roadmap) {
+    let s = &map.stats;
+    let n = map.points.len();
+    println!(
+        "{} points, {} edges, {} connected components; task `{}`; {} active motors; seed {}, {} searches",
+        n,
+        map.edges.len(),
+        map.components(),
+        map.task,
+        map.active.len(),
+        map.seed,
+        map.searches
+    );
+    let extent: Vec<String> = map
+        .extent()
+        .iter()
+        .map(|(lo, hi)| format!("[{lo:.3}, {hi:.3}]"))
+        .collect();
+    println!("task-space extent: {}", extent.join(" × "));
+    if n > 1 {
+        // spacing: distance of each point to its nearest other point
+        let nearest: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| {
+                        map.points[i]
+                            .t
+                            .iter()
+                            .zip(&map.points[j].t)
+                            .map(|(a, b)| (a - b).powi(2))
+                            .sum::<f64>()
+                            .sqrt()
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        let mean = nearest.iter().sum::<f64>() / n as f64;
+        let min = nearest.iter().copied().fold(f64::INFINITY, f64::min);
+        println!(
+            "nearest-neighbour spacing: mean {mean:.4}, min {min:.4} (setting d = {})",
+            map.settings.spacing
+        );
+    }
+    let mean_cost = map.points.iter().map(|p| p.cost).sum::<f64>() / n.max(1) as f64;
+    println!("mean task cost {mean_cost:.4}");
+    println!(
+        "built in {:.1} s (+ {:.1} s edges) on {} threads: {} evaluations ({:.0}/point, {:.0}/s), {} searches, {} failed; stopped: {}",
+        s.build_seconds,
+        s.edge_seconds,
+        s.threads,
+        s.evaluations,
+        s.evaluations as f64 / n.max(1) as f64,
+        s.evaluations as f64 / s.build_seconds.max(1e-9),
+        s.searches_started,
+        s.failures,
+        s.stopped_because
+    );
+}
