@@ -86,8 +86,64 @@ pub fn run(args: &Args) -> Result<()> {
     map.save(&out)
         .with_context(|| format!("saving {}", out.display()))?;
     print_summary(&map);
-    println!("wrote {}", out.display());
+    let svg = out.with_extension("svg");
+    crate::write_atomic(&svg, scatter(&map)?.as_bytes())?;
+    println!("wrote {} and {}", out.display(), svg.display());
     Ok(())
+}
+
+/// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
+/// coloured by task cost from blue (lowest) to red (highest), like Fig. 3 of the parallel paper.
+fn scatter(map: &Roadmap) -> Result<String> {
+    use plotters::prelude::*;
+    let coordinate = |p: &trm_roadmap::MapPoint, i: usize| p.t.get(i).copied().unwrap_or(0.0);
+    let range = |i: usize| {
+        let (lo, hi) = map
+            .points
+            .iter()
+            .map(|p| coordinate(p, i))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        if lo.is_finite() && hi > lo {
+            let pad = 0.05 * (hi - lo);
+            (lo - pad)..(hi + pad)
+        } else {
+            -0.1..0.1
+        }
+    };
+    let (cmin, cmax) = map
+        .points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.cost), b.max(p.cost)));
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 700)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "{} points, task `{}`; colour: cost {cmin:.3} (blue) to {cmax:.3} (red)",
+                    map.points.len(),
+                    map.task
+                ),
+                ("sans-serif", 16),
+            )
+            .margin(10)
+            .build_cartesian_3d(range(0), range(2), range(1))?;
+        chart.with_projection(|mut p| {
+            p.yaw = 0.6;
+            p.pitch = 0.35;
+            p.scale = 0.85;
+            p.into_matrix()
+        });
+        chart.configure_axes().draw()?;
+        chart.draw_series(map.points.iter().map(|p| {
+            let u = if cmax > cmin { (p.cost - cmin) / (cmax - cmin) } else { 0.0 };
+            let color = RGBColor((255.0 * u) as u8, 60, (255.0 * (1.0 - u)) as u8);
+            Circle::new((coordinate(p, 0), coordinate(p, 2), coordinate(p, 1)), 3, color.filled())
+        }))?;
+        root.present()?;
+    }
+    Ok(svg)
 }
 
 /// Arguments of `map-info`.
