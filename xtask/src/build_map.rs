@@ -102,7 +102,9 @@ fn scatter(map: &Roadmap) -> Result<String> {
             .points
             .iter()
             .map(|p| coordinate(p, i))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
         if lo.is_finite() && hi > lo {
             let pad = 0.05 * (hi - lo);
             (lo - pad)..(hi + pad)
@@ -113,7 +115,9 @@ fn scatter(map: &Roadmap) -> Result<String> {
     let (cmin, cmax) = map
         .points
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.cost), b.max(p.cost)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.cost), b.max(p.cost))
+        });
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (800, 700)).into_drawing_area();
@@ -137,9 +141,17 @@ fn scatter(map: &Roadmap) -> Result<String> {
         });
         chart.configure_axes().draw()?;
         chart.draw_series(map.points.iter().map(|p| {
-            let u = if cmax > cmin { (p.cost - cmin) / (cmax - cmin) } else { 0.0 };
+            let u = if cmax > cmin {
+                (p.cost - cmin) / (cmax - cmin)
+            } else {
+                0.0
+            };
             let color = RGBColor((255.0 * u) as u8, 60, (255.0 * (1.0 - u)) as u8);
-            Circle::new((coordinate(p, 0), coordinate(p, 2), coordinate(p, 1)), 3, color.filled())
+            Circle::new(
+                (coordinate(p, 0), coordinate(p, 2), coordinate(p, 1)),
+                3,
+                color.filled(),
+            )
         }))?;
         root.present()?;
     }

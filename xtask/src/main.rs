@@ -9,6 +9,7 @@ mod gen_icub;
 mod model_info;
 mod optimise;
 mod solve;
+mod speedup;
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -48,6 +49,8 @@ enum Command {
     GenIcub,
     /// Run an optimiser on a test function several times: evaluations to target and a summary.
     Optimise(optimise::Args),
+    /// Fig. 2 of the parallel paper: map-building time per thread count, and P's effect.
+    Speedup(speedup::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
 }
@@ -65,6 +68,7 @@ fn main() {
         Command::GenIcub => gen_icub::run(&models_dir()),
         Command::Optimise(args) => optimise::run(&args),
         Command::Solve(args) => solve::run(&args),
+        Command::Speedup(args) => speedup::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
