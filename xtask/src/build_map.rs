@@ -175,6 +175,35 @@ pub fn info(args: &InfoArgs) -> Result<()> {
         map.spec_path
     );
     print_summary(&map);
+    // the spec travels inside the map: rebuild its objective for the cost breakdown
+    let base = std::path::Path::new(&map.spec_path)
+        .parent()
+        .map(PathBuf::from)
+        .unwrap_or_default();
+    match Problem::from_ron(&map.spec, &map.spec_path, &base) {
+        Ok(problem) if problem.objective.dim() == map.active.len() => {
+            let mut scratch = problem.objective.scratch();
+            let mut sums: Vec<(String, f64)> = Vec::new();
+            for p in &map.points {
+                let (_, terms) = problem.objective.breakdown(&p.q, &mut scratch);
+                if sums.is_empty() {
+                    sums = terms.iter().map(|t| (t.label.clone(), 0.0)).collect();
+                }
+                for (s, t) in sums.iter_mut().zip(&terms) {
+                    s.1 += t.weight * t.value;
+                }
+            }
+            println!("mean cost breakdown (weighted):");
+            for (label, total) in sums {
+                println!(
+                    "  {label:<36} {:.5}",
+                    total / map.points.len().max(1) as f64
+                );
+            }
+        }
+        Ok(_) => println!("(the embedded spec no longer matches the map's motors: no breakdown)"),
+        Err(e) => println!("(no cost breakdown: the embedded spec does not load here: {e})"),
+    }
     Ok(())
 }
 
@@ -220,6 +249,31 @@ fn print_summary(map: &Roadmap) {
         println!(
             "nearest-neighbour spacing: mean {mean:.4}, min {min:.4} (setting d = {})",
             map.settings.spacing
+        );
+    }
+    if n > 0 {
+        // coverage: occupied cells of side d within the extent box
+        let d = map.settings.spacing;
+        let extent = map.extent();
+        let cells: Vec<usize> = extent
+            .iter()
+            .map(|(lo, hi)| ((hi - lo) / d).floor() as usize + 1)
+            .collect();
+        let total: f64 = cells.iter().map(|&c| c as f64).product();
+        let mut occupied = std::collections::BTreeSet::new();
+        for p in &map.points {
+            let key: Vec<usize> =
+                p.t.iter()
+                    .zip(&extent)
+                    .map(|(v, (lo, _))| ((v - lo) / d).floor() as usize)
+                    .collect();
+            occupied.insert(key);
+        }
+        println!(
+            "coverage: {} of {} cells of side d in the extent box ({:.0} %)",
+            occupied.len(),
+            total,
+            100.0 * occupied.len() as f64 / total
         );
     }
     let mean_cost = map.points.iter().map(|p| p.cost).sum::<f64>() / n.max(1) as f64;

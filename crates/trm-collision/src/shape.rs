@@ -334,6 +334,14 @@ fn segment_distance_squared(
     (point_on(a1, b1, l1) - point_on(a2, b2, l2)).norm_squared()
 }
 
+/// True when a round shape's bounding sphere lies outside one of a box's slabs: a cheap reject
+/// for large boxes such as tables, which pass the bounding-sphere test for most bodies.
+#[inline]
+fn round_box_apart(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> bool {
+    let c = cuboid.iso.inverse_transform_point(&round.center);
+    (0..3).any(|i| c[i].abs() > half[i] + round.bound)
+}
+
 /// Squared distance between the segment of a placed round shape and a placed box.
 #[inline]
 fn round_box_distance_squared(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> f64 {
@@ -426,14 +434,18 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
                 half_extents: Some(h),
                 ..
             },
-        ) => round_box_distance_squared(p1, p2, h) <= radius * radius,
+        ) => {
+            !round_box_apart(p1, p2, h) && round_box_distance_squared(p1, p2, h) <= radius * radius
+        }
         (
             Geometry::General {
                 half_extents: Some(h),
                 ..
             },
             Geometry::Round { radius, .. },
-        ) => round_box_distance_squared(p2, p1, h) <= radius * radius,
+        ) => {
+            !round_box_apart(p2, p1, h) && round_box_distance_squared(p2, p1, h) <= radius * radius
+        }
         (Geometry::Round { radius, .. }, Geometry::General { shape, .. }) => {
             let (iso, round) = Compiled::round_as_parry(p1, *radius);
             parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref())

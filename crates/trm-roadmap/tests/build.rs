@@ -115,3 +115,45 @@ fn a_small_map_on_the_planar_arm_covers_its_workspace() {
         "{extent:?}"
     );
 }
+
+#[test]
+fn every_fig6_spec_builds_a_non_trivial_map() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/fig6");
+    let mut specs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    specs.sort();
+    assert_eq!(specs.len(), 10);
+    for spec in specs {
+        let problem = Problem::load(&spec).unwrap();
+        let map = build(
+            &problem,
+            &BuildOptions {
+                points: Some(15),
+                searches: Some(2),
+                ..Default::default()
+            },
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(
+            map.points.len(),
+            15,
+            "{}: {}",
+            spec.display(),
+            map.stats.stopped_because
+        );
+        let spread: f64 = map
+            .extent()
+            .iter()
+            .map(|(lo, hi)| hi - lo)
+            .fold(0.0, f64::max);
+        assert!(
+            spread >= 2.0 * map.settings.spacing,
+            "{}: extent {spread}",
+            spec.display()
+        );
+    }
+}
