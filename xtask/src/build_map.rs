@@ -87,14 +87,15 @@ pub fn run(args: &Args) -> Result<()> {
         .with_context(|| format!("saving {}", out.display()))?;
     print_summary(&map);
     let svg = out.with_extension("svg");
-    crate::write_atomic(&svg, scatter(&map)?.as_bytes())?;
+    crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;
     println!("wrote {} and {}", out.display(), svg.display());
     Ok(())
 }
 
 /// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
 /// coloured by task cost from blue (lowest) to red (highest), like Fig. 3 of the parallel paper.
-fn scatter(map: &Roadmap) -> Result<String> {
+/// With `path`, the task-space path is drawn over the points as a black line.
+pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
     use plotters::prelude::*;
     let coordinate = |p: &trm_roadmap::MapPoint, i: usize| p.t.get(i).copied().unwrap_or(0.0);
     let range = |i: usize| {
@@ -153,6 +154,13 @@ fn scatter(map: &Roadmap) -> Result<String> {
                 color.filled(),
             )
         }))?;
+        if let Some(path) = path {
+            let at = |t: &Vec<f64>, i: usize| t.get(i).copied().unwrap_or(0.0);
+            chart.draw_series(LineSeries::new(
+                path.iter().map(|t| (at(t, 0), at(t, 2), at(t, 1))),
+                BLACK.stroke_width(3),
+            ))?;
+        }
         root.present()?;
     }
     Ok(svg)

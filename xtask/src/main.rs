@@ -8,6 +8,7 @@ mod gen_acm;
 mod gen_icub;
 mod model_info;
 mod optimise;
+mod plan;
 mod solve;
 mod speedup;
 
@@ -51,6 +52,8 @@ enum Command {
     Optimise(optimise::Args),
     /// Fig. 2 of the parallel paper: map-building time per thread count, and P's effect.
     Speedup(speedup::Args),
+    /// Plan a motion through one or several maps in the current world (lazy A*).
+    Plan(plan::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
 }
@@ -67,6 +70,7 @@ fn main() {
         Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
         Command::Optimise(args) => optimise::run(&args),
+        Command::Plan(args) => plan::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
     };

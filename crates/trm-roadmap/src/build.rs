@@ -17,6 +17,7 @@ use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
 use trm_tasks::Problem;
 use trm_tasks::spec::MapSpec;
 
+use crate::edges::distance;
 use crate::error::{Result, RoadmapError};
 use crate::index::TaskIndex;
 use crate::map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};
@@ -84,7 +85,7 @@ impl Growing {
         let i = self.points.len();
         let mut near = 0;
         for (j, p) in self.points.iter().enumerate() {
-            if dist(&p.t, &point.t) <= radius {
+            if distance(&p.t, &point.t) <= radius {
                 self.neighbours[j] += 1;
                 near += 1;
             }
@@ -105,14 +106,6 @@ impl Growing {
             .collect();
         Some(ties[rng.random_range(0..ties.len())])
     }
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 /// Builds the map of a spec (it needs a task function and `map` settings, or their defaults).
@@ -231,14 +224,14 @@ pub fn build(
             map.index.nearest(t, m, nn);
             let mut h_map = 0.0;
             for &(dt, j) in nn.iter() {
-                h_map += (d - dt).abs() + settings.smoothness * dist(q, &map.points[j].q);
+                h_map += (d - dt).abs() + settings.smoothness * distance(q, &map.points[j].q);
             }
             h += settings.construct_weight * h_map;
             // h_repel: keep away from the other searches' centres
             let mut h_rep = 0.0;
             for (j, c) in centres.iter().enumerate() {
                 if j != i && have_centres[j] {
-                    h_rep += (d - dist(t, c)).max(0.0);
+                    h_rep += (d - distance(t, c)).max(0.0);
                 }
             }
             h + options.repel_weight * h_rep

@@ -26,19 +26,8 @@ pub fn connect(map: &mut Roadmap, objective: &Objective, neighbours: usize, reso
                 near.truncate(neighbours);
                 near.into_iter()
                     .filter(|&(_, j)| {
-                        let (a, b) = (&points[i].q, &points[j].q);
-                        let span = a
-                            .iter()
-                            .zip(b)
-                            .map(|(x, y)| (x - y).abs())
-                            .fold(0.0, f64::max);
-                        let steps = (span / resolution).ceil().max(1.0) as usize;
-                        (1..steps).all(|s| {
-                            let u = s as f64 / steps as f64;
-                            for k in 0..q.len() {
-                                q[k] = a[k] + u * (b[k] - a[k]);
-                            }
-                            objective.is_collision_free(q, scratch)
+                        segment_is_free(&points[i].q, &points[j].q, resolution, q, |x| {
+                            objective.is_collision_free(x, scratch)
                         })
                     })
                     .map(|(l, j)| (i.min(j), i.max(j), l))
@@ -54,10 +43,35 @@ pub fn connect(map: &mut Roadmap, objective: &Objective, neighbours: usize, reso
     map.stats.edge_seconds = started.elapsed().as_secs_f64();
 }
 
-fn distance(a: &[f64], b: &[f64]) -> f64 {
+/// Euclidean distance between two vectors (joint or task space).
+pub fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(x, y)| (x - y).powi(2))
         .sum::<f64>()
         .sqrt()
+}
+
+/// Whether `free` holds along the straight segment a → b, sampled so that no joint moves more
+/// than `resolution` between samples (both ends included). `q` is scratch of the same length.
+pub fn segment_is_free(
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    q: &mut [f64],
+    mut free: impl FnMut(&[f64]) -> bool,
+) -> bool {
+    let span = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let steps = (span / resolution).ceil().max(1.0) as usize;
+    (0..=steps).all(|s| {
+        let u = s as f64 / steps as f64;
+        for k in 0..q.len() {
+            q[k] = a[k] + u * (b[k] - a[k]);
+        }
+        free(q)
+    })
 }

@@ -18,7 +18,7 @@ mod index;
 mod map;
 
 pub use build::{BuildOptions, Progress, build};
-pub use edges::connect;
+pub use edges::{connect, distance, segment_is_free};
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};

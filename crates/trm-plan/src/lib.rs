@@ -1,0 +1,20 @@
+//! Planning through task-relevant roadmaps (Stollenga et al., IROS 2013, end of Section IV):
+//! A* over one or several maps joined through their common configuration space, with edges and
+//! nodes checked lazily against the *current* world (as OMPL's LazyPRM does), then shortcutting
+//! and time parametrisation within velocity (and acceleration) limits.
+//!
+//! ```no_run
+//! use trm_plan::{Goal, Planner, PlanOptions};
+//! let map = trm_roadmap::Roadmap::load("target/maps/reach.map.json".as_ref())?;
+//! let problem = trm_tasks::Problem::from_ron(&map.spec, &map.spec_path, ".".as_ref())?;
+//! let mut planner = Planner::new(&problem.objective, &[&map])?;
+//! let plan = planner.plan(&problem.start, &Goal::TaskPoint { t: vec![-0.3, 0.1, 0.1], tolerance: 0.03 }, &PlanOptions::default())?;
+//! println!("{} waypoints, {:.2} s", plan.trajectory.positions.len(), plan.trajectory.times.last().unwrap());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod planner;
+mod trajectory;
+
+pub use planner::{Goal, PlanError, PlanOptions, PlanStats, Planned, Planner};
+pub use trajectory::{Trajectory, time_parametrise};

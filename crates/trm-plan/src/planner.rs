@@ -1,0 +1,527 @@
+//! The lazy roadmap planner.
+
+use std::time::Instant;
+
+use petgraph::graph::{NodeIndex, UnGraph};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use thiserror::Error;
+use trm_collision::{CollisionModel, PlacedBodies, World};
+use trm_kinematics::{ActiveSet, PoseBuffer};
+use trm_roadmap::{Roadmap, distance, segment_is_free};
+use trm_tasks::Objective;
+
+use crate::trajectory::{Trajectory, time_parametrise};
+
+/// Planning failures.
+#[derive(Debug, Error, PartialEq)]
+pub enum PlanError {
+    /// Maps that do not share the objective's configuration space.
+    #[error("map {map}: {problem}")]
+    IncompatibleMap {
+        /// Index of the map.
+        map: usize,
+        /// What differs.
+        problem: String,
+    },
+    /// The start configuration collides in the current world, or has the wrong length.
+    #[error("the start configuration is invalid: {0}")]
+    InvalidStart(String),
+    /// No collision-free path; `closest` is the reachable node nearest to the goal.
+    #[error(
+        "goal unreachable: {reason}; the closest reachable node is {closest_node:?} at task distance {closest_distance:.4}"
+    )]
+    Unreachable {
+        /// Why.
+        reason: String,
+        /// The reachable node closest to the goal (task space), if any.
+        closest_node: Option<usize>,
+        /// Its task-space distance to the goal.
+        closest_distance: f64,
+    },
+}
+
+/// A goal.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Goal {
+    /// A configuration (active values), attached to the graph like the start.
+    Configuration(Vec<f64>),
+    /// Any map node within `tolerance` of a task-space point.
+    TaskPoint {
+        /// The point.
+        t: Vec<f64>,
+        /// Task-space tolerance.
+        tolerance: f64,
+    },
+    /// Any map node inside a task-space box.
+    TaskRegion {
+        /// Lower corner.
+        min: Vec<f64>,
+        /// Upper corner.
+        max: Vec<f64>,
+    },
+}
+
+/// Query settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanOptions {
+    /// Largest joint step (rad) between collision checks along an edge.
+    pub resolution: f64,
+    /// Map nodes the start (and a configuration goal) connect to.
+    pub attach_neighbours: usize,
+    /// Shortcut attempts (0 = none).
+    pub shortcuts: usize,
+    /// Seed of the shortcut choices.
+    pub seed: u64,
+    /// Joint velocity used where the model gives none (or a placeholder ≥ 1000), rad/s.
+    pub default_velocity: f64,
+    /// Optional joint acceleration limit, rad/s² (trapezoidal segments).
+    pub acceleration: Option<f64>,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions {
+            resolution: 0.05,
+            attach_neighbours: 10,
+            shortcuts: 100,
+            seed: 0,
+            default_velocity: 1.0,
+            acceleration: None,
+        }
+    }
+}
+
+/// What a query cost.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlanStats {
+    /// A* searches run (1 + re-plans after invalid edges or nodes).
+    pub searches: usize,
+    /// Edges checked by interpolation.
+    pub edges_checked: usize,
+    /// Edges found blocked.
+    pub edges_invalid: usize,
+    /// Nodes found colliding.
+    pub nodes_invalid: usize,
+    /// Roadmap nodes on the path (before shortcutting).
+    pub path_nodes: usize,
+    /// Joint-space length after shortcutting.
+    pub length: f64,
+    /// Wall time, seconds.
+    pub seconds: f64,
+}
+
+/// A planned motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planned {
+    /// The trajectory.
+    pub trajectory: Trajectory,
+    /// Map nodes visited (global indices over all maps).
+    pub nodes: Vec<usize>,
+    /// Statistics.
+    pub stats: PlanStats,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum State {
+    Unknown,
+    Valid,
+    Invalid,
+}
+
+/// The roadmap graph with lazily checked states, for one robot and a current world.
+#[derive(Debug)]
+pub struct Planner<'a> {
+    objective: &'a Objective,
+    active: ActiveSet,
+    collision: CollisionModel,
+    world: World,
+    nodes: Vec<(Vec<f64>, Vec<f64>)>,
+    node_state: Vec<State>,
+    edges: Vec<(usize, usize, f64)>,
+    edge_state: Vec<State>,
+    poses: PoseBuffer,
+    placed: PlacedBodies,
+    scratch: trm_tasks::Scratch,
+}
+
+impl<'a> Planner<'a> {
+    /// A planner over `maps` (built for the same active motors as `objective`), in the world the
+    /// objective was built with. Map nodes and edges are trusted until the world changes; maps
+    /// are joined by edges from each node to its nearest nodes of every other map (checked when
+    /// A* first wants them).
+    pub fn new(objective: &'a Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
+        let names: Vec<&str> = objective.active().names().collect();
+        let mut nodes = Vec::new();
+        let mut edges = Vec::new();
+        let mut edge_state = Vec::new();
+        let mut starts = Vec::new();
+        for (k, map) in maps.iter().enumerate() {
+            if map
+                .active
+                .iter()
+                .map(String::as_str)
+                .ne(names.iter().copied())
+            {
+                return Err(PlanError::IncompatibleMap {
+                    map: k,
+                    problem: format!(
+                        "its active motors ({}) differ from the spec's ({})",
+                        map.active.len(),
+                        names.len()
+                    ),
+                });
+            }
+            let base = nodes.len();
+            starts.push(base);
+            nodes.extend(map.points.iter().map(|p| (p.q.clone(), p.t.clone())));
+            for &(a, b, l) in &map.edges {
+                edges.push((base + a, base + b, l));
+                edge_state.push(State::Valid);
+            }
+        }
+        starts.push(nodes.len());
+        // inter-map edges: each node to its 3 nearest nodes of every other map
+        for (ma, mb) in (0..maps.len()).flat_map(|a| (a + 1..maps.len()).map(move |b| (a, b))) {
+            for i in starts[ma]..starts[ma + 1] {
+                let mut near: Vec<(f64, usize)> = (starts[mb]..starts[mb + 1])
+                    .map(|j| (distance(&nodes[i].0, &nodes[j].0), j))
+                    .collect();
+                near.sort_by(|x, y| x.0.total_cmp(&y.0));
+                for &(l, j) in near.iter().take(3) {
+                    edges.push((i, j, l));
+                    edge_state.push(State::Unknown);
+                }
+            }
+        }
+        let model = objective.active().model();
+        Ok(Planner {
+            objective,
+            active: objective.active().clone(),
+            collision: objective.collision().clone(),
+            world: objective.world().clone(),
+            node_state: vec![State::Valid; nodes.len()],
+            nodes,
+            edges,
+            edge_state,
+            poses: model.pose_buffer(),
+            placed: objective.collision().placed_bodies(),
+            scratch: objective.scratch(),
+        })
+    }
+
+    /// The current world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Replaces the world: every node and edge will be checked again when a search wants it.
+    pub fn set_world(&mut self, world: World) {
+        self.world = world;
+        self.node_state.fill(State::Unknown);
+        self.edge_state.fill(State::Unknown);
+    }
+
+    /// Number of nodes over all maps.
+    pub fn num_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Number of edges (map and inter-map).
+    pub fn num_edges(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// Whether `q` is collision-free in the current world.
+    pub fn is_free(&mut self, q: &[f64]) -> bool {
+        self.active.forward_unchecked(q, &mut self.poses);
+        self.collision.place(&self.poses, &mut self.placed);
+        !self.collision.is_colliding(&self.placed, &self.world)
+    }
+
+    /// Whether the straight segment a → b is free, checked every `resolution` of joint motion.
+    pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let mut q = a.to_vec();
+        segment_is_free(a, b, resolution, &mut q, |x| self.is_free(x))
+    }
+
+    fn task_of(&mut self, q: &[f64]) -> Vec<f64> {
+        self.objective.task_value(q, &mut self.scratch)
+    }
+
+    /// Plans from `start` (active values, need not be a map node) to `goal`.
+    pub fn plan(
+        &mut self,
+        start: &[f64],
+        goal: &Goal,
+        options: &PlanOptions,
+    ) -> Result<Planned, PlanError> {
+        let began = Instant::now();
+        let mut stats = PlanStats::default();
+        if start.len() != self.active.len() {
+            return Err(PlanError::InvalidStart(format!(
+                "{} values for {} active motors",
+                start.len(),
+                self.active.len()
+            )));
+        }
+        if !self.is_free(start) {
+            return Err(PlanError::InvalidStart(
+                "it collides in the current world".into(),
+            ));
+        }
+        let n = self.nodes.len();
+        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
+        let mut extra: Vec<(usize, usize, f64)> = Vec::new();
+        let attach = |q: &[f64],
+                      me: usize,
+                      extra: &mut Vec<(usize, usize, f64)>,
+                      nodes: &[(Vec<f64>, Vec<f64>)]| {
+            let mut near: Vec<(f64, usize)> = (0..nodes.len())
+                .map(|j| (distance(q, &nodes[j].0), j))
+                .collect();
+            near.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for &(l, j) in near.iter().take(options.attach_neighbours) {
+                extra.push((me, j, l));
+            }
+        };
+        attach(start, n, &mut extra, &self.nodes);
+        let goal_q = match goal {
+            Goal::Configuration(q) => {
+                if q.len() != self.active.len() {
+                    return Err(PlanError::Unreachable {
+                        reason: "the goal has the wrong length".into(),
+                        closest_node: None,
+                        closest_distance: f64::INFINITY,
+                    });
+                }
+                if !self.is_free(q) {
+                    return Err(PlanError::Unreachable {
+                        reason: "the goal configuration collides in the current world".into(),
+                        closest_node: None,
+                        closest_distance: f64::INFINITY,
+                    });
+                }
+                attach(q, n + 1, &mut extra, &self.nodes);
+                extra.push((n, n + 1, distance(start, q)));
+                Some(q.clone())
+            }
+            _ => None,
+        };
+        let goal_t = match goal {
+            Goal::Configuration(q) => self.task_of(q),
+            Goal::TaskPoint { t, .. } => t.clone(),
+            Goal::TaskRegion { min, max } => {
+                min.iter().zip(max).map(|(a, b)| (a + b) / 2.0).collect()
+            }
+        };
+        let is_goal_node = |i: usize, nodes: &[(Vec<f64>, Vec<f64>)]| -> bool {
+            match goal {
+                Goal::Configuration(_) => i == n + 1,
+                Goal::TaskPoint { t, tolerance } => i < n && distance(&nodes[i].1, t) <= *tolerance,
+                Goal::TaskRegion { min, max } => {
+                    i < n
+                        && nodes[i]
+                            .1
+                            .iter()
+                            .enumerate()
+                            .all(|(k, v)| *v >= min[k] && *v <= max[k])
+                }
+            }
+        };
+        if goal_q.is_none() && !(0..n).any(|i| is_goal_node(i, &self.nodes)) {
+            let closest = (0..n).min_by(|&a, &b| {
+                distance(&self.nodes[a].1, &goal_t).total_cmp(&distance(&self.nodes[b].1, &goal_t))
+            });
+            return Err(PlanError::Unreachable {
+                reason: "no map node lies within the goal's tolerance or region".into(),
+                closest_node: closest,
+                closest_distance: closest
+                    .map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, &goal_t)),
+            });
+        }
+        let total = n + 2;
+        let mut extra_state = vec![State::Unknown; extra.len()];
+        loop {
+            stats.searches += 1;
+            let mut graph =
+                UnGraph::<(), usize>::with_capacity(total, self.edges.len() + extra.len());
+            for _ in 0..total {
+                graph.add_node(());
+            }
+            let node_ok = |i: usize, st: &[State]| i >= n || st[i] != State::Invalid;
+            for (k, &(a, b, _)) in self.edges.iter().enumerate() {
+                if self.edge_state[k] != State::Invalid
+                    && node_ok(a, &self.node_state)
+                    && node_ok(b, &self.node_state)
+                {
+                    graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
+                }
+            }
+            for (k, &(a, b, _)) in extra.iter().enumerate() {
+                if extra_state[k] != State::Invalid
+                    && node_ok(a, &self.node_state)
+                    && node_ok(b, &self.node_state)
+                {
+                    graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), self.edges.len() + k);
+                }
+            }
+            let length = |k: usize| {
+                if k < self.edges.len() {
+                    self.edges[k].2
+                } else {
+                    extra[k - self.edges.len()].2
+                }
+            };
+            let found = petgraph::algo::astar(
+                &graph,
+                NodeIndex::new(n),
+                |v| is_goal_node(v.index(), &self.nodes),
+                |e| length(*e.weight()),
+                |v| match &goal_q {
+                    Some(q) if v.index() < n => distance(&self.nodes[v.index()].0, q),
+                    _ => 0.0,
+                },
+            );
+            let Some((_, path)) = found else {
+                // the reachable node closest to the goal in task space
+                let reachable = petgraph::algo::dijkstra(&graph, NodeIndex::new(n), None, |e| {
+                    length(*e.weight())
+                });
+                let closest = reachable
+                    .keys()
+                    .map(|v| v.index())
+                    .filter(|&v| v < n)
+                    .min_by(|&a, &b| {
+                        distance(&self.nodes[a].1, &goal_t)
+                            .total_cmp(&distance(&self.nodes[b].1, &goal_t))
+                    });
+                return Err(PlanError::Unreachable {
+                    reason: "no collision-free path through the maps in the current world".into(),
+                    closest_node: closest,
+                    closest_distance: closest
+                        .map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, &goal_t)),
+                });
+            };
+            let config = |i: usize, this: &Self| -> Vec<f64> {
+                if i < n {
+                    this.nodes[i].0.clone()
+                } else if i == n {
+                    start.to_vec()
+                } else {
+                    goal_q.clone().unwrap_or_default()
+                }
+            };
+            // lazily check nodes, then edges, along the path
+            let mut blocked = false;
+            for v in &path {
+                let i = v.index();
+                if i < n && self.node_state[i] == State::Unknown {
+                    let q = self.nodes[i].0.clone();
+                    self.node_state[i] = if self.is_free(&q) {
+                        State::Valid
+                    } else {
+                        State::Invalid
+                    };
+                    if self.node_state[i] == State::Invalid {
+                        stats.nodes_invalid += 1;
+                        blocked = true;
+                    }
+                }
+            }
+            if blocked {
+                continue;
+            }
+            for w in path.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                let k = *graph
+                    .edges_connecting(a, b)
+                    .next()
+                    .map(|e| e.weight())
+                    .unwrap_or(&usize::MAX);
+                let state = if k < self.edges.len() {
+                    self.edge_state[k]
+                } else {
+                    extra_state[k - self.edges.len()]
+                };
+                if state != State::Unknown {
+                    continue;
+                }
+                let (qa, qb) = (config(a.index(), self), config(b.index(), self));
+                stats.edges_checked += 1;
+                let ok = self.segment_free(&qa, &qb, options.resolution);
+                let new = if ok { State::Valid } else { State::Invalid };
+                if k < self.edges.len() {
+                    self.edge_state[k] = new;
+                } else {
+                    extra_state[k - self.edges.len()] = new;
+                }
+                if !ok {
+                    stats.edges_invalid += 1;
+                    blocked = true;
+                    break;
+                }
+            }
+            if blocked {
+                continue;
+            }
+            let node_ids: Vec<usize> = path.iter().map(|v| v.index()).filter(|&i| i < n).collect();
+            let mut waypoints: Vec<Vec<f64>> =
+                path.iter().map(|v| config(v.index(), self)).collect();
+            stats.path_nodes = node_ids.len();
+            self.shortcut(&mut waypoints, options);
+            stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
+            let trajectory = self.timed(&waypoints, options);
+            stats.seconds = began.elapsed().as_secs_f64();
+            return Ok(Planned {
+                trajectory,
+                nodes: node_ids,
+                stats,
+            });
+        }
+    }
+
+    /// Random shortcuts: replace the path between two waypoints by a straight segment when it is
+    /// collision-free.
+    fn shortcut(&mut self, waypoints: &mut Vec<Vec<f64>>, options: &PlanOptions) {
+        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        for _ in 0..options.shortcuts {
+            if waypoints.len() < 3 {
+                break;
+            }
+            let i = rng.random_range(0..waypoints.len() - 2);
+            let j = rng.random_range(i + 2..waypoints.len());
+            let (a, b) = (waypoints[i].clone(), waypoints[j].clone());
+            if self.segment_free(&a, &b, options.resolution) {
+                waypoints.drain(i + 1..j);
+            }
+        }
+    }
+
+    fn timed(&mut self, waypoints: &[Vec<f64>], options: &PlanOptions) -> Trajectory {
+        let task_path = waypoints.iter().map(|q| self.task_of(q)).collect();
+        let model = self.active.model();
+        let velocity: Vec<f64> = self
+            .active
+            .motor_indices()
+            .iter()
+            .map(|&m| {
+                let v = model.motors()[m].limits.velocity;
+                if v.is_finite() && v > 0.0 && v < 1000.0 {
+                    v
+                } else {
+                    options.default_velocity
+                }
+            })
+            .collect();
+        let acceleration = options.acceleration.map(|a| vec![a; velocity.len()]);
+        let times = time_parametrise(waypoints, &velocity, acceleration.as_deref());
+        let positions: Vec<Vec<f64>> = waypoints.iter().map(|q| self.active.to_motors(q)).collect();
+        Trajectory {
+            names: model.motors().iter().map(|m| m.name.clone()).collect(),
+            times,
+            positions,
+            task_path,
+        }
+    }
+}

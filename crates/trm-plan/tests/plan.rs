@@ -1,0 +1,277 @@
+//! Planning through the reach map: trajectories are collision-free in the current world, within
+//! limits and velocity bounds, continuous, and start and end where asked; impossible queries are
+//! clear errors.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use trm_collision::{Shape, World};
+use trm_kinematics::nalgebra::Isometry3;
+use trm_plan::{Goal, PlanError, PlanOptions, Planner};
+use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_tasks::Problem;
+
+fn problem() -> &'static Problem {
+    static P: OnceLock<Problem> = OnceLock::new();
+    P.get_or_init(|| {
+        Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap()
+    })
+}
+
+fn map() -> &'static Roadmap {
+    static M: OnceLock<Roadmap> = OnceLock::new();
+    M.get_or_init(|| {
+        let p = problem();
+        let mut map = build(
+            p,
+            &BuildOptions {
+                points: Some(120),
+                ..Default::default()
+            },
+            |_| {},
+        )
+        .unwrap();
+        connect(&mut map, &p.objective, 8, 0.05);
+        map
+    })
+}
+
+fn with_box() -> World {
+    let mut w = problem().objective.world().clone();
+    w.add(
+        "new_box",
+        Shape::Box {
+            size: [0.08, 0.06, 0.16],
+        },
+        Isometry3::translation(-0.3, 0.08, -0.04),
+    )
+    .unwrap();
+    w
+}
+
+/// Every property a returned trajectory must have, checked independently of the planner's own
+/// bookkeeping (finer interpolation, limits, velocities).
+fn check(planner: &mut Planner, start: &[f64], plan: &trm_plan::Planned, options: &PlanOptions) {
+    let p = problem();
+    let active = p.objective.active();
+    let traj = &plan.trajectory;
+    let qs: Vec<Vec<f64>> = traj
+        .positions
+        .iter()
+        .map(|m| active.from_motors(m))
+        .collect();
+    assert_eq!(qs[0], start, "starts at the start");
+    let (lower, upper) = active.bounds();
+    for q in &qs {
+        for i in 0..q.len() {
+            assert!(q[i] >= lower[i] - 1e-12 && q[i] <= upper[i] + 1e-12);
+        }
+    }
+    for (k, w) in qs.windows(2).enumerate() {
+        assert!(
+            planner.segment_free(&w[0], &w[1], options.resolution / 2.0),
+            "segment {k} collides"
+        );
+        let dt = traj.times[k + 1] - traj.times[k];
+        let step = w[0]
+            .iter()
+            .zip(&w[1])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            step <= options.default_velocity * dt + 1e-9,
+            "segment {k} too fast"
+        );
+    }
+    assert!(traj.times.windows(2).all(|t| t[1] >= t[0]));
+    assert_eq!(traj.task_path.len(), qs.len());
+}
+
+#[test]
+fn a_point_goal_is_reached_collision_free_around_a_new_box() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    planner.set_world(with_box());
+    let options = PlanOptions::default();
+    let goal_t = map.points[map.points.len() / 2].t.clone();
+    let plan = planner
+        .plan(
+            &p.start,
+            &Goal::TaskPoint {
+                t: goal_t.clone(),
+                tolerance: 0.03,
+            },
+            &options,
+        )
+        .unwrap();
+    check(&mut planner, &p.start, &plan, &options);
+    let end = plan.trajectory.task_path.last().unwrap();
+    let d: f64 = end
+        .iter()
+        .zip(&goal_t)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(d <= 0.03, "ends {d} from the goal");
+    // the same query again is reproducible
+    let again = planner
+        .plan(
+            &p.start,
+            &Goal::TaskPoint {
+                t: goal_t,
+                tolerance: 0.03,
+            },
+            &options,
+        )
+        .unwrap();
+    assert_eq!(again.trajectory, plan.trajectory);
+}
+
+#[test]
+fn a_configuration_goal_ends_exactly_there() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    let options = PlanOptions {
+        acceleration: Some(2.0),
+        ..Default::default()
+    };
+    let goal = map.points[map.points.len() - 1].q.clone();
+    let plan = planner
+        .plan(&p.start, &Goal::Configuration(goal.clone()), &options)
+        .unwrap();
+    check(&mut planner, &p.start, &plan, &options);
+    let last = p
+        .objective
+        .active()
+        .from_motors(plan.trajectory.positions.last().unwrap());
+    assert_eq!(last, goal);
+}
+
+#[test]
+fn impossible_queries_are_clear_errors() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    let far = Goal::TaskPoint {
+        t: vec![1.0, 1.0, 1.0],
+        tolerance: 0.03,
+    };
+    match planner.plan(&p.start, &far, &PlanOptions::default()) {
+        Err(PlanError::Unreachable {
+            closest_node: Some(_),
+            closest_distance,
+            ..
+        }) => {
+            assert!(closest_distance > 0.5)
+        }
+        other => panic!("{other:?}"),
+    }
+    // a wall through the whole workspace in front of the robot cuts every path to the goal
+    let mut wall = p.objective.world().clone();
+    wall.add(
+        "wall",
+        Shape::Box {
+            size: [0.02, 2.0, 2.0],
+        },
+        Isometry3::translation(-0.27, 0.0, 0.0),
+    )
+    .unwrap();
+    planner.set_world(wall);
+    let goal_t = map.points[map.points.len() / 2].t.clone();
+    let e = planner.plan(
+        &p.start,
+        &Goal::TaskPoint {
+            t: goal_t,
+            tolerance: 0.05,
+        },
+        &PlanOptions::default(),
+    );
+    assert!(
+        matches!(
+            e,
+            Err(PlanError::InvalidStart(_)) | Err(PlanError::Unreachable { .. })
+        ),
+        "{e:?}"
+    );
+    let e = planner
+        .plan(&p.start[..3], &far, &PlanOptions::default())
+        .unwrap_err();
+    assert!(matches!(e, PlanError::InvalidStart(_)));
+}
+
+#[test]
+fn two_maps_are_joined_through_configuration_space() {
+    let p = problem();
+    let map = map();
+    // split the map by the palm's y into two maps without edges between them
+    let split = |left: bool| {
+        let keep: Vec<usize> = (0..map.points.len())
+            .filter(|&i| (map.points[i].t[1] < 0.1) == left)
+            .collect();
+        let index = |i: usize| keep.iter().position(|&k| k == i);
+        let mut m = map.clone();
+        m.points = keep.iter().map(|&i| map.points[i].clone()).collect();
+        m.edges = map
+            .edges
+            .iter()
+            .filter_map(|&(a, b, l)| Some((index(a)?, index(b)?, l)))
+            .collect();
+        m
+    };
+    let (a, b) = (split(true), split(false));
+    assert!(!a.points.is_empty() && !b.points.is_empty());
+    let mut planner = Planner::new(&p.objective, &[&a, &b]).unwrap();
+    assert!(planner.num_edges() > a.edges.len() + b.edges.len());
+    // from a node of map b to a point only map a covers
+    let start = b.points[0].q.clone();
+    let goal_t = a.points[a.points.len() / 2].t.clone();
+    let options = PlanOptions {
+        shortcuts: 0,
+        ..Default::default()
+    };
+    let plan = planner
+        .plan(
+            &start,
+            &Goal::TaskPoint {
+                t: goal_t,
+                tolerance: 0.01,
+            },
+            &options,
+        )
+        .unwrap();
+    check(&mut planner, &start, &plan, &options);
+    assert!(
+        plan.nodes.iter().any(|&n| n < a.points.len())
+            && plan.nodes.iter().any(|&n| n >= a.points.len())
+    );
+}
+
+#[test]
+fn a_region_goal_ends_inside_the_region() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    let t = &map.points[map.points.len() / 3].t;
+    let (min, max): (Vec<f64>, Vec<f64>) = t.iter().map(|v| (v - 0.02, v + 0.02)).unzip();
+    let options = PlanOptions::default();
+    let plan = planner
+        .plan(
+            &p.start,
+            &Goal::TaskRegion {
+                min: min.clone(),
+                max: max.clone(),
+            },
+            &options,
+        )
+        .unwrap();
+    check(&mut planner, &p.start, &plan, &options);
+    let end = plan.trajectory.task_path.last().unwrap();
+    assert!(
+        end.iter()
+            .enumerate()
+            .all(|(i, v)| *v >= min[i] && *v <= max[i]),
+        "{end:?}"
+    );
+}

@@ -1,0 +1,166 @@
+//! `cargo xtask plan --map FILE [--map FILE2 …] [--world WORLD.ron] --from home|q.json
+//! --to "x,y,z"|q.json [--out traj.csv]`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use trm_collision::World;
+use trm_plan::{Goal, PlanOptions, Planner};
+use trm_roadmap::Roadmap;
+use trm_tasks::Problem;
+
+/// Arguments of `plan`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Map files (repeatable); they must share the first map's active motors.
+    #[arg(long = "map", required = true)]
+    maps: Vec<PathBuf>,
+    /// The current world (RON), replacing the one the maps were built in.
+    #[arg(long)]
+    world: Option<PathBuf>,
+    /// Start: `home` (the spec's start posture) or a JSON file with "motors": {name: value}
+    /// (as `solve --out` writes) or "q": [active values].
+    #[arg(long, default_value = "home")]
+    from: String,
+    /// Goal: a task-space point "x,y,z" (any map node within --tolerance) or a JSON posture file.
+    #[arg(long, allow_hyphen_values = true)]
+    to: String,
+    /// Task-space tolerance for a point goal.
+    #[arg(long, default_value_t = 0.03)]
+    tolerance: f64,
+    /// Trajectory output (CSV; a .json with the task-space path is written beside it).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Seed of the shortcutting.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Joint speed where the model has no limit, rad/s.
+    #[arg(long, default_value_t = 1.0)]
+    velocity: f64,
+}
+
+fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    let active = problem.objective.active();
+    if let Some(q) = v.get("q").and_then(|q| q.as_array()) {
+        let q: Vec<f64> = q.iter().filter_map(|x| x.as_f64()).collect();
+        if q.len() != active.len() {
+            bail!(
+                "{}: \"q\" has {} values for {} active motors",
+                path.display(),
+                q.len(),
+                active.len()
+            );
+        }
+        return Ok(q);
+    }
+    if let Some(m) = v.get("motors").and_then(|m| m.as_object()) {
+        let mut motors = active.to_motors(&problem.start);
+        for (name, value) in m {
+            let i = problem
+                .robot
+                .motor_index(name)
+                .with_context(|| format!("{}: motors", path.display()))?;
+            motors[i] = value
+                .as_f64()
+                .with_context(|| format!("{}: motor {name} is not a number", path.display()))?;
+        }
+        return Ok(active.from_motors(&motors));
+    }
+    bail!(
+        "{}: expected \"motors\": {{name: value}} or \"q\": [..]",
+        path.display()
+    )
+}
+
+/// Plans and reports.
+pub fn run(args: &Args) -> Result<()> {
+    let maps: Vec<Roadmap> = args
+        .maps
+        .iter()
+        .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
+        .collect::<Result<_>>()?;
+    let first = &maps[0];
+    let base = Path::new(&first.spec_path)
+        .parent()
+        .map(PathBuf::from)
+        .unwrap_or_default();
+    let problem = Problem::from_ron(&first.spec, &first.spec_path, &base)
+        .with_context(|| format!("the spec stored in {}", args.maps[0].display()))?;
+    let refs: Vec<&Roadmap> = maps.iter().collect();
+    let mut planner = Planner::new(&problem.objective, &refs)?;
+    if let Some(w) = &args.world {
+        planner.set_world(World::load(w)?);
+    }
+    let start = if args.from == "home" {
+        problem.start.clone()
+    } else {
+        posture(Path::new(&args.from), &problem)?
+    };
+    let goal = if Path::new(&args.to).is_file() {
+        Goal::Configuration(posture(Path::new(&args.to), &problem)?)
+    } else {
+        let t: Vec<f64> = args
+            .to
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("--to `{}`: expected \"x,y,z\" or a posture file", args.to))?;
+        Goal::TaskPoint {
+            t,
+            tolerance: args.tolerance,
+        }
+    };
+    let options = PlanOptions {
+        seed: args.seed,
+        default_velocity: args.velocity,
+        ..Default::default()
+    };
+    let plan = planner.plan(&start, &goal, &options)?;
+    let s = &plan.stats;
+    println!(
+        "{} maps, {} nodes, {} edges; world: {} objects",
+        maps.len(),
+        planner.num_nodes(),
+        planner.num_edges(),
+        planner.world().len()
+    );
+    println!(
+        "path: {} map nodes → {} waypoints after shortcutting, joint-space length {:.3} rad, duration {:.2} s",
+        s.path_nodes,
+        plan.trajectory.times.len(),
+        s.length,
+        plan.trajectory.times.last().copied().unwrap_or(0.0)
+    );
+    println!(
+        "planning: {:.2} ms, {} A* searches, {} edges checked ({} blocked), {} nodes found colliding",
+        s.seconds * 1e3,
+        s.searches,
+        s.edges_checked,
+        s.edges_invalid,
+        s.nodes_invalid
+    );
+    if let Some(last) = plan.trajectory.task_path.last() {
+        println!("reached task point {last:?}");
+    }
+    if let Some(out) = &args.out {
+        crate::write_atomic(out, plan.trajectory.to_csv().as_bytes())?;
+        let json = out.with_extension("json");
+        crate::write_json(&json, &serde_json::to_value(&plan.trajectory)?)?;
+        let svg = out.with_extension("svg");
+        crate::write_atomic(
+            &svg,
+            crate::build_map::scatter(first, Some(&plan.trajectory.task_path))?.as_bytes(),
+        )?;
+        println!(
+            "wrote {}, {} and {}",
+            out.display(),
+            json.display(),
+            svg.display()
+        );
+    }
+    Ok(())
+}
