@@ -105,6 +105,11 @@ impl ActiveSet {
         })
     }
 
+    /// Per movable joint: constant and `(active index, factor)` terms.
+    pub(crate) fn rows(&self) -> &[(f64, Vec<(usize, f64)>)] {
+        &self.rows
+    }
+
     /// The model.
     pub fn model(&self) -> &RobotModel {
         &self.model

@@ -24,10 +24,16 @@
 //! # Ok::<(), trm_kinematics::KinematicsError>(())
 //! ```
 //!
+//! Derivatives come from the same pose buffer: [`ActiveSet::jacobian`] (geometric, world axes),
+//! [`ActiveSet::point_jacobian`], [`ActiveSet::center_of_mass`], [`ActiveSet::com_jacobian`] and
+//! [`ActiveSet::gravity_torques`], all with respect to the active motors (couplings included;
+//! checked against Pinocchio and finite differences).
+//!
 //! World frame = the URDF root link. Joint, motor and active vectors are explained on
 //! [`RobotModel`]. Mesh files are never opened: kinematics needs none.
 
 mod active;
+mod derivatives;
 mod description;
 mod error;
 mod fk;
@@ -35,6 +41,7 @@ mod model;
 mod tree;
 
 pub use active::ActiveSet;
+pub use derivatives::GRAVITY;
 pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,
     MotorSpec, PostureSpec,
@@ -43,5 +50,5 @@ pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use fk::PoseBuffer;
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
-pub use tree::{Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
+pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use urdf_rs;

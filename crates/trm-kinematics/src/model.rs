@@ -336,6 +336,16 @@ impl RobotModel {
         Err(unknown(NameKind::Frame, name, self.frame_names()))
     }
 
+    /// The link a frame (a link, or a named frame attached to a link) moves with.
+    pub fn frame_link(&self, frame: FrameId) -> usize {
+        let i = frame.0;
+        if i < self.num_links() {
+            i
+        } else {
+            self.data.frames[i - self.num_links()].link
+        }
+    }
+
     /// Names of all links then all named frames, in pose-buffer order.
     pub fn frame_names(&self) -> impl Iterator<Item = &str> {
         let links = self.data.tree.links.iter().map(|l| l.name.as_str());

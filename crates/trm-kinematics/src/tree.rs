@@ -59,6 +59,35 @@ pub struct Link {
     pub collisions: Vec<urdf_rs::Collision>,
     /// Line of the `<link>` element in the URDF text, when known.
     pub line: Option<usize>,
+    /// Mass properties (zero mass when the URDF gives no `<inertial>`).
+    pub inertial: Inertial,
+}
+
+/// A link's mass properties, in the link frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inertial {
+    /// Mass, kg.
+    pub mass: f64,
+    /// Centre of mass in the link frame.
+    pub com: Vector3<f64>,
+    /// Inertia tensor about the centre of mass, in link-frame axes.
+    pub inertia: nalgebra::Matrix3<f64>,
+}
+
+impl Inertial {
+    fn from_urdf(i: &urdf_rs::Inertial) -> Self {
+        let pose = pose_from_xyz_rpy(i.origin.xyz.0, i.origin.rpy.0);
+        let t = &i.inertia;
+        let local = nalgebra::Matrix3::new(
+            t.ixx, t.ixy, t.ixz, t.ixy, t.iyy, t.iyz, t.ixz, t.iyz, t.izz,
+        );
+        let r = pose.rotation.to_rotation_matrix();
+        Inertial {
+            mass: i.mass.value,
+            com: pose.translation.vector,
+            inertia: r.matrix() * local * r.matrix().transpose(),
+        }
+    }
 }
 
 /// A URDF joint `<mimic>` element: `value = multiplier · leader + offset`.
@@ -178,6 +207,25 @@ impl Tree {
         let mut joint_names: HashMap<&str, ()> = HashMap::new();
         let mut parent_of: Vec<Option<usize>> = vec![None; robot.links.len()];
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
+        for l in &robot.links {
+            let i = &l.inertial;
+            let t = &i.inertia;
+            check_finite(
+                ctx,
+                "link",
+                &l.name,
+                "inertial",
+                &[i.mass.value, t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz],
+            )?;
+            if i.mass.value < 0.0 {
+                return Err(ctx.invalid(
+                    "link",
+                    &l.name,
+                    format!("mass {} is negative", i.mass.value),
+                    "give a mass ≥ 0 in kg",
+                ));
+            }
+        }
         for (j, joint) in robot.joints.iter().enumerate() {
             if joint_names.insert(joint.name.as_str(), ()).is_some() {
                 return Err(ctx.invalid(
@@ -294,6 +342,7 @@ impl Tree {
                 line: ctx
                     .source
                     .and_then(|src| line_of_element(src, "link", &robot.links[old].name)),
+                inertial: Inertial::from_urdf(&robot.links[old].inertial),
             });
             if let Some(uj) = parent_joint {
                 let mut joint =
