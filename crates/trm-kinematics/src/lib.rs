@@ -36,6 +36,7 @@ mod active;
 mod derivatives;
 mod description;
 mod error;
+mod files;
 mod fk;
 mod model;
 mod tree;
@@ -47,6 +48,7 @@ pub use description::{
     MotorSpec, PostureSpec,
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
+pub use files::write_atomic;
 pub use fk::PoseBuffer;
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;

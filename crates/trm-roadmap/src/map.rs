@@ -1,7 +1,6 @@
 //! Roadmaps and their files: versioned JSON with the spec, seed, settings, software version and
 //! statistics inside, written atomically.
 
-use std::io::Write as _;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -80,34 +79,14 @@ pub struct Roadmap {
 impl Roadmap {
     /// Writes the map as JSON through a temporary file and a rename.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let err = |e: std::io::Error| RoadmapError::File {
-            path: path.display().to_string(),
-            problem: e.to_string(),
-        };
         let text = serde_json::to_string(self).map_err(|e| RoadmapError::File {
             path: path.display().to_string(),
             problem: e.to_string(),
         })?;
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(err)?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-        let result = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(text.as_bytes())?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result.map_err(err)
+        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|e| RoadmapError::File {
+            path: path.display().to_string(),
+            problem: e.to_string(),
+        })
     }
 
     /// Reads a map file; a truncated, foreign or newer file is a clear error.

@@ -275,3 +275,29 @@ impl Cost for Displacement {
             .sqrt()
     }
 }
+
+/// The task-map cost (Gienger et al., eq. 18–19): c_map = (x − x_map)ᵀ W (x − x_map) where x is
+/// the part's pose relative to a world object (position, rotation vector) and x_map the nearest
+/// feasible point of a task map — "anywhere on the handle" instead of one target.
+#[derive(Debug, Clone)]
+pub struct TaskMapCost {
+    /// The map.
+    pub map: std::sync::Arc<trm_taskmap::TaskMap>,
+    /// The part whose pose is compared (e.g. the hand).
+    pub part: FrameId,
+    /// Its name.
+    pub part_name: String,
+    /// The world object the map is expressed relative to.
+    pub object: usize,
+}
+
+impl Cost for TaskMapCost {
+    fn label(&self) -> String {
+        format!("task map {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let object = ctx.world.objects()[self.object].pose();
+        let relative = object.inverse() * ctx.poses.pose(self.part);
+        self.map.cost(&trm_taskmap::to_params(&relative)).0
+    }
+}

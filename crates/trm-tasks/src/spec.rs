@@ -200,6 +200,16 @@ pub enum CostKind {
     },
     /// Minimal displacement from the start posture.
     Displacement,
+    /// Distance (metric W of the map) from the part's pose relative to a world object to the
+    /// nearest point of a task map file (`cargo xtask explore-task-map`).
+    TaskMap {
+        /// The task map file, relative to the spec.
+        file: String,
+        /// The part (e.g. `r_hand`).
+        part: String,
+        /// The world object the map is relative to.
+        object: String,
+    },
 }
 
 /// The task catalogue (Table II and composites).
@@ -502,6 +512,7 @@ impl Problem {
             robot: &robot,
             world: &world,
             ctx: &ctx,
+            base,
         };
         let mut terms = Vec::new();
         for (k, c) in spec.costs.iter().enumerate() {
@@ -708,6 +719,7 @@ struct Resolver<'a> {
     robot: &'a RobotModel,
     world: &'a World,
     ctx: &'a Ctx<'a>,
+    base: &'a Path,
 }
 
 impl Resolver<'_> {
@@ -949,6 +961,23 @@ impl Resolver<'_> {
             CostKind::Displacement => Box::new(Displacement {
                 start: start.to_vec(),
             }),
+            CostKind::TaskMap { file, part, object } => {
+                let path = self.base.join(file);
+                let map = trm_taskmap::TaskMap::load(&path).map_err(|e| {
+                    self.ctx.err(
+                        &field,
+                        &format!("\"{file}\""),
+                        e.to_string(),
+                        "build it with trm_taskmap::explore (cargo xtask explore-task-map)",
+                    )
+                })?;
+                Box::new(crate::costs::TaskMapCost {
+                    map: std::sync::Arc::new(map),
+                    part: self.frame(part, &field)?,
+                    part_name: part.clone(),
+                    object: self.object(object, &field)?,
+                })
+            }
         })
     }
 

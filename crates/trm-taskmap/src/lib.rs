@@ -1,0 +1,23 @@
+//! Task maps (Gienger, Toussaint and Goerick, "Task maps in humanoid robot manipulation",
+//! IROS 2008, Section II and eq. 18–19): a set of feasible points g in a 6-D goal space (the
+//! position and rotation vector of a hand relative to an object) for which an evaluation C(g)
+//! exceeds a threshold θ, explored with the paper's RRT scheme — plus restarts, so that disjoint
+//! clusters are found too — and the task-map cost c_map = (x − x_map)ᵀ W (x − x_map) to the
+//! nearest map element, with its gradient.
+//!
+//! ```
+//! use trm_taskmap::{ExploreSettings, Metric, explore};
+//! // feasible: anywhere along a 20 cm stick (x), within 1 cm of its axis, any roll about it
+//! let feasible = |g: &[f64; 6]| 0.01 - g[1].abs().max(g[2].abs()).max(g[4].abs() / 20.0).max(g[5].abs() / 20.0)
+//!     .max(g[0].abs() - 0.1);
+//! let settings = ExploreSettings { iterations: 3000, ..ExploreSettings::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3]) };
+//! let map = explore(&[[0.0; 6]], &settings, &Metric::default(), feasible)?;
+//! assert!(map.points.len() > 50);
+//! # Ok::<(), trm_taskmap::TaskMapError>(())
+//! ```
+
+mod explore;
+mod map;
+
+pub use explore::{ExploreSettings, explore};
+pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};

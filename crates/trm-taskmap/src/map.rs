@@ -1,0 +1,291 @@
+//! Task maps, their metric and files, and the task-map cost.
+
+use std::path::Path;
+
+use kiddo::{KdTree, SquaredEuclidean};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Task-map errors.
+#[derive(Debug, Error, PartialEq)]
+pub enum TaskMapError {
+    /// A setting out of range.
+    #[error("invalid {what}: {problem}")]
+    Invalid {
+        /// The setting.
+        what: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A start point that is not feasible.
+    #[error(
+        "start g₀ #{index} is infeasible: C = {value} is not above the threshold {threshold}; give a feasible grasp to start from"
+    )]
+    InfeasibleStart {
+        /// Which start.
+        index: usize,
+        /// Its evaluation.
+        value: f64,
+        /// θ.
+        threshold: f64,
+    },
+    /// A file problem.
+    #[error("{path}: {problem}")]
+    File {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+/// The metric W = diag(w_p, w_p, w_p, w_o, w_o, w_o): metres against radians.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Metric {
+    /// Weight of squared position differences (1/m²).
+    pub position: f64,
+    /// Weight of squared rotation-vector differences (1/rad²).
+    pub orientation: f64,
+}
+
+impl Default for Metric {
+    /// 1 cm counts as much as about 0.1 rad (5.7°).
+    fn default() -> Self {
+        Metric {
+            position: 1.0,
+            orientation: 0.01,
+        }
+    }
+}
+
+impl Metric {
+    /// Checks that both weights are positive and finite.
+    pub fn check(&self) -> Result<(), TaskMapError> {
+        for (what, w) in [
+            ("position weight", self.position),
+            ("orientation weight", self.orientation),
+        ] {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(TaskMapError::Invalid {
+                    what: format!("metric {what}"),
+                    problem: format!("{w} is not a positive finite number (a degenerate metric)"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// √W ⊙ g: coordinates in which the metric is Euclidean.
+    pub fn scale(&self, g: &[f64; 6]) -> [f64; 6] {
+        let (p, o) = (self.position.sqrt(), self.orientation.sqrt());
+        [g[0] * p, g[1] * p, g[2] * p, g[3] * o, g[4] * o, g[5] * o]
+    }
+
+    /// The metric distance ‖a − b‖_W.
+    pub fn distance(&self, a: &[f64; 6], b: &[f64; 6]) -> f64 {
+        let w = [
+            self.position,
+            self.position,
+            self.position,
+            self.orientation,
+            self.orientation,
+            self.orientation,
+        ];
+        (0..6)
+            .map(|i| w[i] * (a[i] - b[i]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+}
+
+/// A pose as goal parameters: translation and rotation vector (axis × angle, |angle| ≤ π).
+pub fn to_params(pose: &Isometry3<f64>) -> [f64; 6] {
+    let t = pose.translation.vector;
+    let r = pose.rotation.scaled_axis();
+    [t.x, t.y, t.z, r.x, r.y, r.z]
+}
+
+/// The pose of goal parameters.
+pub fn to_pose(g: &[f64; 6]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(g[0], g[1], g[2]),
+        UnitQuaternion::from_scaled_axis(Vector3::new(g[3], g[4], g[5])),
+    )
+}
+
+/// A feasible point of a task map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TaskPoint {
+    /// Goal parameters (position, rotation vector).
+    pub g: [f64; 6],
+    /// Its evaluation C(g).
+    pub value: f64,
+    /// Tree parent (None for a cluster's root).
+    pub parent: Option<usize>,
+    /// Cluster (tree) index.
+    pub cluster: usize,
+}
+
+/// A task map.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct TaskMap {
+    /// Always `trm-taskmap`.
+    pub format: String,
+    /// File version.
+    pub version: u32,
+    /// The metric.
+    pub metric: Metric,
+    /// θ.
+    pub threshold: f64,
+    /// The points.
+    pub points: Vec<TaskPoint>,
+    /// Evaluations of C spent exploring.
+    pub evaluations: u64,
+    #[serde(skip)]
+    index: Option<TaskIndexCell>,
+}
+
+/// The kd-tree over √W-scaled points.
+struct TaskIndexCell(KdTree<f64, 6>);
+
+impl std::fmt::Debug for TaskIndexCell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("TaskIndexCell")
+    }
+}
+
+impl Clone for TaskMap {
+    fn clone(&self) -> Self {
+        TaskMap::new(
+            self.metric,
+            self.threshold,
+            self.points.clone(),
+            self.evaluations,
+        )
+    }
+}
+
+impl PartialEq for TaskMap {
+    fn eq(&self, other: &Self) -> bool {
+        self.metric == other.metric
+            && self.threshold == other.threshold
+            && self.points == other.points
+            && self.evaluations == other.evaluations
+    }
+}
+
+const FORMAT: &str = "trm-taskmap";
+const VERSION: u32 = 1;
+
+impl TaskMap {
+    pub(crate) fn new(
+        metric: Metric,
+        threshold: f64,
+        points: Vec<TaskPoint>,
+        evaluations: u64,
+    ) -> Self {
+        let mut map = TaskMap {
+            format: FORMAT.into(),
+            version: VERSION,
+            metric,
+            threshold,
+            points,
+            evaluations,
+            index: None,
+        };
+        map.reindex();
+        map
+    }
+
+    fn reindex(&mut self) {
+        let mut index = KdTree::new();
+        for (i, p) in self.points.iter().enumerate() {
+            index.add(&self.metric.scale(&p.g), i as u64);
+        }
+        self.index = Some(TaskIndexCell(index));
+    }
+
+    /// Number of clusters (disjoint trees).
+    pub fn clusters(&self) -> usize {
+        self.points.iter().map(|p| p.cluster + 1).max().unwrap_or(0)
+    }
+
+    /// The nearest map point to `g` and its metric distance.
+    pub fn nearest(&self, g: &[f64; 6]) -> Option<(usize, f64)> {
+        let index = &self.index.as_ref()?.0;
+        if self.points.is_empty() {
+            return None;
+        }
+        let nn = index.nearest_one::<SquaredEuclidean>(&self.metric.scale(g));
+        Some((nn.item as usize, nn.distance.sqrt()))
+    }
+
+    /// The task-map cost c_map = (x − x_map)ᵀ W (x − x_map) to the nearest map point, and its
+    /// gradient 2 W (x − x_map) with respect to x (paper eq. 18–19). An empty map costs +∞.
+    pub fn cost(&self, x: &[f64; 6]) -> (f64, [f64; 6]) {
+        let Some((i, d)) = self.nearest(x) else {
+            return (f64::INFINITY, [0.0; 6]);
+        };
+        let m = &self.points[i].g;
+        let w = [
+            self.metric.position,
+            self.metric.position,
+            self.metric.position,
+            self.metric.orientation,
+            self.metric.orientation,
+            self.metric.orientation,
+        ];
+        let mut grad = [0.0; 6];
+        for k in 0..6 {
+            grad[k] = 2.0 * w[k] * (x[k] - m[k]);
+        }
+        (d * d, grad)
+    }
+
+    /// Writes the map as JSON (atomically).
+    pub fn save(&self, path: &Path) -> Result<(), TaskMapError> {
+        let fail = |problem: String| TaskMapError::File {
+            path: path.display().to_string(),
+            problem,
+        };
+        if self.points.is_empty() {
+            return Err(fail(
+                "the task map is empty: nothing feasible was found, no file written".into(),
+            ));
+        }
+        let text = serde_json::to_string(self).map_err(|e| fail(e.to_string()))?;
+        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|e| fail(e.to_string()))
+    }
+
+    /// Reads a map; truncated, foreign or newer files are clear errors.
+    pub fn load(path: &Path) -> Result<Self, TaskMapError> {
+        let fail = |problem: String| TaskMapError::File {
+            path: path.display().to_string(),
+            problem,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+            if e.is_eof() {
+                fail(format!("truncated ({e})"))
+            } else {
+                fail(format!("not a trm task map: {e}"))
+            }
+        })?;
+        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
+            return Err(fail(format!(
+                "not a trm task map (no `\"format\": \"{FORMAT}\"`)"
+            )));
+        }
+        if value.get("version").and_then(|v| v.as_u64()) != Some(u64::from(VERSION)) {
+            return Err(fail(format!(
+                "unsupported task map version; this trm reads version {VERSION}"
+            )));
+        }
+        let mut map: TaskMap =
+            serde_json::from_value(value).map_err(|e| fail(format!("malformed task map: {e}")))?;
+        map.metric.check()?;
+        map.reindex();
+        Ok(map)
+    }
+}
