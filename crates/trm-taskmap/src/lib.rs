@@ -17,7 +17,9 @@
 //! ```
 
 mod explore;
+mod grasp;
 mod map;
 
 pub use explore::{ExploreSettings, explore};
+pub use grasp::{Finger, GraspResult, Hand};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
