@@ -93,18 +93,36 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
-/// coloured by task cost from blue (lowest) to red (highest), like Fig. 3 of the parallel paper.
-/// With `path`, the task-space path is drawn over the points as a black line.
+/// coloured by task cost, like Fig. 3 of the parallel paper; with `path`, the task-space path
+/// is drawn over them.
 pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
+    let at = |t: &[f64], i: usize| t.get(i).copied().unwrap_or(0.0);
+    let points: Vec<[f64; 3]> = map
+        .points
+        .iter()
+        .map(|p| [at(&p.t, 0), at(&p.t, 1), at(&p.t, 2)])
+        .collect();
+    let costs: Vec<f64> = map.points.iter().map(|p| p.cost).collect();
+    let path: Option<Vec<[f64; 3]>> =
+        path.map(|p| p.iter().map(|t| [at(t, 0), at(t, 1), at(t, 2)]).collect());
+    let title = format!("{} points, task `{}`", map.points.len(), map.task);
+    scatter_points(&title, &points, &costs, path.as_deref())
+}
+
+/// A 3-D scatter of points coloured by value from blue (lowest) to red (highest), with an
+/// optional polyline.
+pub fn scatter_points(
+    title: &str,
+    points: &[[f64; 3]],
+    values: &[f64],
+    path: Option<&[[f64; 3]]>,
+) -> Result<String> {
     use plotters::prelude::*;
-    let coordinate = |p: &trm_roadmap::MapPoint, i: usize| p.t.get(i).copied().unwrap_or(0.0);
     let range = |i: usize| {
-        let (lo, hi) = map
-            .points
+        let (lo, hi) = points
             .iter()
-            .map(|p| coordinate(p, i))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p[i]), b.max(p[i]))
             });
         if lo.is_finite() && hi > lo {
             let pad = 0.05 * (hi - lo);
@@ -113,11 +131,10 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
             -0.1..0.1
         }
     };
-    let (cmin, cmax) = map
-        .points
+    let (vmin, vmax) = values
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.cost), b.max(p.cost))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
         });
     let mut svg = String::new();
     {
@@ -125,12 +142,8 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
         root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(
-                format!(
-                    "{} points, task `{}`; colour: cost {cmin:.3} (blue) to {cmax:.3} (red)",
-                    map.points.len(),
-                    map.task
-                ),
-                ("sans-serif", 16),
+                format!("{title}; colour {vmin:.3} (blue) to {vmax:.3} (red)"),
+                ("sans-serif", 15),
             )
             .margin(10)
             .build_cartesian_3d(range(0), range(2), range(1))?;
@@ -141,23 +154,18 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
             p.into_matrix()
         });
         chart.configure_axes().draw()?;
-        chart.draw_series(map.points.iter().map(|p| {
-            let u = if cmax > cmin {
-                (p.cost - cmin) / (cmax - cmin)
+        chart.draw_series(points.iter().zip(values).map(|(p, v)| {
+            let u = if vmax > vmin {
+                (v - vmin) / (vmax - vmin)
             } else {
                 0.0
             };
             let color = RGBColor((255.0 * u) as u8, 60, (255.0 * (1.0 - u)) as u8);
-            Circle::new(
-                (coordinate(p, 0), coordinate(p, 2), coordinate(p, 1)),
-                3,
-                color.filled(),
-            )
+            Circle::new((p[0], p[2], p[1]), 3, color.filled())
         }))?;
         if let Some(path) = path {
-            let at = |t: &Vec<f64>, i: usize| t.get(i).copied().unwrap_or(0.0);
             chart.draw_series(LineSeries::new(
-                path.iter().map(|t| (at(t, 0), at(t, 2), at(t, 1))),
+                path.iter().map(|t| (t[0], t[2], t[1])),
                 BLACK.stroke_width(3),
             ))?;
         }

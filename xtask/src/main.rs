@@ -3,6 +3,7 @@
 mod build_map;
 mod collide;
 mod compare;
+mod explore_task_map;
 mod fk;
 mod gen_acm;
 mod gen_icub;
@@ -39,6 +40,8 @@ enum Command {
     BuildMap(build_map::Args),
     /// Summarise a map file: points, edges, components, extent, spacing, cost, build statistics.
     MapInfo(build_map::InfoArgs),
+    /// Explore the task map of feasible grasps of an object (RRT with restarts).
+    ExploreTaskMap(explore_task_map::Args),
     /// Table III: xNES against SIR, SIRD, MH, Nelder-Mead (and CMA-ES, (1+1)-CMA-ES) on two postures.
     CompareOptimisers(compare::Args),
     /// Colliding pairs and minimum self-distance of joint configurations read from JSON.
@@ -66,6 +69,7 @@ fn main() {
         Command::MapInfo(args) => build_map::info(&args),
         Command::Collide(args) => collide::run(&args),
         Command::CompareOptimisers(args) => compare::run(&args),
+        Command::ExploreTaskMap(args) => explore_task_map::run(&args),
         Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
         Command::Optimise(args) => optimise::run(&args),

@@ -195,8 +195,9 @@ impl Hand {
     }
 
     /// Evaluates the grasp with the hand link at pose `g` in the object's frame; `object` holds
-    /// the object's parts in its own frame (e.g. a capsule along z at the origin), and opposition
-    /// is measured about the object frame's z axis.
+    /// the object's parts in its own frame (capsules or cylinders along their z axes, e.g. one
+    /// stick, or the segments of a basket handle); opposition is measured about the axis of the
+    /// part nearest to the thumb.
     pub fn evaluate(&self, object: &World, g: &Isometry3<f64>) -> GraspResult {
         let mut poses = self.model.pose_buffer();
         let mut placed = self.collision.placed_bodies();
@@ -253,8 +254,20 @@ impl Hand {
         {
             return fail(motors, names);
         }
-        let axis = to_world.rotation * Vector3::z();
-        let centre = to_world.translation.vector;
+        // opposition about the axis (z) of the object part nearest to the thumb tip
+        let thumb_tip = poses.poses()[self.fingers[0].tip_link].translation.vector;
+        let part = world
+            .objects()
+            .iter()
+            .min_by(|a, b| {
+                let da = (a.pose().translation.vector - thumb_tip).norm();
+                let db = (b.pose().translation.vector - thumb_tip).norm();
+                da.total_cmp(&db)
+            })
+            .map(|o| *o.pose())
+            .unwrap_or(to_world);
+        let axis = part.rotation * Vector3::z();
+        let centre = part.translation.vector;
         let direction = |link: usize| {
             let p = poses.poses()[link].translation.vector - centre;
             (p - axis * axis.dot(&p))
@@ -279,4 +292,31 @@ impl Hand {
             motors,
         }
     }
+}
+
+/// Searches `samples` random object poses relative to the hand (positions in the box
+/// `lower`–`upper` of the hand frame, any orientation) for a successful grasp; returns the best
+/// as goal parameters g (the hand in the object's frame) with its quality.
+pub fn find_grasp(
+    hand: &Hand,
+    object: &World,
+    lower: [f64; 3],
+    upper: [f64; 3],
+    samples: usize,
+    seed: u64,
+) -> Option<([f64; 6], f64)> {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut best: Option<([f64; 6], f64)> = None;
+    for _ in 0..samples {
+        let t = Vector3::from_fn(|i, _| rng.random_range(lower[i]..=upper[i]));
+        let r =
+            Vector3::from_fn(|_, _| rng.random_range(-std::f64::consts::PI..std::f64::consts::PI));
+        let g = Isometry3::new(t, r).inverse();
+        let result = hand.evaluate(object, &g);
+        if result.success && best.is_none_or(|(_, q)| result.quality > q) {
+            best = Some((crate::to_params(&g), result.quality));
+        }
+    }
+    best
 }

@@ -21,5 +21,5 @@ mod grasp;
 mod map;
 
 pub use explore::{ExploreSettings, explore};
-pub use grasp::{Finger, GraspResult, Hand};
+pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
