@@ -32,6 +32,7 @@
 //! | [`sir`] | SIR and SIRD particle methods | Stollenga et al., IROS 2013 |
 //! | [`mh`] | Metropolis–Hastings | Stollenga et al., IROS 2013 |
 //! | [`simplex`] | Nelder–Mead | Nelder & Mead 1965 |
+//! | [`rprop`] | iRprop− (gradient-based, sign only) | Igel & Hüsken 2000 |
 //!
 //! Bounds: every algorithm clamps its candidates into the [`Bounds`] box before handing them
 //! out; the distributions are not truncated.
@@ -47,6 +48,7 @@ pub mod functions;
 mod linalg;
 pub mod mh;
 pub mod oneplusone;
+pub mod rprop;
 mod runner;
 pub mod simplex;
 pub mod sir;
@@ -59,6 +61,7 @@ pub use core::{Bounds, Optimizer, Start, State, StepSize, StopOptions, StopReaso
 pub use error::{OptimError, Result};
 pub use mh::{MetropolisHastings, MhOptions};
 pub use oneplusone::{ConstrainedReport, OnePlusOne, OnePlusOneOptions, minimize_constrained};
+pub use rprop::{Rprop, RpropOptions};
 pub use runner::{Generation, Report, minimize, minimize_fn};
 pub use simplex::{NelderMead, SimplexOptions};
 pub use sir::{Sir, SirOptions};
