@@ -19,7 +19,9 @@
 mod explore;
 mod grasp;
 mod map;
+mod motion;
 
 pub use explore::{ExploreSettings, explore};
 pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
+pub use motion::{Motion, MotionGoal, MotionSettings, ReachProblem};
