@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 use trm_collision::{CollisionModel, ObjectSpec, World};
-use trm_taskmap::{ExploreSettings, Hand, Metric, explore, find_grasp, to_pose};
+use trm_taskmap::{ExploreSettings, Hand, Metric, explore, find_grasp};
 
 /// Arguments of `explore-task-map`.
 #[derive(clap::Args)]
@@ -151,10 +151,7 @@ pub fn run(args: &Args) -> Result<()> {
         ..ExploreSettings::around(g0, e.half_widths)
     };
     let started = std::time::Instant::now();
-    let quality = |g: &[f64; 6]| {
-        let r = hand.evaluate(&object, &to_pose(g));
-        if r.success { r.quality } else { -1.0 }
-    };
+    let quality = |g: &[f64; 6]| hand.quality(&object, g);
     let map = explore(&[g0], &settings, &spec.metric.unwrap_or_default(), quality)?;
     let seconds = started.elapsed().as_secs_f64();
     let out = args.out.clone().unwrap_or_else(|| {

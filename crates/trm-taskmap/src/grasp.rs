@@ -172,6 +172,13 @@ impl Hand {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// C(g) for exploration: the grasp quality if the grasp at goal parameters `g` succeeds,
+    /// −1 otherwise (feasible when > 0).
+    pub fn quality(&self, object: &World, g: &[f64; 6]) -> f64 {
+        let r = self.evaluate(object, &crate::to_pose(g));
+        if r.success { r.quality } else { -1.0 }
+    }
+
     /// Signed distance of every hand body to the object with the hand open at pose `g` (for
     /// finding a first grasp and for debugging).
     pub fn open_distances(&self, object: &World, g: &Isometry3<f64>) -> Vec<(String, f64)> {

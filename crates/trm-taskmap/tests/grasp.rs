@@ -77,10 +77,7 @@ fn grasps_along_the_stick_form_a_task_map() {
         step: 0.015,
         ..ExploreSettings::around(g0, [0.05, 0.05, 0.12, 0.3, 0.3, 0.3])
     };
-    let quality = |g: &[f64; 6]| {
-        let r = hand.evaluate(&stick(), &to_pose(g));
-        if r.success { r.quality } else { -1.0 }
-    };
+    let quality = |g: &[f64; 6]| hand.quality(&stick(), g);
     let map = explore(&[g0], &settings, &Metric::default(), quality).unwrap();
     assert!(map.points.len() > 10, "{} points", map.points.len());
     let (lo, hi) = map

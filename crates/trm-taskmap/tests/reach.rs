@@ -5,7 +5,6 @@ use trm_collision::{CollisionModel, Shape, World};
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_taskmap::{
     ExploreSettings, Hand, Metric, MotionGoal, MotionSettings, ReachProblem, explore, find_grasp,
-    to_pose,
 };
 
 #[test]
@@ -38,10 +37,7 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
         restarts: 0,
         ..ExploreSettings::around(g0, [0.1, 0.1, 0.2, 1.0, 1.0, 1.0])
     };
-    let quality = |g: &[f64; 6]| {
-        let r = hand.evaluate(&stick, &to_pose(g));
-        if r.success { r.quality } else { -1.0 }
-    };
+    let quality = |g: &[f64; 6]| hand.quality(&stick, g);
     let map = explore(&[g0], &settings, &Metric::default(), quality).unwrap();
     // the stick stands upright in front of the robot's right side (iCub: x back, y right, z up)
     let object = Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::new(0.0, 0.0, 0.0));
