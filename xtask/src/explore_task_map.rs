@@ -93,26 +93,38 @@ impl Default for SearchSpec {
     }
 }
 
-/// Explores and writes the map.
-pub fn run(args: &Args) -> Result<()> {
-    let text = std::fs::read_to_string(&args.spec)
-        .with_context(|| format!("reading {}", args.spec.display()))?;
+/// Everything an explored task map comes with.
+pub struct Explored {
+    /// The robot.
+    pub model: trm_kinematics::RobotModel,
+    /// Its collision model.
+    pub collision: CollisionModel,
+    /// The map.
+    pub map: trm_taskmap::TaskMap,
+    /// Exploration wall time, s.
+    pub seconds: f64,
+}
+
+/// Reads a task-map spec, finds the first grasp if needed and explores the map.
+pub fn explore_spec(path: &std::path::Path) -> Result<Explored> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let spec: Spec = ron::from_str(&text).map_err(|e| {
         anyhow::anyhow!(
             "{}:{}:{}: {}",
-            args.spec.display(),
+            path.display(),
             e.span.start.line,
             e.span.start.col,
             e.code
         )
     })?;
-    let base = args.spec.parent().map(PathBuf::from).unwrap_or_default();
+    let base = path.parent().map(PathBuf::from).unwrap_or_default();
     let model = crate::load_model(spec.model.as_ref().map(|m| base.join(m)).as_deref())?;
     let collision = CollisionModel::new(&model)?;
     if spec.hand != "r" && spec.hand != "l" {
         bail!(
             "{}: hand must be \"r\" or \"l\", not {:?}",
-            args.spec.display(),
+            path.display(),
             spec.hand
         );
     }
@@ -121,10 +133,10 @@ pub fn run(args: &Args) -> Result<()> {
         &trm_collision::WorldSpec {
             objects: spec.object,
         },
-        &args.spec.display().to_string(),
+        &path.display().to_string(),
     )?;
     if object.is_empty() {
-        bail!("{}: the object has no parts", args.spec.display());
+        bail!("{}: the object has no parts", path.display());
     }
     let g0 = match spec.start {
         Some(g) => g,
@@ -134,11 +146,11 @@ pub fn run(args: &Args) -> Result<()> {
             else {
                 bail!(
                     "{}: no grasp found in {} random hand poses: the hand cannot grasp this object anywhere in the search box (or give `start`)",
-                    args.spec.display(),
+                    path.display(),
                     s.samples
                 );
             };
-            println!("first grasp found by search: quality {q:.3}");
+            eprintln!("first grasp found by search: quality {q:.3}");
             g
         }
     };
@@ -151,9 +163,21 @@ pub fn run(args: &Args) -> Result<()> {
         ..ExploreSettings::around(g0, e.half_widths)
     };
     let started = std::time::Instant::now();
-    let quality = |g: &[f64; 6]| hand.quality(&object, g);
-    let map = explore(&[g0], &settings, &spec.metric.unwrap_or_default(), quality)?;
-    let seconds = started.elapsed().as_secs_f64();
+    let map = explore(&[g0], &settings, &spec.metric.unwrap_or_default(), |g| {
+        hand.quality(&object, g)
+    })?;
+    Ok(Explored {
+        seconds: started.elapsed().as_secs_f64(),
+        model,
+        collision,
+        map,
+    })
+}
+
+/// Explores and writes the map.
+pub fn run(args: &Args) -> Result<()> {
+    let Explored { map, seconds, .. } = explore_spec(&args.spec)?;
+
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .spec

@@ -12,6 +12,7 @@ mod optimise;
 mod plan;
 mod solve;
 mod speedup;
+mod task_map_studies;
 
 use std::path::{Path, PathBuf};
 
@@ -56,6 +57,8 @@ enum Command {
     Speedup(speedup::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
+    /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
+    TaskMapStudies(task_map_studies::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
 }
@@ -76,6 +79,7 @@ fn main() {
         Command::Plan(args) => plan::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
+        Command::TaskMapStudies(args) => task_map_studies::run(&args),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");
