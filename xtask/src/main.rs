@@ -10,6 +10,7 @@ mod gen_icub;
 mod model_info;
 mod optimise;
 mod plan;
+mod reach_grasp;
 mod solve;
 mod speedup;
 mod task_map_studies;
@@ -59,6 +60,8 @@ enum Command {
     Plan(plan::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
     TaskMapStudies(task_map_studies::Args),
+    /// A reaching motion to grasp an object, optimised with its task map (or an exact target).
+    ReachGrasp(reach_grasp::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
 }
@@ -77,6 +80,7 @@ fn main() {
         Command::GenIcub => gen_icub::run(&models_dir()),
         Command::Optimise(args) => optimise::run(&args),
         Command::Plan(args) => plan::run(&args),
+        Command::ReachGrasp(args) => reach_grasp::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),

@@ -58,14 +58,8 @@ pub fn run(args: &Args) -> Result<()> {
         .active_set(&["torso", "right_arm"], stick.model.posture("home")?)?;
     let world = World::new();
     let place = Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::zeros());
-    // the exact target: the map's grasp nearest the stick's centre (|position along the axis| least)
-    let centre = stick
-        .map
-        .points
-        .iter()
-        .min_by(|a, b| a.g[2].abs().total_cmp(&b.g[2].abs()))
-        .expect("a non-empty map")
-        .g;
+    // the exact target: the map's grasp nearest the stick's centre
+    let centre = stick.map.centre_grasp().expect("a non-empty map");
     let (exact, exact_trace) = reach(&stick, &active, &world, place, MotionGoal::Target(centre))
         .optimise(args.iterations, 1e-3);
     let (mapped, map_trace) = reach(&stick, &active, &world, place, MotionGoal::Map(&stick.map))

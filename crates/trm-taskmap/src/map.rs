@@ -211,6 +211,18 @@ impl TaskMap {
         self.points.iter().map(|p| p.cluster + 1).max().unwrap_or(0)
     }
 
+    /// The grasp whose position lies closest to the object's origin (the "exact target at the
+    /// centre" of the paper's comparison).
+    pub fn centre_grasp(&self) -> Option<[f64; 6]> {
+        self.points
+            .iter()
+            .min_by(|a, b| {
+                let n = |g: &[f64; 6]| g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+                n(&a.g).total_cmp(&n(&b.g))
+            })
+            .map(|p| p.g)
+    }
+
     /// The nearest map point to `g` and its metric distance.
     pub fn nearest(&self, g: &[f64; 6]) -> Option<(usize, f64)> {
         let index = &self.index.as_ref()?.0;

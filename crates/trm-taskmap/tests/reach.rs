@@ -80,3 +80,42 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
     let c = with_map.optimise_sampling("xnes", 0.02, 300, 1).unwrap();
     assert!(c.cost <= with_map.simulate(&with_map.initial_attractors()).cost);
 }
+
+/// The numerical gradient RPROP uses is consistent: central differences at two step sizes agree
+/// where the cost is smooth (no collision changes along the way).
+#[test]
+fn central_difference_gradients_are_consistent_across_step_sizes() {
+    let model = trm_models::icub_upper_body();
+    let collision = CollisionModel::new(&model).unwrap();
+    let active = model
+        .active_set(&["torso", "right_arm"], model.posture("home").unwrap())
+        .unwrap();
+    let world = World::new();
+    let target = [-0.02, -0.08, 0.03, 0.1, -0.2, -1.6];
+    let problem = ReachProblem {
+        active: &active,
+        collision: &collision,
+        world: &world,
+        hand: model.frame_id("r_hand").unwrap(),
+        object: Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::zeros()),
+        start: active.from_motors(model.posture("home").unwrap()),
+        goal: MotionGoal::Target(target),
+        settings: MotionSettings::default(),
+    };
+    let x = problem.initial_attractors();
+    let gradient = |h: f64| -> Vec<f64> {
+        (0..x.len())
+            .map(|i| {
+                let (mut xp, mut xm) = (x.clone(), x.clone());
+                xp[i] += h;
+                xm[i] -= h;
+                (problem.simulate(&xp).cost - problem.simulate(&xm).cost) / (2.0 * h)
+            })
+            .collect()
+    };
+    let (coarse, fine) = (gradient(1e-3), gradient(1e-4));
+    let scale = fine.iter().map(|g| g.abs()).fold(0.0, f64::max);
+    for (a, b) in coarse.iter().zip(&fine) {
+        assert!((a - b).abs() < 0.02 * scale, "{a} vs {b} (scale {scale})");
+    }
+}
