@@ -28,7 +28,7 @@
 //! | [`xnes`] | xNES | Glasmachers et al., GECCO 2010 |
 //! | [`snes`] | separable NES | Schaul et al., GECCO 2011 |
 //! | [`cmaes`] | CMA-ES, Hansen's defaults with active weights | Hansen, arXiv:1604.00772 |
-//! | [`oneplusone`] | (1+1)-CMA-ES and its constrained variant, with bootstrap | Igel et al. 2006; Arnold & Hansen 2012; Rapetti et al. |
+//! | [`oneplusone`] | (1+1)-CMA-ES and its constrained variant, with bootstrap | Igel et al. 2006; Arnold & Hansen 2012; Modugno et al. |
 //! | [`sir`] | SIR and SIRD particle methods | Stollenga et al., IROS 2013 |
 //! | [`mh`] | Metropolis–Hastings | Stollenga et al., IROS 2013 |
 //! | [`simplex`] | Nelder–Mead | Nelder & Mead 1965 |

@@ -289,7 +289,7 @@ pub struct ConstrainedReport {
 }
 
 /// Minimises `objective` subject to `constraints(x, g)` (feasible where every `g_j ≤ 0`) with the
-/// (1+1)-CMA-ES with constrained covariance adaptation, bootstrapped as in Rapetti et al.'s safe
+/// (1+1)-CMA-ES with constrained covariance adaptation, bootstrapped as in Modugno et al.'s safe
 /// trajectory optimisation: when the start violates a constraint, an unconstrained
 /// (1+1)-CMA-ES first minimises the total violation Σ max(0, g_j) until a feasible point appears;
 /// the constrained search then starts there with the initial step size. The objective is only
