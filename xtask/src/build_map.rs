@@ -106,72 +106,7 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
     let path: Option<Vec<[f64; 3]>> =
         path.map(|p| p.iter().map(|t| [at(t, 0), at(t, 1), at(t, 2)]).collect());
     let title = format!("{} points, task `{}`", map.points.len(), map.task);
-    scatter_points(&title, &points, &costs, path.as_deref())
-}
-
-/// A 3-D scatter of points coloured by value from blue (lowest) to red (highest), with an
-/// optional polyline.
-pub fn scatter_points(
-    title: &str,
-    points: &[[f64; 3]],
-    values: &[f64],
-    path: Option<&[[f64; 3]]>,
-) -> Result<String> {
-    use plotters::prelude::*;
-    let range = |i: usize| {
-        let (lo, hi) = points
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                (a.min(p[i]), b.max(p[i]))
-            });
-        if lo.is_finite() && hi > lo {
-            let pad = 0.05 * (hi - lo);
-            (lo - pad)..(hi + pad)
-        } else {
-            -0.1..0.1
-        }
-    };
-    let (vmin, vmax) = values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (800, 700)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!("{title}; colour {vmin:.3} (blue) to {vmax:.3} (red)"),
-                ("sans-serif", 15),
-            )
-            .margin(10)
-            .build_cartesian_3d(range(0), range(2), range(1))?;
-        chart.with_projection(|mut p| {
-            p.yaw = 0.6;
-            p.pitch = 0.35;
-            p.scale = 0.85;
-            p.into_matrix()
-        });
-        chart.configure_axes().draw()?;
-        chart.draw_series(points.iter().zip(values).map(|(p, v)| {
-            let u = if vmax > vmin {
-                (v - vmin) / (vmax - vmin)
-            } else {
-                0.0
-            };
-            let color = RGBColor((255.0 * u) as u8, 60, (255.0 * (1.0 - u)) as u8);
-            Circle::new((p[0], p[2], p[1]), 3, color.filled())
-        }))?;
-        if let Some(path) = path {
-            chart.draw_series(LineSeries::new(
-                path.iter().map(|t| (t[0], t[2], t[1])),
-                BLACK.stroke_width(3),
-            ))?;
-        }
-        root.present()?;
-    }
-    Ok(svg)
+    crate::plot::scatter_points(&title, &points, &costs, path.as_deref())
 }
 
 /// Arguments of `map-info`.

@@ -200,7 +200,7 @@ pub fn run(args: &Args) -> Result<()> {
     );
     crate::write_atomic(
         &svg,
-        crate::build_map::scatter_points(&title, &points, &values, None)?.as_bytes(),
+        crate::plot::scatter_points(&title, &points, &values, None)?.as_bytes(),
     )?;
     println!(
         "{} feasible grasps in {} clusters from {} evaluations in {seconds:.1} s; wrote {} and {}",

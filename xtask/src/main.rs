@@ -10,6 +10,7 @@ mod gen_icub;
 mod model_info;
 mod optimise;
 mod plan;
+mod plot;
 mod reach_grasp;
 mod solve;
 mod speedup;

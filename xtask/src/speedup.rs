@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use plotters::prelude::*;
+use plotters::prelude::{BLACK, Color};
 use trm_roadmap::{BuildOptions, build};
 use trm_tasks::Problem;
 
@@ -116,49 +116,29 @@ pub fn run(args: &Args) -> Result<()> {
     }
     std::fs::create_dir_all(&args.out_dir)?;
     crate::write_atomic(&args.out_dir.join("speedup.md"), md.as_bytes())?;
-    let mut svg = String::new();
-    {
-        let max_t = threads as f64;
-        let root = SVGBackend::with_string(&mut svg, (640, 480)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption("Parallel E-TRM speedup", ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0.5..max_t + 0.5, 0.0..max_t + 0.5)?;
-        chart
-            .configure_mesh()
-            .x_desc("threads")
-            .y_desc("speedup")
-            .draw()?;
-        chart
-            .draw_series(LineSeries::new(
-                [(1.0, 1.0), (max_t, max_t)],
-                BLACK.mix(0.5),
-            ))?
-            .label("ideal")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLACK.mix(0.5)));
-        for (k, p) in args.points.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
-            chart
-                .draw_series(LineSeries::new(
-                    rows.iter()
-                        .map(|(t, times)| (*t as f64, base[k] / times[k])),
-                    color.stroke_width(2),
-                ))?
-                .label(format!("{p} points"))
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
-        root.present()?;
+    let max_t = threads as f64;
+    let mut series = vec![crate::plot::Series {
+        label: "ideal".into(),
+        points: vec![(1.0, 1.0), (max_t, max_t)],
+        color: Some(BLACK.mix(0.5)),
+    }];
+    for (k, p) in args.points.iter().enumerate() {
+        series.push(crate::plot::Series {
+            label: format!("{p} points"),
+            points: rows
+                .iter()
+                .map(|(t, times)| (*t as f64, base[k] / times[k]))
+                .collect(),
+            color: None,
+        });
     }
+    let svg = crate::plot::lines(
+        "Parallel E-TRM speedup",
+        ("threads", "speedup"),
+        0.5..max_t + 0.5,
+        0.0..max_t + 0.5,
+        &series,
+    )?;
     crate::write_atomic(&args.out_dir.join("speedup.svg"), svg.as_bytes())?;
     println!("{md}");
     println!(

@@ -7,7 +7,6 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use plotters::prelude::*;
 use trm_collision::World;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_taskmap::{MotionGoal, MotionSettings, ReachProblem};
@@ -102,52 +101,32 @@ pub fn run(args: &Args) -> Result<()> {
     let _ = writeln!(md, "\nWall time {:.1} s.", started.elapsed().as_secs_f64());
     std::fs::create_dir_all(&args.out_dir)?;
     crate::write_atomic(&args.out_dir.join("table.md"), md.as_bytes())?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (640, 420)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let hi = exact_trace
-            .iter()
-            .chain(&map_trace)
-            .map(|t| t.1)
-            .fold(0.0f64, f64::max)
-            * 1.1;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "Stick: joint-limit proximity of the best motion",
-                ("sans-serif", 16),
-            )
-            .margin(12)
-            .x_label_area_size(35)
-            .y_label_area_size(55)
-            .build_cartesian_2d(0usize..args.iterations, 0.0..hi.max(1e-3))?;
-        chart
-            .configure_mesh()
-            .x_desc("RPROP iteration")
-            .y_desc("joint-limit cost")
-            .draw()?;
-        for (i, (name, trace)) in [("exact target", &exact_trace), ("task map", &map_trace)]
+    let hi = exact_trace
+        .iter()
+        .chain(&map_trace)
+        .map(|t| t.1)
+        .fold(0.0f64, f64::max)
+        * 1.1;
+    let series: Vec<crate::plot::Series> =
+        [("exact target", &exact_trace), ("task map", &map_trace)]
             .into_iter()
-            .enumerate()
-        {
-            let color = Palette99::pick(i).to_rgba();
-            chart
-                .draw_series(LineSeries::new(
-                    trace.iter().enumerate().map(|(k, t)| (k, t.1)),
-                    color.stroke_width(2),
-                ))?
-                .label(name)
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
-        root.present()?;
-    }
+            .map(|(name, trace)| crate::plot::Series {
+                label: name.into(),
+                points: trace
+                    .iter()
+                    .enumerate()
+                    .map(|(k, t)| (k as f64, t.1))
+                    .collect(),
+                color: None,
+            })
+            .collect();
+    let svg = crate::plot::lines(
+        "Stick: joint-limit proximity of the best motion",
+        ("RPROP iteration", "joint-limit cost"),
+        0.0..args.iterations as f64,
+        0.0..hi.max(1e-3),
+        &series,
+    )?;
     crate::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
     println!("{md}");
     println!(

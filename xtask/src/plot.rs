@@ -1,0 +1,125 @@
+//! SVG line charts for the commands' figures (plotters' SVG backend needs no system fonts).
+
+use std::ops::Range;
+
+use anyhow::Result;
+use plotters::prelude::*;
+
+/// One line of a chart; `None` colour = the next palette colour, `Some(BLACK)` for references.
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Points.
+    pub points: Vec<(f64, f64)>,
+    /// Colour; the palette's when absent.
+    pub color: Option<RGBAColor>,
+}
+
+/// A single-panel line chart with a legend, as an SVG document.
+pub fn lines(
+    title: &str,
+    axes: (&str, &str),
+    x: Range<f64>,
+    y: Range<f64>,
+    series: &[Series],
+) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (640, 440)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 16))
+            .margin(12)
+            .x_label_area_size(38)
+            .y_label_area_size(55)
+            .build_cartesian_2d(x, y)?;
+        chart
+            .configure_mesh()
+            .x_desc(axes.0)
+            .y_desc(axes.1)
+            .draw()?;
+        for (i, s) in series.iter().enumerate() {
+            let color = s.color.unwrap_or_else(|| Palette99::pick(i).to_rgba());
+            chart
+                .draw_series(LineSeries::new(
+                    s.points.iter().copied(),
+                    color.stroke_width(2),
+                ))?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// A 3-D scatter of points coloured by value from blue (lowest) to red (highest), with an
+/// optional polyline.
+pub fn scatter_points(
+    title: &str,
+    points: &[[f64; 3]],
+    values: &[f64],
+    path: Option<&[[f64; 3]]>,
+) -> Result<String> {
+    let range = |i: usize| {
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p[i]), b.max(p[i]))
+            });
+        if lo.is_finite() && hi > lo {
+            let pad = 0.05 * (hi - lo);
+            (lo - pad)..(hi + pad)
+        } else {
+            -0.1..0.1
+        }
+    };
+    let (vmin, vmax) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 700)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{title}; colour {vmin:.3} (blue) to {vmax:.3} (red)"),
+                ("sans-serif", 15),
+            )
+            .margin(10)
+            .build_cartesian_3d(range(0), range(2), range(1))?;
+        chart.with_projection(|mut p| {
+            p.yaw = 0.6;
+            p.pitch = 0.35;
+            p.scale = 0.85;
+            p.into_matrix()
+        });
+        chart.configure_axes().draw()?;
+        chart.draw_series(points.iter().zip(values).map(|(p, v)| {
+            let u = if vmax > vmin {
+                (v - vmin) / (vmax - vmin)
+            } else {
+                0.0
+            };
+            let color = RGBColor((255.0 * u) as u8, 60, (255.0 * (1.0 - u)) as u8);
+            Circle::new((p[0], p[2], p[1]), 3, color.filled())
+        }))?;
+        if let Some(path) = path {
+            chart.draw_series(LineSeries::new(
+                path.iter().map(|t| (t[0], t[2], t[1])),
+                BLACK.stroke_width(3),
+            ))?;
+        }
+        root.present()?;
+    }
+    Ok(svg)
+}
