@@ -35,3 +35,13 @@ pub(crate) fn invalid(field: &'static str, problem: impl Into<String>) -> OptimE
         problem: problem.into(),
     }
 }
+
+/// Checks that every `(field, value)` is positive and finite.
+pub(crate) fn positive(values: &[(&'static str, f64)]) -> Result<()> {
+    for &(field, v) in values {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(field, "must be positive and finite"));
+        }
+    }
+    Ok(())
+}

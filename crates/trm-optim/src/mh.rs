@@ -6,7 +6,7 @@ use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
-use crate::error::{OptimError, Result, invalid};
+use crate::error::{Result, positive};
 use crate::linalg::fill_normal;
 
 /// Metropolis–Hastings settings.
@@ -41,9 +41,7 @@ impl MetropolisHastings {
     /// A chain at the start mean.
     pub fn new(start: &Start, options: &MhOptions) -> Result<Self> {
         let steps = start.check()?;
-        if !(options.temperature.is_finite() && options.temperature > 0.0) {
-            return Err(invalid("temperature", "must be positive and finite"));
-        }
+        positive(&[("temperature", options.temperature)])?;
         let mut current = start.mean.clone();
         if let Some(b) = &start.bounds {
             b.clamp(&mut current);
@@ -90,12 +88,6 @@ impl Optimizer for MetropolisHastings {
     }
 
     fn tell(&mut self, fitness: &[f64]) -> Result<()> {
-        if fitness.len() != 1 {
-            return Err(OptimError::WrongFitnessCount {
-                expected: 1,
-                got: fitness.len(),
-            });
-        }
         self.state.told(&self.candidate, fitness)?;
         let f = fitness[0];
         let accept = match self.current_f {

@@ -9,7 +9,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
-use crate::error::{OptimError, Result, invalid};
+use crate::error::{Result, invalid};
 use crate::linalg::fill_normal;
 
 /// (1+1)-CMA-ES settings; `None` = the papers' defaults.
@@ -228,12 +228,6 @@ impl Optimizer for OnePlusOne {
     }
 
     fn tell(&mut self, fitness: &[f64]) -> Result<()> {
-        if fitness.len() != 1 {
-            return Err(OptimError::WrongFitnessCount {
-                expected: 1,
-                got: fitness.len(),
-            });
-        }
         self.state.told(&self.candidate, fitness)?;
         let f = fitness[0];
         match self.parent_f {

@@ -9,7 +9,7 @@ use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
-use crate::error::{Result, invalid};
+use crate::error::{Result, invalid, positive};
 use crate::linalg::fill_normal;
 
 /// SIR/SIRD settings.
@@ -71,9 +71,7 @@ impl Sir {
         if options.particles < 2 {
             return Err(invalid("particles", "needs at least 2"));
         }
-        if !(options.temperature.is_finite() && options.temperature > 0.0) {
-            return Err(invalid("temperature", "must be positive and finite"));
-        }
+        positive(&[("temperature", options.temperature)])?;
         if options.resample_below.is_nan() || options.resample_below < 0.0 {
             return Err(invalid("resample_below", "must be ≥ 0"));
         }

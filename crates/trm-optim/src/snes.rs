@@ -6,7 +6,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
-use crate::error::{Result, invalid};
+use crate::error::{Result, invalid, positive};
 use crate::linalg::{fill_normal, rank};
 use crate::xnes::{default_population, nes_utilities};
 
@@ -52,11 +52,7 @@ impl Snes {
         let eta_sigma = options
             .eta_sigma
             .unwrap_or((3.0 + (d as f64).ln()) / (5.0 * (d as f64).sqrt()));
-        for (field, v) in [("eta_mean", eta_mean), ("eta_sigma", eta_sigma)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(field, "must be positive and finite"));
-            }
-        }
+        positive(&[("eta_mean", eta_mean), ("eta_sigma", eta_sigma)])?;
         Ok(Snes {
             state: State::new(start, lambda),
             lambda,

@@ -8,7 +8,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
-use crate::error::{Result, invalid};
+use crate::error::{Result, invalid, positive};
 use crate::linalg::{ExpmScratch, expm, fill_normal, rank};
 
 /// xNES settings; `None` = the paper's default.
@@ -81,15 +81,11 @@ impl Xnes {
         let eta_mean = options.eta_mean.unwrap_or(1.0);
         let eta_sigma = options.eta_sigma.unwrap_or(default_eta);
         let eta_b = options.eta_b.unwrap_or(default_eta);
-        for (field, v) in [
+        positive(&[
             ("eta_mean", eta_mean),
             ("eta_sigma", eta_sigma),
             ("eta_b", eta_b),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(invalid(field, "must be positive and finite"));
-            }
-        }
+        ])?;
         let sigma = (steps.iter().map(|s| s.ln()).sum::<f64>() / d as f64).exp();
         let b = DMatrix::from_diagonal(&DVector::from_iterator(d, steps.iter().map(|s| s / sigma)));
         Ok(Xnes {
