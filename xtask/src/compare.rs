@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use plotters::prelude::*;
 use rayon::prelude::*;
 use trm_tasks::spec::SolverSpec;
 use trm_tasks::{Problem, solve};
@@ -228,85 +227,57 @@ fn plot(
     postures: usize,
     max_evals: u64,
 ) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let root =
-            SVGBackend::with_string(&mut svg, (900, 420 * postures as u32)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let panels = root.split_evenly((postures, 1));
-        let grid: Vec<u64> = (0..=60)
-            .map(|i| {
-                (10f64.powf(2.0 + i as f64 * ((max_evals as f64).log10() - 2.0) / 60.0)) as u64
-            })
-            .collect();
-        for (p, panel) in panels.iter().enumerate() {
-            let mut curves = Vec::new();
-            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-            for algo in algos {
-                let runs: Vec<&RunResult> = results
-                    .iter()
-                    .filter(|r| r.posture == p && &r.algo == algo)
-                    .collect();
-                let points: Vec<(f64, f64)> = grid
-                    .iter()
-                    .filter_map(|&g| {
-                        let at: Vec<f64> = runs
-                            .iter()
-                            .filter_map(|r| {
-                                r.trace
-                                    .iter()
-                                    .take_while(|(e, _)| *e <= g)
-                                    .last()
-                                    .map(|t| t.1)
-                            })
-                            .collect();
-                        (at.len() == runs.len() && !at.is_empty())
-                            .then(|| (g as f64, at.iter().sum::<f64>() / at.len() as f64))
-                    })
-                    .collect();
-                for (_, c) in &points {
-                    lo = lo.min(*c);
-                    hi = hi.max(*c);
-                }
-                curves.push((algo.clone(), points));
+    let grid: Vec<u64> = (0..=60)
+        .map(|i| (10f64.powf(2.0 + i as f64 * ((max_evals as f64).log10() - 2.0) / 60.0)) as u64)
+        .collect();
+    let mut panels = Vec::new();
+    for p in 0..postures {
+        let mut series = Vec::new();
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for algo in algos {
+            let runs: Vec<&RunResult> = results
+                .iter()
+                .filter(|r| r.posture == p && &r.algo == algo)
+                .collect();
+            let points: Vec<(f64, f64)> = grid
+                .iter()
+                .filter_map(|&g| {
+                    let at: Vec<f64> = runs
+                        .iter()
+                        .filter_map(|r| {
+                            r.trace
+                                .iter()
+                                .take_while(|(e, _)| *e <= g)
+                                .last()
+                                .map(|t| t.1)
+                        })
+                        .collect();
+                    (at.len() == runs.len() && !at.is_empty())
+                        .then(|| (g as f64, at.iter().sum::<f64>() / at.len() as f64))
+                })
+                .collect();
+            for (_, c) in &points {
+                lo = lo.min(*c);
+                hi = hi.max(*c);
             }
-            let lo = (lo.max(1e-3) * 0.8).log10();
-            let hi = (hi.max(1e-2) * 1.2).log10();
-            let mut chart = ChartBuilder::on(panel)
-                .caption(
-                    format!("Posture ({}): mean best cost", p + 1),
-                    ("sans-serif", 20),
-                )
-                .margin(12)
-                .x_label_area_size(40)
-                .y_label_area_size(60)
-                .build_cartesian_2d((100f64.log10())..(max_evals as f64).log10(), lo..hi)?;
-            chart
-                .configure_mesh()
-                .x_desc("evaluations (log10)")
-                .y_desc("cost (log10)")
-                .draw()?;
-            for (i, (algo, points)) in curves.iter().enumerate() {
-                let color = Palette99::pick(i).to_rgba();
-                chart
-                    .draw_series(LineSeries::new(
-                        points.iter().map(|(e, c)| (e.log10(), c.max(1e-3).log10())),
-                        color.stroke_width(2),
-                    ))?
-                    .label(algo.to_uppercase())
-                    .legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
-                    });
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()?;
+            series.push(crate::plot::Series {
+                label: algo.to_uppercase(),
+                points: points
+                    .iter()
+                    .map(|(e, c)| (e.log10(), c.max(1e-3).log10()))
+                    .collect(),
+                color: None,
+            });
         }
-        root.present()?;
+        panels.push(crate::plot::Panel {
+            title: format!("Posture ({}): mean best cost", p + 1),
+            axes: ("evaluations (log10)".into(), "cost (log10)".into()),
+            x: 2.0..(max_evals as f64).log10(),
+            y: (lo.max(1e-3) * 0.8).log10()..(hi.max(1e-2) * 1.2).log10(),
+            series,
+        });
     }
-    Ok(svg)
+    crate::plot::panels((900, 420), &panels)
 }
 
 #[cfg(test)]

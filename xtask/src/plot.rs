@@ -15,49 +15,85 @@ pub struct Series {
     pub color: Option<RGBAColor>,
 }
 
+/// One chart panel: a title, axis labels, ranges and lines.
+pub struct Panel {
+    /// Caption.
+    pub title: String,
+    /// (x, y) axis descriptions.
+    pub axes: (String, String),
+    /// x range.
+    pub x: Range<f64>,
+    /// y range.
+    pub y: Range<f64>,
+    /// The lines.
+    pub series: Vec<Series>,
+}
+
+/// Panels stacked vertically (each `size` pixels), each a line chart with a legend, as an SVG
+/// document.
+pub fn panels(size: (u32, u32), panels: &[Panel]) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (size.0, size.1 * panels.len().max(1) as u32))
+            .into_drawing_area();
+        root.fill(&WHITE)?;
+        for (area, panel) in root
+            .split_evenly((panels.len().max(1), 1))
+            .iter()
+            .zip(panels)
+        {
+            let mut chart = ChartBuilder::on(area)
+                .caption(panel.title.as_str(), ("sans-serif", 16))
+                .margin(12)
+                .x_label_area_size(38)
+                .y_label_area_size(55)
+                .build_cartesian_2d(panel.x.clone(), panel.y.clone())?;
+            chart
+                .configure_mesh()
+                .x_desc(panel.axes.0.as_str())
+                .y_desc(panel.axes.1.as_str())
+                .draw()?;
+            for (i, s) in panel.series.iter().enumerate() {
+                let color = s.color.unwrap_or_else(|| Palette99::pick(i).to_rgba());
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied(),
+                        color.stroke_width(2),
+                    ))?
+                    .label(s.label.as_str())
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
+                    });
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
+        }
+        root.present()?;
+    }
+    Ok(svg)
+}
+
 /// A single-panel line chart with a legend, as an SVG document.
 pub fn lines(
     title: &str,
     axes: (&str, &str),
     x: Range<f64>,
     y: Range<f64>,
-    series: &[Series],
+    series: Vec<Series>,
 ) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (640, 440)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 16))
-            .margin(12)
-            .x_label_area_size(38)
-            .y_label_area_size(55)
-            .build_cartesian_2d(x, y)?;
-        chart
-            .configure_mesh()
-            .x_desc(axes.0)
-            .y_desc(axes.1)
-            .draw()?;
-        for (i, s) in series.iter().enumerate() {
-            let color = s.color.unwrap_or_else(|| Palette99::pick(i).to_rgba());
-            chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    color.stroke_width(2),
-                ))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
-                });
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
-        root.present()?;
-    }
-    Ok(svg)
+    panels(
+        (640, 440),
+        &[Panel {
+            title: title.into(),
+            axes: (axes.0.into(), axes.1.into()),
+            x,
+            y,
+            series,
+        }],
+    )
 }
 
 /// A 3-D scatter of points coloured by value from blue (lowest) to red (highest), with an

@@ -137,7 +137,7 @@ pub fn run(args: &Args) -> Result<()> {
         ("threads", "speedup"),
         0.5..max_t + 0.5,
         0.0..max_t + 0.5,
-        &series,
+        series,
     )?;
     crate::write_atomic(&args.out_dir.join("speedup.svg"), svg.as_bytes())?;
     println!("{md}");

@@ -125,7 +125,7 @@ pub fn run(args: &Args) -> Result<()> {
         ("RPROP iteration", "joint-limit cost"),
         0.0..args.iterations as f64,
         0.0..hi.max(1e-3),
-        &series,
+        series,
     )?;
     crate::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
     println!("{md}");
