@@ -14,6 +14,7 @@ mod plot;
 mod reach_grasp;
 mod solve;
 mod speedup;
+mod stand_up;
 mod task_map_studies;
 
 use std::path::{Path, PathBuf};
@@ -65,6 +66,8 @@ enum Command {
     ReachGrasp(reach_grasp::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
+    /// Safe trajectory optimisation: the iCub stands up from a chair (Table II, Fig. 3, Fig. 4).
+    StandUp(stand_up::Args),
 }
 
 fn main() {
@@ -84,6 +87,7 @@ fn main() {
         Command::ReachGrasp(args) => reach_grasp::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
+        Command::StandUp(args) => stand_up::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),
     };
     if let Err(e) = result {

@@ -15,6 +15,10 @@ use trm_kinematics::{ModelDescription, RobotModel};
 pub const ICUB_UPPER_BODY_URDF: &str = include_str!("../../../models/icub_upper_body.urdf");
 /// models/icub_upper_body.ron: its 41 motors, couplings, frames, groups and postures.
 pub const ICUB_UPPER_BODY_RON: &str = include_str!("../../../models/icub_upper_body.ron");
+/// models/icub_full_body.urdf: the whole iCub (legs included) with primitive collision proxies.
+pub const ICUB_FULL_BODY_URDF: &str = include_str!("../../../models/icub_full_body.urdf");
+/// models/icub_sagittal.ron: the whole iCub reduced to 8 symmetric sagittal motors.
+pub const ICUB_SAGITTAL_RON: &str = include_str!("../../../models/icub_sagittal.ron");
 /// The official iCubGazeboV2_5_visuomanip URDF (75 revolute joints), unchanged.
 pub const ICUB_OFFICIAL_URDF: &str = include_str!("../../../models/icub-visuomanip/model.urdf");
 /// The official iCubGenova04 URDF (32 revolute joints), unchanged.
@@ -33,6 +37,21 @@ pub fn icub_upper_body() -> RobotModel {
         "models/icub_upper_body.urdf",
         &description,
         Some((ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")),
+    )
+    .expect("the shipped model is valid (checked by tests)")
+}
+
+/// The whole iCub moving symmetrically in its sagittal plane: 8 motors (hip pitch, knee, ankle
+/// pitch, torso pitch, shoulder pitch/roll/yaw, elbow), each driving the left and right joint
+/// alike; every other joint held at 0. The model of `cargo xtask stand-up`.
+pub fn icub_sagittal() -> RobotModel {
+    let description = ModelDescription::from_ron(ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")
+        .expect("the shipped description parses (checked by tests)");
+    RobotModel::from_parts(
+        ICUB_FULL_BODY_URDF,
+        "models/icub_full_body.urdf",
+        &description,
+        Some((ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")),
     )
     .expect("the shipped model is valid (checked by tests)")
 }
@@ -67,6 +86,8 @@ mod tests {
     fn every_embedded_model_loads() {
         assert_eq!(super::icub_upper_body().num_joints(), 63);
         assert_eq!(super::icub_official().num_joints(), 75);
+        assert_eq!(super::icub_sagittal().num_joints(), 75);
+        assert_eq!(super::icub_sagittal().motors().len(), 8);
         assert_eq!(super::icub_genova04().num_joints(), 32);
         assert_eq!(super::planar_arm().num_joints(), 3);
         assert_eq!(super::branched_tree().num_joints(), 6);

@@ -280,6 +280,9 @@ pub struct ConstrainedReport {
     pub bootstrap_evaluations: u64,
     /// Whether the best point satisfies every constraint.
     pub feasible: bool,
+    /// The feasible point the constrained search started from (the bootstrap's result, or the
+    /// start itself when it was feasible); `None` when the bootstrap found none.
+    pub feasible_start: Option<Vec<f64>>,
 }
 
 /// Minimises `objective` subject to `constraints(x, g)` (feasible where every `g_j ≤ 0`) with the
@@ -287,9 +290,12 @@ pub struct ConstrainedReport {
 /// trajectory optimisation: when the start violates a constraint, an unconstrained
 /// (1+1)-CMA-ES first minimises the total violation Σ max(0, g_j) until a feasible point appears;
 /// the constrained search then starts there with the initial step size. The objective is only
-/// evaluated at feasible points. `start.stop` budgets the whole run.
+/// evaluated at feasible points. With `bootstrap_budget: None`, `start.stop` budgets the whole
+/// run; with `Some(n)` the bootstrap gets at most n evaluations and the constrained search
+/// `start.stop` on its own (the paper's 500 + 500 rollouts).
 pub fn minimize_constrained<F, G>(
     start: &Start,
+    bootstrap_budget: Option<u64>,
     constraints: usize,
     rng: &mut dyn Rng,
     mut objective: F,
@@ -320,7 +326,11 @@ where
     let mut current = start.clone();
     current.mean = x0;
     if violation(&g) > 0.0 {
-        let mut boot = OnePlusOne::new(&current, &OnePlusOneOptions::default())?;
+        let mut boot_start = current.clone();
+        if bootstrap_budget.is_some() {
+            boot_start.stop.max_evaluations = bootstrap_budget;
+        }
+        let mut boot = OnePlusOne::new(&boot_start, &OnePlusOneOptions::default())?;
         let found: std::cell::RefCell<Option<Vec<f64>>> = Default::default();
         let report = crate::runner::minimize(
             &mut boot,
@@ -344,13 +354,17 @@ where
                     report,
                     bootstrap_evaluations,
                     feasible: false,
+                    feasible_start: None,
                 });
             }
         }
-        if let Some(m) = current.stop.max_evaluations.as_mut() {
-            *m = m.saturating_sub(bootstrap_evaluations);
+        if bootstrap_budget.is_none() {
+            if let Some(m) = current.stop.max_evaluations.as_mut() {
+                *m = m.saturating_sub(bootstrap_evaluations);
+            }
         }
     }
+    let feasible_start = current.mean.clone();
     let mut search = OnePlusOne::new(
         &current,
         &OnePlusOneOptions {
@@ -384,5 +398,6 @@ where
         report,
         bootstrap_evaluations,
         feasible: true,
+        feasible_start: Some(feasible_start),
     })
 }

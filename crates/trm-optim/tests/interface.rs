@@ -205,6 +205,7 @@ fn the_constrained_search_bootstraps_a_feasible_start_and_stays_feasible() {
     let mut infeasible_objective_calls = 0;
     let result = minimize_constrained(
         &start,
+        None,
         2,
         &mut rng,
         |x| {
@@ -237,6 +238,7 @@ fn an_unreachable_feasible_set_is_reported_not_hidden() {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let result = minimize_constrained(
         &start,
+        None,
         1,
         &mut rng,
         |x| x[0],

@@ -378,7 +378,8 @@ pub struct Problem {
 }
 
 /// Finds the first occurrence of `needle` in `text` outside comments: (line, column), 1-based.
-fn locate(text: &str, needle: &str) -> Option<(usize, usize)> {
+/// Spec readers use it to point an error at the offending name.
+pub fn locate(text: &str, needle: &str) -> Option<(usize, usize)> {
     text.lines().enumerate().find_map(|(i, l)| {
         let code = l.split("//").next().unwrap_or("");
         code.find(needle).map(|c| (i + 1, c + 1))
@@ -1031,7 +1032,7 @@ fn anchor_name(a: &AnchorSpec) -> String {
 }
 
 /// A RON error with its position and, for unknown names, the closest valid ones.
-fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
+pub fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
     use ron::error::Error as E;
     let (problem, fix) = match &e.code {
         E::NoSuchEnumVariant {

@@ -1,0 +1,43 @@
+//! Whole-body motions with switching contacts and their safe trajectory optimisation, after
+//! Modugno, Nava, Pucci, Nori, Oriolo and Ivaldi, "Safe trajectory optimization for whole-body
+//! motion of humanoids" (Humanoids 2017): a robot stands up from a chair by tracking an
+//! RBF-parametrised centre-of-mass trajectory; (1+1)-CMA-ES finds a feasible trajectory, then
+//! (1+1)-CMA-ES with constrained covariance adaptation improves it without ever accepting one
+//! that violates a constraint.
+//!
+//! What is modelled, and what is not (we have no dynamics simulator):
+//! * **Kinematic, quasi-static.** Both feet stay flat on the ground; the robot moves
+//!   symmetrically in its sagittal plane (the `icub_sagittal` model couples left and right
+//!   joints), which keeps the closed double-support chain closed exactly. The pelvis pose
+//!   follows from the feet.
+//! * **Controller.** A damped least-squares differential IK tracks the desired CoM (x, z) with a
+//!   minimum-jerk keyframe posture task in its null space; motors listed as locked in a phase
+//!   (the legs while seated) do not move. Not the paper's torque-level centroidal-momentum QP.
+//! * **Torques** are static: ∂(m g z_com)/∂q with the feet fixed, split equally between the left
+//!   and right joint a motor drives; while the chair supports the robot, the locked legs carry
+//!   nothing (the seat/foot load split is statically indeterminate and not modelled).
+//! * **Balance.** The cart-table ZMP x_zmp = x_com − z_com ẍ_com / g (ẍ by central
+//!   differences of the simulated CoM) must stay in the conservative support polygon: the feet
+//!   shrunk by a margin, plus the seat while seated. Leaving the unshrunk polygon counts as a
+//!   fall.
+//!
+//! ```no_run
+//! let problem = trm_wholebody::WholeBody::load("specs/standup.ron")?;
+//! let hand = problem.hand_tuned()?;
+//! println!("{} violations", hand.violations());
+//! # Ok::<(), trm_tasks::TaskError>(())
+//! ```
+
+// errors carry the file, place and fix of a spec problem; they are cold, so their size is fine
+#![allow(clippy::result_large_err)]
+
+pub mod motion;
+pub mod optimise;
+pub mod spec;
+
+pub use motion::{Costs, Rollout, WholeBody, constraint_names};
+pub use optimise::{Comparison, StandUpResult, optimise};
+pub use spec::{MotionSpec, Support};
+
+/// Result alias (errors are [`trm_tasks::TaskError`]: spec errors name file, line and fix).
+pub type Result<T, E = trm_tasks::TaskError> = std::result::Result<T, E>;

@@ -1,0 +1,396 @@
+//! Whole-body motion specs in RON (format: `specs/README.md`, section "Whole-body motions").
+//! [`MotionSpec::load`] reads a file and checks every name and number, with errors that name the
+//! file, line and field and say how to fix them.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use trm_kinematics::{RobotModel, closest_names};
+use trm_tasks::TaskError;
+use trm_tasks::spec::{locate, ron_error};
+
+use crate::Result;
+
+/// A whole-body motion: robot, contacts, phases with their keyframe postures, the parametrised
+/// centre-of-mass trajectory, the controller, the constraints and the optimisation settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// `icub_sagittal` (embedded) or a `.ron`/`.urdf` model path relative to the spec.
+    pub model: String,
+    /// Frames at the centres of the soles (z along the sole normal, x towards the toes); both
+    /// feet stay flat on the ground. The ground frame lies midway between them, x forward, z up.
+    pub feet: (String, String),
+    /// Sole length (along the frame's x) and width, metres.
+    pub sole: (f64, f64),
+    /// The conservative support polygon is the feet's, shrunk by this margin (metres) on every side.
+    pub support_margin: f64,
+    /// The chair seat, a box in the ground frame; `None` for motions without a chair.
+    #[serde(default)]
+    pub chair: Option<ChairSpec>,
+    /// Start posture, degrees, by motor name (motors left out: 0 clamped into limits).
+    pub start: BTreeMap<String, f64>,
+    /// The phases, in order; each ends at a keyframe posture.
+    pub phases: Vec<PhaseSpec>,
+    /// Number of free RBFs per centre-of-mass component and of the time law (the paper: 5).
+    pub rbfs: usize,
+    /// Control step, seconds (the paper: 0.01).
+    pub dt: f64,
+    /// Controller gains.
+    pub controller: ControllerSpec,
+    /// Constraint limits beyond the model's.
+    pub limits: LimitsSpec,
+    /// Weights of the cost terms (the paper: 1.3, 1, 3).
+    pub weights: WeightsSpec,
+    /// Optimisation settings.
+    pub optimiser: OptimiserSpec,
+    /// The hand-tuned reference trajectory the results are normalised by.
+    pub hand_tuned: TrajectorySpec,
+}
+
+/// The chair seat.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChairSpec {
+    /// Centre of the seat box in the ground frame, metres.
+    pub centre: [f64; 3],
+    /// Box size (x depth, y width, z thickness), metres.
+    pub size: [f64; 3],
+    /// Links that rest on the seat while it supports the robot (contact, not collision).
+    pub contacts: Vec<String>,
+}
+
+/// Who carries the robot during a phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Support {
+    /// The feet alone.
+    Feet,
+    /// The feet and the chair seat.
+    FeetAndChair,
+}
+
+/// One phase of the motion.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseSpec {
+    /// A name for reports.
+    pub name: String,
+    /// End time, seconds, of the optimised motion (the hand-tuned one has its own).
+    pub end: f64,
+    /// Contacts carrying the robot.
+    pub support: Support,
+    /// Motors held still (e.g. the legs while seated).
+    #[serde(default)]
+    pub locked: Vec<String>,
+    /// Keyframe posture reached at the phase's end (posture task), degrees by motor name;
+    /// motors left out keep the previous keyframe's value.
+    pub keyframe: BTreeMap<String, f64>,
+}
+
+/// Gains of the differential-IK controller.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSpec {
+    /// Centre-of-mass feedback gain, 1/s.
+    pub com_gain: f64,
+    /// Posture feedback gain in the null space, 1/s.
+    pub posture_gain: f64,
+    /// Damping of the least-squares inverse, metres.
+    pub damping: f64,
+    /// Time constant (s) of the first-order low-pass filter between the IK's joint velocities
+    /// and the joints (the actuators' response); 0 = none. Without it the joint velocities
+    /// jump when a phase unlocks motors, and so would the ZMP.
+    #[serde(default)]
+    pub smoothing: f64,
+}
+
+/// Constraint limits.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    /// Velocity limits, rad/s, by motor (overriding or completing the model's).
+    #[serde(default)]
+    pub velocity: BTreeMap<String, f64>,
+    /// Static torque limits per joint, N·m, by motor (every motor needs one).
+    pub torque: BTreeMap<String, f64>,
+    /// Check self-collision along the motion.
+    #[serde(default = "yes")]
+    pub self_collision: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// Weights of φ_co's terms.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightsSpec {
+    /// Centre-of-mass tracking error (w₁).
+    pub com_error: f64,
+    /// Effort, Σ τ² (w₂).
+    pub effort: f64,
+    /// Backward motion (w₃).
+    pub backward: f64,
+    /// Normaliser of the backward penalty, metres (b_max).
+    pub backward_max: f64,
+}
+
+/// Optimisation settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimiserSpec {
+    /// Rollouts of the unconstrained bootstrap (the paper: 500).
+    pub bootstrap_rollouts: u64,
+    /// Rollouts of the constrained search (the paper: 500).
+    pub rollouts: u64,
+    /// Initial step size (the paper's exploration rate 0.1), in parameter units.
+    pub exploration: f64,
+    /// Start parameters (x fractions, z fractions, time-law log-speeds); all 0 when left out
+    /// (a straight-line blend at constant speed).
+    #[serde(default)]
+    pub start: Option<Vec<f64>>,
+}
+
+/// A trajectory given by hand: phase end times and parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrajectorySpec {
+    /// End time of every phase, seconds.
+    pub ends: Vec<f64>,
+    /// Parameters: `rbfs` x fractions, `rbfs` z fractions, `rbfs` time-law log-speeds.
+    pub params: Vec<f64>,
+}
+
+impl MotionSpec {
+    /// Reads and checks a spec file.
+    pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| TaskError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let spec = Self::from_ron(&text, &path.display().to_string())?;
+        Ok((spec, text))
+    }
+
+    /// Parses a spec (numbers and structure; names are checked against the model by
+    /// [`MotionSpec::check_names`]).
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
+        let spec: MotionSpec = ron::from_str(text).map_err(|e| ron_error(&e, origin))?;
+        let err = |field: &str, needle: &str, problem: String, fix: &str| TaskError::Spec {
+            origin: origin.to_string(),
+            position: locate(text, needle),
+            field: field.to_string(),
+            problem,
+            fix: fix.to_string(),
+        };
+        let positive = [
+            ("dt", spec.dt),
+            ("sole length", spec.sole.0),
+            ("sole width", spec.sole.1),
+            ("controller.com_gain", spec.controller.com_gain),
+            ("controller.damping", spec.controller.damping),
+            ("optimiser.exploration", spec.optimiser.exploration),
+            ("weights.backward_max", spec.weights.backward_max),
+        ];
+        for (field, v) in positive {
+            let key = field.rsplit('.').next().unwrap_or(field);
+            if !(v.is_finite() && v > 0.0) {
+                return Err(err(
+                    field,
+                    key,
+                    format!("must be positive and finite, got {v}"),
+                    "give a positive number",
+                ));
+            }
+        }
+        let w = &spec.weights;
+        let non_negative = [
+            ("support_margin", spec.support_margin),
+            ("controller.posture_gain", spec.controller.posture_gain),
+            ("controller.smoothing", spec.controller.smoothing),
+            ("weights.com_error", w.com_error),
+            ("weights.effort", w.effort),
+            ("weights.backward", w.backward),
+        ];
+        for (field, v) in non_negative {
+            let key = field.rsplit('.').next().unwrap_or(field);
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(err(
+                    field,
+                    key,
+                    format!("must be ≥ 0 and finite, got {v}"),
+                    "give a non-negative number",
+                ));
+            }
+        }
+        if 2.0 * spec.support_margin >= spec.sole.0.min(spec.sole.1) {
+            return Err(err(
+                "support_margin",
+                "support_margin",
+                "leaves no support polygon".into(),
+                "use a margin below half the sole width",
+            ));
+        }
+        if spec.rbfs == 0 {
+            return Err(err(
+                "rbfs",
+                "rbfs",
+                "need at least one RBF".into(),
+                "the paper uses 5",
+            ));
+        }
+        if spec.phases.is_empty() {
+            return Err(err(
+                "phases",
+                "phases",
+                "no phase".into(),
+                "add at least one phase",
+            ));
+        }
+        let ends: Vec<f64> = spec.phases.iter().map(|p| p.end).collect();
+        check_ends(&ends)
+            .map_err(|p| err("phases", "end", p, "phase ends must increase from > 0"))?;
+        check_ends(&spec.hand_tuned.ends)
+            .map_err(|p| err("hand_tuned.ends", "ends", p, "ends must increase from > 0"))?;
+        if spec.hand_tuned.ends.len() != spec.phases.len() {
+            return Err(err(
+                "hand_tuned.ends",
+                "ends",
+                format!(
+                    "{} ends for {} phases",
+                    spec.hand_tuned.ends.len(),
+                    spec.phases.len()
+                ),
+                "give one end time per phase",
+            ));
+        }
+        let n = 3 * spec.rbfs;
+        let params = std::iter::once(("hand_tuned.params", Some(&spec.hand_tuned.params))).chain(
+            std::iter::once(("optimiser.start", spec.optimiser.start.as_ref())),
+        );
+        for (field, p) in params {
+            if let Some(p) = p {
+                if p.len() != n || p.iter().any(|v| !v.is_finite()) {
+                    return Err(err(
+                        field,
+                        field.rsplit('.').next().unwrap_or(field),
+                        format!("{} values (all finite) needed, got {}", n, p.len()),
+                        "give rbfs x fractions, rbfs z fractions and rbfs time-law log-speeds",
+                    ));
+                }
+            }
+        }
+        if let Some(c) = &spec.chair {
+            if c.size.iter().any(|s| !(s.is_finite() && *s > 0.0))
+                || c.centre.iter().any(|v| !v.is_finite())
+            {
+                return Err(err(
+                    "chair",
+                    "chair",
+                    "size must be positive and the centre finite".into(),
+                    "fix the chair box",
+                ));
+            }
+        }
+        if spec.chair.is_none()
+            && spec
+                .phases
+                .iter()
+                .any(|p| p.support == Support::FeetAndChair)
+        {
+            return Err(err(
+                "phases",
+                "FeetAndChair",
+                "a phase is supported by a chair but there is no chair".into(),
+                "add `chair: Some((...))` or use `support: Feet`",
+            ));
+        }
+        Ok(spec)
+    }
+
+    /// Checks every motor and link name against `model`, with suggestions.
+    pub fn check_names(&self, model: &RobotModel, origin: &str, text: &str) -> Result<()> {
+        let motors: Vec<&str> = model.motors().iter().map(|m| m.name.as_str()).collect();
+        let err = |field: &str, name: &str, kind: &str, candidates: &[&str]| {
+            let near = closest_names(name, candidates.iter().copied());
+            TaskError::Spec {
+                origin: origin.to_string(),
+                position: locate(text, &format!("\"{name}\"")),
+                field: field.to_string(),
+                problem: format!("unknown {kind} `{name}`"),
+                fix: if near.is_empty() {
+                    format!("use one of `{}`", candidates.join("`, `"))
+                } else {
+                    format!("did you mean `{}`?", near.join("`, `"))
+                },
+            }
+        };
+        let motor_maps = std::iter::once(("start", &self.start))
+            .chain(self.phases.iter().map(|p| ("keyframe", &p.keyframe)))
+            .chain(std::iter::once(("limits.velocity", &self.limits.velocity)))
+            .chain(std::iter::once(("limits.torque", &self.limits.torque)));
+        for (field, map) in motor_maps {
+            for (name, v) in map {
+                if !motors.contains(&name.as_str()) {
+                    return Err(err(field, name, "motor", &motors));
+                }
+                if !v.is_finite() {
+                    return Err(TaskError::Spec {
+                        origin: origin.to_string(),
+                        position: locate(text, &format!("\"{name}\"")),
+                        field: field.to_string(),
+                        problem: format!("`{name}` is {v}"),
+                        fix: "give a finite number".into(),
+                    });
+                }
+            }
+        }
+        for p in &self.phases {
+            for name in &p.locked {
+                if !motors.contains(&name.as_str()) {
+                    return Err(err("locked", name, "motor", &motors));
+                }
+            }
+        }
+        for m in &motors {
+            if !self.limits.torque.contains_key(*m) {
+                return Err(TaskError::Spec {
+                    origin: origin.to_string(),
+                    position: locate(text, "torque"),
+                    field: "limits.torque".into(),
+                    problem: format!("no torque limit for motor `{m}`"),
+                    fix: format!("add \"{m}\": N·m per joint"),
+                });
+            }
+        }
+        let frames: Vec<&str> = model.frame_names().collect();
+        for f in [&self.feet.0, &self.feet.1] {
+            if model.frame_id(f).is_err() {
+                return Err(err("feet", f, "frame", &frames));
+            }
+        }
+        if let Some(c) = &self.chair {
+            let links: Vec<&str> = model.tree().links.iter().map(|l| l.name.as_str()).collect();
+            for l in &c.contacts {
+                if !links.contains(&l.as_str()) {
+                    return Err(err("chair.contacts", l, "link", &links));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn check_ends(ends: &[f64]) -> std::result::Result<(), String> {
+    let mut last = 0.0;
+    for &e in ends {
+        if !(e.is_finite() && e > last) {
+            return Err(format!("end times {ends:?} do not increase from 0"));
+        }
+        last = e;
+    }
+    Ok(())
+}

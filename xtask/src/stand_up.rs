@@ -1,0 +1,371 @@
+//! `cargo xtask stand-up`: the safe trajectory optimisation of Modugno et al. on the iCub
+//! standing up from a chair — Table II, Fig. 3 and Fig. 4 — and the optimised trajectory.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use plotters::style::{BLACK, Color, RGBColor};
+use trm_wholebody::{Comparison, StandUpResult, WholeBody};
+
+use crate::plot::{Panel, Series, lines, panels};
+
+/// Arguments of `stand-up`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The motion spec.
+    #[arg(default_value = "specs/wholebody/standup.ron")]
+    spec: PathBuf,
+    /// Seed of the optimiser (ChaCha).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Override the spec's bootstrap budget (rollouts).
+    #[arg(long)]
+    bootstrap_rollouts: Option<u64>,
+    /// Override the spec's constrained budget (rollouts).
+    #[arg(long)]
+    rollouts: Option<u64>,
+    /// Output directory (figures, trajectory, JSON).
+    #[arg(long, default_value = "results/stand-up")]
+    out: PathBuf,
+}
+
+/// The paper's Table II (hand-tuned, unconstrained, constrained): CoM error, effort, backward.
+const PAPER: [(&str, f64, f64, f64); 3] = [
+    ("hand-tuned", 1.0, 1.0, 0.186292),
+    ("unconstrained", 0.806484, 0.945829, 0.962220),
+    ("constrained", 0.580518, 0.646327, 0.844451),
+];
+
+/// Runs the command.
+pub fn run(args: &Args) -> Result<()> {
+    let mut problem = WholeBody::load(&args.spec)?;
+    if args.bootstrap_rollouts.is_some() || args.rollouts.is_some() {
+        let mut spec = problem.spec().clone();
+        if let Some(b) = args.bootstrap_rollouts {
+            spec.optimiser.bootstrap_rollouts = b;
+        }
+        if let Some(r) = args.rollouts {
+            spec.optimiser.rollouts = r;
+        }
+        let text = std::fs::read_to_string(&args.spec)?;
+        problem = WholeBody::new(
+            spec,
+            problem.model().clone(),
+            &args.spec.display().to_string(),
+            &text,
+        )?;
+    }
+    let spec = problem.spec();
+    println!(
+        "{}: {} motors, {:.1} kg, CoM from ({:.3}, {:.3}) to ({:.3}, {:.3}) m (x forward, z up), {} parameters, {} constraints",
+        args.spec.display(),
+        problem.model().motors().len(),
+        problem.mass(),
+        problem.com_waypoints().0.x,
+        problem.com_waypoints().0.y,
+        problem.com_waypoints().1.x,
+        problem.com_waypoints().1.y,
+        problem.num_params(),
+        trm_wholebody::constraint_names(problem.model()).len()
+    );
+    let started = Instant::now();
+    let result = trm_wholebody::optimise(&problem, args.seed, |n, best| {
+        if n % 100 == 0 {
+            eprintln!("  rollout {n}: best φ_co {best:.4}");
+        }
+    })?;
+    let elapsed = started.elapsed().as_secs_f64();
+    println!(
+        "seed {}: {} rollouts ({} bootstrap) in {:.1} s ({:.1} ms per rollout); feasible: {}",
+        args.seed,
+        result.rollouts,
+        result.bootstrap_rollouts,
+        elapsed,
+        1e3 * elapsed / result.rollouts.max(1) as f64,
+        result.feasible
+    );
+    print_table(&problem, &result);
+    std::fs::create_dir_all(&args.out)?;
+    write_figures(&problem, &result, &args.out)?;
+    let constrained = result.solutions.last().expect("constrained solution");
+    write_trajectory(&problem, constrained, &args.out.join("trajectory.csv"))?;
+    crate::write_json(
+        &args.out.join("result.json"),
+        &serde_json::to_value(&result)?,
+    )?;
+    if !result.feasible {
+        bail!(
+            "no feasible trajectory found with seed {} in {} rollouts: raise optimiser.bootstrap_rollouts in {} or try another --seed",
+            args.seed,
+            result.rollouts,
+            args.spec.display()
+        );
+    }
+    let _ = spec;
+    Ok(())
+}
+
+fn print_table(problem: &WholeBody, result: &StandUpResult) {
+    println!(
+        "\nTable II (CoM error and effort normalised by the hand-tuned trajectory, backward by b_max):"
+    );
+    println!(
+        "| solution | duration | CoM error | effort | backward | φ_co | violations (samples) | independent check | fallen | paper: CoM error / effort / backward |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for s in &result.solutions {
+        let check = problem.verify(&s.rollout);
+        let paper = PAPER
+            .iter()
+            .find(|p| p.0 == s.name)
+            .map(|p| format!("{:.3} / {:.3} / {:.3}", p.1, p.2, p.3))
+            .unwrap_or_default();
+        println!(
+            "| {} | {:.2} s (switch {:.2} s) | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} | {} |",
+            s.name,
+            s.ends.last().copied().unwrap_or(0.0),
+            s.ends.first().copied().unwrap_or(0.0),
+            s.normalised.com_error,
+            s.normalised.effort,
+            s.normalised.backward,
+            s.phi_co,
+            s.rollout.violations(),
+            if check.is_empty() {
+                "feasible".to_string()
+            } else {
+                format!("{} violated", check.len())
+            },
+            if s.rollout.fallen { "yes" } else { "no" },
+            paper
+        );
+    }
+    for s in &result.solutions {
+        let check = problem.verify(&s.rollout);
+        if !check.is_empty() {
+            println!("\n{} violates:", s.name);
+            for c in check {
+                println!("  {c}");
+            }
+        }
+    }
+}
+
+const COLORS: [RGBColor; 3] = [
+    RGBColor(120, 120, 120),
+    RGBColor(230, 120, 20),
+    RGBColor(20, 90, 200),
+];
+
+fn series(
+    result: &StandUpResult,
+    label: impl Fn(&Comparison) -> String,
+    points: impl Fn(&Comparison) -> Vec<(f64, f64)>,
+) -> Vec<Series> {
+    result
+        .solutions
+        .iter()
+        .enumerate()
+        .map(|(i, s)| Series {
+            label: label(s),
+            points: points(s),
+            color: Some(COLORS[i % COLORS.len()].to_rgba()),
+        })
+        .collect()
+}
+
+fn range(values: impl Iterator<Item = f64>, pad: f64) -> std::ops::Range<f64> {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if lo.is_finite() {
+        (lo - pad)..(hi + pad)
+    } else {
+        0.0..1.0
+    }
+}
+
+fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Result<()> {
+    let duration = result
+        .solutions
+        .iter()
+        .filter_map(|s| s.ends.last().copied())
+        .fold(0.0, f64::max);
+    // Fig. 3 C: the CoM on the sagittal plane (actual and desired)
+    let mut com = series(
+        result,
+        |s| format!("{} (actual)", s.name),
+        |s| s.rollout.com.iter().map(|c| (c[0], c[2])).collect(),
+    );
+    com.push(Series {
+        label: "constrained (desired)".into(),
+        points: result
+            .solutions
+            .last()
+            .map(|s| s.rollout.com_desired.iter().map(|c| (c[0], c[1])).collect())
+            .unwrap_or_default(),
+        color: Some(BLACK.mix(0.5)),
+    });
+    let all = || result.solutions.iter().flat_map(|s| s.rollout.com.iter());
+    let com_svg = lines(
+        "Centre of mass on the sagittal plane (Fig. 3 C)",
+        ("x (m, forward)", "z (m, up)"),
+        range(all().map(|c| c[0]), 0.02),
+        range(all().map(|c| c[2]), 0.02),
+        com,
+    )?;
+    // Fig. 3 D: ZMP x over time with the conservative support polygon
+    let mut zmp = series(
+        result,
+        |s| s.name.clone(),
+        |s| {
+            s.rollout
+                .times
+                .iter()
+                .zip(&s.rollout.zmp)
+                .map(|(t, z)| (*t, z[0]))
+                .collect()
+        },
+    );
+    for (i, s) in result.solutions.iter().enumerate() {
+        for (bound, label) in [(0, "support polygon, back"), (1, "support polygon, front")] {
+            zmp.push(Series {
+                label: format!("{} {label}", s.name),
+                points: s
+                    .rollout
+                    .times
+                    .iter()
+                    .zip(&s.rollout.support)
+                    .map(|(t, b)| (*t, b[bound]))
+                    .collect(),
+                color: Some(COLORS[i % COLORS.len()].mix(0.35)),
+            });
+        }
+    }
+    let zmp_svg = lines(
+        "ZMP (x) and the conservative support polygon (Fig. 3 D)",
+        ("time (s)", "x (m)"),
+        0.0..duration,
+        range(
+            result
+                .solutions
+                .iter()
+                .flat_map(|s| s.rollout.zmp.iter().map(|z| z[0].clamp(-0.5, 0.5))),
+            0.02,
+        ),
+        zmp,
+    )?;
+    // Fig. 3 B: joint positions, one panel per solution
+    let names: Vec<String> = problem
+        .model()
+        .motors()
+        .iter()
+        .map(|m| m.name.clone())
+        .collect();
+    let joint_panels: Vec<Panel> = result
+        .solutions
+        .iter()
+        .map(|s| Panel {
+            title: format!("Joint positions, {} (Fig. 3 B)", s.name),
+            axes: ("time (s)".into(), "degrees".into()),
+            x: 0.0..duration,
+            y: -180.0..180.0,
+            series: names
+                .iter()
+                .enumerate()
+                .map(|(k, n)| Series {
+                    label: n.clone(),
+                    points: s
+                        .rollout
+                        .times
+                        .iter()
+                        .zip(&s.rollout.q)
+                        .map(|(t, q)| (*t, q[k].to_degrees()))
+                        .collect(),
+                    color: None,
+                })
+                .collect(),
+        })
+        .collect();
+    let joints_svg = panels((720, 380), &joint_panels)?;
+    // Fig. 3 A: torques, one panel per solution
+    let torque_panels: Vec<Panel> = result
+        .solutions
+        .iter()
+        .map(|s| Panel {
+            title: format!("Static joint torques, {} (Fig. 3 A)", s.name),
+            axes: ("time (s)".into(), "N m per joint".into()),
+            x: 0.0..duration,
+            y: range(
+                result
+                    .solutions
+                    .iter()
+                    .flat_map(|s| s.rollout.torque.iter().flatten().copied()),
+                1.0,
+            ),
+            series: names
+                .iter()
+                .enumerate()
+                .map(|(k, n)| Series {
+                    label: n.clone(),
+                    points: s
+                        .rollout
+                        .times
+                        .iter()
+                        .zip(&s.rollout.torque)
+                        .map(|(t, tau)| (*t, tau[k]))
+                        .collect(),
+                    color: None,
+                })
+                .collect(),
+        })
+        .collect();
+    let torques_svg = panels((720, 380), &torque_panels)?;
+    // Fig. 4: best φ_co over the constrained rollouts
+    let fitness_svg = lines(
+        "Best φ_co over the constrained rollouts (Fig. 4)",
+        ("rollout", "φ_co (lower is better)"),
+        0.0..(result.trace.last().map_or(1.0, |t| t.0 as f64)),
+        range(result.trace.iter().map(|t| t.1), 0.02),
+        vec![Series {
+            label: "(1+1)-CMA-ES with CCA".into(),
+            points: result.trace.iter().map(|&(e, f)| (e as f64, f)).collect(),
+            color: None,
+        }],
+    )?;
+    for (name, svg) in [
+        ("com.svg", com_svg),
+        ("zmp.svg", zmp_svg),
+        ("joints.svg", joints_svg),
+        ("torques.svg", torques_svg),
+        ("fitness.svg", fitness_svg),
+    ] {
+        crate::write_atomic(&out.join(name), svg.as_bytes())?;
+        eprintln!("wrote {}", out.join(name).display());
+    }
+    Ok(())
+}
+
+/// The optimised motion as CSV: time, phase, motor positions (rad), CoM, desired CoM, ZMP.
+fn write_trajectory(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
+    let mut text = String::from("t,phase");
+    for m in problem.model().motors() {
+        text.push(',');
+        text.push_str(&m.name);
+    }
+    text.push_str(",com_x,com_z,com_desired_x,com_desired_z,zmp_x\n");
+    let r = &s.rollout;
+    for i in 0..r.times.len() {
+        text.push_str(&format!("{:.3},{}", r.times[i], r.phase[i]));
+        for v in &r.q[i] {
+            text.push_str(&format!(",{v:.6}"));
+        }
+        text.push_str(&format!(
+            ",{:.6},{:.6},{:.6},{:.6},{:.6}\n",
+            r.com[i][0], r.com[i][2], r.com_desired[i][0], r.com_desired[i][1], r.zmp[i][0]
+        ));
+    }
+    crate::write_atomic(path, text.as_bytes())?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
