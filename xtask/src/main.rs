@@ -66,7 +66,9 @@ enum Command {
     ReachGrasp(reach_grasp::Args),
     /// Solve a posture (NGIK) from a task spec: cost, breakdown, collision check, posture file.
     Solve(solve::Args),
-    /// Safe trajectory optimisation: the iCub stands up from a chair (Table II, Fig. 3, Fig. 4).
+    /// Safe trajectory optimisation of a whole-body motion spec; by default the iCub stands up
+    /// from a chair (Table II, Fig. 3, Fig. 4).
+    #[command(alias = "whole-body")]
     StandUp(stand_up::Args),
 }
 

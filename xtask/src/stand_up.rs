@@ -67,7 +67,7 @@ pub fn run(args: &Args) -> Result<()> {
         problem.com_waypoints().1.x,
         problem.com_waypoints().1.y,
         problem.num_params(),
-        trm_wholebody::constraint_names(problem.model()).len()
+        trm_wholebody::constraint_names(&problem).len()
     );
     let started = Instant::now();
     let result = trm_wholebody::optimise(&problem, args.seed, |n, best| {
@@ -85,7 +85,8 @@ pub fn run(args: &Args) -> Result<()> {
         1e3 * elapsed / result.rollouts.max(1) as f64,
         result.feasible
     );
-    print_table(&problem, &result);
+    let is_stand_up = args.spec.file_stem().is_some_and(|s| s == "standup");
+    print_table(&problem, &result, is_stand_up);
     std::fs::create_dir_all(&args.out)?;
     write_figures(&problem, &result, &args.out)?;
     let constrained = result.solutions.last().expect("constrained solution");
@@ -106,23 +107,35 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-fn print_table(problem: &WholeBody, result: &StandUpResult) {
+fn print_table(problem: &WholeBody, result: &StandUpResult, paper_column: bool) {
     println!(
         "\nTable II (CoM error and effort normalised by the hand-tuned trajectory, backward by b_max):"
     );
     println!(
-        "| solution | duration | CoM error | effort | backward | φ_co | violations (samples) | independent check | fallen | paper: CoM error / effort / backward |"
+        "| solution | duration | CoM error | effort | backward | φ_co | violations (samples) | independent check | fallen |{}",
+        if paper_column {
+            " paper: CoM error / effort / backward |"
+        } else {
+            ""
+        }
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!(
+        "|---|---|---|---|---|---|---|---|---|{}",
+        if paper_column { "---|" } else { "" }
+    );
     for s in &result.solutions {
         let check = problem.verify(&s.rollout);
-        let paper = PAPER
-            .iter()
-            .find(|p| p.0 == s.name)
-            .map(|p| format!("{:.3} / {:.3} / {:.3}", p.1, p.2, p.3))
-            .unwrap_or_default();
+        let paper = if paper_column {
+            PAPER
+                .iter()
+                .find(|p| p.0 == s.name)
+                .map(|p| format!(" {:.3} / {:.3} / {:.3} |", p.1, p.2, p.3))
+                .unwrap_or_else(|| " |".into())
+        } else {
+            String::new()
+        };
         println!(
-            "| {} | {:.2} s (switch {:.2} s) | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} | {} |",
+            "| {} | {:.2} s (1st phase {:.2} s) | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} |{}",
             s.name,
             s.ends.last().copied().unwrap_or(0.0),
             s.ends.first().copied().unwrap_or(0.0),
@@ -152,7 +165,7 @@ fn print_table(problem: &WholeBody, result: &StandUpResult) {
 }
 
 const COLORS: [RGBColor; 3] = [
-    RGBColor(120, 120, 120),
+    RGBColor(30, 150, 60),
     RGBColor(230, 120, 20),
     RGBColor(20, 90, 200),
 ];
@@ -247,10 +260,11 @@ fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Res
         ("time (s)", "x (m)"),
         0.0..duration,
         range(
-            result
-                .solutions
-                .iter()
-                .flat_map(|s| s.rollout.zmp.iter().map(|z| z[0].clamp(-0.5, 0.5))),
+            result.solutions.iter().flat_map(|s| {
+                let zmp = s.rollout.zmp.iter().map(|z| z[0].clamp(-0.5, 0.5));
+                let front = s.rollout.support.iter().map(|b| b[1]);
+                zmp.chain(front)
+            }),
             0.02,
         ),
         zmp,

@@ -22,7 +22,7 @@
 //!   fall.
 //!
 //! ```no_run
-//! let problem = trm_wholebody::WholeBody::load("specs/standup.ron")?;
+//! let problem = trm_wholebody::WholeBody::load("specs/wholebody/standup.ron")?;
 //! let hand = problem.hand_tuned()?;
 //! println!("{} violations", hand.violations());
 //! # Ok::<(), trm_tasks::TaskError>(())

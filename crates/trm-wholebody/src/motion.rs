@@ -1,13 +1,14 @@
 //! The whole-body problem: a kinematic, quasi-static model of a robot with both feet flat on the
-//! ground (and a chair while seated), a differential-IK controller that tracks a desired
-//! centre-of-mass trajectory with a keyframe posture task in its null space, and rollouts that
-//! record everything the constraints and costs need.
+//! ground (and a seat while seated), a prioritised differential-IK controller that tracks a
+//! desired centre-of-mass trajectory, optionally a hand reaching a target below it, and a
+//! keyframe posture task in the null space of both, and rollouts that record everything the
+//! constraints and costs need.
 
 use std::path::Path;
 
 use nalgebra::{
-    Isometry3, Matrix2, Matrix3xX, Matrix6xX, Point3, Translation3, UnitQuaternion, Vector2,
-    Vector3,
+    DMatrix, DVector, Isometry3, Matrix3xX, Matrix6xX, Point3, Translation3, UnitQuaternion,
+    Vector2, Vector3,
 };
 use serde::{Deserialize, Serialize};
 use trm_collision::{CollisionModel, Other, PlacedBodies, Shape, World};
@@ -30,8 +31,12 @@ pub struct WholeBody {
     feet: (FrameId, FrameId),
     /// Pose of the ground frame in the left sole frame.
     sole_to_ground: Isometry3<f64>,
-    /// The chair in the ground frame, and the links allowed to touch it while it supports.
-    chair: Option<(Shape, Isometry3<f64>, Vec<String>)>,
+    /// World objects: name, shape, pose in the ground frame.
+    objects: Vec<(String, Shape, Isometry3<f64>)>,
+    /// The seat: object name, links allowed to touch it while it supports, its x extent.
+    seat: Option<(String, Vec<String>, [f64; 2])>,
+    /// The reaching frame, its target (x, z) and phase index.
+    reach: Option<(FrameId, Vector2<f64>, usize)>,
     start: Vec<f64>,
     keyframes: Vec<Vec<f64>>,
     locked: Vec<Vec<bool>>,
@@ -48,10 +53,12 @@ pub struct WholeBody {
     feet_box: [f64; 4],
 }
 
-/// The names of the constraints, in the order of [`Rollout::constraints`].
-pub fn constraint_names(model: &RobotModel) -> Vec<String> {
+/// The names of the constraints, in the order of [`Rollout::constraints`]: per motor lower and
+/// upper position limit, velocity and torque; the four sides of the support polygon;
+/// self-collision; world collision; and, with a reach, the final distance to its target.
+pub fn constraint_names(problem: &WholeBody) -> Vec<String> {
     let mut names = Vec::new();
-    for m in model.motors() {
+    for m in problem.model().motors() {
         for kind in ["lower limit", "upper limit", "velocity", "torque"] {
             names.push(format!("{} {kind}", m.name));
         }
@@ -60,7 +67,10 @@ pub fn constraint_names(model: &RobotModel) -> Vec<String> {
         names.push(s.to_string());
     }
     names.push("self-collision".into());
-    names.push("chair collision".into());
+    names.push("world collision".into());
+    if problem.reach.is_some() {
+        names.push("reach target".into());
+    }
     names
 }
 
@@ -81,6 +91,8 @@ pub struct Rollout {
     pub com: Vec<[f64; 3]>,
     /// Desired centre of mass (x, z), m.
     pub com_desired: Vec<[f64; 2]>,
+    /// Position (x, y, z) of the reaching frame in the ground frame, m (empty without a reach).
+    pub hand: Vec<[f64; 3]>,
     /// Cart-table zero-moment point (x, y) on the ground, m.
     pub zmp: Vec<[f64; 2]>,
     /// Conservative support polygon at each sample: [x_min, x_max, y_min, y_max].
@@ -104,6 +116,8 @@ pub struct Costs {
     pub effort: f64,
     /// Σ_i of the backward motion of the CoM along x and down along z, m.
     pub backward: f64,
+    /// Final distance (x, z) of the reaching frame to its target, m (0 without a reach).
+    pub reach: f64,
 }
 
 impl Rollout {
@@ -272,19 +286,51 @@ impl WholeBody {
             -half_gap - width / 2.0,
             half_gap + width / 2.0,
         ];
-        let chair = spec.chair.as_ref().map(|c| {
-            (
-                Shape::Box { size: c.size },
-                Isometry3::translation(c.centre[0], c.centre[1], c.centre[2]),
-                c.contacts.clone(),
-            )
+        let objects = spec
+            .world
+            .objects
+            .iter()
+            .map(|o| {
+                let pose = Isometry3::from_parts(
+                    Translation3::from(Vector3::from(o.xyz)),
+                    UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
+                );
+                (o.name.clone(), o.shape.clone(), pose)
+            })
+            .collect();
+        let seat = spec.seat.as_ref().and_then(|seat| {
+            spec.world
+                .objects
+                .iter()
+                .find(|o| o.name == seat.object)
+                .and_then(|o| match o.shape {
+                    Shape::Box { size } => Some((
+                        seat.object.clone(),
+                        seat.contacts.clone(),
+                        [o.xyz[0] - size[0] / 2.0, o.xyz[0] + size[0] / 2.0],
+                    )),
+                    _ => None,
+                })
         });
+        let reach = match &spec.reach {
+            Some(r) => Some((
+                model.frame_id(&r.frame)?,
+                Vector2::new(r.target.0, r.target.1),
+                spec.phases
+                    .iter()
+                    .position(|p| p.name == r.phase)
+                    .unwrap_or(spec.phases.len() - 1),
+            )),
+            None => None,
+        };
         let mut problem = WholeBody {
             active,
             collision,
             feet,
             sole_to_ground,
-            chair,
+            objects,
+            seat,
+            reach,
             start,
             keyframes,
             locked,
@@ -314,6 +360,16 @@ impl WholeBody {
         let mut frame = Frame::new(self);
         let (_, c) = frame.update(self, q);
         [c.x, c.y, c.z]
+    }
+
+    /// Position (x, y, z) of a link or named frame's origin in the ground frame at motor
+    /// positions `q`, with the feet flat.
+    pub fn point_at(&self, q: &[f64], frame: &str) -> Result<[f64; 3]> {
+        let id = self.model().frame_id(frame)?;
+        let mut f = Frame::new(self);
+        f.update(self, q);
+        let p = f.point(self, id);
+        Ok([p.x, p.y, p.z])
     }
 
     /// The start posture and the keyframe ending each phase, motor positions in rad.
@@ -364,9 +420,9 @@ impl WholeBody {
 
     fn real_polygon(&self, support: Support) -> [f64; 4] {
         let mut b = self.feet_box;
-        if let (Support::FeetAndChair, Some(c)) = (support, &self.spec.chair) {
-            b[0] = b[0].min(c.centre[0] - c.size[0] / 2.0);
-            b[1] = b[1].max(c.centre[0] + c.size[0] / 2.0);
+        if let (Support::FeetAndSeat, Some((_, _, x))) = (support, &self.seat) {
+            b[0] = b[0].min(x[0]);
+            b[1] = b[1].max(x[1]);
         }
         b
     }
@@ -428,8 +484,7 @@ impl WholeBody {
         let times: Vec<f64> = (0..=steps).map(|i| i as f64 * dt).collect();
         let desired = self.desired_com(params, duration, &times)?;
         let n = self.active.len();
-        let names = constraint_names(self.model());
-        let nc = names.len();
+        let nc = constraint_names(self).len();
         let mut out = Rollout {
             constraints: vec![0.0; nc],
             violated_samples: vec![0; nc],
@@ -437,20 +492,11 @@ impl WholeBody {
         };
         let mut frame = Frame::new(self);
         let mut q = self.start.clone();
-        let mut world = World::new();
-        if let Some((shape, _, _)) = &self.chair {
-            world
-                .add("chair", shape.clone(), Isometry3::identity())
-                .map_err(TaskError::from)?;
-        }
-        let empty = World::new();
+        let mut world = self.world()?;
         let mut g = vec![0.0; nc];
         let mut qdot = vec![0.0; n];
-        let (kc, kq, damping) = (
-            spec.controller.com_gain,
-            spec.controller.posture_gain,
-            spec.controller.damping,
-        );
+        let mut hand_start: Option<Vector2<f64>> = None;
+        let ctl = &spec.controller;
         for (i, &t) in times.iter().enumerate() {
             let phase = ends
                 .iter()
@@ -460,57 +506,67 @@ impl WholeBody {
             let support = spec.phases[phase].support;
             let locked = &self.locked[phase];
             let (_, com) = frame.update(self, &q);
-            // posture reference: minimum-jerk blend from the previous keyframe to this one
+            let min_jerk = |tau: f64| {
+                let tau = tau.clamp(0.0, 1.0);
+                tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+            };
+            let blend = min_jerk((t - t0) / (ends[phase] - t0));
+            let blend_next = min_jerk((t + dt - t0) / (ends[phase] - t0));
+            let columns = |j: &Matrix3xX<f64>| {
+                DMatrix::from_fn(2, n, |r, k| if locked[k] { 0.0 } else { j[(2 * r, k)] })
+            };
+            // 1. the centre of mass (x, z) along the desired trajectory
+            let (now, next) = (desired[i], desired[(i + 1).min(steps)]);
+            let feedforward = Vector2::new(next[0] - now[0], next[1] - now[1]) / dt;
+            let error = Vector2::new(now[0] - com.x, now[1] - com.z);
+            let mut tasks = vec![(
+                columns(&frame.com_jacobian),
+                DVector::from_column_slice((feedforward + error * ctl.com_gain).as_slice()),
+            )];
+            // 2. the hand along a minimum-jerk line to its target during its phase
+            if let Some((hand_frame, target, reach_phase)) = self.reach {
+                let p = frame.point(self, hand_frame);
+                out.hand.push([p.x, p.y, p.z]);
+                if phase == reach_phase {
+                    let from = *hand_start.get_or_insert(Vector2::new(p.x, p.z));
+                    let (want, want_next) = (
+                        from + (target - from) * blend,
+                        from + (target - from) * blend_next,
+                    );
+                    let v = (want_next - want) / dt
+                        + (want - Vector2::new(p.x, p.z)) * self.reach_gain();
+                    tasks.push((
+                        columns(&frame.point_jacobian),
+                        DVector::from_column_slice(v.as_slice()),
+                    ));
+                }
+            }
+            // 3. the posture: minimum-jerk blend from the previous keyframe to this one
             let from = if phase == 0 {
                 &self.start
             } else {
                 &self.keyframes[phase - 1]
             };
             let to = &self.keyframes[phase];
-            let tau = ((t - t0) / (ends[phase] - t0)).clamp(0.0, 1.0);
-            let blend = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
-            // CoM task, x and z rows of the CoM Jacobian in the ground frame
-            let jn = &frame.com_jacobian;
-            let mut jj = nalgebra::DMatrix::<f64>::zeros(2, n);
-            for k in 0..n {
-                if !locked[k] {
-                    jj[(0, k)] = jn[(0, k)];
-                    jj[(1, k)] = jn[(2, k)];
-                }
-            }
-            let next = desired[(i + 1).min(steps)];
-            let now = desired[i];
-            let feedforward = if i < steps {
-                Vector2::new(next[0] - now[0], next[1] - now[1]) / dt
-            } else {
-                Vector2::zeros()
-            };
-            let error = Vector2::new(now[0] - com.x, now[1] - com.z);
-            let v = feedforward + error * kc;
-            let jjt = &jj * jj.transpose();
-            let m = Matrix2::new(jjt[(0, 0)], jjt[(0, 1)], jjt[(1, 0)], jjt[(1, 1)])
-                + Matrix2::identity() * damping * damping;
-            let inv = m.try_inverse().unwrap_or_else(Matrix2::zeros);
-            let pinv = jj.transpose() * nalgebra::DMatrix::from_column_slice(2, 2, inv.as_slice());
-            let posture = nalgebra::DVector::from_fn(n, |k, _| {
+            let posture = DVector::from_fn(n, |k, _| {
                 if locked[k] {
                     0.0
                 } else {
-                    kq * (from[k] + (to[k] - from[k]) * blend - q[k])
+                    ctl.posture_gain * (from[k] + (to[k] - from[k]) * blend - q[k])
                 }
             });
-            let task = &pinv * nalgebra::DVector::from_column_slice(v.as_slice());
-            let null = &posture - &pinv * (&jj * &posture);
-            let filter = if spec.controller.smoothing > 0.0 {
-                (dt / spec.controller.smoothing).min(1.0)
+            let command = prioritised(&tasks, &posture, ctl.damping);
+            let filter = if ctl.smoothing > 0.0 {
+                (dt / ctl.smoothing).min(1.0)
             } else {
                 1.0
             };
             for k in 0..n {
-                qdot[k] += filter * (task[k] + null[k] - qdot[k]);
+                qdot[k] += filter * (command[k] - qdot[k]);
             }
             // static torques per joint: the motors hold the robot's weight, ∂(m g z_com)/∂q
-            // (legs resting on the chair carry nothing while it supports them)
+            // (legs resting on the seat carry nothing while it supports them)
+            let jn = &frame.com_jacobian;
             let torque: Vec<f64> = (0..n)
                 .map(|k| {
                     if locked[k] {
@@ -529,33 +585,12 @@ impl WholeBody {
                 g[4 * k + 3] = torque[k].abs() - self.torque[k];
             }
             let base = 4 * n + 4;
-            self.collision.place(&frame.poses, &mut frame.placed);
-            if spec.limits.self_collision && self.collision.any_self_collision(&frame.placed) {
-                g[base] = self
-                    .collision
-                    .colliding_pairs(&frame.placed, &empty)
-                    .iter()
-                    .map(|p| -p.distance)
-                    .sum::<f64>()
-                    .max(1e-6);
-            }
-            if let Some((_, pose, contacts)) = &self.chair {
-                world
-                    .set_pose("chair", frame.root_in_ground.inverse() * pose)
-                    .map_err(TaskError::from)?;
-                if self.collision.any_world_collision(&frame.placed, &world) {
-                    let allowed = support == Support::FeetAndChair;
-                    g[base + 1] = self
-                        .collision
-                        .colliding_pairs(&frame.placed, &world)
-                        .iter()
-                        .filter(|p| matches!(p.other, Other::Object(_)))
-                        .filter(|p| {
-                            let link = p.body.split('#').next().unwrap_or(&p.body);
-                            !(allowed && contacts.iter().any(|c| c == link))
-                        })
-                        .map(|p| -p.distance)
-                        .sum::<f64>();
+            g[base] = self.self_penetration(&mut frame);
+            g[base + 1] = self.world_penetration(&mut frame, &mut world, support);
+            if let (Some((_, target, _)), Some(h)) = (self.reach, out.hand.last()) {
+                if i == steps {
+                    let d = (Vector2::new(h[0], h[2]) - target).norm();
+                    g[base + 2] = d - spec.reach.as_ref().map_or(0.0, |r| r.tolerance);
                 }
             }
             for (c, v) in g.iter().enumerate() {
@@ -605,6 +640,9 @@ impl WholeBody {
             out.zmp.push(zmp);
         }
         out.costs = costs(&out);
+        if let (Some((_, target, _)), Some(h)) = (self.reach, out.hand.last()) {
+            out.costs.reach = (Vector2::new(h[0], h[2]) - target).norm();
+        }
         Ok(out)
     }
 
@@ -621,6 +659,64 @@ impl WholeBody {
 }
 
 impl WholeBody {
+    /// The world objects, placed at the identity until [`WholeBody::world_penetration`] moves
+    /// them into the root frame.
+    fn world(&self) -> Result<World> {
+        let mut world = World::new();
+        for (name, shape, _) in &self.objects {
+            world.add(name, shape.clone(), Isometry3::identity())?;
+        }
+        Ok(world)
+    }
+
+    fn reach_gain(&self) -> f64 {
+        self.spec.reach.as_ref().map_or(0.0, |r| r.gain)
+    }
+
+    /// Total penetration depth of the robot with itself at the posture in `frame` (0 if free).
+    fn self_penetration(&self, frame: &mut Frame) -> f64 {
+        self.collision.place(&frame.poses, &mut frame.placed);
+        if !self.spec.limits.self_collision || !self.collision.any_self_collision(&frame.placed) {
+            return 0.0;
+        }
+        self.collision
+            .colliding_pairs(&frame.placed, &World::new())
+            .iter()
+            .map(|p| -p.distance)
+            .sum::<f64>()
+            .max(1e-9)
+    }
+
+    /// Total penetration depth of the robot with the world objects (the seat's contact links
+    /// excepted while it supports), after [`WholeBody::self_penetration`] placed the bodies.
+    fn world_penetration(&self, frame: &mut Frame, world: &mut World, support: Support) -> f64 {
+        if self.objects.is_empty() {
+            return 0.0;
+        }
+        let ground_to_root = frame.root_in_ground.inverse();
+        for (name, _, pose) in &self.objects {
+            let _ = world.set_pose(name, ground_to_root * pose);
+        }
+        if !self.collision.any_world_collision(&frame.placed, world) {
+            return 0.0;
+        }
+        let seated = support == Support::FeetAndSeat;
+        self.collision
+            .colliding_pairs(&frame.placed, world)
+            .iter()
+            .filter(|p| match (&p.other, &self.seat) {
+                (Other::Object(o), Some((seat, contacts, _))) if seated && o == seat => {
+                    let link = p.body.split('#').next().unwrap_or(&p.body);
+                    !contacts.iter().any(|c| c == link)
+                }
+                (Other::Object(_), _) => true,
+                _ => false,
+            })
+            .map(|p| -p.distance)
+            .sum::<f64>()
+            .max(0.0)
+    }
+
     /// Re-checks a recorded rollout against every constraint without the controller's own
     /// bookkeeping: motor limits from the model, velocities from differences of the recorded
     /// positions, torques from central differences of the potential energy m g z_com, the ZMP
@@ -634,11 +730,9 @@ impl WholeBody {
         let model = self.model();
         let dt = self.spec.dt;
         let mut frame = Frame::new(self);
-        let mut world = World::new();
-        if let Some((shape, _, _)) = &self.chair {
-            let _ = world.add("chair", shape.clone(), Isometry3::identity());
-        }
+        let mut world = self.world().unwrap_or_default();
         let h = 1e-6;
+        let r_len = r.q.len();
         for (i, q) in r.q.iter().enumerate() {
             let t = r.times[i];
             let phase = &self.spec.phases[r.phase[i]];
@@ -672,24 +766,18 @@ impl WholeBody {
                 }
             }
             frame.update(self, q);
-            self.collision.place(&frame.poses, &mut frame.placed);
-            if self.spec.limits.self_collision && self.collision.count_self(&frame.placed) > 0 {
+            if self.self_penetration(&mut frame) > 0.0 {
                 note("self-collision".into(), t);
             }
-            if let Some((_, pose, contacts)) = &self.chair {
-                let _ = world.set_pose("chair", frame.root_in_ground.inverse() * pose);
-                let allowed = phase.support == Support::FeetAndChair;
-                let touching = self
-                    .collision
-                    .colliding_pairs(&frame.placed, &world)
-                    .into_iter()
-                    .any(|p| {
-                        let link = p.body.split('#').next().unwrap_or(&p.body).to_string();
-                        matches!(p.other, Other::Object(_))
-                            && !(allowed && contacts.contains(&link))
-                    });
-                if touching {
-                    note("chair collision".into(), t);
+            if self.world_penetration(&mut frame, &mut world, phase.support) > 0.0 {
+                note("world collision".into(), t);
+            }
+            if let (Some((hand, target, _)), Some(r)) = (self.reach, &self.spec.reach) {
+                if i + 1 == r_len {
+                    let p = frame.point(self, hand);
+                    if (Vector2::new(p.x, p.z) - target).norm() > r.tolerance + 1e-9 {
+                        note("reach target missed".into(), t);
+                    }
                 }
             }
         }
@@ -715,15 +803,43 @@ fn costs(r: &Rollout) -> Costs {
     c
 }
 
+/// Joint velocities for tasks in strict priority (each `(J, v)` solved in the null space of the
+/// ones before, damped least squares) and a posture velocity in the null space of all of them.
+fn prioritised(
+    tasks: &[(DMatrix<f64>, DVector<f64>)],
+    posture: &DVector<f64>,
+    damping: f64,
+) -> DVector<f64> {
+    let n = posture.len();
+    let mut qdot = DVector::zeros(n);
+    let mut null = DMatrix::<f64>::identity(n, n);
+    for (j, v) in tasks {
+        let jn = j * &null;
+        let rows = jn.nrows();
+        let inverse = (&jn * jn.transpose() + DMatrix::identity(rows, rows) * damping * damping)
+            .try_inverse()
+            .unwrap_or_else(|| DMatrix::zeros(rows, rows));
+        let pinv = jn.transpose() * inverse;
+        qdot += &pinv * (v - j * &qdot);
+        null -= &pinv * &jn;
+    }
+    qdot + null * posture
+}
+
 /// Per-sample kinematic quantities in the ground frame.
 #[derive(Debug, Clone)]
 struct Frame {
     poses: PoseBuffer,
     placed: PlacedBodies,
-    com_root: Matrix3xX<f64>,
+    /// Jacobians in the root frame (scratch).
+    root_jacobian: Matrix3xX<f64>,
+    frame_jacobian: Matrix6xX<f64>,
     sole: Matrix6xX<f64>,
+    sole_origin: Point3<f64>,
     /// CoM Jacobian in the ground frame with the left foot fixed (3 × n).
     com_jacobian: Matrix3xX<f64>,
+    /// Jacobian of the last [`Frame::point`] in the ground frame with the left foot fixed.
+    point_jacobian: Matrix3xX<f64>,
     root_in_ground: Isometry3<f64>,
 }
 
@@ -733,31 +849,61 @@ impl Frame {
         Frame {
             poses: p.model().pose_buffer(),
             placed: p.collision.placed_bodies(),
-            com_root: Matrix3xX::zeros(n),
+            root_jacobian: Matrix3xX::zeros(n),
+            frame_jacobian: Matrix6xX::zeros(n),
             sole: Matrix6xX::zeros(n),
+            sole_origin: Point3::origin(),
             com_jacobian: Matrix3xX::zeros(n),
+            point_jacobian: Matrix3xX::zeros(n),
             root_in_ground: Isometry3::identity(),
         }
     }
 
-    /// FK at `q`; returns the mass and the CoM in the ground frame and fills the Jacobian.
+    /// FK at `q`; returns the mass and the CoM in the ground frame and fills its Jacobian.
     fn update(&mut self, p: &WholeBody, q: &[f64]) -> (f64, Point3<f64>) {
         p.active.forward_unchecked(q, &mut self.poses);
         let sole_pose = *self.poses.pose(p.feet.0);
-        let ground_in_root = sole_pose * p.sole_to_ground;
-        self.root_in_ground = ground_in_root.inverse();
-        let (mass, c) = p.active.center_of_mass(&self.poses);
-        p.active.com_jacobian(&self.poses, &mut self.com_root);
+        self.root_in_ground = (sole_pose * p.sole_to_ground).inverse();
+        self.sole_origin = Point3::from(sole_pose.translation.vector);
         p.active.jacobian(&self.poses, p.feet.0, &mut self.sole);
-        // velocity of the CoM relative to the (fixed) sole: J_c − J_v + [c − o]× J_ω
-        let r = c - Point3::from(sole_pose.translation.vector);
+        let (mass, c) = p.active.center_of_mass(&self.poses);
+        p.active.com_jacobian(&self.poses, &mut self.root_jacobian);
+        let mut out = std::mem::take(&mut self.com_jacobian);
+        self.relative_to_sole(&c, &mut out);
+        self.com_jacobian = out;
+        (mass, self.root_in_ground * c)
+    }
+
+    /// Position of `frame_id`'s origin in the ground frame; fills `point_jacobian`. Call after
+    /// [`Frame::update`].
+    fn point(&mut self, p: &WholeBody, frame_id: FrameId) -> Point3<f64> {
+        p.active
+            .jacobian(&self.poses, frame_id, &mut self.frame_jacobian);
+        let origin = Point3::from(self.poses.pose(frame_id).translation.vector);
+        for k in 0..self.frame_jacobian.ncols() {
+            for r in 0..3 {
+                self.root_jacobian[(r, k)] = self.frame_jacobian[(r, k)];
+            }
+        }
+        let mut out = std::mem::take(&mut self.point_jacobian);
+        self.relative_to_sole(&origin, &mut out);
+        self.point_jacobian = out;
+        self.root_in_ground * origin
+    }
+
+    /// `out` = the ground-frame Jacobian of point `c` whose root-frame Jacobian is in
+    /// `root_jacobian`, with the left sole fixed: R (J_c − J_v + [c − o]× J_ω).
+    fn relative_to_sole(&self, c: &Point3<f64>, out: &mut Matrix3xX<f64>) {
+        let r = c - self.sole_origin;
         let rot = self.root_in_ground.rotation.to_rotation_matrix();
-        for k in 0..self.com_root.ncols() {
+        if out.ncols() != self.root_jacobian.ncols() {
+            *out = Matrix3xX::zeros(self.root_jacobian.ncols());
+        }
+        for k in 0..self.root_jacobian.ncols() {
             let v = Vector3::new(self.sole[(0, k)], self.sole[(1, k)], self.sole[(2, k)]);
             let w = Vector3::new(self.sole[(3, k)], self.sole[(4, k)], self.sole[(5, k)]);
-            let rel = self.com_root.column(k) - v + r.cross(&w);
-            self.com_jacobian.set_column(k, &(rot * rel));
+            let rel = self.root_jacobian.column(k) - v + r.cross(&w);
+            out.set_column(k, &(rot * rel));
         }
-        (mass, self.root_in_ground * c)
     }
 }

@@ -57,6 +57,7 @@ impl WholeBody {
             com_error: costs.com_error / reference.com_error.max(f64::MIN_POSITIVE),
             effort: costs.effort / reference.effort.max(f64::MIN_POSITIVE),
             backward: costs.backward / w.backward_max,
+            reach: costs.reach,
         };
         let phi = (w.com_error * normalised.com_error
             + w.effort * normalised.effort
@@ -103,7 +104,7 @@ pub fn optimise(
         max_evaluations: Some(spec.optimiser.rollouts),
         ..StopOptions::default()
     };
-    let nc = crate::constraint_names(problem.model()).len();
+    let nc = crate::constraint_names(problem).len();
     // one rollout per candidate serves both the constraints and the objective
     let cache: RefCell<Option<(Vec<f64>, Rollout)>> = RefCell::new(None);
     let failure: RefCell<Option<TaskError>> = RefCell::new(None);

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use trm_collision::{Shape, WorldSpec};
 use trm_kinematics::{RobotModel, closest_names};
 use trm_tasks::TaskError;
 use trm_tasks::spec::{locate, ron_error};
@@ -26,9 +27,16 @@ pub struct MotionSpec {
     pub sole: (f64, f64),
     /// The conservative support polygon is the feet's, shrunk by this margin (metres) on every side.
     pub support_margin: f64,
-    /// The chair seat, a box in the ground frame; `None` for motions without a chair.
+    /// Objects around the robot, in the ground frame (x forward, y left, z up); the robot must
+    /// not collide with them, except the seat's contact links while the seat supports it.
     #[serde(default)]
-    pub chair: Option<ChairSpec>,
+    pub world: WorldSpec,
+    /// The seat (a box of `world`) and the links resting on it; `None` without a seat.
+    #[serde(default)]
+    pub seat: Option<SeatSpec>,
+    /// A hand (frame) that reaches a target during one phase; `None` for no reach.
+    #[serde(default)]
+    pub reach: Option<ReachSpec>,
     /// Start posture, degrees, by motor name (motors left out: 0 clamped into limits).
     pub start: BTreeMap<String, f64>,
     /// The phases, in order; each ends at a keyframe posture.
@@ -49,16 +57,32 @@ pub struct MotionSpec {
     pub hand_tuned: TrajectorySpec,
 }
 
-/// The chair seat.
+/// The seat.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ChairSpec {
-    /// Centre of the seat box in the ground frame, metres.
-    pub centre: [f64; 3],
-    /// Box size (x depth, y width, z thickness), metres.
-    pub size: [f64; 3],
+pub struct SeatSpec {
+    /// Name of a box in `world`.
+    pub object: String,
     /// Links that rest on the seat while it supports the robot (contact, not collision).
     pub contacts: Vec<String>,
+}
+
+/// A reaching task: the frame's origin moves along a minimum-jerk line from where it is at the
+/// phase's start to `target` at the phase's end (x and z; y is free), as a task below the
+/// centre of mass and above the posture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReachSpec {
+    /// A link or named frame of the model (e.g. `l_palm_center`).
+    pub frame: String,
+    /// Target (x, z) in the ground frame, metres.
+    pub target: (f64, f64),
+    /// The phase (by name) during which the hand reaches.
+    pub phase: String,
+    /// Feedback gain, 1/s.
+    pub gain: f64,
+    /// The final distance to the target must stay below this (a constraint), metres.
+    pub tolerance: f64,
 }
 
 /// Who carries the robot during a phase.
@@ -66,8 +90,8 @@ pub struct ChairSpec {
 pub enum Support {
     /// The feet alone.
     Feet,
-    /// The feet and the chair seat.
-    FeetAndChair,
+    /// The feet and the seat.
+    FeetAndSeat,
 }
 
 /// One phase of the motion.
@@ -283,30 +307,55 @@ impl MotionSpec {
                 }
             }
         }
-        if let Some(c) = &spec.chair {
-            if c.size.iter().any(|s| !(s.is_finite() && *s > 0.0))
-                || c.centre.iter().any(|v| !v.is_finite())
-            {
-                return Err(err(
-                    "chair",
-                    "chair",
-                    "size must be positive and the centre finite".into(),
-                    "fix the chair box",
-                ));
+        if let Some(seat) = &spec.seat {
+            match spec.world.objects.iter().find(|o| o.name == seat.object) {
+                Some(o) if matches!(o.shape, Shape::Box { .. }) && o.rpy == [0.0; 3] => {}
+                _ => {
+                    return Err(err(
+                        "seat.object",
+                        "object",
+                        format!("`{}` is not an axis-aligned box of `world`", seat.object),
+                        "name a `Box` object of `world` with rpy (0, 0, 0)",
+                    ));
+                }
             }
         }
-        if spec.chair.is_none()
+        if spec.seat.is_none()
             && spec
                 .phases
                 .iter()
-                .any(|p| p.support == Support::FeetAndChair)
+                .any(|p| p.support == Support::FeetAndSeat)
         {
             return Err(err(
                 "phases",
-                "FeetAndChair",
-                "a phase is supported by a chair but there is no chair".into(),
-                "add `chair: Some((...))` or use `support: Feet`",
+                "FeetAndSeat",
+                "a phase is supported by a seat but there is no seat".into(),
+                "add `seat: Some((object: ..., contacts: [...]))` or use `support: Feet`",
             ));
+        }
+        if let Some(r) = &spec.reach {
+            if !spec.phases.iter().any(|p| p.name == r.phase) {
+                let names: Vec<&str> = spec.phases.iter().map(|p| p.name.as_str()).collect();
+                return Err(err(
+                    "reach.phase",
+                    &format!("\"{}\"", r.phase),
+                    format!("no phase named `{}`", r.phase),
+                    &format!("use one of `{}`", names.join("`, `")),
+                ));
+            }
+            let ok = [r.gain, r.tolerance]
+                .iter()
+                .all(|v| v.is_finite() && *v > 0.0)
+                && r.target.0.is_finite()
+                && r.target.1.is_finite();
+            if !ok {
+                return Err(err(
+                    "reach",
+                    "reach",
+                    "gain and tolerance must be positive, the target finite".into(),
+                    "fix the reach numbers",
+                ));
+            }
         }
         Ok(spec)
     }
@@ -372,12 +421,17 @@ impl MotionSpec {
                 return Err(err("feet", f, "frame", &frames));
             }
         }
-        if let Some(c) = &self.chair {
+        if let Some(c) = &self.seat {
             let links: Vec<&str> = model.tree().links.iter().map(|l| l.name.as_str()).collect();
             for l in &c.contacts {
                 if !links.contains(&l.as_str()) {
-                    return Err(err("chair.contacts", l, "link", &links));
+                    return Err(err("seat.contacts", l, "link", &links));
                 }
+            }
+        }
+        if let Some(r) = &self.reach {
+            if model.frame_id(&r.frame).is_err() {
+                return Err(err("reach.frame", &r.frame, "frame", &frames));
             }
         }
         Ok(())

@@ -91,7 +91,7 @@ fn the_hand_tuned_trajectory_violates_what_the_independent_check_finds() {
     let p = problem();
     let r = p.hand_tuned().unwrap();
     assert!(r.violations() > 0);
-    let names = trm_wholebody::constraint_names(p.model());
+    let names = trm_wholebody::constraint_names(&p);
     let violated: Vec<&str> = names
         .iter()
         .zip(&r.violated_samples)
@@ -183,4 +183,40 @@ fn spec_errors_name_the_place_and_the_fix() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("outside") && e.contains("torso_pitch"), "{e}");
+}
+
+#[test]
+fn the_same_machinery_reaches_towards_a_low_shelf() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../specs/wholebody/low_shelf.ron"
+    );
+    let p = WholeBody::load(path).unwrap();
+    let names = trm_wholebody::constraint_names(&p);
+    assert_eq!(names.last().unwrap(), "reach target");
+    let (start, _) = p.keyframes();
+    let palm = p.point_at(start, "l_palm_center").unwrap();
+    let target = p.spec().reach.as_ref().unwrap().target;
+    let r = p.rollout(&[0.0; 15], &p.ends()).unwrap();
+    let last = r.hand.last().unwrap();
+    let before = ((palm[0] - target.0).powi(2) + (palm[2] - target.1).powi(2)).sqrt();
+    assert!(
+        r.costs.reach < 0.2 * before,
+        "{} vs {before}",
+        r.costs.reach
+    );
+    assert!((last[0] - palm[0]).abs() > 0.0);
+    // the slow hand-tuned reach misses its target and touches the shelf: both found twice
+    let hand = p.hand_tuned().unwrap();
+    let check = p.verify(&hand);
+    assert!(
+        check.iter().any(|c| c.starts_with("reach target missed")),
+        "{check:?}"
+    );
+    assert!(
+        check.iter().any(|c| c.starts_with("world collision")),
+        "{check:?}"
+    );
+    let i = names.iter().position(|n| n == "world collision").unwrap();
+    assert!(hand.violated_samples[i] > 0 && hand.violated_samples[names.len() - 1] == 1);
 }
