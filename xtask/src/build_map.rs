@@ -31,6 +31,9 @@ pub struct Args {
     /// Interpolation step (rad) for checking edges.
     #[arg(long, default_value_t = 0.05)]
     edge_resolution: f64,
+    /// Also write a 3-D view of the map (`<out stem>.scene.html` and `.scene.json`).
+    #[arg(long)]
+    view: bool,
 }
 
 /// Builds, connects and saves a map.
@@ -89,6 +92,12 @@ pub fn run(args: &Args) -> Result<()> {
     let svg = out.with_extension("svg");
     crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;
     println!("wrote {} and {}", out.display(), svg.display());
+    if args.view {
+        let mut scene =
+            crate::view::problem_scene(&problem, &format!("map of {}", args.spec.display()))?;
+        crate::view::add_map(&mut scene, &map, problem.objective.active())?;
+        crate::view::write_scene(&scene, &crate::view::scene_path(&out))?;
+    }
     Ok(())
 }
 

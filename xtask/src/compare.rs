@@ -37,6 +37,10 @@ pub struct Args {
     /// Stop a run when its best has not improved for this many evaluations.
     #[arg(long, default_value_t = 30_000)]
     no_improvement: u64,
+    /// Also write a 3-D view per posture (`posture<N>.scene.html`): one frame per algorithm,
+    /// its best run's posture.
+    #[arg(long)]
+    pub view: bool,
     /// Output directory for table.md, runs.csv and convergence.svg.
     #[arg(long, default_value = "target/compare-optimisers")]
     out_dir: PathBuf,
@@ -74,6 +78,7 @@ struct RunResult {
     collision_free: bool,
     seconds: f64,
     trace: Vec<(u64, f64)>,
+    motors: Vec<f64>,
 }
 
 fn mean_sem(v: &[f64]) -> (f64, f64) {
@@ -150,6 +155,7 @@ pub fn run(args: &Args) -> Result<()> {
                 collision_free: s.collision_free,
                 seconds: s.wall_time.as_secs_f64(),
                 trace: s.trace,
+                motors: s.motors,
             })
         })
         .collect::<Result<_>>()?;
@@ -217,6 +223,28 @@ pub fn run(args: &Args) -> Result<()> {
         "wrote {}/{{table.md, runs.csv, convergence.svg}}; wall time {wall:.1} s",
         args.out_dir.display()
     );
+    if args.view {
+        for (p, problem) in problems.iter().enumerate() {
+            let title = format!(
+                "{}: best posture of each algorithm ({})",
+                specs[p].display(),
+                args.algos.join(", ")
+            );
+            let mut scene = crate::view::problem_scene(problem, &title)?;
+            scene.frames.clear();
+            for (i, algo) in args.algos.iter().enumerate() {
+                let best = results
+                    .iter()
+                    .filter(|r| r.posture == p && &r.algo == algo)
+                    .min_by(|a, b| a.cost.total_cmp(&b.cost));
+                if let Some(best) = best {
+                    scene.add_frame(i as f64, &best.motors)?;
+                }
+            }
+            let page = args.out_dir.join(format!("posture{}.scene.html", p + 1));
+            crate::view::write_scene(&scene, &page)?;
+        }
+    }
     Ok(())
 }
 
@@ -288,6 +316,7 @@ mod tests {
     fn the_comparison_writes_its_outputs_and_does_not_depend_on_the_thread_count() {
         let dir = std::env::temp_dir().join(format!("trm-compare-{}", std::process::id()));
         let args = |out: &str| Args {
+            view: false,
             specs: Vec::new(),
             algos: vec!["xnes".into(), "sird".into(), "simplex".into()],
             runs: 2,

@@ -16,6 +16,7 @@ mod solve;
 mod speedup;
 mod stand_up;
 mod task_map_studies;
+mod view;
 
 use std::path::{Path, PathBuf};
 
@@ -70,6 +71,8 @@ enum Command {
     /// from a chair (Table II, Fig. 3, Fig. 4).
     #[command(alias = "whole-body")]
     StandUp(stand_up::Args),
+    /// A 3-D view (JSON scene + self-contained three.js page) of a robot, world, map and motion.
+    View(view::Args),
 }
 
 fn main() {
@@ -90,6 +93,7 @@ fn main() {
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
+        Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),
     };
     if let Err(e) = result {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use trm_collision::World;
 use trm_plan::{Goal, PlanOptions, Planner};
 use trm_roadmap::Roadmap;
@@ -34,46 +34,24 @@ pub struct Args {
     /// Seed of the shortcutting.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Also write a 3-D view (maps, world, the motion and its task-space path) beside --out
+    /// (`<stem>.scene.html`), or as target/plan.scene.html.
+    #[arg(long)]
+    view: bool,
     /// Joint speed where the model has no limit, rad/s.
     #[arg(long, default_value_t = 1.0)]
     velocity: f64,
 }
 
 fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
     let active = problem.objective.active();
-    if let Some(q) = v.get("q").and_then(|q| q.as_array()) {
-        let q: Vec<f64> = q.iter().filter_map(|x| x.as_f64()).collect();
-        if q.len() != active.len() {
-            bail!(
-                "{}: \"q\" has {} values for {} active motors",
-                path.display(),
-                q.len(),
-                active.len()
-            );
-        }
-        return Ok(q);
-    }
-    if let Some(m) = v.get("motors").and_then(|m| m.as_object()) {
-        let mut motors = active.to_motors(&problem.start);
-        for (name, value) in m {
-            let i = problem
-                .robot
-                .motor_index(name)
-                .with_context(|| format!("{}: motors", path.display()))?;
-            motors[i] = value
-                .as_f64()
-                .with_context(|| format!("{}: motor {name} is not a number", path.display()))?;
-        }
-        return Ok(active.from_motors(&motors));
-    }
-    bail!(
-        "{}: expected \"motors\": {{name: value}} or \"q\": [..]",
-        path.display()
-    )
+    let motors = crate::view::posture_motors(
+        path,
+        &problem.robot,
+        Some(active),
+        &active.to_motors(&problem.start),
+    )?;
+    Ok(active.from_motors(&motors))
 }
 
 /// Plans and reports.
@@ -161,6 +139,33 @@ pub fn run(args: &Args) -> Result<()> {
             json.display(),
             svg.display()
         );
+    }
+    if args.view {
+        let mut scene = crate::view::problem_scene(&problem, "planned motion")?;
+        scene.frames.clear();
+        for (t, q) in plan.trajectory.times.iter().zip(&plan.trajectory.positions) {
+            scene.add_frame(*t, q)?;
+        }
+        scene.set_path(
+            plan.trajectory
+                .task_path
+                .iter()
+                .map(|p| {
+                    [
+                        p[0],
+                        p.get(1).copied().unwrap_or(0.0),
+                        p.get(2).copied().unwrap_or(0.0),
+                    ]
+                })
+                .collect(),
+        );
+        scene.set_world(planner.world());
+        crate::view::add_map(&mut scene, first, problem.objective.active())?;
+        let out = args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("target/plan.csv"));
+        crate::view::write_scene(&scene, &crate::view::scene_path(&out))?;
     }
     Ok(())
 }

@@ -25,6 +25,9 @@ pub struct Args {
     /// Override the spec's constrained budget (rollouts).
     #[arg(long)]
     rollouts: Option<u64>,
+    /// Also write a 3-D view of the optimised motion (`scene.html`, `scene.json` in --out).
+    #[arg(long)]
+    view: bool,
     /// Output directory (figures, trajectory, JSON).
     #[arg(long, default_value = "results/stand-up")]
     out: PathBuf,
@@ -56,7 +59,6 @@ pub fn run(args: &Args) -> Result<()> {
             &text,
         )?;
     }
-    let spec = problem.spec();
     println!(
         "{}: {} motors, {:.1} kg, CoM from ({:.3}, {:.3}) to ({:.3}, {:.3}) m (x forward, z up), {} parameters, {} constraints",
         args.spec.display(),
@@ -95,6 +97,9 @@ pub fn run(args: &Args) -> Result<()> {
         &args.out.join("result.json"),
         &serde_json::to_value(&result)?,
     )?;
+    if args.view {
+        write_view(&problem, constrained, &args.out.join("scene.html"))?;
+    }
     if !result.feasible {
         bail!(
             "no feasible trajectory found with seed {} in {} rollouts: raise optimiser.bootstrap_rollouts in {} or try another --seed",
@@ -103,7 +108,6 @@ pub fn run(args: &Args) -> Result<()> {
             args.spec.display()
         );
     }
-    let _ = spec;
     Ok(())
 }
 
@@ -358,6 +362,25 @@ fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Res
         eprintln!("wrote {}", out.join(name).display());
     }
     Ok(())
+}
+
+/// The motion in the ground frame (feet flat), with its world and the CoM path.
+fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
+    let title = format!(
+        "{} solution ({:.2} s)",
+        s.name,
+        s.ends.last().copied().unwrap_or(0.0)
+    );
+    let mut scene = trm_view::Scene::new(&title, problem.collision());
+    let world = trm_collision::World::from_spec(&problem.spec().world, "spec world")?;
+    scene.set_world(&world);
+    let r = &s.rollout;
+    // every 5th control step (20 frames per second) keeps the page light
+    for i in (0..r.times.len()).step_by(5) {
+        scene.add_frame_at(r.times[i], &r.q[i], &problem.root_pose(&r.q[i]))?;
+    }
+    scene.set_path(r.com.clone());
+    crate::view::write_scene(&scene, path)
 }
 
 /// The optimised motion as CSV: time, phase, motor positions (rad), CoM, desired CoM, ZMP.

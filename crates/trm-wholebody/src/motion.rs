@@ -372,6 +372,18 @@ impl WholeBody {
         Ok([p.x, p.y, p.z])
     }
 
+    /// Pose of the robot's root link in the ground frame at motor positions `q` (feet flat).
+    pub fn root_pose(&self, q: &[f64]) -> Isometry3<f64> {
+        let mut f = Frame::new(self);
+        f.update(self, q);
+        f.root_in_ground
+    }
+
+    /// The robot's collision model.
+    pub fn collision(&self) -> &CollisionModel {
+        &self.collision
+    }
+
     /// The start posture and the keyframe ending each phase, motor positions in rad.
     pub fn keyframes(&self) -> (&[f64], &[Vec<f64>]) {
         (&self.start, &self.keyframes)

@@ -1,0 +1,468 @@
+//! Scenes for looking at what trm computes: a robot's collision shapes, link poses over time
+//! (postures or a motion), world objects, roadmap task points and edges coloured by cost, and a
+//! task-space path — as a versioned JSON document ([`Scene`], format `trm-scene` v1) and as one
+//! self-contained HTML page that renders it with three.js ([`Scene::to_html`]).
+//!
+//! The page's code lives in `viewer/` (an npm package: three.js and our `src/main.js`, bundled by
+//! esbuild into `viewer/dist/viewer.js`). When the bundle has been built it is inlined, so the
+//! page works offline; otherwise the page loads the same pinned three.js from a public CDN.
+//!
+//! ```
+//! let model = trm_models::icub_upper_body();
+//! let collision = trm_collision::CollisionModel::new(&model)?;
+//! let mut scene = trm_view::Scene::new("iCub at home", &collision);
+//! scene.add_frame(0.0, &model.posture("home")?.to_vec())?;
+//! let html = scene.to_html(None)?;
+//! assert!(html.contains("trm-scene"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+use trm_collision::{CollisionModel, Shape, World};
+use trm_kinematics::JointKind;
+use trm_kinematics::nalgebra::Isometry3;
+use trm_kinematics::{PoseBuffer, RobotModel};
+
+/// The scene format's name and version.
+pub const FORMAT: &str = "trm-scene";
+/// The scene format version this crate writes and reads.
+pub const VERSION: u32 = 1;
+/// The three.js version the page uses (the one `viewer/package.json` pins).
+pub const THREE_VERSION: &str = "0.187.0";
+/// The viewer's own code (bundled with three.js by `npm run build` in `viewer/`).
+pub const VIEWER_SOURCE: &str = include_str!("../../../viewer/src/main.js");
+
+/// Errors of scene building.
+#[derive(Debug, Error)]
+pub enum ViewError {
+    /// Invalid input.
+    #[error("{what}: {problem}")]
+    Invalid {
+        /// What was given.
+        what: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// From the kinematics.
+    #[error(transparent)]
+    Kinematics(#[from] trm_kinematics::KinematicsError),
+    /// JSON encoding.
+    #[error("scene JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// Reading the bundle.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The problem.
+        message: String,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = ViewError> = std::result::Result<T, E>;
+
+/// A pose as `[x, y, z, qx, qy, qz, qw]`.
+pub type Pose = [f64; 7];
+
+/// A shape in the scene: `{"type": "box", "size": [...]}` etc.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum SceneShape {
+    /// Ball.
+    Sphere {
+        /// Radius.
+        radius: f64,
+    },
+    /// Box by full side lengths.
+    Box {
+        /// Side lengths.
+        size: [f64; 3],
+    },
+    /// Cylinder along z.
+    Cylinder {
+        /// Radius.
+        radius: f64,
+        /// Length.
+        length: f64,
+    },
+    /// Capsule along z (length between the cap centres).
+    Capsule {
+        /// Radius.
+        radius: f64,
+        /// Length.
+        length: f64,
+    },
+    /// Convex hull of points.
+    Convex {
+        /// Points.
+        points: Vec<[f64; 3]>,
+    },
+}
+
+impl From<&Shape> for SceneShape {
+    fn from(s: &Shape) -> Self {
+        match s {
+            Shape::Sphere { radius } => SceneShape::Sphere { radius: *radius },
+            Shape::Box { size } => SceneShape::Box { size: *size },
+            Shape::Cylinder { radius, length } => SceneShape::Cylinder {
+                radius: *radius,
+                length: *length,
+            },
+            Shape::Capsule { radius, length } => SceneShape::Capsule {
+                radius: *radius,
+                length: *length,
+            },
+            Shape::Convex { points } => SceneShape::Convex {
+                points: points.clone(),
+            },
+        }
+    }
+}
+
+/// A collision body on a link.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneBody {
+    /// Body name.
+    pub name: String,
+    /// Index into [`Scene::links`].
+    pub link: usize,
+    /// Shape.
+    pub shape: SceneShape,
+    /// Pose of the shape in the link frame.
+    pub local: Pose,
+}
+
+/// One frame: the link poses at a time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneFrame {
+    /// Time, seconds (or an index for a set of postures).
+    pub t: f64,
+    /// Pose of the robot's root link in the scene (identity unless the robot stands on its
+    /// feet, say).
+    pub base: Pose,
+    /// Joint values (one per movable joint): what the page's own forward kinematics uses.
+    pub joints: Vec<f64>,
+    /// World poses of [`Scene::links`].
+    pub poses: Vec<Pose>,
+}
+
+/// A world object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneObject {
+    /// Name.
+    pub name: String,
+    /// Shape.
+    pub shape: SceneShape,
+    /// World pose.
+    pub pose: Pose,
+}
+
+/// A roadmap: task points coloured by cost, edges, and each point's posture.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SceneMap {
+    /// Where each point is drawn (its task point, or a frame's position), metres.
+    pub points: Vec<[f64; 3]>,
+    /// Cost of each point (colour).
+    pub cost: Vec<f64>,
+    /// Edges as point index pairs.
+    pub edges: Vec<[usize; 2]>,
+    /// Joint values of each point's posture (shown on click).
+    pub joints: Vec<Vec<f64>>,
+}
+
+/// What the page needs to run forward kinematics for map postures: the tree.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SceneKinematics {
+    /// Link names in tree order (parents first).
+    pub links: Vec<String>,
+    /// Joints in tree order (joint i's child is link i + 1).
+    pub joints: Vec<SceneJoint>,
+}
+
+/// A tree joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SceneJoint {
+    /// Parent link index.
+    pub parent: usize,
+    /// `revolute` (also continuous), `prismatic` or `fixed`.
+    pub kind: String,
+    /// Joint frame in the parent link frame.
+    pub origin: Pose,
+    /// Unit axis in the joint frame.
+    pub axis: [f64; 3],
+    /// Index into a frame's `joints` (movable joints only).
+    pub coordinate: Option<usize>,
+}
+
+/// A scene document.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Scene {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// Always [`VERSION`].
+    pub version: u32,
+    /// The software that wrote it.
+    pub generator: String,
+    /// Page title.
+    pub title: String,
+    /// Names of the links that carry bodies (the order of every frame's poses).
+    pub links: Vec<String>,
+    /// Tree index of each of [`Scene::links`].
+    pub link_index: Vec<usize>,
+    /// Collision bodies.
+    pub bodies: Vec<SceneBody>,
+    /// Frames (one per posture or trajectory sample).
+    pub frames: Vec<SceneFrame>,
+    /// World objects.
+    pub world: Vec<SceneObject>,
+    /// Optional roadmap.
+    pub map: Option<SceneMap>,
+    /// Optional task-space path (e.g. a planned motion's hand positions).
+    pub path: Vec<[f64; 3]>,
+    /// The kinematic tree, for the page's forward kinematics.
+    pub kinematics: SceneKinematics,
+    #[serde(skip)]
+    model: Option<RobotModel>,
+}
+
+fn pose(p: &Isometry3<f64>) -> Pose {
+    let t = p.translation.vector;
+    let q = p.rotation.coords; // (i, j, k, w)
+    let r = |v: f64| (v * 1e7).round() / 1e7;
+    [r(t.x), r(t.y), r(t.z), r(q.x), r(q.y), r(q.z), r(q.w)]
+}
+
+impl Scene {
+    /// An empty scene of `collision`'s robot: its bodies and tree, no frames yet.
+    pub fn new(title: &str, collision: &CollisionModel) -> Self {
+        let model = collision.robot().clone();
+        let tree = model.tree();
+        let mut links: Vec<String> = Vec::new();
+        let mut link_index = Vec::new();
+        let mut bodies = Vec::new();
+        for b in collision.bodies() {
+            let slot = match link_index.iter().position(|&l| l == b.link) {
+                Some(s) => s,
+                None => {
+                    link_index.push(b.link);
+                    links.push(tree.links[b.link].name.clone());
+                    links.len() - 1
+                }
+            };
+            bodies.push(SceneBody {
+                name: b.name.clone(),
+                link: slot,
+                shape: (&b.shape).into(),
+                local: pose(&b.local),
+            });
+        }
+        let kinematics = SceneKinematics {
+            links: tree.links.iter().map(|l| l.name.clone()).collect(),
+            joints: tree
+                .joints
+                .iter()
+                .map(|j| SceneJoint {
+                    parent: j.parent,
+                    kind: match j.kind {
+                        JointKind::Prismatic => "prismatic",
+                        JointKind::Fixed => "fixed",
+                        _ => "revolute",
+                    }
+                    .into(),
+                    origin: pose(&j.local_origin),
+                    axis: [j.axis.x, j.axis.y, j.axis.z],
+                    coordinate: j.coordinate,
+                })
+                .collect(),
+        };
+        Scene {
+            format: FORMAT.into(),
+            version: VERSION,
+            generator: format!("trm {}", env!("CARGO_PKG_VERSION")),
+            title: title.into(),
+            links,
+            link_index,
+            bodies,
+            frames: Vec::new(),
+            world: Vec::new(),
+            map: None,
+            path: Vec::new(),
+            kinematics,
+            model: Some(model),
+        }
+    }
+
+    fn model(&self) -> Result<&RobotModel> {
+        self.model.as_ref().ok_or_else(|| ViewError::Invalid {
+            what: "scene".into(),
+            problem: "read from JSON: it has no robot model to add frames with".into(),
+        })
+    }
+
+    /// Joint values for motor values `motors`; fills `buffer` with the link poses.
+    fn posture(&self, motors: &[f64], buffer: &mut PoseBuffer) -> Result<Vec<f64>> {
+        let model = self.model()?;
+        if motors.len() != model.motors().len() || motors.iter().any(|v| !v.is_finite()) {
+            return Err(ViewError::Invalid {
+                what: "posture".into(),
+                problem: format!(
+                    "{} finite motor values needed, got {}",
+                    model.motors().len(),
+                    motors.len()
+                ),
+            });
+        }
+        let mut joints = vec![0.0; model.num_joints()];
+        model.motors_to_joints(motors, &mut joints)?;
+        model.all_active().forward(motors, buffer)?;
+        Ok(joints)
+    }
+
+    /// Adds a frame at time `t` for motor values `motors` (every motor of the model).
+    pub fn add_frame(&mut self, t: f64, motors: &[f64]) -> Result<()> {
+        self.add_frame_at(t, motors, &Isometry3::identity())
+    }
+
+    /// Adds a frame with the robot's root link at `base` in the scene.
+    pub fn add_frame_at(&mut self, t: f64, motors: &[f64], base: &Isometry3<f64>) -> Result<()> {
+        let mut buffer = self.model()?.pose_buffer();
+        let joints = self.posture(motors, &mut buffer)?;
+        let poses = self
+            .link_index
+            .iter()
+            .map(|&l| pose(&(base * buffer.poses()[l])))
+            .collect();
+        self.frames.push(SceneFrame {
+            t,
+            base: pose(base),
+            joints,
+            poses,
+        });
+        Ok(())
+    }
+
+    /// Adds the world's objects.
+    pub fn set_world(&mut self, world: &World) {
+        self.world = world
+            .objects()
+            .iter()
+            .map(|o| SceneObject {
+                name: o.name().into(),
+                shape: o.shape().into(),
+                pose: pose(o.pose()),
+            })
+            .collect();
+    }
+
+    /// Sets the roadmap: for each point its drawn position, cost and motor values; and edges.
+    pub fn set_map(
+        &mut self,
+        points: Vec<[f64; 3]>,
+        cost: Vec<f64>,
+        postures: &[Vec<f64>],
+        edges: Vec<[usize; 2]>,
+    ) -> Result<()> {
+        let n = points.len();
+        if cost.len() != n || postures.len() != n {
+            return Err(ViewError::Invalid {
+                what: "map".into(),
+                problem: format!(
+                    "{n} points, {} costs, {} postures",
+                    cost.len(),
+                    postures.len()
+                ),
+            });
+        }
+        if let Some(e) = edges.iter().find(|e| e[0] >= n || e[1] >= n) {
+            return Err(ViewError::Invalid {
+                what: "map".into(),
+                problem: format!("edge {e:?} names a point beyond {n}"),
+            });
+        }
+        let model = self.model()?;
+        let mut joints = Vec::with_capacity(n);
+        for q in postures {
+            let mut j = vec![0.0; model.num_joints()];
+            model.motors_to_joints(q, &mut j)?;
+            joints.push(j.iter().map(|v| (v * 1e6).round() / 1e6).collect());
+        }
+        self.map = Some(SceneMap {
+            points,
+            cost,
+            edges,
+            joints,
+        });
+        Ok(())
+    }
+
+    /// Sets the task-space path.
+    pub fn set_path(&mut self, path: Vec<[f64; 3]>) {
+        self.path = path;
+    }
+
+    /// The scene as JSON.
+    pub fn to_json(&self) -> Result<String> {
+        Ok(serde_json::to_string(self)?)
+    }
+
+    /// Reads a scene, checking its format and version.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let scene: Scene = serde_json::from_str(text)?;
+        if scene.format != FORMAT || scene.version > VERSION {
+            return Err(ViewError::Invalid {
+                what: "scene".into(),
+                problem: format!(
+                    "format {} v{} (this software reads {FORMAT} up to v{VERSION})",
+                    scene.format, scene.version
+                ),
+            });
+        }
+        Ok(scene)
+    }
+
+    /// One self-contained HTML page that renders the scene. `bundle`: the built viewer
+    /// (`viewer/dist/viewer.js`), inlined; `None`: our source as a module that imports the
+    /// pinned three.js from a public CDN.
+    pub fn to_html(&self, bundle: Option<&str>) -> Result<String> {
+        // `</` cannot appear inside a <script>: JSON escapes it as `<\/`
+        let json = self.to_json()?.replace("</", "<\\/");
+        let title = self
+            .title
+            .replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;");
+        let script = match bundle {
+            Some(code) => format!(
+                "<script>{}</script>",
+                code.replace("</script", "<\\/script")
+            ),
+            None => format!(
+                "<script type=\"importmap\">{{\"imports\": {{\"three\": \"https://cdn.jsdelivr.net/npm/three@{v}/build/three.module.js\", \"three/addons/\": \"https://cdn.jsdelivr.net/npm/three@{v}/examples/jsm/\"}}}}</script>\n<script type=\"module\">{}</script>",
+                VIEWER_SOURCE,
+                v = THREE_VERSION
+            ),
+        };
+        Ok(format!(
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<meta name=\"generator\" content=\"{}\">\n</head>\n<body>\n<script id=\"trm-scene\" type=\"application/json\">{json}</script>\n{script}\n</body>\n</html>\n",
+            self.generator
+        ))
+    }
+}
+
+/// The built viewer bundle, `viewer/dist/viewer.js` under `repo`, if `npm run build` made it.
+pub fn find_bundle(repo: &Path) -> Result<Option<String>> {
+    let path = repo.join("viewer/dist/viewer.js");
+    if !path.is_file() {
+        return Ok(None);
+    }
+    std::fs::read_to_string(&path)
+        .map(Some)
+        .map_err(|e| ViewError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+}

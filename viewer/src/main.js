@@ -1,0 +1,382 @@
+// The trm viewer: renders a `trm-scene` document (crates/trm-view) embedded in the page as
+// <script id="trm-scene" type="application/json">. Robot collision shapes per link, link poses
+// per frame (play, pause, scrub), world objects, roadmap points and edges coloured by cost
+// (click a point to see its posture), a task-space path. After the first render it writes what
+// it drew into <pre id="trm-report"> so that a headless browser test can check it.
+// URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing.
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { ConvexGeometry } from 'three/addons/geometries/ConvexGeometry.js';
+
+const BACKGROUND = 0xf4f4f4;
+const scene3 = new THREE.Scene();
+scene3.background = new THREE.Color(BACKGROUND);
+const data = JSON.parse(document.getElementById('trm-scene').textContent);
+const params = new URLSearchParams(window.location.search);
+
+// ---- page layout -------------------------------------------------------------------------
+document.body.style.cssText = 'margin:0;overflow:hidden;font:13px sans-serif;';
+const panel = document.createElement('div');
+panel.style.cssText =
+  'position:absolute;top:8px;left:8px;background:rgba(255,255,255,.9);padding:8px 10px;' +
+  'border:1px solid #bbb;border-radius:4px;max-width:340px;';
+document.body.appendChild(panel);
+const heading = document.createElement('div');
+heading.style.cssText = 'font-weight:bold;margin-bottom:4px;';
+heading.textContent = data.title;
+panel.appendChild(heading);
+const info = document.createElement('div');
+info.id = 'trm-info';
+info.style.cssText = 'margin-top:6px;color:#333;';
+const report = document.createElement('pre');
+report.id = 'trm-report';
+report.style.cssText =
+  'position:absolute;bottom:0;right:4px;margin:0;font-size:10px;color:#888;max-width:60%;white-space:pre-wrap;';
+document.body.appendChild(report);
+
+function toggle(label, initial, onChange) {
+  const row = document.createElement('label');
+  row.style.cssText = 'display:block;';
+  const box = document.createElement('input');
+  box.type = 'checkbox';
+  box.checked = initial;
+  box.addEventListener('change', () => onChange(box.checked));
+  row.appendChild(box);
+  row.appendChild(document.createTextNode(' ' + label));
+  panel.appendChild(row);
+  return box;
+}
+
+// ---- shapes ------------------------------------------------------------------------------
+function geometry(shape) {
+  switch (shape.type) {
+    case 'sphere':
+      return new THREE.SphereGeometry(shape.radius, 24, 16);
+    case 'box':
+      return new THREE.BoxGeometry(shape.size[0], shape.size[1], shape.size[2]);
+    case 'cylinder':
+      return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, 24).rotateX(Math.PI / 2);
+    case 'capsule':
+      return new THREE.CapsuleGeometry(shape.radius, shape.length, 8, 16).rotateX(Math.PI / 2);
+    case 'convex':
+      return new ConvexGeometry(shape.points.map((p) => new THREE.Vector3(p[0], p[1], p[2])));
+    default:
+      throw new Error('unknown shape ' + shape.type);
+  }
+}
+
+function setPose(object, p) {
+  object.position.set(p[0], p[1], p[2]);
+  object.quaternion.set(p[3], p[4], p[5], p[6]);
+}
+
+function poseMatrix(p) {
+  return new THREE.Matrix4().compose(
+    new THREE.Vector3(p[0], p[1], p[2]),
+    new THREE.Quaternion(p[3], p[4], p[5], p[6]),
+    new THREE.Vector3(1, 1, 1),
+  );
+}
+
+// ---- robot -------------------------------------------------------------------------------
+const robot = new THREE.Group();
+scene3.add(robot);
+const linkGroups = data.links.map(() => {
+  const g = new THREE.Group();
+  robot.add(g);
+  return g;
+});
+let meshes = 0;
+data.bodies.forEach((b, i) => {
+  const hue = (b.link * 0.137) % 1;
+  const material = new THREE.MeshStandardMaterial({
+    color: new THREE.Color().setHSL(hue, 0.45, 0.55),
+    roughness: 0.7,
+    transparent: true,
+    opacity: 0.85,
+  });
+  const mesh = new THREE.Mesh(geometry(b.shape), material);
+  setPose(mesh, b.local);
+  mesh.name = b.name;
+  linkGroups[b.link].add(mesh);
+  meshes += 1;
+});
+
+// forward kinematics of the tree for a joint vector (root at `base`): world matrix of every link
+function forward(joints, base) {
+  const world = [base ? poseMatrix(base) : new THREE.Matrix4()];
+  data.kinematics.joints.forEach((j) => {
+    const m = world[j.parent].clone().multiply(poseMatrix(j.origin));
+    if (j.coordinate !== null && j.kind !== 'fixed') {
+      const v = joints[j.coordinate];
+      const axis = new THREE.Vector3(j.axis[0], j.axis[1], j.axis[2]);
+      if (j.kind === 'prismatic') {
+        m.multiply(new THREE.Matrix4().makeTranslation(axis.multiplyScalar(v)));
+      } else {
+        m.multiply(new THREE.Matrix4().makeRotationAxis(axis, v));
+      }
+    }
+    world.push(m);
+  });
+  return world;
+}
+
+function showJoints(joints) {
+  const world = forward(joints);
+  data.link_index.forEach((l, slot) => {
+    world[l].decompose(linkGroups[slot].position, linkGroups[slot].quaternion, new THREE.Vector3());
+  });
+}
+
+// the page's kinematics against the scene's (computed by trm): largest position difference
+function fkError() {
+  if (data.frames.length === 0) return 0;
+  const f = data.frames[0];
+  const world = forward(f.joints, f.base);
+  let worst = 0;
+  data.link_index.forEach((l, slot) => {
+    const p = new THREE.Vector3();
+    const q = new THREE.Quaternion();
+    world[l].decompose(p, q, new THREE.Vector3());
+    const e = f.poses[slot];
+    worst = Math.max(worst, Math.abs(p.x - e[0]), Math.abs(p.y - e[1]), Math.abs(p.z - e[2]));
+    const dot = Math.abs(q.x * e[3] + q.y * e[4] + q.z * e[5] + q.w * e[6]);
+    worst = Math.max(worst, 1 - Math.min(1, dot));
+  });
+  return worst;
+}
+
+// ---- world -------------------------------------------------------------------------------
+const world = new THREE.Group();
+scene3.add(world);
+data.world.forEach((o) => {
+  const mesh = new THREE.Mesh(
+    geometry(o.shape),
+    new THREE.MeshStandardMaterial({ color: 0x8a8a8a, transparent: true, opacity: 0.45 }),
+  );
+  setPose(mesh, o.pose);
+  mesh.name = o.name;
+  world.add(mesh);
+});
+
+// ---- map ---------------------------------------------------------------------------------
+const map = data.map;
+let mapPoints = null;
+let mapEdges = null;
+let costRange = [0, 1];
+function costColor(c) {
+  const [lo, hi] = costRange;
+  const u = hi > lo ? (c - lo) / (hi - lo) : 0.5;
+  return new THREE.Color().setHSL((1 - u) * 0.66, 0.85, 0.5); // blue (low) to red (high)
+}
+if (map && map.points.length > 0) {
+  costRange = [Math.min(...map.cost), Math.max(...map.cost)];
+  const positions = new Float32Array(map.points.length * 3);
+  const colors = new Float32Array(map.points.length * 3);
+  map.points.forEach((p, i) => {
+    positions.set(p, 3 * i);
+    const c = costColor(map.cost[i]);
+    colors.set([c.r, c.g, c.b], 3 * i);
+  });
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+  g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+  mapPoints = new THREE.Points(g, new THREE.PointsMaterial({ size: 6, sizeAttenuation: false, vertexColors: true }));
+  scene3.add(mapPoints);
+  const ep = new Float32Array(map.edges.length * 6);
+  const ec = new Float32Array(map.edges.length * 6);
+  map.edges.forEach(([a, b], i) => {
+    ep.set(map.points[a], 6 * i);
+    ep.set(map.points[b], 6 * i + 3);
+    ec.set(colors.subarray(3 * a, 3 * a + 3), 6 * i);
+    ec.set(colors.subarray(3 * b, 3 * b + 3), 6 * i + 3);
+  });
+  const eg = new THREE.BufferGeometry();
+  eg.setAttribute('position', new THREE.BufferAttribute(ep, 3));
+  eg.setAttribute('color', new THREE.BufferAttribute(ec, 3));
+  mapEdges = new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 }));
+  scene3.add(mapEdges);
+}
+
+// ---- path --------------------------------------------------------------------------------
+let path = null;
+if (data.path.length > 1) {
+  const g = new THREE.BufferGeometry().setFromPoints(data.path.map((p) => new THREE.Vector3(p[0], p[1], p[2])));
+  path = new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0xe07000 }));
+  scene3.add(path);
+}
+
+// ---- lights, grid, camera ------------------------------------------------------------------
+scene3.add(new THREE.HemisphereLight(0xffffff, 0x667788, 2.2));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(2, -3, 4);
+scene3.add(sun);
+const grid = new THREE.GridHelper(2, 20, 0xaaaaaa, 0xdddddd);
+grid.rotateX(Math.PI / 2);
+scene3.add(grid);
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+renderer.setSize(window.innerWidth, window.innerHeight);
+document.body.appendChild(renderer.domElement);
+const camera = new THREE.PerspectiveCamera(45, window.innerWidth / window.innerHeight, 0.01, 100);
+camera.up.set(0, 0, 1);
+const controls = new OrbitControls(camera, renderer.domElement);
+
+// ---- frames and playback -----------------------------------------------------------------
+const frames = data.frames;
+let current = 0;
+let playing = params.get('play') === '1' && frames.length > 1;
+function showFrame(i) {
+  current = Math.max(0, Math.min(frames.length - 1, i));
+  const f = frames[current];
+  if (!f) return;
+  f.poses.forEach((p, slot) => setPose(linkGroups[slot], p));
+  slider.value = String(current);
+  timeLabel.textContent = `frame ${current + 1}/${frames.length}, t = ${f.t.toFixed(2)} s`;
+}
+const controlsRow = document.createElement('div');
+controlsRow.style.cssText = 'margin:4px 0;';
+const playButton = document.createElement('button');
+playButton.textContent = playing ? 'pause' : 'play';
+playButton.disabled = frames.length < 2;
+const slider = document.createElement('input');
+slider.type = 'range';
+slider.min = '0';
+slider.max = String(Math.max(0, frames.length - 1));
+slider.style.cssText = 'width:180px;vertical-align:middle;';
+const timeLabel = document.createElement('div');
+controlsRow.appendChild(playButton);
+controlsRow.appendChild(slider);
+panel.appendChild(controlsRow);
+panel.appendChild(timeLabel);
+let clock = 0;
+playButton.addEventListener('click', () => {
+  playing = !playing;
+  playButton.textContent = playing ? 'pause' : 'play';
+  if (playing && current >= frames.length - 1) showFrame(0);
+  clock = frames[current] ? frames[current].t : 0;
+});
+slider.addEventListener('input', () => {
+  playing = false;
+  playButton.textContent = 'play';
+  showFrame(Number(slider.value));
+});
+
+toggle('collision shapes', true, (v) => { robot.visible = v; });
+if (data.world.length) toggle(`world (${data.world.length} objects)`, true, (v) => { world.visible = v; });
+if (mapPoints) {
+  toggle(`map points (${map.points.length})`, true, (v) => { mapPoints.visible = v; });
+  toggle(`map edges (${map.edges.length})`, true, (v) => { mapEdges.visible = v; });
+  const legend = document.createElement('div');
+  legend.style.cssText = 'margin-top:4px;';
+  legend.innerHTML =
+    '<div>point cost</div><div style="height:10px;width:180px;background:linear-gradient(to right,' +
+    'hsl(240,85%,50%),hsl(120,85%,50%),hsl(0,85%,50%))"></div>' +
+    `<div style="width:180px;display:flex;justify-content:space-between"><span>${costRange[0].toPrecision(3)}</span>` +
+    `<span>${costRange[1].toPrecision(3)}</span></div><div>click a point to see its posture</div>`;
+  panel.appendChild(legend);
+}
+if (path) toggle(`path (${data.path.length} points)`, true, (v) => { path.visible = v; });
+panel.appendChild(info);
+
+// ---- picking map points ------------------------------------------------------------------
+const raycaster = new THREE.Raycaster();
+let downAt = null;
+renderer.domElement.addEventListener('pointerdown', (e) => { downAt = [e.clientX, e.clientY]; });
+renderer.domElement.addEventListener('pointerup', (e) => {
+  if (!mapPoints || !mapPoints.visible || !downAt) return;
+  if (Math.hypot(e.clientX - downAt[0], e.clientY - downAt[1]) > 4) return; // a drag, not a click
+  const ndc = new THREE.Vector2((e.clientX / window.innerWidth) * 2 - 1, -(e.clientY / window.innerHeight) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  raycaster.params.Points.threshold = 0.01 * camera.position.distanceTo(controls.target);
+  const hit = raycaster.intersectObject(mapPoints)[0];
+  if (hit === undefined) return;
+  const i = hit.index;
+  playing = false;
+  playButton.textContent = 'play';
+  showJoints(map.joints[i]);
+  const p = map.points[i];
+  info.textContent = `map point ${i}: cost ${map.cost[i].toPrecision(4)}, at (${p.map((v) => v.toFixed(3)).join(', ')})`;
+});
+
+// ---- camera fit, first render, report ----------------------------------------------------
+const box = new THREE.Box3();
+if (frames.length) showFrame(0);
+box.expandByObject(robot);
+if (mapPoints) box.expandByObject(mapPoints);
+box.expandByObject(world);
+const centre = box.getCenter(new THREE.Vector3());
+const radius = Math.max(0.3, box.getSize(new THREE.Vector3()).length() / 2);
+controls.target.copy(centre);
+camera.position.copy(centre).add(new THREE.Vector3(-1.6, -1.9, 1.1).multiplyScalar(radius));
+controls.update();
+
+const start = params.has('frame') ? Number(params.get('frame')) : 0;
+showFrame(start);
+renderer.render(scene3, camera);
+
+function drawnPixels() {
+  const gl = renderer.getContext();
+  const w = gl.drawingBufferWidth;
+  const h = gl.drawingBufferHeight;
+  const pixels = new Uint8Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+  const [r, g, b] = [(BACKGROUND >> 16) & 255, (BACKGROUND >> 8) & 255, BACKGROUND & 255];
+  let n = 0;
+  for (let i = 0; i < pixels.length; i += 4) {
+    if (Math.abs(pixels[i] - r) > 8 || Math.abs(pixels[i + 1] - g) > 8 || Math.abs(pixels[i + 2] - b) > 8) n += 1;
+  }
+  return { n, w, h };
+}
+const drawn = drawnPixels();
+// mean time of a few full renders (software WebGL in headless tests: an upper bound)
+const timed = performance.now();
+for (let k = 0; k < 5; k += 1) renderer.render(scene3, camera);
+renderer.getContext().finish();
+const renderMs = (performance.now() - timed) / 5;
+report.textContent = JSON.stringify({
+  format: data.format,
+  version: data.version,
+  bodies: meshes,
+  links: linkGroups.length,
+  world: data.world.length,
+  points: map ? map.points.length : 0,
+  edges: map ? map.edges.length : 0,
+  path: data.path.length,
+  frames: frames.length,
+  frame: current,
+  fk_error: fkError(),
+  pixels: drawn.n,
+  width: drawn.w,
+  height: drawn.h,
+  render_ms: Math.round(renderMs * 10) / 10,
+  three: THREE.REVISION,
+});
+document.body.dataset.ready = '1';
+
+let last = performance.now();
+function animate(now) {
+  const dt = (now - last) / 1000;
+  last = now;
+  if (playing && frames.length > 1) {
+    clock += dt;
+    let i = current;
+    while (i + 1 < frames.length && frames[i + 1].t <= clock) i += 1;
+    if (i !== current) showFrame(i);
+    if (i >= frames.length - 1) {
+      playing = false;
+      playButton.textContent = 'play';
+    }
+  }
+  controls.update();
+  renderer.render(scene3, camera);
+  requestAnimationFrame(animate);
+}
+requestAnimationFrame(animate);
+window.addEventListener('resize', () => {
+  camera.aspect = window.innerWidth / window.innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(window.innerWidth, window.innerHeight);
+});

@@ -1,0 +1,517 @@
+//! `cargo xtask view [MODEL|SPEC] [--posture P.json]… [--map FILE] [--traj T.csv|.json]
+//! [--world W.ron] [--out scene.html]`: a JSON scene and a self-contained three.js page of a
+//! robot, its world, a roadmap and a motion. The other commands' `--view` flags use
+//! [`write_scene`].
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use trm_collision::{CollisionModel, World};
+use trm_kinematics::{ActiveSet, RobotModel};
+use trm_roadmap::Roadmap;
+use trm_tasks::Problem;
+use trm_view::Scene;
+
+/// Arguments of `view`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A model (.urdf or .ron description) or a task spec; default: the map's spec, else the
+    /// embedded iCub upper body.
+    input: Option<PathBuf>,
+    /// A posture file ("motors": {name: value}, as `solve --out` writes, or "q": [active
+    /// values] with a spec); repeatable, one frame each.
+    #[arg(long = "posture")]
+    postures: Vec<PathBuf>,
+    /// A roadmap file: its points (coloured by cost), edges and postures.
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// A trajectory: CSV with a `time` (or `t`) column and motor-name columns (as `plan` and
+    /// `stand-up` write), or `plan`'s JSON (with its task-space path).
+    #[arg(long)]
+    traj: Option<PathBuf>,
+    /// World objects (RON), replacing the spec's.
+    #[arg(long)]
+    world: Option<PathBuf>,
+    /// The page; the JSON scene is written beside it.
+    #[arg(long, default_value = "target/view/scene.html")]
+    out: PathBuf,
+    /// Meshes for models that use them.
+    #[command(flatten)]
+    mesh: crate::MeshArgs,
+}
+
+/// What the scene is of: the robot, its active motors, a start posture and a world.
+struct Subject {
+    robot: RobotModel,
+    active: Option<ActiveSet>,
+    start: Vec<f64>,
+    world: World,
+    title: String,
+}
+
+fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
+    let from_problem = |p: Problem, title: String| Subject {
+        start: p.objective.active().to_motors(&p.start),
+        active: Some(p.objective.active().clone()),
+        world: p.objective.world().clone(),
+        robot: p.robot,
+        title,
+    };
+    match (&args.input, map) {
+        (Some(path), _) => {
+            let title = path.display().to_string();
+            let is_spec = path.extension().is_some_and(|e| e == "ron")
+                && std::fs::read_to_string(path)
+                    .with_context(|| format!("reading {}", path.display()))?
+                    .contains("costs");
+            if is_spec {
+                Ok(from_problem(Problem::load(path)?, title))
+            } else {
+                let robot = crate::load_model(Some(path))?;
+                Ok(Subject {
+                    start: home(&robot),
+                    active: None,
+                    world: World::new(),
+                    robot,
+                    title,
+                })
+            }
+        }
+        (None, Some(map)) => {
+            let base = Path::new(&map.spec_path)
+                .parent()
+                .unwrap_or(Path::new("."))
+                .to_path_buf();
+            let p = Problem::from_ron(&map.spec, &map.spec_path, &base)
+                .with_context(|| format!("the spec stored in the map ({})", map.spec_path))?;
+            Ok(from_problem(p, format!("map of {}", map.spec_path)))
+        }
+        (None, None) => {
+            let robot = trm_models::icub_upper_body();
+            Ok(Subject {
+                start: home(&robot),
+                active: None,
+                world: World::new(),
+                robot,
+                title: "iCub upper body".into(),
+            })
+        }
+    }
+}
+
+fn home(robot: &RobotModel) -> Vec<f64> {
+    robot
+        .posture("home")
+        .map(|p| p.to_vec())
+        .unwrap_or_else(|_| robot.neutral_motors())
+}
+
+/// Motor values from a posture file: "motors": {name: value} over `start`, or "q": [active
+/// values] when `active` is known.
+pub fn posture_motors(
+    path: &Path,
+    robot: &RobotModel,
+    active: Option<&ActiveSet>,
+    start: &[f64],
+) -> Result<Vec<f64>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+    if let Some(m) = v.get("motors").and_then(|m| m.as_object()) {
+        let mut motors = start.to_vec();
+        for (name, value) in m {
+            let i = robot
+                .motor_index(name)
+                .with_context(|| format!("{}: motors", path.display()))?;
+            motors[i] = value
+                .as_f64()
+                .with_context(|| format!("{}: motor {name} is not a number", path.display()))?;
+        }
+        return Ok(motors);
+    }
+    if let Some(q) = v.get("q").and_then(|q| q.as_array()) {
+        let Some(active) = active else {
+            bail!(
+                "{}: \"q\" holds active values, which need a spec; give the spec or write \"motors\"",
+                path.display()
+            );
+        };
+        let q: Vec<f64> = q.iter().filter_map(|x| x.as_f64()).collect();
+        if q.len() != active.len() {
+            bail!(
+                "{}: \"q\" has {} values for {} active motors",
+                path.display(),
+                q.len(),
+                active.len()
+            );
+        }
+        let mut motors = start.to_vec();
+        for (&m, v) in active.motor_indices().iter().zip(&q) {
+            motors[m] = *v;
+        }
+        return Ok(motors);
+    }
+    bail!(
+        "{}: expected \"motors\": {{name: value}} or \"q\": [..]",
+        path.display()
+    )
+}
+
+/// Timed postures (time, motor values).
+type Frames = Vec<(f64, Vec<f64>)>;
+
+/// Frames and task-space path of a trajectory file.
+fn trajectory(path: &Path, robot: &RobotModel, start: &[f64]) -> Result<(Frames, Vec<[f64; 3]>)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    if path.extension().is_some_and(|e| e == "json") {
+        let t: trm_plan::Trajectory = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not a trajectory written by `plan`", path.display()))?;
+        let columns: Vec<usize> = t
+            .names
+            .iter()
+            .map(|n| {
+                robot
+                    .motor_index(n)
+                    .with_context(|| format!("{}: names", path.display()))
+            })
+            .collect::<Result<_>>()?;
+        let frames = t
+            .times
+            .iter()
+            .zip(&t.positions)
+            .map(|(time, q)| {
+                let mut motors = start.to_vec();
+                for (&c, v) in columns.iter().zip(q) {
+                    motors[c] = *v;
+                }
+                (*time, motors)
+            })
+            .collect();
+        return Ok((frames, t.task_path.iter().map(|p| point3(p)).collect()));
+    }
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .with_context(|| format!("{}: empty", path.display()))?
+        .split(',')
+        .collect();
+    let time = header
+        .iter()
+        .position(|h| *h == "time" || *h == "t")
+        .with_context(|| format!("{}:1: no `time` column", path.display()))?;
+    let columns: Vec<(usize, usize)> = header
+        .iter()
+        .enumerate()
+        .filter_map(|(c, h)| robot.motor_index(h).ok().map(|m| (c, m)))
+        .collect();
+    if columns.is_empty() {
+        bail!(
+            "{}:1: no column names a motor of {} (e.g. `{}`)",
+            path.display(),
+            robot.name(),
+            robot.motors()[0].name
+        );
+    }
+    let mut frames = Vec::new();
+    for (n, line) in lines.enumerate() {
+        let fields: Vec<&str> = line.split(',').collect();
+        let number = |c: usize| -> Result<f64> {
+            fields
+                .get(c)
+                .and_then(|f| f.trim().parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .with_context(|| {
+                    format!(
+                        "{}:{}: column {} is not a number",
+                        path.display(),
+                        n + 2,
+                        c + 1
+                    )
+                })
+        };
+        let mut motors = start.to_vec();
+        for &(c, m) in &columns {
+            motors[m] = number(c)?;
+        }
+        frames.push((number(time)?, motors));
+    }
+    Ok((frames, Vec::new()))
+}
+
+fn point3(v: &[f64]) -> [f64; 3] {
+    [
+        v.first().copied().unwrap_or(0.0),
+        v.get(1).copied().unwrap_or(0.0),
+        v.get(2).copied().unwrap_or(0.0),
+    ]
+}
+
+/// Adds a roadmap's points (task vectors, first three components), costs, edges and postures.
+pub fn add_map(scene: &mut Scene, map: &Roadmap, active: &ActiveSet) -> Result<()> {
+    scene.set_map(
+        map.points.iter().map(|p| point3(&p.t)).collect(),
+        map.points.iter().map(|p| p.cost).collect(),
+        &map.points
+            .iter()
+            .map(|p| active.to_motors(&p.q))
+            .collect::<Vec<_>>(),
+        map.edges.iter().map(|&(a, b, _)| [a, b]).collect(),
+    )?;
+    Ok(())
+}
+
+/// A scene of a task spec's robot and world at its start posture (frame 0).
+pub fn problem_scene(problem: &Problem, title: &str) -> Result<Scene> {
+    let mut scene = Scene::new(title, problem.objective.collision());
+    scene.set_world(problem.objective.world());
+    scene.add_frame(0.0, &problem.objective.active().to_motors(&problem.start))?;
+    Ok(scene)
+}
+
+/// Where a command's `--view` page goes: beside `out`, named `<stem>.scene.html`.
+pub fn scene_path(out: &Path) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().to_string());
+    out.with_file_name(format!("{stem}.scene.html"))
+}
+
+/// Writes `out` (.html) and the scene beside it (.json); the page inlines the viewer bundle when
+/// `viewer/dist/viewer.js` exists, else it loads three.js from a CDN.
+pub fn write_scene(scene: &Scene, out: &Path) -> Result<()> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let repo = crate::models_dir().join("..");
+    let bundle = trm_view::find_bundle(&repo)?;
+    crate::write_atomic(&out.with_extension("json"), scene.to_json()?.as_bytes())?;
+    crate::write_atomic(out, scene.to_html(bundle.as_deref())?.as_bytes())?;
+    let how = if bundle.is_some() {
+        "three.js inlined, works offline".to_string()
+    } else {
+        format!(
+            "loads three.js {} from a CDN; `npm ci && npm run build` in viewer/ makes it offline",
+            trm_view::THREE_VERSION
+        )
+    };
+    eprintln!(
+        "wrote {} ({how}) and {}: {} bodies, {} frames{}",
+        out.display(),
+        out.with_extension("json").display(),
+        scene.bodies.len(),
+        scene.frames.len(),
+        scene
+            .map
+            .as_ref()
+            .map(|m| format!(", {} map points, {} edges", m.points.len(), m.edges.len()))
+            .unwrap_or_default()
+    );
+    Ok(())
+}
+
+/// Runs the command.
+pub fn run(args: &Args) -> Result<()> {
+    let map = match &args.map {
+        Some(p) => Some(Roadmap::load(p).with_context(|| format!("loading {}", p.display()))?),
+        None => None,
+    };
+    let mut s = subject(args, map.as_ref())?;
+    if let Some(w) = &args.world {
+        s.world = World::load(w)?;
+    }
+    let collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
+    let mut scene = Scene::new(&s.title, &collision);
+    scene.set_world(&s.world);
+    for (i, p) in args.postures.iter().enumerate() {
+        let motors = posture_motors(p, &s.robot, s.active.as_ref(), &s.start)?;
+        scene.add_frame(i as f64, &motors)?;
+    }
+    if let Some(t) = &args.traj {
+        let (frames, path) = trajectory(t, &s.robot, &s.start)?;
+        for (time, motors) in frames {
+            scene.add_frame(time, &motors)?;
+        }
+        scene.set_path(path);
+    }
+    if scene.frames.is_empty() {
+        scene.add_frame(0.0, &s.start)?;
+    }
+    if let Some(map) = &map {
+        let active = match &s.active {
+            Some(a) if a.len() == map.active.len() => a.clone(),
+            _ => s.robot.active_set(&map.active, &s.start)?,
+        };
+        add_map(&mut scene, map, &active)?;
+    }
+    write_scene(&scene, &args.out)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+    use std::process::Command;
+
+    use trm_collision::{CollisionModel, World};
+    use trm_view::Scene;
+
+    /// A scene with everything: the iCub over 6 frames, a world, a 200-point map with edges, a path.
+    fn full_scene() -> Scene {
+        let model = trm_models::icub_upper_body();
+        let collision = CollisionModel::new(&model).unwrap();
+        let mut scene = Scene::new("browser test", &collision);
+        let home = super::home(&model);
+        let mut postures = Vec::new();
+        for i in 0..200 {
+            let mut q = home.clone();
+            for (k, m) in model.motors().iter().enumerate() {
+                let wave = ((i * 7 + k * 13) as f64).sin() * 0.4;
+                q[k] = (q[k] + wave).clamp(m.limits.lower, m.limits.upper);
+            }
+            postures.push(q);
+        }
+        for (i, q) in postures.iter().take(6).enumerate() {
+            scene.add_frame(0.2 * i as f64, q).unwrap();
+        }
+        let world = World::load(crate::models_dir().join("../specs/worlds/table.ron")).unwrap();
+        scene.set_world(&world);
+        let points: Vec<[f64; 3]> = (0..200)
+            .map(|i| {
+                let a = i as f64 * 0.1;
+                [-0.3 + 0.1 * a.cos(), 0.2 * a.sin(), 0.1 + 0.001 * i as f64]
+            })
+            .collect();
+        let cost = (0..200).map(|i| i as f64).collect();
+        let edges = (0..199).map(|i| [i, i + 1]).collect();
+        scene
+            .set_map(points.clone(), cost, &postures, edges)
+            .unwrap();
+        scene.set_path(points[..50].to_vec());
+        scene
+    }
+
+    fn chromium() -> Option<PathBuf> {
+        let path = std::env::var_os("TRM_CHROMIUM")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
+        path.is_file().then_some(path)
+    }
+
+    fn headless(chromium: &Path, profile: &Path, extra: &[&str], url: &str) -> String {
+        let out = Command::new(chromium)
+            .args([
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--use-angle=swiftshader",
+                "--enable-unsafe-swiftshader",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+                "--window-size=1024,768",
+                "--virtual-time-budget=10000",
+            ])
+            .arg(format!("--user-data-dir={}", profile.display()))
+            .args(extra)
+            .arg(url)
+            .output()
+            .expect("chromium runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    /// The page, opened at a fixed frame in headless Chromium with software WebGL, reports what
+    /// it drew; the report must match the scene. Runs where Chromium and the built viewer
+    /// bundle exist; `.ci/run` installs both and sets TRM_BROWSER_TEST=1, which makes their
+    /// absence a failure.
+    #[test]
+    fn the_page_draws_the_scene_in_a_real_browser() {
+        let required = std::env::var_os("TRM_BROWSER_TEST").is_some_and(|v| v == "1");
+        let repo = crate::models_dir().join("..");
+        let bundle = trm_view::find_bundle(&repo).unwrap();
+        let (Some(chromium), Some(bundle)) = (chromium(), bundle) else {
+            assert!(
+                !required,
+                "TRM_BROWSER_TEST=1 but Chromium (/usr/bin/chromium or TRM_CHROMIUM) or viewer/dist/viewer.js is missing"
+            );
+            eprintln!("skipped: needs Chromium and `npm run build` in viewer/ (.ci/run does both)");
+            return;
+        };
+        let scene = full_scene();
+        let dir = repo.join("target/ci-artefacts");
+        std::fs::create_dir_all(&dir).unwrap();
+        let page = dir.join("viewer.html");
+        std::fs::write(&page, scene.to_html(Some(&bundle)).unwrap()).unwrap();
+        let url = format!("file://{}?frame=3", page.canonicalize().unwrap().display());
+        let profile = std::env::temp_dir().join(format!("trm-chromium-{}", std::process::id()));
+        let dom = headless(&chromium, &profile, &["--dump-dom"], &url);
+        let start = dom
+            .find("<pre id=\"trm-report\"")
+            .expect("the page wrote its report");
+        let json_start = dom[start..].find('>').unwrap() + start + 1;
+        let json_end = dom[json_start..].find("</pre>").unwrap() + json_start;
+        let report: serde_json::Value = serde_json::from_str(&dom[json_start..json_end]).unwrap();
+        let map = scene.map.as_ref().unwrap();
+        assert_eq!(report["bodies"], scene.bodies.len());
+        assert_eq!(report["links"], scene.links.len());
+        assert_eq!(report["world"], scene.world.len());
+        assert_eq!(report["points"], map.points.len());
+        assert_eq!(report["edges"], map.edges.len());
+        assert_eq!(report["path"], scene.path.len());
+        assert_eq!(report["frames"], scene.frames.len());
+        assert_eq!(report["frame"], 3);
+        assert!(report["fk_error"].as_f64().unwrap() < 1e-5, "{report}");
+        let pixels = report["pixels"].as_f64().unwrap();
+        let area = report["width"].as_f64().unwrap() * report["height"].as_f64().unwrap();
+        assert!(pixels > 0.05 * area && pixels < 0.9 * area, "{report}");
+        let shot = dir.join("viewer.png");
+        let arg = format!("--screenshot={}", shot.display());
+        headless(&chromium, &profile, &[&arg], &url);
+        assert!(std::fs::metadata(&shot).unwrap().len() > 10_000);
+        let _ = std::fs::remove_dir_all(&profile);
+    }
+
+    #[test]
+    fn view_writes_the_page_and_the_scene_and_reads_trajectories() {
+        let dir = std::env::temp_dir().join(format!("trm-view-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("traj.csv");
+        std::fs::write(
+            &csv,
+            "time,r_elbow,torso_pitch\n0,0.5,0\n0.1,0.6,0.1\n0.2,0.7,0.2\n",
+        )
+        .unwrap();
+        let out = dir.join("scene.html");
+        let args = super::Args {
+            input: None,
+            postures: vec![],
+            map: None,
+            traj: Some(csv.clone()),
+            world: Some(crate::models_dir().join("../specs/worlds/table.ron")),
+            out: out.clone(),
+            mesh: crate::MeshArgs::default(),
+        };
+        super::run(&args).unwrap();
+        let scene = Scene::from_json(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+            .unwrap();
+        assert_eq!(scene.frames.len(), 3);
+        assert_eq!(scene.world.len(), 4);
+        assert!(std::fs::read_to_string(&out).unwrap().contains("trm-scene"));
+        // a bad row names the file, line and column
+        std::fs::write(&csv, "time,r_elbow\n0,0.5\n0.1,x\n").unwrap();
+        let e = super::run(&args).unwrap_err().to_string();
+        assert!(e.contains("traj.csv:3") && e.contains("column 2"), "{e}");
+        // a CSV with no motor column says which names it expects
+        std::fs::write(&csv, "time,elbow\n0,0.5\n").unwrap();
+        let e = super::run(&args).unwrap_err().to_string();
+        assert!(e.contains("no column names a motor"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
