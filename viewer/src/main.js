@@ -49,20 +49,22 @@ function toggle(label, initial, onChange) {
 }
 
 // ---- shapes ------------------------------------------------------------------------------
+// shapes as trm-collision writes them: {"Box": {"size": [...]}}, cylinders and capsules along z
 function geometry(shape) {
-  switch (shape.type) {
-    case 'sphere':
-      return new THREE.SphereGeometry(shape.radius, 24, 16);
-    case 'box':
-      return new THREE.BoxGeometry(shape.size[0], shape.size[1], shape.size[2]);
-    case 'cylinder':
-      return new THREE.CylinderGeometry(shape.radius, shape.radius, shape.length, 24).rotateX(Math.PI / 2);
-    case 'capsule':
-      return new THREE.CapsuleGeometry(shape.radius, shape.length, 8, 16).rotateX(Math.PI / 2);
-    case 'convex':
-      return new ConvexGeometry(shape.points.map((p) => new THREE.Vector3(p[0], p[1], p[2])));
+  const [kind, s] = Object.entries(shape)[0];
+  switch (kind) {
+    case 'Sphere':
+      return new THREE.SphereGeometry(s.radius, 24, 16);
+    case 'Box':
+      return new THREE.BoxGeometry(s.size[0], s.size[1], s.size[2]);
+    case 'Cylinder':
+      return new THREE.CylinderGeometry(s.radius, s.radius, s.length, 24).rotateX(Math.PI / 2);
+    case 'Capsule':
+      return new THREE.CapsuleGeometry(s.radius, s.length, 8, 16).rotateX(Math.PI / 2);
+    case 'Convex':
+      return new ConvexGeometry(s.points.map((p) => new THREE.Vector3(p[0], p[1], p[2])));
     default:
-      throw new Error('unknown shape ' + shape.type);
+      throw new Error('unknown shape ' + kind);
   }
 }
 

@@ -68,61 +68,6 @@ pub type Result<T, E = ViewError> = std::result::Result<T, E>;
 /// A pose as `[x, y, z, qx, qy, qz, qw]`.
 pub type Pose = [f64; 7];
 
-/// A shape in the scene: `{"type": "box", "size": [...]}` etc.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase")]
-pub enum SceneShape {
-    /// Ball.
-    Sphere {
-        /// Radius.
-        radius: f64,
-    },
-    /// Box by full side lengths.
-    Box {
-        /// Side lengths.
-        size: [f64; 3],
-    },
-    /// Cylinder along z.
-    Cylinder {
-        /// Radius.
-        radius: f64,
-        /// Length.
-        length: f64,
-    },
-    /// Capsule along z (length between the cap centres).
-    Capsule {
-        /// Radius.
-        radius: f64,
-        /// Length.
-        length: f64,
-    },
-    /// Convex hull of points.
-    Convex {
-        /// Points.
-        points: Vec<[f64; 3]>,
-    },
-}
-
-impl From<&Shape> for SceneShape {
-    fn from(s: &Shape) -> Self {
-        match s {
-            Shape::Sphere { radius } => SceneShape::Sphere { radius: *radius },
-            Shape::Box { size } => SceneShape::Box { size: *size },
-            Shape::Cylinder { radius, length } => SceneShape::Cylinder {
-                radius: *radius,
-                length: *length,
-            },
-            Shape::Capsule { radius, length } => SceneShape::Capsule {
-                radius: *radius,
-                length: *length,
-            },
-            Shape::Convex { points } => SceneShape::Convex {
-                points: points.clone(),
-            },
-        }
-    }
-}
-
 /// A collision body on a link.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SceneBody {
@@ -130,8 +75,10 @@ pub struct SceneBody {
     pub name: String,
     /// Index into [`Scene::links`].
     pub link: usize,
-    /// Shape.
-    pub shape: SceneShape,
+    /// Shape, as trm-collision writes it: `{"Box": {"size": [x, y, z]}}`, `{"Sphere":
+    /// {"radius": r}}`, `{"Cylinder"|"Capsule": {"radius": r, "length": l}}` (along z),
+    /// `{"Convex": {"points": [...]}}`.
+    pub shape: Shape,
     /// Pose of the shape in the link frame.
     pub local: Pose,
 }
@@ -155,8 +102,8 @@ pub struct SceneFrame {
 pub struct SceneObject {
     /// Name.
     pub name: String,
-    /// Shape.
-    pub shape: SceneShape,
+    /// Shape (as in [`SceneBody::shape`]).
+    pub shape: Shape,
     /// World pose.
     pub pose: Pose,
 }
@@ -256,7 +203,7 @@ impl Scene {
             bodies.push(SceneBody {
                 name: b.name.clone(),
                 link: slot,
-                shape: (&b.shape).into(),
+                shape: b.shape.clone(),
                 local: pose(&b.local),
             });
         }
@@ -352,7 +299,7 @@ impl Scene {
             .iter()
             .map(|o| SceneObject {
                 name: o.name().into(),
-                shape: o.shape().into(),
+                shape: o.shape().clone(),
                 pose: pose(o.pose()),
             })
             .collect();
