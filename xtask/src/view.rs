@@ -7,16 +7,19 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use trm_collision::{CollisionModel, World};
+use trm_kinematics::nalgebra::Isometry3;
 use trm_kinematics::{ActiveSet, RobotModel};
 use trm_roadmap::Roadmap;
 use trm_tasks::Problem;
 use trm_view::Scene;
+use trm_wholebody::WholeBody;
 
 /// Arguments of `view`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A model (.urdf or .ron description) or a task spec; default: the map's spec, else the
-    /// embedded iCub upper body.
+    /// A model (.urdf or .ron description), a task spec or a whole-body motion spec (its robot
+    /// stands on its feet in its world); default: the map's spec, else the embedded iCub upper
+    /// body.
     input: Option<PathBuf>,
     /// A posture file ("motors": {name: value}, as `solve --out` writes, or "q": [active
     /// values] with a spec); repeatable, one frame each.
@@ -47,6 +50,8 @@ struct Subject {
     start: Vec<f64>,
     world: World,
     title: String,
+    /// A whole-body motion spec: frames stand on its feet, in its ground frame.
+    motion: Option<WholeBody>,
 }
 
 fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
@@ -56,16 +61,29 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
         world: p.objective.world().clone(),
         robot: p.robot,
         title,
+        motion: None,
     };
     match (&args.input, map) {
         (Some(path), _) => {
             let title = path.display().to_string();
-            let is_spec = path.extension().is_some_and(|e| e == "ron")
-                && std::fs::read_to_string(path)
+            let text = if path.extension().is_some_and(|e| e == "ron") {
+                std::fs::read_to_string(path)
                     .with_context(|| format!("reading {}", path.display()))?
-                    .contains("costs");
-            if is_spec {
+            } else {
+                String::new()
+            };
+            if text.contains("costs") {
                 Ok(from_problem(Problem::load(path)?, title))
+            } else if text.contains("phases") && text.contains("feet") {
+                let motion = WholeBody::load(path)?;
+                Ok(Subject {
+                    robot: motion.model().clone(),
+                    active: None,
+                    start: motion.keyframes().0.to_vec(),
+                    world: World::from_spec(&motion.spec().world, &title)?,
+                    title,
+                    motion: Some(motion),
+                })
             } else {
                 let robot = crate::load_model(Some(path))?;
                 Ok(Subject {
@@ -74,6 +92,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
                     world: World::new(),
                     robot,
                     title,
+                    motion: None,
                 })
             }
         }
@@ -94,6 +113,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
                 world: World::new(),
                 robot,
                 title: "iCub upper body".into(),
+                motion: None,
             })
         }
     }
@@ -324,19 +344,24 @@ pub fn run(args: &Args) -> Result<()> {
     let collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
     let mut scene = Scene::new(&s.title, &collision);
     scene.set_world(&s.world);
+    let base = |motors: &[f64]| {
+        s.motion
+            .as_ref()
+            .map_or_else(Isometry3::identity, |m| m.root_pose(motors))
+    };
     for (i, p) in args.postures.iter().enumerate() {
         let motors = posture_motors(p, &s.robot, s.active.as_ref(), &s.start)?;
-        scene.add_frame(i as f64, &motors)?;
+        scene.add_frame_at(i as f64, &motors, &base(&motors))?;
     }
     if let Some(t) = &args.traj {
         let (frames, path) = trajectory(t, &s.robot, &s.start)?;
         for (time, motors) in frames {
-            scene.add_frame(time, &motors)?;
+            scene.add_frame_at(time, &motors, &base(&motors))?;
         }
         scene.set_path(path);
     }
     if scene.frames.is_empty() {
-        scene.add_frame(0.0, &s.start)?;
+        scene.add_frame_at(0.0, &s.start, &base(&s.start))?;
     }
     if let Some(map) = &map {
         let active = match &s.active {
