@@ -280,65 +280,30 @@ fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Res
         .iter()
         .map(|m| m.name.clone())
         .collect();
-    let joint_panels: Vec<Panel> = result
-        .solutions
-        .iter()
-        .map(|s| Panel {
-            title: format!("Joint positions, {} (Fig. 3 B)", s.name),
-            axes: ("time (s)".into(), "degrees".into()),
-            x: 0.0..duration,
-            y: -180.0..180.0,
-            series: names
-                .iter()
-                .enumerate()
-                .map(|(k, n)| Series {
-                    label: n.clone(),
-                    points: s
-                        .rollout
-                        .times
-                        .iter()
-                        .zip(&s.rollout.q)
-                        .map(|(t, q)| (*t, q[k].to_degrees()))
-                        .collect(),
-                    color: None,
-                })
-                .collect(),
-        })
-        .collect();
-    let joints_svg = panels((720, 380), &joint_panels)?;
+    let joints_svg = per_motor_panels(
+        result,
+        &names,
+        ("Joint positions", "Fig. 3 B", "degrees"),
+        (0.0..duration, -180.0..180.0),
+        |r| &r.q,
+        f64::to_degrees,
+    )?;
     // Fig. 3 A: torques, one panel per solution
-    let torque_panels: Vec<Panel> = result
-        .solutions
-        .iter()
-        .map(|s| Panel {
-            title: format!("Static joint torques, {} (Fig. 3 A)", s.name),
-            axes: ("time (s)".into(), "N m per joint".into()),
-            x: 0.0..duration,
-            y: range(
-                result
-                    .solutions
-                    .iter()
-                    .flat_map(|s| s.rollout.torque.iter().flatten().copied()),
-                1.0,
-            ),
-            series: names
-                .iter()
-                .enumerate()
-                .map(|(k, n)| Series {
-                    label: n.clone(),
-                    points: s
-                        .rollout
-                        .times
-                        .iter()
-                        .zip(&s.rollout.torque)
-                        .map(|(t, tau)| (*t, tau[k]))
-                        .collect(),
-                    color: None,
-                })
-                .collect(),
-        })
-        .collect();
-    let torques_svg = panels((720, 380), &torque_panels)?;
+    let torque_range = range(
+        result
+            .solutions
+            .iter()
+            .flat_map(|s| s.rollout.torque.iter().flatten().copied()),
+        1.0,
+    );
+    let torques_svg = per_motor_panels(
+        result,
+        &names,
+        ("Static joint torques", "Fig. 3 A", "N m per joint"),
+        (0.0..duration, torque_range),
+        |r| &r.torque,
+        |v| v,
+    )?;
     // Fig. 4: best φ_co over the constrained rollouts
     let fitness_svg = lines(
         "Best φ_co over the constrained rollouts (Fig. 4)",
@@ -362,6 +327,44 @@ fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Res
         eprintln!("wrote {}", out.join(name).display());
     }
     Ok(())
+}
+
+/// One panel per solution with one line per motor of `values(rollout)[sample][motor]`, mapped
+/// by `scale`; `what` = (quantity, figure, unit).
+fn per_motor_panels(
+    result: &StandUpResult,
+    names: &[String],
+    what: (&str, &str, &str),
+    ranges: (std::ops::Range<f64>, std::ops::Range<f64>),
+    values: impl Fn(&trm_wholebody::Rollout) -> &Vec<Vec<f64>>,
+    scale: impl Fn(f64) -> f64,
+) -> Result<String> {
+    let all: Vec<Panel> = result
+        .solutions
+        .iter()
+        .map(|s| Panel {
+            title: format!("{}, {} ({})", what.0, s.name, what.1),
+            axes: ("time (s)".into(), what.2.into()),
+            x: ranges.0.clone(),
+            y: ranges.1.clone(),
+            series: names
+                .iter()
+                .enumerate()
+                .map(|(k, n)| Series {
+                    label: n.clone(),
+                    points: s
+                        .rollout
+                        .times
+                        .iter()
+                        .zip(values(&s.rollout))
+                        .map(|(t, v)| (*t, scale(v[k])))
+                        .collect(),
+                    color: None,
+                })
+                .collect(),
+        })
+        .collect();
+    panels((720, 380), &all)
 }
 
 /// The motion in the ground frame (feet flat), with its world and the CoM path.
