@@ -100,6 +100,13 @@ pub fn run(args: &Args) -> Result<()> {
     if args.view {
         write_view(&problem, constrained, &args.out.join("scene.html"))?;
     }
+    let check = problem.verify(&constrained.rollout);
+    if result.feasible && !check.is_empty() {
+        bail!(
+            "the independent check finds violations the optimiser did not see: {}",
+            check.join("; ")
+        );
+    }
     if !result.feasible {
         bail!(
             "no feasible trajectory found with seed {} in {} rollouts: raise optimiser.bootstrap_rollouts in {} or try another --seed",
