@@ -7,6 +7,8 @@
 //! esbuild into `viewer/dist/viewer.js`). When the bundle has been built it is inlined, so the
 //! page works offline; otherwise the page loads the same pinned three.js from a public CDN.
 //!
+//! `tools/trm-rrd` turns a scene file into a Rerun recording.
+//!
 //! ```
 //! let model = trm_models::icub_upper_body();
 //! let collision = trm_collision::CollisionModel::new(&model)?;
