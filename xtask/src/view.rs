@@ -423,33 +423,38 @@ mod tests {
         path.is_file().then_some(path)
     }
 
+    /// Runs headless Chromium on `url`; a crash of the browser itself (seen once in a few
+    /// dozen runs on a loaded machine) is retried twice with a fresh profile.
     fn headless(chromium: &Path, profile: &Path, extra: &[&str], url: &str) -> String {
-        let out = Command::new(chromium)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--use-angle=swiftshader",
-                "--enable-unsafe-swiftshader",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--window-size=1024,768",
-                "--virtual-time-budget=10000",
-            ])
-            .arg(format!("--user-data-dir={}", profile.display()))
-            .args(extra)
-            .arg(url)
-            .output()
-            .expect("chromium runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).into_owned()
+        let mut last = String::new();
+        for attempt in 0..3 {
+            let dir = profile.join(attempt.to_string());
+            let out = Command::new(chromium)
+                .args([
+                    "--headless",
+                    "--no-sandbox",
+                    "--disable-gpu",
+                    "--use-angle=swiftshader",
+                    "--enable-unsafe-swiftshader",
+                    "--disable-quic",
+                    "--no-first-run",
+                    "--disable-background-networking",
+                    "--disable-component-update",
+                    "--disable-sync",
+                    "--window-size=1024,768",
+                    "--virtual-time-budget=10000",
+                ])
+                .arg(format!("--user-data-dir={}", dir.display()))
+                .args(extra)
+                .arg(url)
+                .output()
+                .expect("chromium runs");
+            if out.status.success() {
+                return String::from_utf8_lossy(&out.stdout).into_owned();
+            }
+            last = format!("{}: {}", out.status, String::from_utf8_lossy(&out.stderr));
+        }
+        panic!("chromium failed three times; last: {last}");
     }
 
     /// The page, opened at a fixed frame in headless Chromium with software WebGL, reports what
