@@ -305,8 +305,11 @@ renderer.domElement.addEventListener('pointerup', (e) => {
 
 // ---- camera fit, first render, report ----------------------------------------------------
 const box = new THREE.Box3();
-if (frames.length) showFrame(0);
-box.expandByObject(robot);
+// fit the camera to the robot at the first, middle and last frames, the map and the world
+[frames.length - 1, Math.floor(frames.length / 2), 0].forEach((i) => {
+  if (i >= 0) showFrame(i);
+  box.expandByObject(robot);
+});
 if (mapPoints) box.expandByObject(mapPoints);
 box.expandByObject(world);
 const centre = box.getCenter(new THREE.Vector3());
