@@ -10,16 +10,23 @@
 //!   symmetrically in its sagittal plane (the `icub_sagittal` model couples left and right
 //!   joints), which keeps the closed double-support chain closed exactly. The pelvis pose
 //!   follows from the feet.
-//! * **Controller.** A damped least-squares differential IK tracks the desired CoM (x, z) with a
-//!   minimum-jerk keyframe posture task in its null space; motors listed as locked in a phase
-//!   (the legs while seated) do not move. Not the paper's torque-level centroidal-momentum QP.
+//! * **Controller.** A prioritised damped least-squares differential IK tracks the desired CoM
+//!   (x, z), then optionally a hand reaching a target, with a minimum-jerk keyframe posture task
+//!   in the null space of both; joint velocities pass a first-order filter; motors listed as
+//!   locked in a phase (the legs while seated) do not move. Not the paper's torque-level
+//!   centroidal-momentum QP.
 //! * **Torques** are static: ∂(m g z_com)/∂q with the feet fixed, split equally between the left
-//!   and right joint a motor drives; while the chair supports the robot, the locked legs carry
+//!   and right joint a motor drives; while the seat supports the robot, the locked legs carry
 //!   nothing (the seat/foot load split is statically indeterminate and not modelled).
 //! * **Balance.** The cart-table ZMP x_zmp = x_com − z_com ẍ_com / g (ẍ by central
 //!   differences of the simulated CoM) must stay in the conservative support polygon: the feet
 //!   shrunk by a margin, plus the seat while seated. Leaving the unshrunk polygon counts as a
 //!   fall.
+//!
+//! Constraints along the whole motion: position, velocity and static-torque limits, ZMP,
+//! self-collision and collision with the world (the seat's contact links excepted while it
+//! supports); [`WholeBody::verify`] re-checks a rollout independently. Specs: `specs/README.md`,
+//! "Whole-body motions".
 //!
 //! ```no_run
 //! let problem = trm_wholebody::WholeBody::load("specs/wholebody/standup.ron")?;
