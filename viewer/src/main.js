@@ -3,7 +3,8 @@
 // per frame (play, pause, scrub), world objects, roadmap points and edges coloured by cost
 // (click a point to see its posture), a task-space path. After the first render it writes what
 // it drew into <pre id="trm-report"> so that a headless browser test can check it.
-// URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing.
+// URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing; ?pick=I shows map
+// point I's posture as a click on it does.
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -294,14 +295,17 @@ renderer.domElement.addEventListener('pointerup', (e) => {
   raycaster.setFromCamera(ndc, camera);
   raycaster.params.Points.threshold = 0.01 * camera.position.distanceTo(controls.target);
   const hit = raycaster.intersectObject(mapPoints)[0];
-  if (hit === undefined) return;
-  const i = hit.index;
+  if (hit !== undefined) pick(hit.index);
+});
+
+// show map point i's posture (a click, or ?pick=i)
+function pick(i) {
   playing = false;
   playButton.textContent = 'play';
   showJoints(map.joints[i]);
   const p = map.points[i];
   info.textContent = `map point ${i}: cost ${map.cost[i].toPrecision(4)}, at (${p.map((v) => v.toFixed(3)).join(', ')})`;
-});
+}
 
 // ---- camera fit, first render, report ----------------------------------------------------
 const box = new THREE.Box3();
@@ -341,7 +345,16 @@ const timed = performance.now();
 for (let k = 0; k < 5; k += 1) renderer.render(scene3, camera);
 renderer.getContext().finish();
 const renderMs = (performance.now() - timed) / 5;
+const picked = {};
+if (map && params.has('pick')) {
+  const i = Number(params.get('pick'));
+  pick(i);
+  renderer.render(scene3, camera);
+  const last = linkGroups[linkGroups.length - 1].position;
+  Object.assign(picked, { picked: i, picked_last_link: [last.x, last.y, last.z] });
+}
 report.textContent = JSON.stringify({
+  ...picked,
   format: data.format,
   version: data.version,
   bodies: meshes,

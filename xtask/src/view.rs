@@ -381,21 +381,28 @@ mod tests {
     use trm_collision::{CollisionModel, World};
     use trm_view::Scene;
 
+    /// 200 postures of the iCub around home.
+    fn full_postures() -> Vec<Vec<f64>> {
+        let model = trm_models::icub_upper_body();
+        let home = super::home(&model);
+        (0..200)
+            .map(|i| {
+                let mut q = home.clone();
+                for (k, m) in model.motors().iter().enumerate() {
+                    let wave = ((i * 7 + k * 13) as f64).sin() * 0.4;
+                    q[k] = (q[k] + wave).clamp(m.limits.lower, m.limits.upper);
+                }
+                q
+            })
+            .collect()
+    }
+
     /// A scene with everything: the iCub over 6 frames, a world, a 200-point map with edges, a path.
     fn full_scene() -> Scene {
         let model = trm_models::icub_upper_body();
         let collision = CollisionModel::new(&model).unwrap();
         let mut scene = Scene::new("browser test", &collision);
-        let home = super::home(&model);
-        let mut postures = Vec::new();
-        for i in 0..200 {
-            let mut q = home.clone();
-            for (k, m) in model.motors().iter().enumerate() {
-                let wave = ((i * 7 + k * 13) as f64).sin() * 0.4;
-                q[k] = (q[k] + wave).clamp(m.limits.lower, m.limits.upper);
-            }
-            postures.push(q);
-        }
+        let postures = full_postures();
         for (i, q) in postures.iter().take(6).enumerate() {
             scene.add_frame(0.2 * i as f64, q).unwrap();
         }
@@ -479,7 +486,10 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let page = dir.join("viewer.html");
         std::fs::write(&page, scene.to_html(Some(&bundle)).unwrap()).unwrap();
-        let url = format!("file://{}?frame=3", page.canonicalize().unwrap().display());
+        let url = format!(
+            "file://{}?frame=3&pick=7",
+            page.canonicalize().unwrap().display()
+        );
         let profile = std::env::temp_dir().join(format!("trm-chromium-{}", std::process::id()));
         let dom = headless(&chromium, &profile, &["--dump-dom"], &url);
         let start = dom
@@ -498,6 +508,23 @@ mod tests {
         assert_eq!(report["frames"], scene.frames.len());
         assert_eq!(report["frame"], 3);
         assert!(report["fk_error"].as_f64().unwrap() < 1e-5, "{report}");
+        // ?pick=7 shows map point 7's posture, computed by the page: its last link is where
+        // trm's kinematics puts it
+        assert_eq!(report["picked"], 7);
+        let model = trm_models::icub_upper_body();
+        let mut poses = model.pose_buffer();
+        let posture = full_postures()[7].clone();
+        model.all_active().forward(&posture, &mut poses).unwrap();
+        let want = poses.poses()[*scene.link_index.last().unwrap()]
+            .translation
+            .vector;
+        let got = &report["picked_last_link"];
+        for k in 0..3 {
+            assert!(
+                (got[k].as_f64().unwrap() - want[k]).abs() < 1e-5,
+                "{got} vs {want}"
+            );
+        }
         let pixels = report["pixels"].as_f64().unwrap();
         let area = report["width"].as_f64().unwrap() * report["height"].as_f64().unwrap();
         assert!(pixels > 0.05 * area && pixels < 0.9 * area, "{report}");
