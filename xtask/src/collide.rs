@@ -125,8 +125,7 @@ mod tests {
     #[test]
     fn collide_reports_crossed_arms_and_a_table_through_the_hand() {
         let model = trm_models::icub_upper_body();
-        let dir = std::env::temp_dir().join(format!("trm-collide-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_dir("collide-test");
         let names = [
             "l_shoulder_pitch",
             "l_shoulder_roll",

@@ -219,8 +219,7 @@ mod tests {
 
     #[test]
     fn explores_a_stick_and_reports_an_ungraspable_object() {
-        let dir = std::env::temp_dir().join(format!("trm-etm-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_dir("etm");
         let spec = dir.join("stick.ron");
         std::fs::write(
             &spec,

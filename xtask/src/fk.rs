@@ -163,8 +163,7 @@ mod tests {
             root.join("crates/trm-kinematics/tests/fixtures/icub_visuomanip.pinocchio.json");
         let expected: Value =
             serde_json::from_str(&std::fs::read_to_string(&fixture).unwrap()).unwrap();
-        let dir = std::env::temp_dir().join(format!("trm-fk-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_dir("fk-test");
         let input = dir.join("in.json");
         let configs = json!({"joint_names": expected["joint_names"], "samples": expected["samples"].as_array().unwrap().iter().map(|s| json!({"q": s["q"]})).collect::<Vec<_>>()});
         std::fs::write(&input, configs.to_string()).unwrap();
@@ -205,8 +204,7 @@ mod tests {
 
     #[test]
     fn fk_rejects_unknown_joint_names_with_a_suggestion() {
-        let dir = std::env::temp_dir().join(format!("trm-fk-bad-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_dir("fk-bad");
         let input = dir.join("in.json");
         std::fs::write(
             &input,

@@ -142,6 +142,22 @@ impl MeshArgs {
     }
 }
 
+/// Comma-separated numbers given to a flag (`--to 0.1,0.2,0.3`); `expected` says what fits.
+fn numbers(flag: &str, text: &str, expected: &str) -> Result<Vec<f64>> {
+    text.split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{flag} `{text}`: expected {expected}"))
+}
+
+/// A fresh scratch directory for a test, named after it and this process.
+#[cfg(test)]
+fn test_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("trm-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// Writes `value` as pretty JSON to `path` (atomically) and says so on stderr.
 fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
     write_atomic(path, serde_json::to_string_pretty(value)?.as_bytes())?;

@@ -81,12 +81,7 @@ pub fn run(args: &Args) -> Result<()> {
     let goal = if Path::new(&args.to).is_file() {
         Goal::Configuration(posture(Path::new(&args.to), &problem)?)
     } else {
-        let t: Vec<f64> = args
-            .to
-            .split(',')
-            .map(|s| s.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .with_context(|| format!("--to `{}`: expected \"x,y,z\" or a posture file", args.to))?;
+        let t = crate::numbers("--to", &args.to, "\"x,y,z\" or a posture file")?;
         Goal::TaskPoint {
             t,
             tolerance: args.tolerance,

@@ -35,12 +35,7 @@ pub struct Args {
 /// Optimises the reach and reports it.
 pub fn run(args: &Args) -> Result<()> {
     let e = explore_spec(&args.spec)?;
-    let v: Vec<f64> = args
-        .at
-        .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--at `{}`: expected \"x,y,z\" or \"x,y,z,yaw\"", args.at))?;
+    let v = crate::numbers("--at", &args.at, "\"x,y,z\" or \"x,y,z,yaw\"")?;
     anyhow::ensure!(
         v.len() == 3 || v.len() == 4,
         "--at `{}`: expected 3 or 4 numbers",

@@ -537,8 +537,7 @@ mod tests {
 
     #[test]
     fn view_writes_the_page_and_the_scene_and_reads_trajectories() {
-        let dir = std::env::temp_dir().join(format!("trm-view-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::test_dir("view");
         let csv = dir.join("traj.csv");
         std::fs::write(
             &csv,

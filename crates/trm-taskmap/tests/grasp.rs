@@ -1,23 +1,11 @@
 //! The kinematic grasp evaluation on the iCub's right hand and a stick (a capsule), and a task
 //! map explored with it.
 
-use trm_collision::{CollisionModel, Shape, World};
+use trm_collision::CollisionModel;
+mod common;
+use common::stick;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_taskmap::{ExploreSettings, Hand, Metric, explore, to_params, to_pose};
-
-fn stick() -> World {
-    let mut w = World::new();
-    w.add(
-        "stick",
-        Shape::Capsule {
-            radius: 0.02,
-            length: 0.3,
-        },
-        Isometry3::identity(),
-    )
-    .unwrap();
-    w
-}
 
 /// A power grasp found by sampling (object pose in the hand frame).
 fn known_grasp() -> Isometry3<f64> {

@@ -1,7 +1,8 @@
 //! Reaching a stick with an exact target versus with its task map (the paper's Fig. 7 study,
 //! small): both optimisations lower the cost; the map lets the hand end anywhere on the stick.
 
-use trm_collision::{CollisionModel, Shape, World};
+use trm_collision::{CollisionModel, World};
+mod common;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_taskmap::{
     ExploreSettings, Hand, Metric, MotionGoal, MotionSettings, ReachProblem, explore, find_grasp,
@@ -12,17 +13,7 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
     let model = trm_models::icub_upper_body();
     let collision = CollisionModel::new(&model).unwrap();
     let hand = Hand::icub(&model, &collision, "r").unwrap();
-    let mut stick = World::new();
-    stick
-        .add(
-            "stick",
-            Shape::Capsule {
-                radius: 0.02,
-                length: 0.3,
-            },
-            Isometry3::identity(),
-        )
-        .unwrap();
+    let stick = common::stick();
     let (g0, _) = find_grasp(
         &hand,
         &stick,
