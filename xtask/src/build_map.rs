@@ -136,12 +136,8 @@ pub fn info(args: &InfoArgs) -> Result<()> {
     );
     print_summary(&map);
     // the spec travels inside the map: rebuild its objective for the cost breakdown
-    let base = std::path::Path::new(&map.spec_path)
-        .parent()
-        .map(PathBuf::from)
-        .unwrap_or_default();
-    match Problem::from_ron(&map.spec, &map.spec_path, &base) {
-        Ok(problem) if problem.objective.dim() == map.active.len() => {
+    match map.problem() {
+        Ok(problem) => {
             let mut scratch = problem.objective.scratch();
             let mut sums: Vec<(String, f64)> = Vec::new();
             for p in &map.points {
@@ -161,83 +157,44 @@ pub fn info(args: &InfoArgs) -> Result<()> {
                 );
             }
         }
-        Ok(_) => println!("(the embedded spec no longer matches the map's motors: no breakdown)"),
-        Err(e) => println!("(no cost breakdown: the embedded spec does not load here: {e})"),
+        Err(e) => println!("(no cost breakdown: {e})"),
     }
     Ok(())
 }
 
 fn print_summary(map: &Roadmap) {
     let s = &map.stats;
-    let n = map.points.len();
+    let summary = map.summary();
+    let n = summary.points;
     println!(
         "{} points, {} edges, {} connected components; task `{}`; {} active motors; seed {}, {} searches",
         n,
-        map.edges.len(),
-        map.components(),
+        summary.edges,
+        summary.components,
         map.task,
         map.active.len(),
         map.seed,
         map.searches
     );
-    let extent: Vec<String> = map
-        .extent()
+    let extent: Vec<String> = summary
+        .extent
         .iter()
         .map(|(lo, hi)| format!("[{lo:.3}, {hi:.3}]"))
         .collect();
     println!("task-space extent: {}", extent.join(" × "));
-    if n > 1 {
-        // spacing: distance of each point to its nearest other point
-        let nearest: Vec<f64> = (0..n)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| {
-                        map.points[i]
-                            .t
-                            .iter()
-                            .zip(&map.points[j].t)
-                            .map(|(a, b)| (a - b).powi(2))
-                            .sum::<f64>()
-                            .sqrt()
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect();
-        let mean = nearest.iter().sum::<f64>() / n as f64;
-        let min = nearest.iter().copied().fold(f64::INFINITY, f64::min);
+    if let Some((mean, min)) = summary.spacing {
         println!(
             "nearest-neighbour spacing: mean {mean:.4}, min {min:.4} (setting d = {})",
             map.settings.spacing
         );
     }
-    if n > 0 {
-        // coverage: occupied cells of side d within the extent box
-        let d = map.settings.spacing;
-        let extent = map.extent();
-        let cells: Vec<usize> = extent
-            .iter()
-            .map(|(lo, hi)| ((hi - lo) / d).floor() as usize + 1)
-            .collect();
-        let total: f64 = cells.iter().map(|&c| c as f64).product();
-        let mut occupied = std::collections::BTreeSet::new();
-        for p in &map.points {
-            let key: Vec<usize> =
-                p.t.iter()
-                    .zip(&extent)
-                    .map(|(v, (lo, _))| ((v - lo) / d).floor() as usize)
-                    .collect();
-            occupied.insert(key);
-        }
+    if let Some((occupied, total)) = summary.coverage {
         println!(
-            "coverage: {} of {} cells of side d in the extent box ({:.0} %)",
-            occupied.len(),
-            total,
-            100.0 * occupied.len() as f64 / total
+            "coverage: {occupied} of {total} cells of side d in the extent box ({:.0} %)",
+            100.0 * occupied as f64 / total
         );
     }
-    let mean_cost = map.points.iter().map(|p| p.cost).sum::<f64>() / n.max(1) as f64;
-    println!("mean task cost {mean_cost:.4}");
+    println!("mean task cost {:.4}", summary.mean_cost);
     println!(
         "built in {:.1} s (+ {:.1} s edges) on {} threads: {} evaluations ({:.0}/point, {:.0}/s), {} searches, {} failed; stopped: {}",
         s.build_seconds,

@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
-use serde::{Deserialize, Serialize};
+use anyhow::{Context, Result};
+use trm_kinematics::ConfigurationsFile;
 use serde_json::{Map, Value, json};
 
 /// Arguments of `fk`.
@@ -20,21 +20,6 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-/// The input file.
-#[derive(Deserialize, Serialize)]
-pub struct Configs {
-    /// URDF joint names, one per column of `q`.
-    pub joint_names: Vec<String>,
-    /// The configurations.
-    pub samples: Vec<Sample>,
-}
-
-#[derive(Deserialize, Serialize)]
-pub struct Sample {
-    /// Values of `joint_names`, radians (metres for prismatic joints).
-    pub q: Vec<f64>,
-}
-
 fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
     let r = p.rotation.to_rotation_matrix();
     let m = r.matrix();
@@ -49,30 +34,9 @@ fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
 pub fn read_configurations(
     model: &trm_kinematics::RobotModel,
     path: &std::path::Path,
-) -> Result<(Configs, Vec<Vec<f64>>)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let configs: Configs = serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{}: expected {{\"joint_names\": [...], \"samples\": [{{\"q\": [...]}}]}}",
-            path.display()
-        )
-    })?;
-    let columns: Vec<usize> = configs
-        .joint_names
-        .iter()
-        .map(|n| model.joint_index(n))
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("{}: joint_names", path.display()))?;
-    let given: Vec<bool> = (0..model.num_joints())
-        .map(|j| columns.contains(&j))
-        .collect();
-    let missing: Vec<&str> = model
-        .joint_names()
-        .enumerate()
-        .filter(|(j, _)| !given[*j])
-        .map(|(_, n)| n)
-        .collect();
+) -> Result<(ConfigurationsFile, Vec<Vec<f64>>)> {
+    let configs = ConfigurationsFile::load(path)?;
+    let missing = configs.missing_joints(model);
     if !missing.is_empty() {
         eprintln!(
             "note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}",
@@ -80,28 +44,7 @@ pub fn read_configurations(
             missing.join(", ")
         );
     }
-    let mut all = Vec::with_capacity(configs.samples.len());
-    for (s, sample) in configs.samples.iter().enumerate() {
-        if sample.q.len() != columns.len() {
-            bail!(
-                "{}: sample {s} has {} values for {} joint_names",
-                path.display(),
-                sample.q.len(),
-                columns.len()
-            );
-        }
-        let mut joints = vec![0.0; model.num_joints()];
-        for (&j, &v) in columns.iter().zip(&sample.q) {
-            joints[j] = v;
-        }
-        for j in 0..model.num_joints() {
-            if let (false, Some(m)) = (given[j], &model.joint(j).mimic) {
-                let leader = model.joint_index(&m.leader)?;
-                joints[j] = m.multiplier * joints[leader] + m.offset;
-            }
-        }
-        all.push(joints);
-    }
+    let all = configs.joint_vectors(model, path)?;
     Ok((configs, all))
 }
 

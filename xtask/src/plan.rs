@@ -62,11 +62,8 @@ pub fn run(args: &Args) -> Result<()> {
         .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
         .collect::<Result<_>>()?;
     let first = &maps[0];
-    let base = Path::new(&first.spec_path)
-        .parent()
-        .map(PathBuf::from)
-        .unwrap_or_default();
-    let problem = Problem::from_ron(&first.spec, &first.spec_path, &base)
+    let problem = first
+        .problem()
         .with_context(|| format!("the spec stored in {}", args.maps[0].display()))?;
     let refs: Vec<&Roadmap> = maps.iter().collect();
     let mut planner = Planner::new(&problem.objective, &refs)?;

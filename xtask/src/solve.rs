@@ -91,24 +91,21 @@ pub fn run(args: &Args) -> Result<()> {
                 )
             })
             .collect();
-        crate::write_json(
-            out,
-            &json!({
-                "spec": problem.origin,
-                "algo": solver.algo,
-                "seed": solver.seed,
-                "cost": s.cost,
-                "collision_free": s.collision_free,
-                "evaluations": s.evaluations,
-                "best_at_evaluation": s.best_at,
-                "wall_time_s": s.wall_time.as_secs_f64(),
-                "motors": robot.motors().iter().zip(&s.motors).map(|(m, v)| (m.name.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "active": objective.active().names().zip(&s.q).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-                "breakdown": s.breakdown.iter().map(|t| json!({"term": t.label, "weight": t.weight, "value": t.value})).collect::<Vec<_>>(),
-                "task": s.task,
-                "frames": frames,
-            }),
-        )?;
+        let file = trm_kinematics::PostureFile::from_motors(robot, &s.motors)?
+            .with("spec", problem.origin.as_str())
+            .with("algo", solver.algo.as_str())
+            .with("seed", solver.seed)
+            .with("cost", s.cost)
+            .with("collision_free", s.collision_free)
+            .with("evaluations", s.evaluations)
+            .with("best_at_evaluation", s.best_at)
+            .with("wall_time_s", s.wall_time.as_secs_f64())
+            .with("active", objective.active().names().zip(&s.q).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>())
+            .with("breakdown", s.breakdown.iter().map(|t| json!({"term": t.label, "weight": t.weight, "value": t.value})).collect::<Vec<_>>())
+            .with("task", s.task.clone())
+            .with("frames", frames);
+        file.save(out)?;
+        eprintln!("wrote {}", out.display());
     }
     Ok(())
 }

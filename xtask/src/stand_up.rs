@@ -393,26 +393,9 @@ fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
     crate::view::write_scene(&scene, path)
 }
 
-/// The optimised motion as CSV: time, phase, motor positions (rad), CoM, desired CoM, ZMP.
+/// The optimised motion as CSV ([`trm_wholebody::Rollout::to_csv`]).
 fn write_trajectory(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
-    let mut text = String::from("t,phase");
-    for m in problem.model().motors() {
-        text.push(',');
-        text.push_str(&m.name);
-    }
-    text.push_str(",com_x,com_z,com_desired_x,com_desired_z,zmp_x\n");
-    let r = &s.rollout;
-    for i in 0..r.times.len() {
-        text.push_str(&format!("{:.3},{}", r.times[i], r.phase[i]));
-        for v in &r.q[i] {
-            text.push_str(&format!(",{v:.6}"));
-        }
-        text.push_str(&format!(
-            ",{:.6},{:.6},{:.6},{:.6},{:.6}\n",
-            r.com[i][0], r.com[i][2], r.com_desired[i][0], r.com_desired[i][1], r.zmp[i][0]
-        ));
-    }
-    crate::write_atomic(path, text.as_bytes())?;
+    crate::write_atomic(path, s.rollout.to_csv(problem.model()).as_bytes())?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::nalgebra::Isometry3;
 use trm_kinematics::{ActiveSet, RobotModel};
@@ -97,11 +97,8 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             }
         }
         (None, Some(map)) => {
-            let base = Path::new(&map.spec_path)
-                .parent()
-                .unwrap_or(Path::new("."))
-                .to_path_buf();
-            let p = Problem::from_ron(&map.spec, &map.spec_path, &base)
+            let p = map
+                .problem()
                 .with_context(|| format!("the spec stored in the map ({})", map.spec_path))?;
             Ok(from_problem(p, format!("map of {}", map.spec_path)))
         }
@@ -134,130 +131,19 @@ pub fn posture_motors(
     active: Option<&ActiveSet>,
     start: &[f64],
 ) -> Result<Vec<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
-    if let Some(m) = v.get("motors").and_then(|m| m.as_object()) {
-        let mut motors = start.to_vec();
-        for (name, value) in m {
-            let i = robot
-                .motor_index(name)
-                .with_context(|| format!("{}: motors", path.display()))?;
-            motors[i] = value
-                .as_f64()
-                .with_context(|| format!("{}: motor {name} is not a number", path.display()))?;
-        }
-        return Ok(motors);
-    }
-    if let Some(q) = v.get("q").and_then(|q| q.as_array()) {
-        let Some(active) = active else {
-            bail!(
-                "{}: \"q\" holds active values, which need a spec; give the spec or write \"motors\"",
-                path.display()
-            );
-        };
-        let q: Vec<f64> = q.iter().filter_map(|x| x.as_f64()).collect();
-        if q.len() != active.len() {
-            bail!(
-                "{}: \"q\" has {} values for {} active motors",
-                path.display(),
-                q.len(),
-                active.len()
-            );
-        }
-        let mut motors = start.to_vec();
-        for (&m, v) in active.motor_indices().iter().zip(&q) {
-            motors[m] = *v;
-        }
-        return Ok(motors);
-    }
-    bail!(
-        "{}: expected \"motors\": {{name: value}} or \"q\": [..]",
-        path.display()
-    )
+    Ok(trm_kinematics::PostureFile::load(path)?.to_motors(robot, active, start, path)?)
 }
 
 /// Timed postures (time, motor values).
 type Frames = Vec<(f64, Vec<f64>)>;
 
-/// Frames and task-space path of a trajectory file.
+/// Frames and task-space path of a trajectory file (CSV or JSON).
 fn trajectory(path: &Path, robot: &RobotModel, start: &[f64]) -> Result<(Frames, Vec<[f64; 3]>)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    if path.extension().is_some_and(|e| e == "json") {
-        let t: trm_plan::Trajectory = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a trajectory written by `plan`", path.display()))?;
-        let columns: Vec<usize> = t
-            .names
-            .iter()
-            .map(|n| {
-                robot
-                    .motor_index(n)
-                    .with_context(|| format!("{}: names", path.display()))
-            })
-            .collect::<Result<_>>()?;
-        let frames = t
-            .times
-            .iter()
-            .zip(&t.positions)
-            .map(|(time, q)| {
-                let mut motors = start.to_vec();
-                for (&c, v) in columns.iter().zip(q) {
-                    motors[c] = *v;
-                }
-                (*time, motors)
-            })
-            .collect();
-        return Ok((frames, t.task_path.iter().map(|p| point3(p)).collect()));
-    }
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .with_context(|| format!("{}: empty", path.display()))?
-        .split(',')
-        .collect();
-    let time = header
-        .iter()
-        .position(|h| *h == "time" || *h == "t")
-        .with_context(|| format!("{}:1: no `time` column", path.display()))?;
-    let columns: Vec<(usize, usize)> = header
-        .iter()
-        .enumerate()
-        .filter_map(|(c, h)| robot.motor_index(h).ok().map(|m| (c, m)))
-        .collect();
-    if columns.is_empty() {
-        bail!(
-            "{}:1: no column names a motor of {} (e.g. `{}`)",
-            path.display(),
-            robot.name(),
-            robot.motors()[0].name
-        );
-    }
-    let mut frames = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let fields: Vec<&str> = line.split(',').collect();
-        let number = |c: usize| -> Result<f64> {
-            fields
-                .get(c)
-                .and_then(|f| f.trim().parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .with_context(|| {
-                    format!(
-                        "{}:{}: column {} is not a number",
-                        path.display(),
-                        n + 2,
-                        c + 1
-                    )
-                })
-        };
-        let mut motors = start.to_vec();
-        for &(c, m) in &columns {
-            motors[m] = number(c)?;
-        }
-        frames.push((number(time)?, motors));
-    }
-    Ok((frames, Vec::new()))
+    let t = trm_plan::Trajectory::load(path, robot)?;
+    let frames = t
+        .motor_frames(robot, start)
+        .with_context(|| format!("{}: names", path.display()))?;
+    Ok((frames, t.task_path.iter().map(|p| point3(p)).collect()))
 }
 
 fn point3(v: &[f64]) -> [f64; 3] {

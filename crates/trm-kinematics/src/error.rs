@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 /// What kind of name a lookup failed on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum NameKind {
     /// A URDF link.
     Link,
@@ -38,7 +39,23 @@ impl fmt::Display for NameKind {
 
 /// Everything that can go wrong while loading or using a robot model.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum KinematicsError {
+    /// A versioned JSON file could not be read or written.
+    #[error(transparent)]
+    File(#[from] crate::files::FileError),
+    /// A file trm reads (a posture file, a configuration file) holds something invalid.
+    #[error("{}: {}{problem}\n  fix: {fix}", path.display(), if field.is_empty() { String::new() } else { format!("{field}: ") })]
+    InvalidFile {
+        /// The file.
+        path: PathBuf,
+        /// The field path inside it (`motors.r_elbow`), or empty for the whole file.
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// What to do about it.
+        fix: String,
+    },
     /// A file could not be read.
     #[error("{}: cannot read file: {source}", path.display())]
     Io {

@@ -39,6 +39,7 @@ mod error;
 mod files;
 mod fk;
 mod model;
+mod posture;
 mod tree;
 
 pub use active::ActiveSet;
@@ -48,8 +49,9 @@ pub use description::{
     MotorSpec, PostureSpec,
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
-pub use files::write_atomic;
+pub use files::{FileError, load_versioned, parse_versioned, save_json, write_atomic};
 pub use fk::PoseBuffer;
+pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
 pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};

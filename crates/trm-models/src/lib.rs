@@ -12,21 +12,21 @@
 use trm_kinematics::{ModelDescription, RobotModel};
 
 /// models/icub_upper_body.urdf: the iCub upper body with primitive collision proxies.
-pub const ICUB_UPPER_BODY_URDF: &str = include_str!("../../../models/icub_upper_body.urdf");
+pub const ICUB_UPPER_BODY_URDF: &str = include_str!("../models/icub_upper_body.urdf");
 /// models/icub_upper_body.ron: its 41 motors, couplings, frames, groups and postures.
-pub const ICUB_UPPER_BODY_RON: &str = include_str!("../../../models/icub_upper_body.ron");
+pub const ICUB_UPPER_BODY_RON: &str = include_str!("../models/icub_upper_body.ron");
 /// models/icub_full_body.urdf: the whole iCub (legs included) with primitive collision proxies.
-pub const ICUB_FULL_BODY_URDF: &str = include_str!("../../../models/icub_full_body.urdf");
+pub const ICUB_FULL_BODY_URDF: &str = include_str!("../models/icub_full_body.urdf");
 /// models/icub_sagittal.ron: the whole iCub reduced to 8 symmetric sagittal motors.
-pub const ICUB_SAGITTAL_RON: &str = include_str!("../../../models/icub_sagittal.ron");
+pub const ICUB_SAGITTAL_RON: &str = include_str!("../models/icub_sagittal.ron");
 /// The official iCubGazeboV2_5_visuomanip URDF (75 revolute joints), unchanged.
-pub const ICUB_OFFICIAL_URDF: &str = include_str!("../../../models/icub-visuomanip/model.urdf");
+pub const ICUB_OFFICIAL_URDF: &str = include_str!("../models/icub-visuomanip/model.urdf");
 /// The official iCubGenova04 URDF (32 revolute joints), unchanged.
-pub const ICUB_GENOVA04_URDF: &str = include_str!("../../../models/icub-genova04/model.urdf");
+pub const ICUB_GENOVA04_URDF: &str = include_str!("../models/icub-genova04/model.urdf");
 /// models/planar_arm.urdf: a three-link planar arm.
-pub const PLANAR_ARM_URDF: &str = include_str!("../../../models/planar_arm.urdf");
+pub const PLANAR_ARM_URDF: &str = include_str!("../models/planar_arm.urdf");
 /// models/branched_tree.urdf: a small tree with continuous, prismatic, mimic and fixed joints.
-pub const BRANCHED_TREE_URDF: &str = include_str!("../../../models/branched_tree.urdf");
+pub const BRANCHED_TREE_URDF: &str = include_str!("../models/branched_tree.urdf");
 
 /// The 41-motor iCub upper body (the default model of trm).
 pub fn icub_upper_body() -> RobotModel {

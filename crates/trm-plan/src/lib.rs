@@ -6,7 +6,7 @@
 //! ```no_run
 //! use trm_plan::{Goal, Planner, PlanOptions};
 //! let map = trm_roadmap::Roadmap::load("target/maps/reach.map.json".as_ref())?;
-//! let problem = trm_tasks::Problem::from_ron(&map.spec, &map.spec_path, ".".as_ref())?;
+//! let problem = map.problem()?;
 //! let mut planner = Planner::new(&problem.objective, &[&map])?;
 //! let plan = planner.plan(&problem.start, &Goal::TaskPoint { t: vec![-0.3, 0.1, 0.1], tolerance: 0.03 }, &PlanOptions::default())?;
 //! println!("{} waypoints, {:.2} s", plan.trajectory.positions.len(), plan.trajectory.times.last().unwrap());

@@ -14,8 +14,32 @@ use trm_tasks::Objective;
 use crate::trajectory::{Trajectory, time_parametrise};
 
 /// Planning failures.
-#[derive(Debug, Error, PartialEq)]
+#[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum PlanError {
+    /// From the kinematics (an unknown motor name, a wrong vector length).
+    #[error(transparent)]
+    Kinematics(#[from] trm_kinematics::KinematicsError),
+    /// A file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// A trajectory file holds something invalid.
+    #[error("{}{}: {problem}\n  fix: {fix}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
+    InvalidTrajectory {
+        /// The file.
+        path: std::path::PathBuf,
+        /// 1-based line, 0 when unknown.
+        line: usize,
+        /// What is wrong.
+        problem: String,
+        /// What to do about it.
+        fix: String,
+    },
     /// Maps that do not share the objective's configuration space.
     #[error("map {map}: {problem}")]
     IncompatibleMap {
@@ -29,7 +53,7 @@ pub enum PlanError {
     InvalidStart(String),
     /// No collision-free path; `closest` is the reachable node nearest to the goal.
     #[error(
-        "goal unreachable: {reason}; the closest reachable node is {closest_node:?} at task distance {closest_distance:.4}"
+        "goal unreachable: {reason}{}", match closest_node { Some(n) => format!("; the closest reachable node is {n}, at task distance {closest_distance:.4}"), None => "; no map node is reachable".into() }
     )]
     Unreachable {
         /// Why.

@@ -7,7 +7,11 @@ pub type Result<T, E = RoadmapError> = std::result::Result<T, E>;
 
 /// Roadmap errors.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum RoadmapError {
+    /// A map file could not be read or written.
+    #[error(transparent)]
+    MapFile(#[from] trm_kinematics::FileError),
     /// From the task layer (specs, objective, solver); boxed, it is large.
     #[error(transparent)]
     Tasks(Box<trm_tasks::TaskError>),

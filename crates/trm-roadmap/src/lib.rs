@@ -21,4 +21,4 @@ pub use build::{BuildOptions, Progress, build};
 pub use edges::{connect, distance, segment_is_free};
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
-pub use map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};
+pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Roadmap, VERSION};

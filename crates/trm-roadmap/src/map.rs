@@ -79,42 +79,101 @@ pub struct Roadmap {
 impl Roadmap {
     /// Writes the map as JSON through a temporary file and a rename.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let text = serde_json::to_string(self).map_err(|e| RoadmapError::File {
-            path: path.display().to_string(),
-            problem: e.to_string(),
-        })?;
-        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|e| RoadmapError::File {
-            path: path.display().to_string(),
-            problem: e.to_string(),
-        })
+        Ok(trm_kinematics::save_json(path, self, FORMAT)?)
     }
 
-    /// Reads a map file; a truncated, foreign or newer file is a clear error.
+    /// Reads a map file; a truncated, foreign or newer file, or one whose points and edges do
+    /// not fit together, is a clear error.
     pub fn load(path: &Path) -> Result<Self> {
-        let fail = |problem: String| RoadmapError::File {
+        let map: Roadmap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
+        map.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),
-            problem,
-        };
-        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
-        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
-            if e.is_eof() {
-                fail(format!("truncated ({e}); rebuild the map"))
-            } else {
-                fail(format!("not a trm roadmap: {e}"))
-            }
+            problem: format!("{problem}; rebuild the map"),
         })?;
-        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
-            return Err(fail(format!(
-                "not a trm roadmap (no `\"format\": \"{FORMAT}\"`)"
+        Ok(map)
+    }
+
+    /// Checks that points and edges fit together: one value per active motor in every posture,
+    /// one task dimension for all, finite numbers, edges between existing points.
+    fn check(&self) -> std::result::Result<(), String> {
+        let dim = self.points.first().map_or(0, |p| p.t.len());
+        for (i, p) in self.points.iter().enumerate() {
+            if p.q.len() != self.active.len() {
+                return Err(format!("points[{i}].q has {} values for {} active motors", p.q.len(), self.active.len()));
+            }
+            if p.t.len() != dim {
+                return Err(format!("points[{i}].t has {} dimensions, points[0].t {dim}", p.t.len()));
+            }
+            if !(p.q.iter().chain(&p.t).all(|v| v.is_finite()) && p.cost.is_finite()) {
+                return Err(format!("points[{i}] holds a non-finite value"));
+            }
+        }
+        for (k, &(a, b, w)) in self.edges.iter().enumerate() {
+            if a >= self.points.len() || b >= self.points.len() || a == b || !w.is_finite() {
+                return Err(format!("edges[{k}] = ({a}, {b}, {w}) does not join two of the {} points", self.points.len()));
+            }
+        }
+        Ok(())
+    }
+
+    /// The task this map was built for, rebuilt from the spec the map carries (its model and
+    /// world files are found relative to the spec's original location, `spec_path`). Fails when
+    /// the spec no longer loads or no longer has the map's active motors.
+    pub fn problem(&self) -> Result<trm_tasks::Problem> {
+        let base = Path::new(&self.spec_path).parent().unwrap_or(Path::new("."));
+        let problem = trm_tasks::Problem::from_ron(&self.spec, &self.spec_path, base)?;
+        let names: Vec<&str> = problem.objective.active().names().collect();
+        if names != self.active.iter().map(String::as_str).collect::<Vec<_>>() {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the spec stored in the map ({}) now selects {} active motors, the map has {}: rebuild the map",
+                self.spec_path,
+                names.len(),
+                self.active.len()
             )));
         }
-        let version = value.get("version").and_then(|v| v.as_u64()).unwrap_or(0);
-        if version != u64::from(VERSION) {
-            return Err(fail(format!(
-                "roadmap file version {version}; this trm reads version {VERSION}: rebuild it"
-            )));
+        Ok(problem)
+    }
+
+    /// Spacing, coverage and cost of the map's points ([`MapSummary`]).
+    pub fn summary(&self) -> MapSummary {
+        let n = self.points.len();
+        let extent = self.extent();
+        let distance = |a: &MapPoint, b: &MapPoint| {
+            a.t.iter().zip(&b.t).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+        };
+        let nearest: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| distance(&self.points[i], &self.points[j]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        let spacing = (n > 1).then(|| {
+            (
+                nearest.iter().sum::<f64>() / n as f64,
+                nearest.iter().copied().fold(f64::INFINITY, f64::min),
+            )
+        });
+        let d = self.settings.spacing;
+        let coverage = (n > 0 && d > 0.0).then(|| {
+            let total: f64 = extent.iter().map(|(lo, hi)| ((hi - lo) / d).floor() + 1.0).product();
+            let occupied: std::collections::BTreeSet<Vec<u64>> = self
+                .points
+                .iter()
+                .map(|p| p.t.iter().zip(&extent).map(|(v, (lo, _))| ((v - lo) / d).floor() as u64).collect())
+                .collect();
+            (occupied.len(), total)
+        });
+        MapSummary {
+            points: n,
+            edges: self.edges.len(),
+            components: self.components(),
+            extent,
+            spacing,
+            coverage,
+            mean_cost: self.points.iter().map(|p| p.cost).sum::<f64>() / n.max(1) as f64,
         }
-        serde_json::from_value(value).map_err(|e| fail(format!("malformed roadmap: {e}")))
     }
 
     /// Task-space extent: per dimension (min, max).
@@ -140,4 +199,24 @@ impl Roadmap {
         }
         petgraph::algo::connected_components(&graph)
     }
+}
+
+/// What [`Roadmap::summary`] reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapSummary {
+    /// Number of points.
+    pub points: usize,
+    /// Number of edges.
+    pub edges: usize,
+    /// Connected components of the edge graph.
+    pub components: usize,
+    /// Task-space extent, per dimension (min, max).
+    pub extent: Vec<(f64, f64)>,
+    /// Task-space distance of each point to its nearest other point: (mean, min); `None` below
+    /// two points.
+    pub spacing: Option<(f64, f64)>,
+    /// Cells of side d (the map's spacing setting) in the extent box: (occupied, total).
+    pub coverage: Option<(usize, f64)>,
+    /// Mean task cost of the points.
+    pub mean_cost: f64,
 }

@@ -8,8 +8,12 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Task-map errors.
-#[derive(Debug, Error, PartialEq)]
+#[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum TaskMapError {
+    /// A task-map file could not be read or written.
+    #[error(transparent)]
+    MapFile(#[from] trm_kinematics::FileError),
     /// A setting out of range.
     #[error("invalid {what}: {problem}")]
     Invalid {
@@ -266,36 +270,12 @@ impl TaskMap {
                 "the task map is empty: nothing feasible was found, no file written".into(),
             ));
         }
-        let text = serde_json::to_string(self).map_err(|e| fail(e.to_string()))?;
-        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|e| fail(e.to_string()))
+        Ok(trm_kinematics::save_json(path, self, FORMAT)?)
     }
 
     /// Reads a map; truncated, foreign or newer files are clear errors.
     pub fn load(path: &Path) -> Result<Self, TaskMapError> {
-        let fail = |problem: String| TaskMapError::File {
-            path: path.display().to_string(),
-            problem,
-        };
-        let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
-        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
-            if e.is_eof() {
-                fail(format!("truncated ({e})"))
-            } else {
-                fail(format!("not a trm task map: {e}"))
-            }
-        })?;
-        if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
-            return Err(fail(format!(
-                "not a trm task map (no `\"format\": \"{FORMAT}\"`)"
-            )));
-        }
-        if value.get("version").and_then(|v| v.as_u64()) != Some(u64::from(VERSION)) {
-            return Err(fail(format!(
-                "unsupported task map version; this trm reads version {VERSION}"
-            )));
-        }
-        let mut map: TaskMap =
-            serde_json::from_value(value).map_err(|e| fail(format!("malformed task map: {e}")))?;
+        let mut map: TaskMap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
         map.metric.check()?;
         map.reindex();
         Ok(map)

@@ -35,11 +35,15 @@ pub const VERSION: u32 = 1;
 /// The three.js version the page uses (the one `viewer/package.json` pins).
 pub const THREE_VERSION: &str = "0.187.0";
 /// The viewer's own code (bundled with three.js by `npm run build` in `viewer/`).
-pub const VIEWER_SOURCE: &str = include_str!("../../../viewer/src/main.js");
+pub const VIEWER_SOURCE: &str = include_str!("../viewer/main.js");
 
 /// Errors of scene building.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum ViewError {
+    /// A scene file could not be read or written.
+    #[error(transparent)]
+    SceneFile(#[from] trm_kinematics::FileError),
     /// Invalid input.
     #[error("{what}: {problem}")]
     Invalid {
@@ -358,19 +362,20 @@ impl Scene {
         Ok(serde_json::to_string(self)?)
     }
 
-    /// Reads a scene, checking its format and version.
+    /// Reads a scene, checking its format and version (the one versioned-JSON reader of trm,
+    /// [`trm_kinematics::parse_versioned`]).
     pub fn from_json(text: &str) -> Result<Self> {
-        let scene: Scene = serde_json::from_str(text)?;
-        if scene.format != FORMAT || scene.version > VERSION {
-            return Err(ViewError::Invalid {
-                what: "scene".into(),
-                problem: format!(
-                    "format {} v{} (this software reads {FORMAT} up to v{VERSION})",
-                    scene.format, scene.version
-                ),
-            });
-        }
-        Ok(scene)
+        Ok(trm_kinematics::parse_versioned(
+            std::path::Path::new("<scene>"),
+            text,
+            FORMAT,
+            VERSION,
+        )?)
+    }
+
+    /// Reads a scene file.
+    pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
+        Ok(trm_kinematics::load_versioned(path.as_ref(), FORMAT, VERSION)?)
     }
 
     /// One self-contained HTML page that renders the scene. `bundle`: the built viewer

@@ -103,7 +103,7 @@ fn scenes_round_trip_and_name_their_format() {
         Scene::from_json(&newer)
             .unwrap_err()
             .to_string()
-            .contains("v99")
+            .contains("version 99")
     );
     // a scene read back cannot add frames (it has no model) and says so
     let mut back = back;

@@ -121,6 +121,32 @@ pub struct Costs {
 }
 
 impl Rollout {
+    /// The motion as CSV: a header `t,phase,<motor names of model>,com_x,com_z,com_desired_x,
+    /// com_desired_z,zmp_x`, then one row per control step (seconds, phase index, motor
+    /// positions in rad, CoM, desired CoM and ZMP in m, ground frame). `trm_plan::Trajectory`
+    /// reads it back (time and motor columns).
+    pub fn to_csv(&self, model: &RobotModel) -> String {
+        use std::fmt::Write as _;
+        let mut text = String::from("t,phase");
+        for m in model.motors() {
+            text.push(',');
+            text.push_str(&m.name);
+        }
+        text.push_str(",com_x,com_z,com_desired_x,com_desired_z,zmp_x\n");
+        for i in 0..self.times.len() {
+            let _ = write!(text, "{:.3},{}", self.times[i], self.phase[i]);
+            for v in &self.q[i] {
+                let _ = write!(text, ",{v:.6}");
+            }
+            let _ = writeln!(
+                text,
+                ",{:.6},{:.6},{:.6},{:.6},{:.6}",
+                self.com[i][0], self.com[i][2], self.com_desired[i][0], self.com_desired[i][1], self.zmp[i][0]
+            );
+        }
+        text
+    }
+
     /// Number of (sample, constraint) violations.
     pub fn violations(&self) -> usize {
         self.violated_samples.iter().sum()

@@ -1,0 +1,340 @@
+//! Posture files — a robot's motor values by name (JSON), with whatever the writer adds — and
+//! configuration files — URDF joint values by joint name, many samples (JSON).
+//!
+//! Format (what `cargo xtask solve --out` writes and `plan`/`view` read):
+//!
+//! ```json
+//! { "motors": { "r_shoulder_pitch": -0.5, "r_elbow": 1.1, … },
+//!   "q": [ … ],
+//!   "cost": 0.12, "breakdown": [ … ], … }
+//! ```
+//!
+//! `motors` names motors of the model (missing ones keep a start posture's values); `q` instead
+//! holds the values of a task's active motors in their order (needs that task's [`ActiveSet`]).
+//! One of the two must be there. Any other key is metadata, kept on reading and written back.
+//!
+//! A configuration file ([`ConfigurationsFile`], what `cargo xtask fk` and `collide` read) holds
+//! URDF joint values, one column per named joint:
+//!
+//! ```json
+//! { "joint_names": ["r_shoulder_pitch", "r_elbow"], "samples": [ { "q": [0.1, 0.5] }, … ] }
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{KinematicsError, Result};
+use crate::files::FileError;
+use crate::{ActiveSet, RobotModel};
+
+/// A posture file: motor values by name and/or a task's active values, plus metadata.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PostureFile {
+    /// Motor values by motor name (radians or metres).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motors: Option<BTreeMap<String, f64>>,
+    /// Values of a task's active motors, in the task's order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub q: Option<Vec<f64>>,
+    /// Everything else in the file (cost, breakdown, frames, the spec it came from, …).
+    #[serde(flatten)]
+    pub metadata: serde_json::Map<String, serde_json::Value>,
+}
+
+impl PostureFile {
+    /// A posture file holding every motor of `robot` at `motors` (one value per motor).
+    pub fn from_motors(robot: &RobotModel, motors: &[f64]) -> Result<Self> {
+        check_len("motor values", robot.motors().len(), motors.len())?;
+        Ok(PostureFile {
+            motors: Some(
+                robot
+                    .motors()
+                    .iter()
+                    .zip(motors)
+                    .map(|(m, v)| (m.name.clone(), *v))
+                    .collect(),
+            ),
+            ..Default::default()
+        })
+    }
+
+    /// Adds (or replaces) a metadata entry; chainable.
+    pub fn with(mut self, key: &str, value: impl Into<serde_json::Value>) -> Self {
+        self.metadata.insert(key.to_string(), value.into());
+        self
+    }
+
+    /// Parses posture-file JSON; `origin` names it in errors.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
+        serde_json::from_str(text).map_err(|e| invalid(origin, "", e.to_string(), FIX))
+    }
+
+    /// Reads a posture file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Writes the file atomically (pretty JSON).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        for (field, values) in [
+            ("motors", self.motors.iter().flat_map(|m| m.values()).copied().collect::<Vec<_>>()),
+            ("q", self.q.clone().unwrap_or_default()),
+        ] {
+            if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+                return Err(invalid(
+                    path,
+                    field,
+                    format!("holds {v}, which JSON cannot carry"),
+                    "only finite values can be written",
+                ));
+            }
+        }
+        let text = serde_json::to_string_pretty(self).map_err(|source| {
+            KinematicsError::File(FileError::Serialize {
+                path: path.to_path_buf(),
+                format: "posture",
+                source,
+            })
+        })?;
+        crate::write_atomic(path, text.as_bytes()).map_err(|source| KinematicsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    }
+
+    /// The motor vector of `robot` this file describes: `start` (one value per motor) with the
+    /// file's `motors` set by name, or with `active`'s motors set from `q`. `origin` names the
+    /// file in errors. Unknown motor names get suggestions; non-finite values are refused.
+    pub fn to_motors(
+        &self,
+        robot: &RobotModel,
+        active: Option<&ActiveSet>,
+        start: &[f64],
+        origin: &Path,
+    ) -> Result<Vec<f64>> {
+        check_len("start motor values", robot.motors().len(), start.len())?;
+        let mut motors = start.to_vec();
+        if let Some(named) = &self.motors {
+            for (name, &value) in named {
+                let i = robot.motor_index(name).map_err(|e| {
+                    invalid(origin, &format!("motors.{name}"), e.to_string(), "use the model's motor names (`cargo xtask model-info`)")
+                })?;
+                if !value.is_finite() {
+                    return Err(invalid(origin, &format!("motors.{name}"), format!("is {value}"), "give a finite value"));
+                }
+                motors[i] = value;
+            }
+            return Ok(motors);
+        }
+        if let Some(q) = &self.q {
+            let Some(active) = active else {
+                return Err(invalid(
+                    origin,
+                    "q",
+                    "holds active values, which need the task they belong to".into(),
+                    "give the task spec, or write \"motors\": {name: value}",
+                ));
+            };
+            if q.len() != active.len() {
+                return Err(invalid(
+                    origin,
+                    "q",
+                    format!("has {} values for {} active motors", q.len(), active.len()),
+                    "write one value per active motor of the task",
+                ));
+            }
+            for (&m, &v) in active.motor_indices().iter().zip(q) {
+                motors[m] = v;
+            }
+            return Ok(motors);
+        }
+        Err(invalid(origin, "", "neither \"motors\" nor \"q\"".into(), FIX))
+    }
+}
+
+/// A configurations file: URDF joint values by joint name, one row per sample.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConfigurationsFile {
+    /// URDF joint names, one per column of every sample's `q`.
+    pub joint_names: Vec<String>,
+    /// The configurations.
+    pub samples: Vec<ConfigurationSample>,
+}
+
+/// One configuration of a [`ConfigurationsFile`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConfigurationSample {
+    /// Values of the file's `joint_names`, radians (metres for prismatic joints).
+    pub q: Vec<f64>,
+    /// Anything else a sample carries (kept, e.g. the poses `fk` adds).
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+impl ConfigurationsFile {
+    /// Reads a configurations file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| {
+            invalid(
+                path,
+                "",
+                e.to_string(),
+                "expected {\"joint_names\": [...], \"samples\": [{\"q\": [...]}]}",
+            )
+        })
+    }
+
+    /// The joint names of `robot` the file leaves out (they are 0, or follow their leader when
+    /// they mimic one).
+    pub fn missing_joints<'a>(&self, robot: &'a RobotModel) -> Vec<&'a str> {
+        robot
+            .joint_names()
+            .filter(|n| !self.joint_names.iter().any(|g| g == n))
+            .collect()
+    }
+
+    /// Per sample, the full joint vector of `robot` (one value per movable joint, the order of
+    /// [`RobotModel::joint_names`]): joints not named are 0, mimic joints not named follow their
+    /// leader. `origin` names the file in errors.
+    pub fn joint_vectors(&self, robot: &RobotModel, origin: &Path) -> Result<Vec<Vec<f64>>> {
+        let columns: Vec<usize> = self
+            .joint_names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                robot.joint_index(n).map_err(|e| {
+                    invalid(origin, &format!("joint_names[{i}]"), e.to_string(), "use the URDF's joint names")
+                })
+            })
+            .collect::<Result<_>>()?;
+        for (i, &c) in columns.iter().enumerate() {
+            if columns[..i].contains(&c) {
+                return Err(invalid(
+                    origin,
+                    &format!("joint_names[{i}]"),
+                    format!("`{}` is named twice", self.joint_names[i]),
+                    "name every joint once",
+                ));
+            }
+        }
+        let given: Vec<bool> = (0..robot.num_joints()).map(|j| columns.contains(&j)).collect();
+        let followers: Vec<(usize, usize, f64, f64)> = (0..robot.num_joints())
+            .filter(|&j| !given[j])
+            .filter_map(|j| robot.joint(j).mimic.as_ref().map(|m| (j, m)))
+            .map(|(j, m)| Ok((j, robot.joint_index(&m.leader)?, m.multiplier, m.offset)))
+            .collect::<Result<_>>()?;
+        self.samples
+            .iter()
+            .enumerate()
+            .map(|(s, sample)| {
+                if sample.q.len() != columns.len() {
+                    return Err(invalid(
+                        origin,
+                        &format!("samples[{s}].q"),
+                        format!("has {} values for {} joint_names", sample.q.len(), columns.len()),
+                        "give one value per joint name",
+                    ));
+                }
+                if let Some(k) = sample.q.iter().position(|v| !v.is_finite()) {
+                    return Err(invalid(
+                        origin,
+                        &format!("samples[{s}].q[{k}]"),
+                        format!("is {}", sample.q[k]),
+                        "give finite joint values",
+                    ));
+                }
+                let mut joints = vec![0.0; robot.num_joints()];
+                for (&j, &v) in columns.iter().zip(&sample.q) {
+                    joints[j] = v;
+                }
+                for &(j, leader, multiplier, offset) in &followers {
+                    joints[j] = multiplier * joints[leader] + offset;
+                }
+                Ok(joints)
+            })
+            .collect()
+    }
+}
+
+const FIX: &str = "a posture file is JSON with \"motors\": {name: value} or \"q\": [active values]";
+
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(KinematicsError::WrongLength {
+            what,
+            expected,
+            got,
+        })
+    }
+}
+
+fn invalid(path: &Path, field: &str, problem: String, fix: &str) -> KinematicsError {
+    KinematicsError::InvalidFile {
+        path: PathBuf::from(path),
+        field: field.to_string(),
+        problem,
+        fix: fix.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn arm() -> RobotModel {
+        RobotModel::from_urdf_str(
+            r#"<robot name="a"><link name="b"/><link name="c"/>
+            <joint name="j" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#,
+            "<arm>",
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn a_posture_file_round_trips_with_its_metadata() {
+        let robot = arm();
+        let file = PostureFile::from_motors(&robot, &[0.25]).unwrap().with("cost", 1.5);
+        let text = serde_json::to_string(&file).unwrap();
+        let back = PostureFile::from_json(&text, Path::new("p.json")).unwrap();
+        assert_eq!(back, file);
+        assert_eq!(back.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap(), [0.25]);
+    }
+
+    #[test]
+    fn unknown_motors_and_active_values_without_a_task_are_located_errors() {
+        let robot = arm();
+        let file = PostureFile::from_json(r#"{"motors": {"jj": 0.1}}"#, Path::new("p.json")).unwrap();
+        let e = file.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap_err().to_string();
+        assert!(e.contains("p.json: motors.jj") && e.contains("did you mean `j`"), "{e}");
+        let file = PostureFile::from_json(r#"{"q": [0.1]}"#, Path::new("p.json")).unwrap();
+        let e = file.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap_err().to_string();
+        assert!(e.contains("p.json: q:"), "{e}");
+        let with_task = file.to_motors(&robot, Some(&robot.all_active()), &[0.0], Path::new("p.json"));
+        assert_eq!(with_task.unwrap(), [0.1]);
+    }
+
+    #[test]
+    fn non_finite_values_are_not_written() {
+        let robot = arm();
+        let dir = std::env::temp_dir().join(format!("trm-posture-{}", std::process::id()));
+        let file = PostureFile::from_motors(&robot, &[f64::NAN]).unwrap();
+        assert!(file.save(dir.join("p.json")).is_err());
+        assert!(!dir.join("p.json").exists());
+    }
+}
