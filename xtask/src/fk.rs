@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use trm_kinematics::ConfigurationsFile;
 use serde_json::{Map, Value, json};
+use trm_kinematics::ConfigurationsFile;
 
 /// Arguments of `fk`.
 #[derive(clap::Args)]

@@ -108,11 +108,12 @@ fn models_dir() -> PathBuf {
     dir.canonicalize().unwrap_or(dir)
 }
 
-/// Loads `path` (a .urdf or .ron model description), or the embedded iCub upper body when absent.
+/// Loads `path` (a .urdf or .ron model description, or an embedded model's name), or the
+/// embedded iCub upper body when absent.
 fn load_model(path: Option<&Path>) -> Result<RobotModel> {
     match path {
         None => Ok(trm_models::icub_upper_body()),
-        Some(p) => Ok(RobotModel::load(p)?),
+        Some(p) => Ok(trm_models::load(&p.to_string_lossy(), Path::new(""))?),
     }
 }
 

@@ -100,8 +100,22 @@ pub fn run(args: &Args) -> Result<()> {
             .with("evaluations", s.evaluations)
             .with("best_at_evaluation", s.best_at)
             .with("wall_time_s", s.wall_time.as_secs_f64())
-            .with("active", objective.active().names().zip(&s.q).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>())
-            .with("breakdown", s.breakdown.iter().map(|t| json!({"term": t.label, "weight": t.weight, "value": t.value})).collect::<Vec<_>>())
+            .with(
+                "active",
+                objective
+                    .active()
+                    .names()
+                    .zip(&s.q)
+                    .map(|(n, v)| (n.to_string(), json!(v)))
+                    .collect::<serde_json::Map<_, _>>(),
+            )
+            .with(
+                "breakdown",
+                s.breakdown
+                    .iter()
+                    .map(|t| json!({"term": t.label, "weight": t.weight, "value": t.value}))
+                    .collect::<Vec<_>>(),
+            )
             .with("task", s.task.clone())
             .with("frames", frames);
         file.save(out)?;

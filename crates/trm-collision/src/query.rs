@@ -22,6 +22,7 @@ impl CollisionCount {
 
 /// What a body touched.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Other {
     /// Another body of the robot.
     Body(String),
@@ -29,13 +30,19 @@ pub enum Other {
     Object(String),
 }
 
-/// A colliding pair, for debugging and reports.
+/// A colliding pair, for debugging and reports: names for people, indices for programs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CollidingPair {
-    /// The robot body.
+    /// The robot body's name.
     pub body: String,
-    /// What it collides with.
+    /// What it collides with, by name.
     pub other: Other,
+    /// Index of the robot body in [`CollisionModel::bodies`] (its link:
+    /// `bodies()[body_index].link`).
+    pub body_index: usize,
+    /// Index of what it collides with: a body index for [`Other::Body`], an index into
+    /// [`World::objects`] for [`Other::Object`].
+    pub other_index: usize,
     /// Signed distance (≤ 0: minus the penetration depth).
     pub distance: f64,
 }
@@ -168,6 +175,8 @@ impl CollisionModel {
             out.push(CollidingPair {
                 body: bodies[a].name.clone(),
                 other: Other::Body(bodies[b].name.clone()),
+                body_index: a,
+                other_index: b,
                 distance: signed_distance(&compiled[a], &p[a], &compiled[b], &p[b]),
             });
             Some(false)
@@ -177,6 +186,8 @@ impl CollisionModel {
             out.push(CollidingPair {
                 body: bodies[i].name.clone(),
                 other: Other::Object(object.name().to_string()),
+                body_index: i,
+                other_index: o,
                 distance: signed_distance(&compiled[i], &p[i], &object.compiled, &object.placed),
             });
             Some(false)

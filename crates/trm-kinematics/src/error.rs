@@ -112,6 +112,16 @@ pub enum KinematicsError {
         /// The closest existing names, best first.
         suggestions: Vec<String>,
     },
+    /// A model name that is neither embedded nor a file.
+    #[error("unknown model `{name}`: no embedded model has that name and {} is no file{}\n  fix: give a .urdf or .ron path, or an embedded model", looked_for.display(), suggest(suggestions))]
+    UnknownModel {
+        /// The name given.
+        name: String,
+        /// The file looked for.
+        looked_for: PathBuf,
+        /// The closest embedded model names.
+        suggestions: Vec<String>,
+    },
     /// A vector had the wrong number of entries.
     #[error("{what}: expected {expected} values, got {got}")]
     WrongLength {

@@ -49,7 +49,7 @@ pub enum FileError {
         source: serde_json::Error,
     },
     /// The file is not JSON, or not this kind of file.
-    #[error("{}: not a {format} file{}\n  fix: give a file written by trm as {format}", path.display(), detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default())]
+    #[error("{}: not a {format} file{}\n  fix: give a {format} file written by trm", path.display(), detail.as_ref().map(|d| format!(" ({d})")).unwrap_or_default())]
     WrongFormat {
         /// The file.
         path: std::path::PathBuf,

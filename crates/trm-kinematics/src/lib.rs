@@ -51,8 +51,8 @@ pub use description::{
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use files::{FileError, load_versioned, parse_versioned, save_json, write_atomic};
 pub use fk::PoseBuffer;
-pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
+pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use urdf_rs;

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use nalgebra::Isometry3;
 
-use crate::description::{DisableReason, ModelDescription};
+use crate::description::{DisableReason, FrameSpec, ModelDescription};
 use crate::error::{KinematicsError, NameKind, Result, unknown};
 use crate::fk::{AffineRow, Plan, PoseBuffer};
 use crate::tree::{Ctx, JointKind, Limits, Tree, pose_from_xyz_rpy};
@@ -196,30 +196,12 @@ impl RobotModel {
             text: desc_text.map(|d| d.0),
         };
         let (motors, couplings) = resolve_motors(&tree, desc, &dctx)?;
-        let frames = resolve_frames(&tree, desc, &dctx)?;
+        let frames = resolve_frames(&tree, Vec::new(), &desc.frames, &dctx)?;
         let groups = resolve_groups(&motors, desc, &dctx)?;
         let postures = resolve_postures(&motors, desc, &dctx)?;
         let (disabled_collisions, enabled_collisions) =
             resolve_collision_pairs(&tree, desc, &dctx)?;
-        let frame_offsets: Vec<_> = frames.iter().map(|f| (f.link, f.local_offset)).collect();
-        let identity: Vec<[(usize, f64); 1]> =
-            (0..tree.movable.len()).map(|c| [(c, 1.0)]).collect();
-        let joint_rows: Vec<AffineRow> = identity
-            .iter()
-            .map(|t| AffineRow {
-                constant: 0.0,
-                terms: t,
-            })
-            .collect();
-        let joint_plan = Plan::compile(&tree, &frame_offsets, &joint_rows);
-        let motor_rows: Vec<AffineRow> = couplings
-            .iter()
-            .map(|c| AffineRow {
-                constant: c.offset,
-                terms: &c.terms,
-            })
-            .collect();
-        let motor_plan = Plan::compile(&tree, &frame_offsets, &motor_rows);
+        let (joint_plan, motor_plan) = compile_plans(&tree, &frames, &couplings);
         Ok(RobotModel {
             data: Arc::new(ModelData {
                 origin: ctx.origin.to_string(),
@@ -231,6 +213,31 @@ impl RobotModel {
                 postures,
                 disabled_collisions,
                 enabled_collisions,
+                joint_plan,
+                motor_plan,
+            }),
+        })
+    }
+
+    /// The same model with more named frames (attached to links or to earlier frames), as a
+    /// task spec adds them; `origin` names where they come from in errors. Pose buffers of the
+    /// new model hold the new frames after the old ones.
+    pub fn with_frames(&self, frames: &[FrameSpec], origin: &str) -> Result<Self> {
+        let d = &*self.data;
+        let ctx = DescCtx { origin, text: None };
+        let all = resolve_frames(&d.tree, d.frames.clone(), frames, &ctx)?;
+        let (joint_plan, motor_plan) = compile_plans(&d.tree, &all, &d.couplings);
+        Ok(RobotModel {
+            data: Arc::new(ModelData {
+                origin: d.origin.clone(),
+                tree: d.tree.clone(),
+                motors: d.motors.clone(),
+                couplings: d.couplings.clone(),
+                frames: all,
+                groups: d.groups.clone(),
+                postures: d.postures.clone(),
+                disabled_collisions: d.disabled_collisions.clone(),
+                enabled_collisions: d.enabled_collisions.clone(),
                 joint_plan,
                 motor_plan,
             }),
@@ -804,9 +811,38 @@ fn own_motor_of(joint: &crate::tree::Joint) -> Motor {
     }
 }
 
-fn resolve_frames(tree: &Tree, desc: &ModelDescription, ctx: &DescCtx) -> Result<Vec<NamedFrame>> {
-    let mut frames: Vec<NamedFrame> = Vec::new();
-    for f in &desc.frames {
+/// The compiled forward passes over joint values and over motor values.
+fn compile_plans(tree: &Tree, frames: &[NamedFrame], couplings: &[Coupling]) -> (Plan, Plan) {
+    let frame_offsets: Vec<_> = frames.iter().map(|f| (f.link, f.local_offset)).collect();
+    let identity: Vec<[(usize, f64); 1]> = (0..tree.movable.len()).map(|c| [(c, 1.0)]).collect();
+    let joint_rows: Vec<AffineRow> = identity
+        .iter()
+        .map(|t| AffineRow {
+            constant: 0.0,
+            terms: t,
+        })
+        .collect();
+    let joint_plan = Plan::compile(&tree, &frame_offsets, &joint_rows);
+    let motor_rows: Vec<AffineRow> = couplings
+        .iter()
+        .map(|c| AffineRow {
+            constant: c.offset,
+            terms: &c.terms,
+        })
+        .collect();
+    let motor_plan = Plan::compile(&tree, &frame_offsets, &motor_rows);
+    (joint_plan, motor_plan)
+}
+
+/// `existing` frames followed by `specs`, resolved against the tree and the frames before them.
+fn resolve_frames(
+    tree: &Tree,
+    existing: Vec<NamedFrame>,
+    specs: &[FrameSpec],
+    ctx: &DescCtx,
+) -> Result<Vec<NamedFrame>> {
+    let mut frames = existing;
+    for f in specs {
         let element = format!("frame \"{}\"", f.name);
         if tree.link_index(&f.name).is_some() || frames.iter().any(|g| g.name == f.name) {
             return Err(ctx.invalid(

@@ -85,7 +85,14 @@ impl PostureFile {
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
         for (field, values) in [
-            ("motors", self.motors.iter().flat_map(|m| m.values()).copied().collect::<Vec<_>>()),
+            (
+                "motors",
+                self.motors
+                    .iter()
+                    .flat_map(|m| m.values())
+                    .copied()
+                    .collect::<Vec<_>>(),
+            ),
             ("q", self.q.clone().unwrap_or_default()),
         ] {
             if let Some(v) = values.iter().find(|v| !v.is_finite()) {
@@ -125,10 +132,20 @@ impl PostureFile {
         if let Some(named) = &self.motors {
             for (name, &value) in named {
                 let i = robot.motor_index(name).map_err(|e| {
-                    invalid(origin, &format!("motors.{name}"), e.to_string(), "use the model's motor names (`cargo xtask model-info`)")
+                    invalid(
+                        origin,
+                        &format!("motors.{name}"),
+                        e.to_string(),
+                        "use the model's motor names (`cargo xtask model-info`)",
+                    )
                 })?;
                 if !value.is_finite() {
-                    return Err(invalid(origin, &format!("motors.{name}"), format!("is {value}"), "give a finite value"));
+                    return Err(invalid(
+                        origin,
+                        &format!("motors.{name}"),
+                        format!("is {value}"),
+                        "give a finite value",
+                    ));
                 }
                 motors[i] = value;
             }
@@ -156,7 +173,12 @@ impl PostureFile {
             }
             return Ok(motors);
         }
-        Err(invalid(origin, "", "neither \"motors\" nor \"q\"".into(), FIX))
+        Err(invalid(
+            origin,
+            "",
+            "neither \"motors\" nor \"q\"".into(),
+            FIX,
+        ))
     }
 }
 
@@ -216,7 +238,12 @@ impl ConfigurationsFile {
             .enumerate()
             .map(|(i, n)| {
                 robot.joint_index(n).map_err(|e| {
-                    invalid(origin, &format!("joint_names[{i}]"), e.to_string(), "use the URDF's joint names")
+                    invalid(
+                        origin,
+                        &format!("joint_names[{i}]"),
+                        e.to_string(),
+                        "use the URDF's joint names",
+                    )
                 })
             })
             .collect::<Result<_>>()?;
@@ -230,7 +257,9 @@ impl ConfigurationsFile {
                 ));
             }
         }
-        let given: Vec<bool> = (0..robot.num_joints()).map(|j| columns.contains(&j)).collect();
+        let given: Vec<bool> = (0..robot.num_joints())
+            .map(|j| columns.contains(&j))
+            .collect();
         let followers: Vec<(usize, usize, f64, f64)> = (0..robot.num_joints())
             .filter(|&j| !given[j])
             .filter_map(|j| robot.joint(j).mimic.as_ref().map(|m| (j, m)))
@@ -244,7 +273,11 @@ impl ConfigurationsFile {
                     return Err(invalid(
                         origin,
                         &format!("samples[{s}].q"),
-                        format!("has {} values for {} joint_names", sample.q.len(), columns.len()),
+                        format!(
+                            "has {} values for {} joint_names",
+                            sample.q.len(),
+                            columns.len()
+                        ),
                         "give one value per joint name",
                     ));
                 }
@@ -309,23 +342,44 @@ mod tests {
     #[test]
     fn a_posture_file_round_trips_with_its_metadata() {
         let robot = arm();
-        let file = PostureFile::from_motors(&robot, &[0.25]).unwrap().with("cost", 1.5);
+        let file = PostureFile::from_motors(&robot, &[0.25])
+            .unwrap()
+            .with("cost", 1.5);
         let text = serde_json::to_string(&file).unwrap();
         let back = PostureFile::from_json(&text, Path::new("p.json")).unwrap();
         assert_eq!(back, file);
-        assert_eq!(back.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap(), [0.25]);
+        assert_eq!(
+            back.to_motors(&robot, None, &[0.0], Path::new("p.json"))
+                .unwrap(),
+            [0.25]
+        );
     }
 
     #[test]
     fn unknown_motors_and_active_values_without_a_task_are_located_errors() {
         let robot = arm();
-        let file = PostureFile::from_json(r#"{"motors": {"jj": 0.1}}"#, Path::new("p.json")).unwrap();
-        let e = file.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap_err().to_string();
-        assert!(e.contains("p.json: motors.jj") && e.contains("did you mean `j`"), "{e}");
+        let file =
+            PostureFile::from_json(r#"{"motors": {"jj": 0.1}}"#, Path::new("p.json")).unwrap();
+        let e = file
+            .to_motors(&robot, None, &[0.0], Path::new("p.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("p.json: motors.jj") && e.contains("did you mean `j`"),
+            "{e}"
+        );
         let file = PostureFile::from_json(r#"{"q": [0.1]}"#, Path::new("p.json")).unwrap();
-        let e = file.to_motors(&robot, None, &[0.0], Path::new("p.json")).unwrap_err().to_string();
+        let e = file
+            .to_motors(&robot, None, &[0.0], Path::new("p.json"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("p.json: q:"), "{e}");
-        let with_task = file.to_motors(&robot, Some(&robot.all_active()), &[0.0], Path::new("p.json"));
+        let with_task = file.to_motors(
+            &robot,
+            Some(&robot.all_active()),
+            &[0.0],
+            Path::new("p.json"),
+        );
         assert_eq!(with_task.unwrap(), [0.1]);
     }
 

@@ -9,7 +9,57 @@
 //! The iCub files are derived from robotology/icub-models (CC-BY-SA-4.0, © Istituto Italiano
 //! di Tecnologia); see `models/icub-visuomanip/NOTICE.md`.
 
-use trm_kinematics::{ModelDescription, RobotModel};
+use std::path::Path;
+
+use trm_kinematics::{KinematicsError, ModelDescription, RobotModel};
+
+/// The names of the embedded models, as specs and [`by_name`] know them.
+pub const NAMES: &[&str] = &[
+    "icub_upper_body",
+    "icub_sagittal",
+    "icub_official",
+    "icub_genova04",
+    "planar_arm",
+    "branched_tree",
+];
+
+/// The embedded model called `name` (one of [`NAMES`]).
+pub fn by_name(name: &str) -> Option<RobotModel> {
+    Some(match name {
+        "icub_upper_body" => icub_upper_body(),
+        "icub_sagittal" => icub_sagittal(),
+        "icub_official" => icub_official(),
+        "icub_genova04" => icub_genova04(),
+        "planar_arm" => planar_arm(),
+        "branched_tree" => branched_tree(),
+        _ => return None,
+    })
+}
+
+/// The one model loader of specs and commands: an embedded model by name ([`NAMES`]), else a
+/// `.urdf` or `.ron` model file at `base.join(name)`. A name that is neither gets an error that
+/// lists the embedded models closest to it.
+///
+/// ```
+/// let arm = trm_models::load("planar_arm", ".".as_ref())?;
+/// assert_eq!(arm.motors().len(), 3);
+/// assert!(trm_models::load("icub_uper_body", ".".as_ref()).unwrap_err().to_string().contains("icub_upper_body"));
+/// # Ok::<(), trm_kinematics::KinematicsError>(())
+/// ```
+pub fn load(name: &str, base: &Path) -> Result<RobotModel, KinematicsError> {
+    if let Some(model) = by_name(name) {
+        return Ok(model);
+    }
+    let path = base.join(name);
+    if path.is_file() {
+        return RobotModel::load(&path);
+    }
+    Err(KinematicsError::UnknownModel {
+        name: name.to_string(),
+        looked_for: path,
+        suggestions: trm_kinematics::closest_names(name, NAMES.iter().copied()),
+    })
+}
 
 /// models/icub_upper_body.urdf: the iCub upper body with primitive collision proxies.
 pub const ICUB_UPPER_BODY_URDF: &str = include_str!("../models/icub_upper_body.urdf");
@@ -91,5 +141,8 @@ mod tests {
         assert_eq!(super::icub_genova04().num_joints(), 32);
         assert_eq!(super::planar_arm().num_joints(), 3);
         assert_eq!(super::branched_tree().num_joints(), 6);
+        for name in super::NAMES {
+            assert!(super::by_name(name).is_some(), "{name}");
+        }
     }
 }

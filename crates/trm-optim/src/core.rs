@@ -200,8 +200,9 @@ impl Start {
         self
     }
 
-    /// Checks the settings and returns the per-coordinate steps.
-    pub(crate) fn check(&self) -> Result<Vec<f64>> {
+    /// Checks the settings and returns the per-coordinate initial step sizes (what a new
+    /// algorithm's constructor calls first).
+    pub fn check(&self) -> Result<Vec<f64>> {
         let d = self.mean.len();
         if d == 0 {
             return Err(invalid("mean", "dimension 0"));
@@ -246,8 +247,9 @@ pub struct State {
 }
 
 impl State {
-    /// Bookkeeping for dimension `d` and `lambda` candidates per generation.
-    pub(crate) fn new(start: &Start, lambda: usize) -> Self {
+    /// Bookkeeping for `start`'s dimension and `lambda` candidates per generation (the
+    /// constructor of an [`Optimizer`] implementation creates one).
+    pub fn new(start: &Start, lambda: usize) -> Self {
         let d = start.mean.len();
         let history = 10 + (30 * d).div_ceil(lambda.max(1));
         State {
@@ -271,18 +273,20 @@ impl State {
 
     /// Clamps a candidate into the bounds, if any.
     #[inline]
-    pub(crate) fn clamp(&self, x: &mut [f64]) {
+    pub fn clamp(&self, x: &mut [f64]) {
         if let Some(b) = &self.bounds {
             b.clamp(x);
         }
     }
 
-    pub(crate) fn asked(&mut self, n: usize) {
+    /// Notes that `n` candidates were handed out (call at the end of `ask`).
+    pub fn asked(&mut self, n: usize) {
         self.pending = n;
     }
 
-    /// Records a generation's values for its candidates; returns an error on a count mismatch.
-    pub(crate) fn told(&mut self, candidates: &[Vec<f64>], fitness: &[f64]) -> Result<()> {
+    /// Records a generation's values for its candidates (call at the start of `tell`); returns
+    /// an error on a count mismatch or a `tell` without `ask`.
+    pub fn told(&mut self, candidates: &[Vec<f64>], fitness: &[f64]) -> Result<()> {
         if self.pending == 0 {
             return Err(OptimError::NoPendingAsk);
         }
@@ -316,11 +320,13 @@ impl State {
         Ok(())
     }
 
-    pub(crate) fn set_degenerate(&mut self) {
+    /// Marks the search distribution as degenerate (a [`StopReason`] from now on).
+    pub fn set_degenerate(&mut self) {
         self.degenerate = true;
     }
 
-    pub(crate) fn record_centre(&mut self, x: &[f64], f: f64) {
+    /// Records the value `f` of the distribution centre `x` (counts as an evaluation).
+    pub fn record_centre(&mut self, x: &[f64], f: f64) {
         self.evaluations += 1;
         if f.is_nan() || f == f64::NEG_INFINITY {
             self.invalid = true;
@@ -337,7 +343,7 @@ impl State {
     }
 
     /// Every stopping reason that holds, given the distribution's largest standard deviation.
-    pub(crate) fn reasons(&self, spread: f64) -> Vec<StopReason> {
+    pub fn reasons(&self, spread: f64) -> Vec<StopReason> {
         let s = &self.stop;
         let mut out = Vec::new();
         if s.max_evaluations.is_some_and(|m| self.evaluations >= m) {
@@ -422,6 +428,12 @@ impl State {
 }
 
 /// An ask/tell optimiser minimising a function of `dim()` variables.
+///
+/// Implement it for your own algorithm and every runner of trm accepts it ([`crate::minimize`],
+/// NGIK's `trm_tasks::solve_with`, map building): keep a [`State`] (from [`State::new`]), clamp
+/// candidates with [`State::clamp`], call [`State::asked`] at the end of `ask` and
+/// [`State::told`] at the start of `tell`; the stopping rules then work as for the built-in
+/// algorithms. `examples/random_search.rs` is a complete one.
 ///
 /// Each generation: `ask` hands out candidates (reused buffers: no allocation), the caller
 /// evaluates them in any order or in parallel, `tell` takes their values in the same order.

@@ -6,8 +6,8 @@ use petgraph::graph::{NodeIndex, UnGraph};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
-use trm_collision::{CollisionModel, PlacedBodies, World};
-use trm_kinematics::{ActiveSet, PoseBuffer};
+use trm_collision::World;
+use trm_kinematics::ActiveSet;
 use trm_roadmap::{Roadmap, distance, segment_is_free};
 use trm_tasks::Objective;
 
@@ -158,14 +158,11 @@ enum State {
 pub struct Planner<'a> {
     objective: &'a Objective,
     active: ActiveSet,
-    collision: CollisionModel,
     world: World,
     nodes: Vec<(Vec<f64>, Vec<f64>)>,
     node_state: Vec<State>,
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
-    poses: PoseBuffer,
-    placed: PlacedBodies,
     scratch: trm_tasks::Scratch,
 }
 
@@ -218,18 +215,14 @@ impl<'a> Planner<'a> {
                 }
             }
         }
-        let model = objective.active().model();
         Ok(Planner {
             objective,
             active: objective.active().clone(),
-            collision: objective.collision().clone(),
             world: objective.world().clone(),
             node_state: vec![State::Valid; nodes.len()],
             nodes,
             edges,
             edge_state,
-            poses: model.pose_buffer(),
-            placed: objective.collision().placed_bodies(),
             scratch: objective.scratch(),
         })
     }
@@ -258,9 +251,8 @@ impl<'a> Planner<'a> {
 
     /// Whether `q` is collision-free in the current world.
     pub fn is_free(&mut self, q: &[f64]) -> bool {
-        self.active.forward_unchecked(q, &mut self.poses);
-        self.collision.place(&self.poses, &mut self.placed);
-        !self.collision.is_colliding(&self.placed, &self.world)
+        self.objective
+            .is_collision_free_in(q, &self.world, &mut self.scratch)
     }
 
     /// Whether the straight segment a → b is free, checked every `resolution` of joint motion.

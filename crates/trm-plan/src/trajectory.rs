@@ -49,14 +49,37 @@ impl Trajectory {
     /// every row has one value per name and that times do not decrease.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self, PlanError> {
         let t: Trajectory = serde_json::from_str(text).map_err(|e| {
-            invalid(origin, e.line(), e.to_string(), "give a trajectory written by trm (`plan --out x.json`)")
+            invalid(
+                origin,
+                e.line(),
+                e.to_string(),
+                "give a trajectory written by trm (`plan --out x.json`)",
+            )
         })?;
         if t.times.len() != t.positions.len() {
-            return Err(invalid(origin, 0, format!("{} times for {} positions", t.times.len(), t.positions.len()), "give one time per waypoint"));
+            return Err(invalid(
+                origin,
+                0,
+                format!(
+                    "{} times for {} positions",
+                    t.times.len(),
+                    t.positions.len()
+                ),
+                "give one time per waypoint",
+            ));
         }
         for (i, row) in t.positions.iter().enumerate() {
             if row.len() != t.names.len() {
-                return Err(invalid(origin, 0, format!("positions[{i}] has {} values for {} names", row.len(), t.names.len()), "give one value per name"));
+                return Err(invalid(
+                    origin,
+                    0,
+                    format!(
+                        "positions[{i}] has {} values for {} names",
+                        row.len(),
+                        t.names.len()
+                    ),
+                    "give one value per name",
+                ));
             }
         }
         check_times(&t.times, origin, |i| (0, format!("times[{i}]")))?;
@@ -69,13 +92,28 @@ impl Trajectory {
         let mut lines = text.lines();
         let header: Vec<&str> = lines
             .next()
-            .ok_or_else(|| invalid(origin, 1, "empty file".into(), "write a header `time,<motor names…>`"))?
+            .ok_or_else(|| {
+                invalid(
+                    origin,
+                    1,
+                    "empty file".into(),
+                    "write a header `time,<motor names…>`",
+                )
+            })?
             .split(',')
             .map(str::trim)
             .collect();
-        let time = header.iter().position(|h| *h == "time" || *h == "t").ok_or_else(|| {
-            invalid(origin, 1, "no `time` column".into(), "name the time column `time`")
-        })?;
+        let time = header
+            .iter()
+            .position(|h| *h == "time" || *h == "t")
+            .ok_or_else(|| {
+                invalid(
+                    origin,
+                    1,
+                    "no `time` column".into(),
+                    "name the time column `time`",
+                )
+            })?;
         let columns: Vec<(usize, &str)> = header
             .iter()
             .enumerate()
@@ -87,12 +125,20 @@ impl Trajectory {
                 origin,
                 1,
                 format!("no column names a motor of {}", robot.name()),
-                &format!("name columns after motors, e.g. `{}`", robot.motors().first().map_or("", |m| m.name.as_str())),
+                &format!(
+                    "name columns after motors, e.g. `{}`",
+                    robot.motors().first().map_or("", |m| m.name.as_str())
+                ),
             ));
         }
         for (i, (_, name)) in columns.iter().enumerate() {
             if columns[..i].iter().any(|(_, n)| n == name) {
-                return Err(invalid(origin, 1, format!("motor `{name}` has two columns"), "keep one column per motor"));
+                return Err(invalid(
+                    origin,
+                    1,
+                    format!("motor `{name}` has two columns"),
+                    "keep one column per motor",
+                ));
             }
         }
         let mut t = Trajectory {
@@ -112,10 +158,22 @@ impl Trajectory {
                     .get(c)
                     .and_then(|f| f.trim().parse::<f64>().ok())
                     .filter(|v| v.is_finite())
-                    .ok_or_else(|| invalid(origin, line_no, format!("column {} (`{}`) is not a finite number", c + 1, header[c]), "write finite numbers"))
+                    .ok_or_else(|| {
+                        invalid(
+                            origin,
+                            line_no,
+                            format!("column {} (`{}`) is not a finite number", c + 1, header[c]),
+                            "write finite numbers",
+                        )
+                    })
             };
             t.times.push(number(time)?);
-            t.positions.push(columns.iter().map(|&(c, _)| number(c)).collect::<Result<_, _>>()?);
+            t.positions.push(
+                columns
+                    .iter()
+                    .map(|&(c, _)| number(c))
+                    .collect::<Result<_, _>>()?,
+            );
         }
         check_times(&t.times, origin, |i| (i + 2, "time".into()))?;
         Ok(t)
@@ -124,8 +182,14 @@ impl Trajectory {
     /// Reads a trajectory file of `robot`: JSON when the extension is `.json`, else CSV.
     pub fn load(path: impl AsRef<Path>, robot: &RobotModel) -> Result<Self, PlanError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io { path: path.to_path_buf(), source })?;
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) {
+        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
             Self::from_json(&text, path)
         } else {
             Self::from_csv(&text, path, robot)
@@ -134,7 +198,11 @@ impl Trajectory {
 
     /// Full motor vectors of `robot` at every waypoint: `start` (one value per motor) with the
     /// trajectory's named motors set. Unknown names get suggestions.
-    pub fn motor_frames(&self, robot: &RobotModel, start: &[f64]) -> Result<Vec<(f64, Vec<f64>)>, PlanError> {
+    pub fn motor_frames(
+        &self,
+        robot: &RobotModel,
+        start: &[f64],
+    ) -> Result<Vec<(f64, Vec<f64>)>, PlanError> {
         let columns: Vec<usize> = self
             .names
             .iter()
@@ -164,11 +232,24 @@ fn invalid(origin: &Path, line: usize, problem: String, fix: &str) -> PlanError 
     }
 }
 
-fn check_times(times: &[f64], origin: &Path, at: impl Fn(usize) -> (usize, String)) -> Result<(), PlanError> {
+fn check_times(
+    times: &[f64],
+    origin: &Path,
+    at: impl Fn(usize) -> (usize, String),
+) -> Result<(), PlanError> {
     for i in 1..times.len() {
         if times[i] < times[i - 1] || !times[i].is_finite() {
             let (line, field) = at(i);
-            return Err(invalid(origin, line, format!("{field} = {} comes before the previous {}", times[i], times[i - 1]), "times must not decrease"));
+            return Err(invalid(
+                origin,
+                line,
+                format!(
+                    "{field} = {} comes before the previous {}",
+                    times[i],
+                    times[i - 1]
+                ),
+                "times must not decrease",
+            ));
         }
     }
     Ok(())

@@ -99,10 +99,17 @@ impl Roadmap {
         let dim = self.points.first().map_or(0, |p| p.t.len());
         for (i, p) in self.points.iter().enumerate() {
             if p.q.len() != self.active.len() {
-                return Err(format!("points[{i}].q has {} values for {} active motors", p.q.len(), self.active.len()));
+                return Err(format!(
+                    "points[{i}].q has {} values for {} active motors",
+                    p.q.len(),
+                    self.active.len()
+                ));
             }
             if p.t.len() != dim {
-                return Err(format!("points[{i}].t has {} dimensions, points[0].t {dim}", p.t.len()));
+                return Err(format!(
+                    "points[{i}].t has {} dimensions, points[0].t {dim}",
+                    p.t.len()
+                ));
             }
             if !(p.q.iter().chain(&p.t).all(|v| v.is_finite()) && p.cost.is_finite()) {
                 return Err(format!("points[{i}] holds a non-finite value"));
@@ -110,7 +117,10 @@ impl Roadmap {
         }
         for (k, &(a, b, w)) in self.edges.iter().enumerate() {
             if a >= self.points.len() || b >= self.points.len() || a == b || !w.is_finite() {
-                return Err(format!("edges[{k}] = ({a}, {b}, {w}) does not join two of the {} points", self.points.len()));
+                return Err(format!(
+                    "edges[{k}] = ({a}, {b}, {w}) does not join two of the {} points",
+                    self.points.len()
+                ));
             }
         }
         Ok(())
@@ -120,7 +130,9 @@ impl Roadmap {
     /// world files are found relative to the spec's original location, `spec_path`). Fails when
     /// the spec no longer loads or no longer has the map's active motors.
     pub fn problem(&self) -> Result<trm_tasks::Problem> {
-        let base = Path::new(&self.spec_path).parent().unwrap_or(Path::new("."));
+        let base = Path::new(&self.spec_path)
+            .parent()
+            .unwrap_or(Path::new("."));
         let problem = trm_tasks::Problem::from_ron(&self.spec, &self.spec_path, base)?;
         let names: Vec<&str> = problem.objective.active().names().collect();
         if names != self.active.iter().map(String::as_str).collect::<Vec<_>>() {
@@ -139,7 +151,11 @@ impl Roadmap {
         let n = self.points.len();
         let extent = self.extent();
         let distance = |a: &MapPoint, b: &MapPoint| {
-            a.t.iter().zip(&b.t).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+            a.t.iter()
+                .zip(&b.t)
+                .map(|(x, y)| (x - y).powi(2))
+                .sum::<f64>()
+                .sqrt()
         };
         let nearest: Vec<f64> = (0..n)
             .map(|i| {
@@ -157,11 +173,19 @@ impl Roadmap {
         });
         let d = self.settings.spacing;
         let coverage = (n > 0 && d > 0.0).then(|| {
-            let total: f64 = extent.iter().map(|(lo, hi)| ((hi - lo) / d).floor() + 1.0).product();
+            let total: f64 = extent
+                .iter()
+                .map(|(lo, hi)| ((hi - lo) / d).floor() + 1.0)
+                .product();
             let occupied: std::collections::BTreeSet<Vec<u64>> = self
                 .points
                 .iter()
-                .map(|p| p.t.iter().zip(&extent).map(|(v, (lo, _))| ((v - lo) / d).floor() as u64).collect())
+                .map(|p| {
+                    p.t.iter()
+                        .zip(&extent)
+                        .map(|(v, (lo, _))| ((v - lo) / d).floor() as u64)
+                        .collect()
+                })
                 .collect();
             (occupied.len(), total)
         });

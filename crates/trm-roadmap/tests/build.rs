@@ -82,7 +82,7 @@ fn maps_round_trip_through_files_and_bad_files_are_clear_errors() {
     // foreign JSON
     std::fs::write(&path, "{\"points\": []}").unwrap();
     let e = Roadmap::load(&path).unwrap_err().to_string();
-    assert!(e.contains("not a trm roadmap"), "{e}");
+    assert!(e.contains("not a trm-roadmap file"), "{e}");
     // newer version
     std::fs::write(&path, text.replacen("\"version\":1", "\"version\":99", 1)).unwrap();
     let e = Roadmap::load(&path).unwrap_err().to_string();

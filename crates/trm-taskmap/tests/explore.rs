@@ -123,7 +123,7 @@ fn maps_round_trip_and_the_cost_has_the_right_gradient() {
         TaskMap::load(&path)
             .unwrap_err()
             .to_string()
-            .contains("not a trm task map")
+            .contains("not a trm-taskmap file")
     );
     std::fs::remove_file(&path).unwrap();
     // zero at a map point, positive off the map, gradient = finite differences

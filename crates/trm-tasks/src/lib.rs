@@ -25,6 +25,7 @@
 //! The catalogue is closed in the file format and open in code: implement [`Cost`] or
 //! [`TaskFunction`] and add it to an [`Objective`].
 
+mod comparison;
 mod context;
 pub mod costs;
 mod error;
@@ -33,10 +34,11 @@ mod objective;
 pub mod spec;
 pub mod tasks;
 
+pub use comparison::{Comparison, ComparisonResult, ComparisonRun, ComparisonSummary};
 pub use context::{Anchor, Context};
 pub use costs::Cost;
 pub use error::{Result, TaskError};
-pub use ngik::{Solution, solve};
+pub use ngik::{Solution, solve, solve_with, solver_start};
 pub use objective::{Objective, Scratch, TermValue};
 pub use spec::{Problem, Spec};
 pub use tasks::TaskFunction;

@@ -4,10 +4,10 @@
 
 use std::time::{Duration, Instant};
 
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use trm_optim::{Bounds, Start, StopOptions, StopReason, by_name, minimize};
+use trm_optim::{Bounds, Optimizer, Start, StopOptions, StopReason, by_name, minimize};
 
 use crate::error::Result;
 use crate::objective::{Objective, TermValue};
@@ -40,25 +40,58 @@ pub struct Solution {
     pub trace: Vec<(u64, f64)>,
 }
 
-/// Minimises `objective` from the active values `start` with the solver settings. Candidates
-/// are kept within the motor limits. The start itself is evaluated too (one extra evaluation):
-/// the result is never worse than the start.
-pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Solution> {
+/// The optimiser's start for `objective` from the active values `start` with the solver
+/// settings: mean `start`, step `solver.sigma`, the motor limits as bounds, the spec's budgets.
+/// Build your own [`Optimizer`] from it and hand it to [`solve_with`].
+pub fn solver_start(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Start> {
     let (lower, upper) = objective.active().bounds();
-    let settings = Start::new(start.to_vec(), solver.sigma)
+    Ok(Start::new(start.to_vec(), solver.sigma)
         .with_bounds(Bounds::new(lower, upper)?)
         .with_stop(StopOptions {
             max_evaluations: Some(solver.max_evaluations),
             no_improvement_evaluations: solver.no_improvement,
             target: solver.target,
             ..Default::default()
-        });
+        }))
+}
+
+/// Minimises `objective` from the active values `start` with the solver settings (the
+/// optimiser named by `solver.algo`, seeded with `solver.seed`). Candidates are kept within the
+/// motor limits. The start itself is evaluated too (one extra evaluation): the result is never
+/// worse than the start.
+pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Solution> {
+    let settings = solver_start(objective, start, solver)?;
     let mut optimizer = by_name(&solver.algo, &settings, solver.population)?;
     let mut rng = ChaCha8Rng::seed_from_u64(solver.seed);
+    solve_with(objective, start, optimizer.as_mut(), &mut rng)
+}
+
+/// NGIK with any optimiser — yours included (implement [`Optimizer`]): minimises `objective`
+/// from the active values `start`, evaluating each population in parallel, drawing every random
+/// number from `rng`. The optimiser must have `objective.dim()` variables (see
+/// [`solver_start`]). The start is evaluated too, clamped into the motor limits: the result is
+/// never worse than the start.
+pub fn solve_with(
+    objective: &Objective,
+    start: &[f64],
+    optimizer: &mut dyn Optimizer,
+    rng: &mut dyn Rng,
+) -> Result<Solution> {
+    if optimizer.dim() != objective.dim() || start.len() != objective.dim() {
+        return Err(crate::TaskError::Invalid {
+            what: "solve_with".into(),
+            problem: format!(
+                "the optimiser has {} variables and the start {} values for an objective of {} active motors",
+                optimizer.dim(),
+                start.len(),
+                objective.dim()
+            ),
+        });
+    }
     let started = Instant::now();
     let report = minimize(
-        optimizer.as_mut(),
-        &mut rng,
+        optimizer,
+        rng,
         |xs, out| {
             xs.par_iter().zip(out.par_iter_mut()).for_each_init(
                 || objective.scratch(),
@@ -72,8 +105,9 @@ pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Resul
     let mut scratch = objective.scratch();
     let mut report = report;
     let mut clamped = start.to_vec();
-    if let Some(b) = &settings.bounds {
-        b.clamp(&mut clamped);
+    let (lower, upper) = objective.active().bounds();
+    for ((x, lo), hi) in clamped.iter_mut().zip(&lower).zip(&upper) {
+        *x = x.clamp(*lo, *hi);
     }
     let start_cost = objective.eval(&clamped, &mut scratch);
     report.evaluations += 1;

@@ -66,6 +66,17 @@ impl Objective {
         }
     }
 
+    /// The same objective in another world (builder form of [`Objective::set_world`]).
+    pub fn with_world(mut self, world: World) -> Self {
+        self.world = world;
+        self
+    }
+
+    /// Replaces the world the collision and world-dependent costs see.
+    pub fn set_world(&mut self, world: World) {
+        self.world = world;
+    }
+
     /// Adds a term `weight · cost` (weight finite and ≥ 0).
     pub fn add(&mut self, weight: f64, cost: Box<dyn Cost>) -> Result<()> {
         if !(weight.is_finite() && weight >= 0.0) {
@@ -227,8 +238,14 @@ impl Objective {
 
     /// Whether `q` is free of self- and world collisions.
     pub fn is_collision_free(&self, q: &[f64], scratch: &mut Scratch) -> bool {
+        self.is_collision_free_in(q, &self.world, scratch)
+    }
+
+    /// Whether `q` is free of self-collisions and of collisions with `world` (another world
+    /// than the objective's: the planner's current one, say).
+    pub fn is_collision_free_in(&self, q: &[f64], world: &World, scratch: &mut Scratch) -> bool {
         self.pose(q, scratch, true);
-        !self.collision.is_colliding(&scratch.placed, &self.world)
+        !self.collision.is_colliding(&scratch.placed, world)
     }
 
     /// The task vector g(q) (empty without a task function).

@@ -4,12 +4,12 @@
 //! the file, line, column and field, and suggest the closest valid names.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use trm_collision::{CollisionModel, World, WorldSpec};
 use trm_kinematics::nalgebra::Vector3;
-use trm_kinematics::{ActiveSet, FrameId, FrameSpec, ModelDescription, RobotModel, closest_names};
+use trm_kinematics::{ActiveSet, FrameId, FrameSpec, RobotModel, closest_names};
 
 use crate::context::Anchor;
 use crate::costs::{
@@ -443,8 +443,8 @@ impl Problem {
 
     fn build(spec: Spec, text: &str, origin: &str, base: &Path) -> Result<Self> {
         let ctx = Ctx { origin, text };
-        let (robot, source) = load_model(&spec.model, base, &ctx)?;
-        let robot = with_frames(robot, source, &spec.frames, &ctx)?;
+        let robot = load_model(&spec.model, base, &ctx)?;
+        let robot = with_frames(robot, &spec.frames, &ctx)?;
         let mut motors = match &spec.start {
             None => robot
                 .posture("home")
@@ -590,92 +590,29 @@ impl Problem {
     }
 }
 
-/// What a model was built from, so that spec frames can be added: (URDF text, URDF origin,
-/// description).
-type ModelSource = (String, String, ModelDescription);
-
-fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<(RobotModel, ModelSource)> {
-    let embedded: [(&str, &str, &str, Option<&str>); 3] = [
-        (
-            "icub_upper_body",
-            trm_models::ICUB_UPPER_BODY_URDF,
-            "models/icub_upper_body.urdf",
-            Some(trm_models::ICUB_UPPER_BODY_RON),
+/// The spec's model: an embedded one by name or a file relative to the spec
+/// ([`trm_models::load`]), with errors located at the spec's `model` field.
+fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<RobotModel> {
+    trm_models::load(name, base).map_err(|e| match e {
+        trm_kinematics::KinematicsError::UnknownModel { looked_for, .. } => ctx.err(
+            "model",
+            &format!("\"{name}\""),
+            format!(
+                "`{name}` is neither an embedded model nor a file (looked for {})",
+                looked_for.display()
+            ),
+            ctx.suggest(
+                name,
+                trm_models::NAMES.iter().copied(),
+                "give a .urdf/.ron path relative to the spec, or icub_upper_body",
+            ),
         ),
-        (
-            "planar_arm",
-            trm_models::PLANAR_ARM_URDF,
-            "models/planar_arm.urdf",
-            None,
-        ),
-        (
-            "branched_tree",
-            trm_models::BRANCHED_TREE_URDF,
-            "models/branched_tree.urdf",
-            None,
-        ),
-    ];
-    let (urdf, origin, description) =
-        if let Some((_, urdf, origin, ron)) = embedded.iter().find(|(n, ..)| *n == name) {
-            let description = match ron {
-                Some(text) => ModelDescription::from_ron(text, "models/icub_upper_body.ron")?,
-                None => ModelDescription::default(),
-            };
-            (urdf.to_string(), origin.to_string(), description)
-        } else {
-            let path: PathBuf = base.join(name);
-            if !path.is_file() {
-                return Err(ctx.err(
-                    "model",
-                    &format!("\"{name}\""),
-                    format!(
-                        "`{name}` is neither an embedded model nor a file (looked for {})",
-                        path.display()
-                    ),
-                    ctx.suggest(
-                        name,
-                        embedded.iter().map(|e| e.0),
-                        "give a .urdf/.ron path relative to the spec, or icub_upper_body",
-                    ),
-                ));
-            }
-            let read = |p: &Path| {
-                std::fs::read_to_string(p).map_err(|e| TaskError::Io {
-                    path: p.display().to_string(),
-                    message: e.to_string(),
-                })
-            };
-            if path.extension().is_some_and(|e| e == "ron") {
-                let text = read(&path)?;
-                let description = ModelDescription::from_ron(&text, &path.display().to_string())?;
-                let urdf_path = path
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .join(&description.urdf);
-                (
-                    read(&urdf_path)?,
-                    urdf_path.display().to_string(),
-                    description,
-                )
-            } else {
-                (
-                    read(&path)?,
-                    path.display().to_string(),
-                    ModelDescription::default(),
-                )
-            }
-        };
-    let robot = RobotModel::from_parts(&urdf, &origin, &description, None)?;
-    Ok((robot, (urdf, origin, description)))
+        other => other.into(),
+    })
 }
 
 /// The model with the spec's extra frames added (checked here, so errors point into the spec).
-fn with_frames(
-    robot: RobotModel,
-    source: ModelSource,
-    frames: &[FrameSpec],
-    ctx: &Ctx,
-) -> Result<RobotModel> {
+fn with_frames(robot: RobotModel, frames: &[FrameSpec], ctx: &Ctx) -> Result<RobotModel> {
     if frames.is_empty() {
         return Ok(robot);
     }
@@ -711,9 +648,7 @@ fn with_frames(
         }
         known.push(f.name.clone());
     }
-    let (urdf, origin, mut description) = source;
-    description.frames.extend(frames.iter().cloned());
-    Ok(RobotModel::from_parts(&urdf, &origin, &description, None)?)
+    Ok(robot.with_frames(frames, ctx.origin)?)
 }
 
 struct Resolver<'a> {

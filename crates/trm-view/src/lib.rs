@@ -375,7 +375,11 @@ impl Scene {
 
     /// Reads a scene file.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
-        Ok(trm_kinematics::load_versioned(path.as_ref(), FORMAT, VERSION)?)
+        Ok(trm_kinematics::load_versioned(
+            path.as_ref(),
+            FORMAT,
+            VERSION,
+        )?)
     }
 
     /// One self-contained HTML page that renders the scene. `bundle`: the built viewer

@@ -141,7 +141,11 @@ impl Rollout {
             let _ = writeln!(
                 text,
                 ",{:.6},{:.6},{:.6},{:.6},{:.6}",
-                self.com[i][0], self.com[i][2], self.com_desired[i][0], self.com_desired[i][1], self.zmp[i][0]
+                self.com[i][0],
+                self.com[i][2],
+                self.com_desired[i][0],
+                self.com_desired[i][1],
+                self.zmp[i][0]
             );
         }
         text
@@ -179,11 +183,7 @@ impl WholeBody {
         let (spec, text) = MotionSpec::load(path)?;
         let origin = path.display().to_string();
         let base = path.parent().unwrap_or(Path::new("."));
-        let model = if spec.model == "icub_sagittal" {
-            trm_models::icub_sagittal()
-        } else {
-            RobotModel::load(base.join(&spec.model))?
-        };
+        let model = trm_models::load(&spec.model, base)?;
         Self::new(spec, model, &origin, &text)
     }
 
@@ -744,8 +744,10 @@ impl WholeBody {
             .iter()
             .filter(|p| match (&p.other, &self.seat) {
                 (Other::Object(o), Some((seat, contacts, _))) if seated && o == seat => {
-                    let link = p.body.split('#').next().unwrap_or(&p.body);
-                    !contacts.iter().any(|c| c == link)
+                    let link = self.collision.bodies()[p.body_index].link;
+                    !contacts
+                        .iter()
+                        .any(|c| self.model().tree().links[link].name == *c)
                 }
                 (Other::Object(_), _) => true,
                 _ => false,
