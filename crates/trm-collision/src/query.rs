@@ -22,7 +22,6 @@ impl CollisionCount {
 
 /// What a body touched.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
 pub enum Other {
     /// Another body of the robot.
     Body(String),

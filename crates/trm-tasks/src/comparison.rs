@@ -3,7 +3,7 @@
 //! seeded runs each, with the paper's settings.
 //!
 //! ```
-//! # let spec = r#"(model: "planar_arm", active: ["all"],
+//! # let spec = r#"(model: "planar_arm",
 //! #     costs: [(weight: 1.0, cost: Position(part: "tool", target: Point((0.5, 0.5, 0.0))))])"#;
 //! # let problem = trm_tasks::Problem::from_ron(spec, "<example>", std::path::Path::new("."))?;
 //! use trm_tasks::Comparison;
