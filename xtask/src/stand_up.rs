@@ -382,8 +382,7 @@ fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
         s.ends.last().copied().unwrap_or(0.0)
     );
     let mut scene = trm_view::Scene::new(&title, problem.collision());
-    let world = trm_collision::World::from_spec(&problem.spec().world, "spec world")?;
-    scene.set_world(&world);
+    scene.set_world(problem.ground_world());
     let r = &s.rollout;
     // every 5th control step (20 frames per second) keeps the page light
     for i in (0..r.times.len()).step_by(5) {

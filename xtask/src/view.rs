@@ -80,7 +80,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
                     robot: motion.model().clone(),
                     active: None,
                     start: motion.keyframes().0.to_vec(),
-                    world: World::from_spec(&motion.spec().world, &title)?,
+                    world: motion.ground_world().clone(),
                     title,
                     motion: Some(motion),
                 })

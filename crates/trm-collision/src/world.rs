@@ -88,23 +88,49 @@ impl World {
         Self::default()
     }
 
-    /// Builds a world from its RON form; `origin` names the source in errors.
+    /// Builds a world from parsed RON data; `origin` names the source in errors.
     pub fn from_spec(spec: &WorldSpec, origin: &str) -> Result<Self> {
+        Self::build(spec, origin, None)
+    }
+
+    /// Builds a world from RON data parsed out of `text`, where it sits at field path `at`
+    /// (`""` for a world file, `"world"` inside a task spec), so that an error names the line
+    /// of the object it is about.
+    pub fn from_spec_in(spec: &WorldSpec, origin: &str, text: &str, at: &str) -> Result<Self> {
+        Self::build(spec, origin, Some((text, at)))
+    }
+
+    fn build(spec: &WorldSpec, origin: &str, located: Option<(&str, &str)>) -> Result<Self> {
         let mut world = World::new();
-        for o in &spec.objects {
+        for (i, o) in spec.objects.iter().enumerate() {
+            let path = match located {
+                Some((_, "")) | None => format!("objects[{i}]"),
+                Some((_, at)) => format!("{at}.objects[{i}]"),
+            };
+            let line = located
+                .and_then(|(text, _)| trm_kinematics::locate_ron_path(text, &path))
+                .map(|(line, _)| line);
+            let element = format!("{path} (\"{}\")", o.name);
             world
                 .add(&o.name, o.shape.clone(), pose_from_xyz_rpy(o.xyz, o.rpy))
                 .map_err(|e| match e {
                     CollisionError::InvalidShape { problem, fix, .. } => {
                         CollisionError::InvalidShape {
                             origin: origin.to_string(),
-                            line: None,
-                            element: format!("object \"{}\"", o.name),
+                            line,
+                            element: element.clone(),
                             problem,
                             fix,
                         }
                     }
-                    other => other,
+                    other => CollisionError::InvalidShape {
+                        origin: origin.to_string(),
+                        line,
+                        element: element.clone(),
+                        problem: other.to_string(),
+                        fix: "give every object a unique name, a finite pose and a valid shape"
+                            .into(),
+                    },
                 })?;
         }
         Ok(world)
@@ -112,13 +138,20 @@ impl World {
 
     /// Parses a RON world; `origin` names the source in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
-        let spec: WorldSpec = ron::from_str(text).map_err(|e| CollisionError::MalformedWorld {
-            origin: origin.to_string(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
+        let spec: WorldSpec = ron::from_str(text).map_err(|e| {
+            let p = trm_kinematics::explain_ron_error(&e);
+            CollisionError::MalformedWorld {
+                origin: origin.to_string(),
+                line: p.line,
+                column: p.column,
+                message: if p.fix.is_empty() {
+                    p.problem
+                } else {
+                    format!("{}; {}", p.problem, p.fix)
+                },
+            }
         })?;
-        Self::from_spec(&spec, origin)
+        Self::from_spec_in(&spec, origin, text, "")
     }
 
     /// Reads a RON world file.
@@ -205,6 +238,21 @@ impl World {
         let i = self.index(name)?;
         check_pose(&format!("world object `{name}`"), &pose)?;
         let o = &mut self.objects[i];
+        o.pose = pose;
+        o.compiled.place(&pose, &mut o.placed);
+        Ok(())
+    }
+
+    /// Moves the object at `index` (into [`World::objects`]): the index-based form of
+    /// [`World::set_pose`], for loops that move every object each step.
+    pub fn set_pose_at(&mut self, index: usize, pose: Isometry3<f64>) -> Result<()> {
+        let Some(o) = self.objects.get_mut(index) else {
+            return Err(CollisionError::InvalidValue {
+                what: "world object index".into(),
+                problem: format!("{index} is beyond the {} objects", self.objects.len()),
+            });
+        };
+        check_pose(&format!("world object `{}`", o.name), &pose)?;
         o.pose = pose;
         o.compiled.place(&pose, &mut o.placed);
         Ok(())

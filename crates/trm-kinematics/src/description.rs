@@ -157,11 +157,18 @@ pub struct PostureSpec {
 impl ModelDescription {
     /// Parses RON text; `origin` names the file in errors.
     pub fn from_ron(text: &str, origin: &str) -> crate::Result<Self> {
-        ron::from_str(text).map_err(|e| crate::KinematicsError::MalformedDescription {
-            origin: origin.to_string(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
+        ron::from_str(text).map_err(|e| {
+            let p = crate::explain_ron_error(&e);
+            crate::KinematicsError::MalformedDescription {
+                origin: origin.to_string(),
+                line: p.line,
+                column: p.column,
+                message: if p.fix.is_empty() {
+                    p.problem
+                } else {
+                    format!("{}; {}", p.problem, p.fix)
+                },
+            }
         })
     }
 }

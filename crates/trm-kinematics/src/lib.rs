@@ -54,7 +54,7 @@ pub use files::{FileError, load_versioned, parse_versioned, save_json, write_ato
 pub use fk::PoseBuffer;
 pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
-pub use ron_path::locate_ron_path;
 pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
+pub use ron_path::{RonProblem, explain_ron_error, locate_ron_path};
 pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use urdf_rs;

@@ -822,7 +822,7 @@ fn compile_plans(tree: &Tree, frames: &[NamedFrame], couplings: &[Coupling]) -> 
             terms: t,
         })
         .collect();
-    let joint_plan = Plan::compile(&tree, &frame_offsets, &joint_rows);
+    let joint_plan = Plan::compile(tree, &frame_offsets, &joint_rows);
     let motor_rows: Vec<AffineRow> = couplings
         .iter()
         .map(|c| AffineRow {
@@ -830,7 +830,7 @@ fn compile_plans(tree: &Tree, frames: &[NamedFrame], couplings: &[Coupling]) -> 
             terms: &c.terms,
         })
         .collect();
-    let motor_plan = Plan::compile(&tree, &frame_offsets, &motor_rows);
+    let motor_plan = Plan::compile(tree, &frame_offsets, &motor_rows);
     (joint_plan, motor_plan)
 }
 

@@ -32,6 +32,66 @@ pub fn locate_ron_path(text: &str, path: &str) -> Option<(usize, usize)> {
     Some(line_column(text, position))
 }
 
+/// A RON parse error explained for people: where, what, and how to fix it (the closest valid
+/// names for an unknown field or variant).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RonProblem {
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What is wrong.
+    pub problem: String,
+    /// What to do about it (may be empty).
+    pub fix: String,
+}
+
+/// Explains a RON parse error (the one reader behind every RON file of trm: model
+/// descriptions, worlds, task specs, motion specs).
+pub fn explain_ron_error(e: &ron::error::SpannedError) -> RonProblem {
+    use ron::error::Error as E;
+    let suggestion = |found: &str, expected: &[&str]| {
+        let near = crate::closest_names(found, expected.iter().copied());
+        if near.is_empty() {
+            format!("expected one of `{}`", expected.join("`, `"))
+        } else {
+            format!(
+                "did you mean `{}`? (expected one of `{}`)",
+                near.join("`, `"),
+                expected.join("`, `")
+            )
+        }
+    };
+    let (problem, fix) = match &e.code {
+        E::NoSuchEnumVariant {
+            expected, found, ..
+        } => (
+            format!("unknown variant `{found}`"),
+            suggestion(found, expected),
+        ),
+        E::NoSuchStructField {
+            expected, found, ..
+        } => (
+            format!("unknown field `{found}`"),
+            suggestion(found, expected),
+        ),
+        E::MissingStructField { field, .. } => (
+            format!("missing field `{field}`"),
+            format!("add `{field}: ...`"),
+        ),
+        E::DuplicateStructField { field, .. } => {
+            (format!("field `{field}` is given twice"), "keep one".into())
+        }
+        other => (other.to_string(), String::new()),
+    };
+    RonProblem {
+        line: e.span.start.line,
+        column: e.span.start.col,
+        problem,
+        fix,
+    }
+}
+
 /// One step of a path.
 #[derive(Debug, PartialEq)]
 enum Segment {
@@ -80,9 +140,11 @@ enum Kind {
 impl Node {
     fn child(&self, segment: &Segment) -> Option<(&Node, usize)> {
         match (&self.kind, segment) {
-            (Kind::Struct(fields), Segment::Field(name)) | (Kind::Map(fields), Segment::Field(name)) => {
-                fields.iter().find(|(k, ..)| k == name).map(|(_, at, v)| (v, *at))
-            }
+            (Kind::Struct(fields), Segment::Field(name))
+            | (Kind::Map(fields), Segment::Field(name)) => fields
+                .iter()
+                .find(|(k, ..)| k == name)
+                .map(|(_, at, v)| (v, *at)),
             (Kind::Seq(items), Segment::Index(i)) => items.get(*i).map(|v| (v, v.start)),
             // a newtype wrapper (`Some(…)`, a variant holding one struct) is looked through
             (Kind::Seq(items), Segment::Field(_)) if items.len() == 1 => items[0].child(segment),
@@ -116,7 +178,8 @@ impl Scanner<'_> {
                 Some(b'/') if self.bytes.get(self.at + 1) == Some(&b'*') => {
                     self.at += 2;
                     while self.at < self.bytes.len()
-                        && !(self.bytes[self.at] == b'*' && self.bytes.get(self.at + 1) == Some(&b'/'))
+                        && !(self.bytes[self.at] == b'*'
+                            && self.bytes.get(self.at + 1) == Some(&b'/'))
                     {
                         self.at += 1;
                     }
@@ -151,7 +214,12 @@ impl Scanner<'_> {
         self.at += 1; // the quote
         while self.at < self.bytes.len() {
             if self.bytes[self.at] == b'"'
-                && self.bytes[self.at + 1..].iter().take(hashes).filter(|&&c| c == b'#').count() == hashes
+                && self.bytes[self.at + 1..]
+                    .iter()
+                    .take(hashes)
+                    .filter(|&&c| c == b'#')
+                    .count()
+                    == hashes
             {
                 self.at += 1 + hashes;
                 return;
@@ -162,7 +230,10 @@ impl Scanner<'_> {
 
     fn identifier(&mut self) -> String {
         let start = self.at;
-        while self.peek().is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_') {
+        while self
+            .peek()
+            .is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_')
+        {
             self.at += 1;
         }
         String::from_utf8_lossy(&self.bytes[start..self.at]).into_owned()
@@ -197,10 +268,9 @@ impl Scanner<'_> {
             }
             _ => {
                 // numbers, chars, signs: up to the next delimiter
-                while self
-                    .peek()
-                    .is_some_and(|c| !matches!(c, b',' | b')' | b']' | b'}' | b':') && !c.is_ascii_whitespace())
-                {
+                while self.peek().is_some_and(|c| {
+                    !matches!(c, b',' | b')' | b']' | b'}' | b':') && !c.is_ascii_whitespace()
+                }) {
                     self.at += 1;
                 }
                 Kind::Atom
@@ -215,7 +285,10 @@ impl Scanner<'_> {
         self.at += 1;
         self.skip();
         let first = self.at;
-        let is_struct = if self.peek().is_some_and(|c| c.is_ascii_alphabetic() || c == b'_') {
+        let is_struct = if self
+            .peek()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == b'_')
+        {
             self.identifier();
             self.skip();
             self.peek() == Some(b':')
@@ -285,7 +358,8 @@ impl Scanner<'_> {
                 _ => {
                     let key_at = self.at;
                     let key_node = self.value(depth + 1)?;
-                    let raw = String::from_utf8_lossy(&self.bytes[key_node.start..self.at]).into_owned();
+                    let raw =
+                        String::from_utf8_lossy(&self.bytes[key_node.start..self.at]).into_owned();
                     self.skip();
                     if self.peek()? != b':' {
                         return None;
@@ -333,8 +407,14 @@ mod tests {
         assert_eq!(locate_ron_path(SPEC, "world.objects[1].xyz"), Some((7, 52)));
         assert_eq!(locate_ron_path(SPEC, "world.objects[1]"), Some((7, 9)));
         assert_eq!(locate_ron_path(SPEC, "costs[1].cost.part"), Some((11, 38)));
-        assert_eq!(locate_ron_path(SPEC, "costs[0].cost.weights.torso"), Some((10, 51)));
-        assert_eq!(locate_ron_path(SPEC, "world.objects[1].shape.radius"), Some((7, 37)));
+        assert_eq!(
+            locate_ron_path(SPEC, "costs[0].cost.weights.torso"),
+            Some((10, 51))
+        );
+        assert_eq!(
+            locate_ron_path(SPEC, "world.objects[1].shape.radius"),
+            Some((7, 37))
+        );
         assert_eq!(locate_ron_path(SPEC, "costs[2]"), None);
         assert_eq!(locate_ron_path(SPEC, "solver.seed"), None);
         assert_eq!(locate_ron_path(SPEC, ""), Some((2, 1)));
@@ -342,7 +422,17 @@ mod tests {
 
     #[test]
     fn broken_or_hostile_text_gives_none_not_a_panic() {
-        for text in ["", "(", "(a: ", "((((((", "(a: [1, 2", "\"unterminated", "r#\"x", "{1: }", "(a b)"] {
+        for text in [
+            "",
+            "(",
+            "(a: ",
+            "((((((",
+            "(a: [1, 2",
+            "\"unterminated",
+            "r#\"x",
+            "{1: }",
+            "(a b)",
+        ] {
             let _ = locate_ron_path(text, "a[0].b");
         }
         let deep = "(".repeat(100_000);

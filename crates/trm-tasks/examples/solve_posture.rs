@@ -3,7 +3,7 @@
 //!
 //! `cargo run -p trm-tasks --example solve_posture [-- SPEC.ron]`
 
-use trm_tasks::{Problem, TaskError, solve};
+use trm_tasks::{Problem, solve};
 
 const SPEC: &str = r#"(
     model: "icub_upper_body",
@@ -17,7 +17,7 @@ const SPEC: &str = r#"(
     solver: (max_evaluations: 6000, seed: 1),
 )"#;
 
-fn main() -> Result<(), TaskError> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let problem = match std::env::args().nth(1) {
         Some(path) => Problem::load(path)?,
         None => Problem::from_ron(SPEC, "<example>", std::path::Path::new("."))?,

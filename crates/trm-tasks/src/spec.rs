@@ -377,13 +377,17 @@ pub struct Problem {
     pub start: Vec<f64>,
 }
 
-/// Finds the first occurrence of `needle` in `text` outside comments: (line, column), 1-based.
-/// Spec readers use it to point an error at the offending name.
-pub fn locate(text: &str, needle: &str) -> Option<(usize, usize)> {
-    text.lines().enumerate().find_map(|(i, l)| {
-        let code = l.split("//").next().unwrap_or("");
-        code.find(needle).map(|c| (i + 1, c + 1))
-    })
+/// 1-based (line, column) of field path `field` (`solver.sigma`, `costs[2].cost.part`) in spec
+/// text, or of the nearest ancestor the text spells out (a field left at its default is not
+/// written): [`trm_kinematics::locate_ron_path`].
+pub fn locate_field(text: &str, field: &str) -> Option<(usize, usize)> {
+    let mut path = field;
+    loop {
+        if let Some(at) = trm_kinematics::locate_ron_path(text, path) {
+            return Some(at);
+        }
+        path = &path[..path.rfind(['.', '['])?];
+    }
 }
 
 struct Ctx<'a> {
@@ -392,16 +396,12 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn err(
-        &self,
-        field: &str,
-        needle: &str,
-        problem: impl Into<String>,
-        fix: impl Into<String>,
-    ) -> TaskError {
+    /// A spec error at field path `field` (`costs[2].cost.part`), located in the text by that
+    /// path — or by its nearest ancestor the text spells out.
+    fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskError {
         TaskError::Spec {
             origin: self.origin.to_string(),
-            position: locate(self.text, needle),
+            position: locate_field(self.text, field),
             field: field.to_string(),
             problem: problem.into(),
             fix: fix.into(),
@@ -453,7 +453,6 @@ impl Problem {
             Some(start) => robot.posture(start).map(<[f64]>::to_vec).map_err(|_| {
                 ctx.err(
                     "start",
-                    &format!("\"{start}\""),
                     format!("`{start}` is no posture of the model"),
                     ctx.suggest(
                         start,
@@ -466,8 +465,7 @@ impl Problem {
         for (name, v) in &spec.start_values {
             let i = robot.motor_index(name).map_err(|_| {
                 ctx.err(
-                    "start_values",
-                    &format!("\"{name}\""),
+                    &format!("start_values.{name}"),
                     format!("`{name}` is no motor"),
                     ctx.suggest(
                         name,
@@ -481,7 +479,7 @@ impl Problem {
         let active = if spec.active.is_empty() {
             robot.all_active()
         } else {
-            for name in &spec.active {
+            for (i, name) in spec.active.iter().enumerate() {
                 if robot.select_motors(&[name]).is_err() {
                     let candidates = robot
                         .motors()
@@ -489,8 +487,7 @@ impl Problem {
                         .map(|m| m.name.as_str())
                         .chain(robot.groups().map(|(g, _)| g));
                     return Err(ctx.err(
-                        "active",
-                        &format!("\"{name}\""),
+                        &format!("active[{i}]"),
                         format!("`{name}` is no motor or group"),
                         ctx.suggest(name, candidates, "use motor or group names"),
                     ));
@@ -498,12 +495,11 @@ impl Problem {
             }
             robot.active_set(&spec.active, &motors)?
         };
-        let world = World::from_spec(&spec.world, origin)?;
+        let world = World::from_spec_in(&spec.world, origin, text, "world")?;
         let collision = CollisionModel::new(&robot)?;
         let start = active.from_motors(&motors);
         if spec.costs.is_empty() {
             return Err(ctx.err(
-                "costs",
                 "costs",
                 "the list is empty",
                 "add at least one weighted cost term",
@@ -520,7 +516,6 @@ impl Problem {
             if !(c.weight.is_finite() && c.weight >= 0.0) {
                 return Err(ctx.err(
                     &format!("costs[{k}].weight"),
-                    &format!("weight: {}", c.weight),
                     format!("{} is not a finite number ≥ 0", c.weight),
                     "weights are non-negative multipliers",
                 ));
@@ -542,7 +537,6 @@ impl Problem {
             if !(n.sigma.is_finite() && n.sigma >= 0.0) {
                 return Err(ctx.err(
                     "noise.sigma",
-                    "sigma",
                     format!("{} is not a finite number ≥ 0", n.sigma),
                     "give a standard deviation in radians",
                 ));
@@ -552,7 +546,6 @@ impl Problem {
         if !trm_optim::ALGORITHMS.contains(&spec.solver.algo.as_str()) {
             return Err(ctx.err(
                 "solver.algo",
-                &format!("\"{}\"", spec.solver.algo),
                 format!("unknown algorithm `{}`", spec.solver.algo),
                 ctx.suggest(
                     &spec.solver.algo,
@@ -564,7 +557,6 @@ impl Problem {
         if !(spec.solver.sigma.is_finite() && spec.solver.sigma > 0.0) {
             return Err(ctx.err(
                 "solver.sigma",
-                "sigma",
                 "must be positive",
                 "give an initial step in radians",
             ));
@@ -573,7 +565,6 @@ impl Problem {
             if !(m.spacing.is_finite() && m.spacing > 0.0) {
                 return Err(ctx.err(
                     "map.spacing",
-                    "spacing",
                     "must be positive",
                     "give the task-space spacing d",
                 ));
@@ -596,7 +587,6 @@ fn load_model(name: &str, base: &Path, ctx: &Ctx) -> Result<RobotModel> {
     trm_models::load(name, base).map_err(|e| match e {
         trm_kinematics::KinematicsError::UnknownModel { looked_for, .. } => ctx.err(
             "model",
-            &format!("\"{name}\""),
             format!(
                 "`{name}` is neither an embedded model nor a file (looked for {})",
                 looked_for.display()
@@ -617,19 +607,17 @@ fn with_frames(robot: RobotModel, frames: &[FrameSpec], ctx: &Ctx) -> Result<Rob
         return Ok(robot);
     }
     let mut known: Vec<String> = robot.frame_names().map(str::to_string).collect();
-    for f in frames {
+    for (i, f) in frames.iter().enumerate() {
         if known.contains(&f.name) {
             return Err(ctx.err(
-                "frames",
-                &format!("\"{}\"", f.name),
+                &format!("frames[{i}].name"),
                 format!("`{}` already names a link or frame", f.name),
                 "choose a new name",
             ));
         }
         if !known.contains(&f.link) {
             return Err(ctx.err(
-                "frames",
-                &format!("\"{}\"", f.link),
+                &format!("frames[{i}].link"),
                 format!("`{}` is no link or earlier frame", f.link),
                 ctx.suggest(
                     &f.link,
@@ -640,8 +628,7 @@ fn with_frames(robot: RobotModel, frames: &[FrameSpec], ctx: &Ctx) -> Result<Rob
         }
         if f.xyz.iter().chain(&f.rpy).any(|v| !v.is_finite()) {
             return Err(ctx.err(
-                "frames",
-                &format!("\"{}\"", f.name),
+                &format!("frames[{i}]"),
                 "the offset is not finite",
                 "write finite numbers",
             ));
@@ -663,7 +650,6 @@ impl Resolver<'_> {
         self.robot.frame_id(name).map_err(|_| {
             self.ctx.err(
                 field,
-                &format!("\"{name}\""),
                 format!("`{name}` is no link or named frame of the model"),
                 self.ctx.suggest(
                     name,
@@ -686,7 +672,6 @@ impl Resolver<'_> {
         self.world.index(name).map_err(|_| {
             self.ctx.err(
                 field,
-                &format!("\"{name}\""),
                 format!("`{name}` is no world object"),
                 self.ctx.suggest(
                     name,
@@ -703,7 +688,6 @@ impl Resolver<'_> {
         } else {
             Err(self.ctx.err(
                 field,
-                field,
                 format!("{v:?} is not finite"),
                 "write finite numbers",
             ))
@@ -716,7 +700,6 @@ impl Resolver<'_> {
         if n < 1e-12 {
             return Err(self.ctx.err(
                 field,
-                field,
                 "the axis is zero",
                 "give a non-zero axis, e.g. (0, 0, 1)",
             ));
@@ -728,22 +711,18 @@ impl Resolver<'_> {
         if m.iter().any(|b| *b) {
             Ok(m)
         } else {
-            Err(self.ctx.err(
-                field,
-                "mask",
-                "masks every axis out",
-                "keep at least one axis",
-            ))
+            Err(self
+                .ctx
+                .err(field, "masks every axis out", "keep at least one axis"))
         }
     }
 
-    fn positive(&self, v: f64, field: &str, name: &str) -> Result<f64> {
+    fn positive(&self, v: f64, field: &str) -> Result<f64> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
             Err(self.ctx.err(
                 field,
-                name,
                 format!("{v} must be positive"),
                 "give a positive length",
             ))
@@ -765,8 +744,7 @@ impl Resolver<'_> {
                     None => motors.to_vec(),
                     Some(p) => self.robot.posture(p).map(<[f64]>::to_vec).map_err(|_| {
                         self.ctx.err(
-                            &field,
-                            &format!("\"{p}\""),
+                            &format!("{field}.cost.posture"),
                             format!("`{p}` is no posture"),
                             self.ctx.suggest(
                                 p,
@@ -780,8 +758,7 @@ impl Resolver<'_> {
                 for (name, value) in weights {
                     if !(value.is_finite() && *value >= 0.0) {
                         return Err(self.ctx.err(
-                            &field,
-                            &format!("\"{name}\""),
+                            &format!("{field}.cost.weights.{name}"),
                             format!("weight {value} is not a finite number ≥ 0"),
                             "use non-negative weights",
                         ));
@@ -794,8 +771,7 @@ impl Resolver<'_> {
                             .map(|m| m.name.as_str())
                             .chain(self.robot.groups().map(|(g, _)| g));
                         self.ctx.err(
-                            &field,
-                            &format!("\"{name}\""),
+                            &format!("{field}.cost.weights.{name}"),
                             format!("`{name}` is no motor or group"),
                             self.ctx
                                 .suggest(name, candidates, "use motor or group names"),
@@ -821,15 +797,23 @@ impl Resolver<'_> {
             }),
             CostKind::Position { part, target, mask } => {
                 let target = match target {
-                    TargetSpec::Part(p) => Region::Point(Anchor::Frame(self.frame(p, &field)?)),
-                    TargetSpec::Object(o) => Region::Point(Anchor::Object(self.object(o, &field)?)),
-                    TargetSpec::Point(p) => Region::Point(Anchor::Point(self.finite(*p, &field)?)),
+                    TargetSpec::Part(p) => Region::Point(Anchor::Frame(
+                        self.frame(p, &format!("{field}.cost.target"))?,
+                    )),
+                    TargetSpec::Object(o) => Region::Point(Anchor::Object(
+                        self.object(o, &format!("{field}.cost.target"))?,
+                    )),
+                    TargetSpec::Point(p) => Region::Point(Anchor::Point(
+                        self.finite(*p, &format!("{field}.cost.target"))?,
+                    )),
                     TargetSpec::Box { min, max } => {
-                        let (min, max) = (self.finite(*min, &field)?, self.finite(*max, &field)?);
+                        let (min, max) = (
+                            self.finite(*min, &format!("{field}.cost.target.min"))?,
+                            self.finite(*max, &format!("{field}.cost.target.max"))?,
+                        );
                         if (0..3).any(|i| min[i] > max[i]) {
                             return Err(self.ctx.err(
-                                &field,
-                                "min",
+                                &format!("{field}.cost.target.min"),
                                 "a box min exceeds its max",
                                 "swap the corners",
                             ));
@@ -837,26 +821,29 @@ impl Resolver<'_> {
                         Region::Box { min, max }
                     }
                     TargetSpec::Sphere { center, radius } => Region::Sphere {
-                        center: self.anchor(center, &field)?,
-                        radius: self.positive(*radius, &field, "radius")?,
+                        center: self.anchor(center, &format!("{field}.cost.target.center"))?,
+                        radius: self.positive(*radius, &format!("{field}.cost.target.radius"))?,
                     },
                 };
                 Box::new(Position {
-                    part: self.frame(part, &field)?,
+                    part: self.frame(part, &format!("{field}.cost.part"))?,
                     part_name: part.clone(),
                     target,
-                    mask: self.mask(*mask, &field)?,
+                    mask: self.mask(*mask, &format!("{field}.cost.mask"))?,
                 })
             }
             CostKind::Orientation { part, axis, toward } => Box::new(Orientation {
-                part: self.frame(part, &field)?,
+                part: self.frame(part, &format!("{field}.cost.part"))?,
                 part_name: part.clone(),
-                axis: self.unit(*axis, &field)?,
+                axis: self.unit(*axis, &format!("{field}.cost.axis"))?,
                 target: match toward {
-                    DirectionSpec::Fixed(d) => Direction::Fixed(self.unit(*d, &field)?),
-                    DirectionSpec::Axis { part, axis } => {
-                        Direction::Axis(self.frame(part, &field)?, self.unit(*axis, &field)?)
+                    DirectionSpec::Fixed(d) => {
+                        Direction::Fixed(self.unit(*d, &format!("{field}.cost.toward"))?)
                     }
+                    DirectionSpec::Axis { part, axis } => Direction::Axis(
+                        self.frame(part, &format!("{field}.cost.toward.part"))?,
+                        self.unit(*axis, &format!("{field}.cost.toward.axis"))?,
+                    ),
                 },
             }),
             CostKind::Pointing {
@@ -865,12 +852,12 @@ impl Resolver<'_> {
                 at,
                 distance,
             } => Box::new(Pointing {
-                part: self.frame(part, &field)?,
+                part: self.frame(part, &format!("{field}.cost.part"))?,
                 part_name: part.clone(),
-                axis: self.unit(*axis, &field)?,
-                target: self.anchor(at, &field)?,
+                axis: self.unit(*axis, &format!("{field}.cost.axis"))?,
+                target: self.anchor(at, &format!("{field}.cost.at"))?,
                 distance: match distance {
-                    Some(d) => Some(self.positive(*d, &field, "distance")?),
+                    Some(d) => Some(self.positive(*d, &format!("{field}.cost.distance"))?),
                     None => None,
                 },
             }),
@@ -880,18 +867,19 @@ impl Resolver<'_> {
                 min_distance,
                 mask,
             } => Box::new(Repel {
-                a: self.anchor(a, &field)?,
-                b: self.anchor(b, &field)?,
+                a: self.anchor(a, &format!("{field}.cost.a"))?,
+                b: self.anchor(b, &format!("{field}.cost.b"))?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
-                min_distance: self.positive(*min_distance, &field, "min_distance")?,
-                mask: self.mask(*mask, &field)?,
+                min_distance: self
+                    .positive(*min_distance, &format!("{field}.cost.min_distance"))?,
+                mask: self.mask(*mask, &format!("{field}.cost.mask"))?,
             }),
             CostKind::JointLimits { margin } => {
                 let (lower, upper) = active.bounds();
                 Box::new(JointLimits {
                     lower,
                     upper,
-                    margin: self.positive(*margin, &field, "margin")?,
+                    margin: self.positive(*margin, &format!("{field}.cost.margin"))?,
                 })
             }
             CostKind::Displacement => Box::new(Displacement {
@@ -901,59 +889,57 @@ impl Resolver<'_> {
                 let path = self.base.join(file);
                 let map = trm_taskmap::TaskMap::load(&path).map_err(|e| {
                     self.ctx.err(
-                        &field,
-                        &format!("\"{file}\""),
+                        &format!("{field}.cost.file"),
                         e.to_string(),
                         "build it with trm_taskmap::explore (cargo xtask explore-task-map)",
                     )
                 })?;
                 Box::new(crate::costs::TaskMapCost {
                     map: std::sync::Arc::new(map),
-                    part: self.frame(part, &field)?,
+                    part: self.frame(part, &format!("{field}.cost.part"))?,
                     part_name: part.clone(),
-                    object: self.object(object, &field)?,
+                    object: self.object(object, &format!("{field}.cost.object"))?,
                 })
             }
         })
     }
 
     fn task(&self, t: &TaskSpec) -> Result<Box<dyn TaskFunction>> {
-        let field = "task";
         Ok(match t {
             TaskSpec::Position { part, mask } => Box::new(PositionTask {
-                part: self.frame(part, field)?,
+                part: self.frame(part, "task.part")?,
                 part_name: part.clone(),
-                mask: self.mask(*mask, field)?,
+                mask: self.mask(*mask, "task.mask")?,
             }),
             TaskSpec::Rotation { part, axis, mask } => Box::new(RotationTask {
-                part: self.frame(part, field)?,
+                part: self.frame(part, "task.part")?,
                 part_name: part.clone(),
-                axis: self.unit(*axis, field)?,
-                mask: self.mask(*mask, field)?,
+                axis: self.unit(*axis, "task.axis")?,
+                mask: self.mask(*mask, "task.mask")?,
             }),
             TaskSpec::Distance { a, b } => Box::new(DistanceTask {
-                a: self.anchor(a, field)?,
-                b: self.anchor(b, field)?,
+                a: self.anchor(a, "task.a")?,
+                b: self.anchor(b, "task.b")?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
             }),
             TaskSpec::Angle { a, b, u1, u2 } => Box::new(AngleTask {
-                a: self.anchor(a, field)?,
-                b: self.anchor(b, field)?,
+                a: self.anchor(a, "task.a")?,
+                b: self.anchor(b, "task.b")?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
-                u1: self.unit(*u1, field)?,
-                u2: self.unit(*u2, field)?,
+                u1: self.unit(*u1, "task.u1")?,
+                u2: self.unit(*u2, "task.u2")?,
             }),
             TaskSpec::Midpoint { a, b, mask } => Box::new(MidpointTask {
-                a: self.anchor(a, field)?,
-                b: self.anchor(b, field)?,
+                a: self.anchor(a, "task.a")?,
+                b: self.anchor(b, "task.b")?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
-                mask: self.mask(*mask, field)?,
+                mask: self.mask(*mask, "task.mask")?,
             }),
             TaskSpec::RodDirection { a, b, mask } => Box::new(RodDirectionTask {
-                a: self.anchor(a, field)?,
-                b: self.anchor(b, field)?,
+                a: self.anchor(a, "task.a")?,
+                b: self.anchor(b, "task.b")?,
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
-                mask: self.mask(*mask, field)?,
+                mask: self.mask(*mask, "task.mask")?,
             }),
         })
     }
@@ -968,44 +954,12 @@ fn anchor_name(a: &AnchorSpec) -> String {
 
 /// A RON error with its position and, for unknown names, the closest valid ones.
 pub fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
-    use ron::error::Error as E;
-    let (problem, fix) = match &e.code {
-        E::NoSuchEnumVariant {
-            expected, found, ..
-        } => (
-            format!("unknown variant `{found}`"),
-            suggestion(found, expected),
-        ),
-        E::NoSuchStructField {
-            expected, found, ..
-        } => (
-            format!("unknown field `{found}`"),
-            suggestion(found, expected),
-        ),
-        E::MissingStructField { field, .. } => (
-            format!("missing field `{field}`"),
-            format!("add `{field}: ...`"),
-        ),
-        other => (other.to_string(), String::new()),
-    };
+    let p = trm_kinematics::explain_ron_error(e);
     TaskError::Spec {
         origin: origin.to_string(),
-        position: Some((e.span.start.line, e.span.start.col)),
+        position: Some((p.line, p.column)),
         field: "spec".into(),
-        problem,
-        fix,
-    }
-}
-
-fn suggestion(found: &str, expected: &[&str]) -> String {
-    let near = closest_names(found, expected.iter().copied());
-    if near.is_empty() {
-        format!("expected one of `{}`", expected.join("`, `"))
-    } else {
-        format!(
-            "did you mean `{}`? (expected one of `{}`)",
-            near.join("`, `"),
-            expected.join("`, `")
-        )
+        problem: p.problem,
+        fix: p.fix,
     }
 }

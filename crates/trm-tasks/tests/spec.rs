@@ -185,3 +185,33 @@ fn spec_frames_become_parts() {
     );
     assert!(e.contains("already names"), "{e}");
 }
+
+#[test]
+fn errors_point_at_their_own_field_not_the_first_matching_word() {
+    // a bad solver.sigma after a good noise sigma
+    let e = error(
+        "(model: \"planar_arm\",\n costs: [(weight: 1.0, cost: Displacement)],\n noise: Some((samples: 4, sigma: 0.1, seed: 1)),\n solver: (algo: \"xnes\", sigma: -1.0),\n)",
+    );
+    assert!(e.starts_with("bad.ron:4:25: solver.sigma:"), "{e}");
+    // the second of two identical part names
+    let e = error(
+        "(model: \"planar_arm\", costs: [\n (weight: 1.0, cost: Position(part: \"tool\", target: Point((0.5, 0.0, 0.0)))),\n (weight: 1.0, cost: Position(part: \"tool\", target: Part(\"tol\"))),\n])",
+    );
+    assert!(
+        e.starts_with("bad.ron:3:45: costs[1].cost.target:") && e.contains("did you mean `tool`"),
+        "{e}"
+    );
+    // a world object names its line
+    let e = error(
+        "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)],\n world: (objects: [\n (name: \"a\", shape: Sphere(radius: 0.1)),\n (name: \"b\", shape: Sphere(radius: -0.1)),\n ]),\n)",
+    );
+    assert!(e.starts_with("bad.ron:4: world.objects[1] (\"b\")"), "{e}");
+    // a weight of a home-posture group
+    let e = error(
+        "(model: \"icub_upper_body\", costs: [\n (weight: 1.0, cost: HomePosture(weights: {\"torso\": 2.0, \"tosro\": 1.0})),\n])",
+    );
+    assert!(
+        e.starts_with("bad.ron:2:58: costs[0].cost.weights.tosro:") && e.contains("`torso`"),
+        "{e}"
+    );
+}

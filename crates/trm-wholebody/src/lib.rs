@@ -32,12 +32,13 @@
 //! let problem = trm_wholebody::WholeBody::load("specs/wholebody/standup.ron")?;
 //! let hand = problem.hand_tuned()?;
 //! println!("{} violations", hand.violations());
-//! # Ok::<(), trm_tasks::TaskError>(())
+//! # Ok::<(), trm_wholebody::WholeBodyError>(())
 //! ```
 
 // errors carry the file, place and fix of a spec problem; they are cold, so their size is fine
 #![allow(clippy::result_large_err)]
 
+mod error;
 pub mod motion;
 pub mod optimise;
 pub mod spec;
@@ -46,5 +47,7 @@ pub use motion::{Costs, Rollout, WholeBody, constraint_names};
 pub use optimise::{Comparison, StandUpResult, optimise};
 pub use spec::{MotionSpec, Support};
 
-/// Result alias (errors are [`trm_tasks::TaskError`]: spec errors name file, line and fix).
-pub type Result<T, E = trm_tasks::TaskError> = std::result::Result<T, E>;
+pub use error::WholeBodyError;
+
+/// Result alias of this crate.
+pub type Result<T, E = WholeBodyError> = std::result::Result<T, E>;

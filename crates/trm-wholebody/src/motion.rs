@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use crate::WholeBodyError;
 use nalgebra::{
     DMatrix, DVector, Isometry3, Matrix3xX, Matrix6xX, Point3, Translation3, UnitQuaternion,
     Vector2, Vector3,
@@ -13,7 +14,6 @@ use nalgebra::{
 use serde::{Deserialize, Serialize};
 use trm_collision::{CollisionModel, Other, PlacedBodies, Shape, World};
 use trm_kinematics::{ActiveSet, FrameId, PoseBuffer, RobotModel};
-use trm_tasks::TaskError;
 use trm_trajectory::{RbfTrajectory, TimeLaw};
 
 use crate::Result;
@@ -31,8 +31,8 @@ pub struct WholeBody {
     feet: (FrameId, FrameId),
     /// Pose of the ground frame in the left sole frame.
     sole_to_ground: Isometry3<f64>,
-    /// World objects: name, shape, pose in the ground frame.
-    objects: Vec<(String, Shape, Isometry3<f64>)>,
+    /// World objects with their poses in the ground frame.
+    ground_world: World,
     /// The seat: object name, links allowed to touch it while it supports, its x extent.
     seat: Option<(String, Vec<String>, [f64; 2])>,
     /// The reaching frame, its target (x, z) and phase index.
@@ -190,12 +190,8 @@ impl WholeBody {
     /// Builds the problem from a parsed spec and its model (`origin`/`text` locate errors).
     pub fn new(spec: MotionSpec, model: RobotModel, origin: &str, text: &str) -> Result<Self> {
         spec.check_names(&model, origin, text)?;
-        let spec_err = |field: &str, problem: String, fix: &str| TaskError::Spec {
-            origin: origin.to_string(),
-            position: trm_tasks::spec::locate(text, field),
-            field: field.to_string(),
-            problem,
-            fix: fix.to_string(),
+        let spec_err = |field: &str, problem: String, fix: &str| {
+            WholeBodyError::spec(text, origin, field, problem, fix)
         };
         let active = model.all_active();
         let n = active.len();
@@ -215,16 +211,17 @@ impl WholeBody {
             .iter()
             .map(|m| (m.limits.lower, m.limits.upper))
             .unzip();
-        for (name, q) in std::iter::once(("start", &start)).chain(
+        for (field, (name, q)) in std::iter::once(("start".to_string(), ("start", &start))).chain(
             spec.phases
                 .iter()
                 .zip(&keyframes)
-                .map(|(p, k)| (p.name.as_str(), k)),
+                .enumerate()
+                .map(|(i, (p, k))| (format!("phases[{i}].keyframe"), (p.name.as_str(), k))),
         ) {
             for (i, v) in q.iter().enumerate() {
                 if *v < lower[i] - 1e-9 || *v > upper[i] + 1e-9 {
                     return Err(spec_err(
-                        if name == "start" { "start" } else { "keyframe" },
+                        &format!("{field}.{}", model.motors()[i].name),
                         format!(
                             "posture `{name}` puts `{}` at {:.1}°, outside [{:.1}°, {:.1}°]",
                             model.motors()[i].name,
@@ -244,7 +241,7 @@ impl WholeBody {
                 Some(v) if v > 0.0 => velocity.push(v),
                 _ => {
                     return Err(spec_err(
-                        "velocity",
+                        "limits.velocity",
                         format!("no velocity limit for motor `{}`", m.name),
                         "add it to limits.velocity (rad/s)",
                     ));
@@ -312,18 +309,7 @@ impl WholeBody {
             -half_gap - width / 2.0,
             half_gap + width / 2.0,
         ];
-        let objects = spec
-            .world
-            .objects
-            .iter()
-            .map(|o| {
-                let pose = Isometry3::from_parts(
-                    Translation3::from(Vector3::from(o.xyz)),
-                    UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
-                );
-                (o.name.clone(), o.shape.clone(), pose)
-            })
-            .collect();
+        let ground_world = World::from_spec_in(&spec.world, origin, text, "world")?;
         let seat = spec.seat.as_ref().and_then(|seat| {
             spec.world
                 .objects
@@ -354,7 +340,7 @@ impl WholeBody {
             collision,
             feet,
             sole_to_ground,
-            objects,
+            ground_world,
             seat,
             reach,
             start,
@@ -477,12 +463,12 @@ impl WholeBody {
     ) -> Result<Vec<[f64; 2]>> {
         let r = self.spec.rbfs;
         if params.len() != 3 * r || params.iter().any(|p| !p.is_finite()) {
-            return Err(TaskError::Invalid {
+            return Err(WholeBodyError::Invalid {
                 what: "trajectory parameters".into(),
                 problem: format!("need {} finite values, got {:?}", 3 * r, params),
             });
         }
-        let traj_err = |e: trm_trajectory::TrajectoryError| TaskError::Invalid {
+        let traj_err = |e: trm_trajectory::TrajectoryError| WholeBodyError::Invalid {
             what: "trajectory".into(),
             problem: e.to_string(),
         };
@@ -511,7 +497,7 @@ impl WholeBody {
     pub fn rollout(&self, params: &[f64], ends: &[f64]) -> Result<Rollout> {
         let spec = &self.spec;
         if ends.len() != spec.phases.len() {
-            return Err(TaskError::Invalid {
+            return Err(WholeBodyError::Invalid {
                 what: "phase ends".into(),
                 problem: format!("{} ends for {} phases", ends.len(), spec.phases.len()),
             });
@@ -697,14 +683,15 @@ impl WholeBody {
 }
 
 impl WholeBody {
-    /// The world objects, placed at the identity until [`WholeBody::world_penetration`] moves
-    /// them into the root frame.
+    /// The world objects, in the ground frame (x forward, y left, z up, between the soles).
+    pub fn ground_world(&self) -> &World {
+        &self.ground_world
+    }
+
+    /// A copy of the world for a rollout; [`WholeBody::world_penetration`] moves its objects
+    /// into the root frame at every step.
     fn world(&self) -> Result<World> {
-        let mut world = World::new();
-        for (name, shape, _) in &self.objects {
-            world.add(name, shape.clone(), Isometry3::identity())?;
-        }
-        Ok(world)
+        Ok(self.ground_world.clone())
     }
 
     fn reach_gain(&self) -> f64 {
@@ -728,12 +715,12 @@ impl WholeBody {
     /// Total penetration depth of the robot with the world objects (the seat's contact links
     /// excepted while it supports), after [`WholeBody::self_penetration`] placed the bodies.
     fn world_penetration(&self, frame: &mut Frame, world: &mut World, support: Support) -> f64 {
-        if self.objects.is_empty() {
+        if self.ground_world.is_empty() {
             return 0.0;
         }
         let ground_to_root = frame.root_in_ground.inverse();
-        for (name, _, pose) in &self.objects {
-            let _ = world.set_pose(name, ground_to_root * pose);
+        for (i, o) in self.ground_world.objects().iter().enumerate() {
+            let _ = world.set_pose_at(i, ground_to_root * o.pose());
         }
         if !self.collision.any_world_collision(&frame.placed, world) {
             return 0.0;

@@ -4,11 +4,11 @@
 
 use std::cell::RefCell;
 
+use crate::WholeBodyError;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use trm_optim::{Start, StopOptions, oneplusone::minimize_constrained};
-use trm_tasks::TaskError;
 
 use crate::Result;
 use crate::motion::{Costs, Rollout, WholeBody};
@@ -107,7 +107,7 @@ pub fn optimise(
     let nc = crate::constraint_names(problem).len();
     // one rollout per candidate serves both the constraints and the objective
     let cache: RefCell<Option<(Vec<f64>, Rollout)>> = RefCell::new(None);
-    let failure: RefCell<Option<TaskError>> = RefCell::new(None);
+    let failure: RefCell<Option<WholeBodyError>> = RefCell::new(None);
     let run = |x: &[f64]| -> Option<Rollout> {
         if let Some((cx, r)) = cache.borrow().as_ref() {
             if cx == x {
@@ -150,7 +150,7 @@ pub fn optimise(
             progress(*rollouts.borrow(), *best.borrow());
         },
     )
-    .map_err(|e| TaskError::Invalid {
+    .map_err(|e| WholeBodyError::Invalid {
         what: "optimisation".into(),
         problem: e.to_string(),
     })?;

@@ -5,11 +5,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use crate::WholeBodyError;
 use serde::{Deserialize, Serialize};
 use trm_collision::{Shape, WorldSpec};
 use trm_kinematics::{RobotModel, closest_names};
-use trm_tasks::TaskError;
-use trm_tasks::spec::{locate, ron_error};
 
 use crate::Result;
 
@@ -191,9 +190,9 @@ impl MotionSpec {
     /// Reads and checks a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| TaskError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        let text = std::fs::read_to_string(path).map_err(|source| WholeBodyError::Io {
+            path: path.to_path_buf(),
+            source,
         })?;
         let spec = Self::from_ron(&text, &path.display().to_string())?;
         Ok((spec, text))
@@ -202,29 +201,32 @@ impl MotionSpec {
     /// Parses a spec (numbers and structure; names are checked against the model by
     /// [`MotionSpec::check_names`]).
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
-        let spec: MotionSpec = ron::from_str(text).map_err(|e| ron_error(&e, origin))?;
-        let err = |field: &str, needle: &str, problem: String, fix: &str| TaskError::Spec {
-            origin: origin.to_string(),
-            position: locate(text, needle),
-            field: field.to_string(),
-            problem,
-            fix: fix.to_string(),
+        let spec: MotionSpec = ron::from_str(text).map_err(|e| {
+            let p = trm_kinematics::explain_ron_error(&e);
+            WholeBodyError::Spec {
+                origin: origin.to_string(),
+                position: Some((p.line, p.column)),
+                field: "spec".into(),
+                problem: p.problem,
+                fix: p.fix,
+            }
+        })?;
+        let err = |field: &str, problem: String, fix: &str| {
+            WholeBodyError::spec(text, origin, field, problem, fix)
         };
         let positive = [
             ("dt", spec.dt),
-            ("sole length", spec.sole.0),
-            ("sole width", spec.sole.1),
+            ("sole[0]", spec.sole.0),
+            ("sole[1]", spec.sole.1),
             ("controller.com_gain", spec.controller.com_gain),
             ("controller.damping", spec.controller.damping),
             ("optimiser.exploration", spec.optimiser.exploration),
             ("weights.backward_max", spec.weights.backward_max),
         ];
         for (field, v) in positive {
-            let key = field.rsplit('.').next().unwrap_or(field);
             if !(v.is_finite() && v > 0.0) {
                 return Err(err(
                     field,
-                    key,
                     format!("must be positive and finite, got {v}"),
                     "give a positive number",
                 ));
@@ -240,11 +242,9 @@ impl MotionSpec {
             ("weights.backward", w.backward),
         ];
         for (field, v) in non_negative {
-            let key = field.rsplit('.').next().unwrap_or(field);
             if !(v.is_finite() && v >= 0.0) {
                 return Err(err(
                     field,
-                    key,
                     format!("must be ≥ 0 and finite, got {v}"),
                     "give a non-negative number",
                 ));
@@ -253,7 +253,6 @@ impl MotionSpec {
         if 2.0 * spec.support_margin >= spec.sole.0.min(spec.sole.1) {
             return Err(err(
                 "support_margin",
-                "support_margin",
                 "leaves no support polygon".into(),
                 "use a margin below half the sole width",
             ));
@@ -261,28 +260,20 @@ impl MotionSpec {
         if spec.rbfs == 0 {
             return Err(err(
                 "rbfs",
-                "rbfs",
                 "need at least one RBF".into(),
                 "the paper uses 5",
             ));
         }
         if spec.phases.is_empty() {
-            return Err(err(
-                "phases",
-                "phases",
-                "no phase".into(),
-                "add at least one phase",
-            ));
+            return Err(err("phases", "no phase".into(), "add at least one phase"));
         }
         let ends: Vec<f64> = spec.phases.iter().map(|p| p.end).collect();
-        check_ends(&ends)
-            .map_err(|p| err("phases", "end", p, "phase ends must increase from > 0"))?;
+        check_ends(&ends).map_err(|p| err("phases", p, "phase ends must increase from > 0"))?;
         check_ends(&spec.hand_tuned.ends)
-            .map_err(|p| err("hand_tuned.ends", "ends", p, "ends must increase from > 0"))?;
+            .map_err(|p| err("hand_tuned.ends", p, "ends must increase from > 0"))?;
         if spec.hand_tuned.ends.len() != spec.phases.len() {
             return Err(err(
                 "hand_tuned.ends",
-                "ends",
                 format!(
                     "{} ends for {} phases",
                     spec.hand_tuned.ends.len(),
@@ -300,7 +291,6 @@ impl MotionSpec {
                 if p.len() != n || p.iter().any(|v| !v.is_finite()) {
                     return Err(err(
                         field,
-                        field.rsplit('.').next().unwrap_or(field),
                         format!("{} values (all finite) needed, got {}", n, p.len()),
                         "give rbfs x fractions, rbfs z fractions and rbfs time-law log-speeds",
                     ));
@@ -313,7 +303,6 @@ impl MotionSpec {
                 _ => {
                     return Err(err(
                         "seat.object",
-                        "object",
                         format!("`{}` is not an axis-aligned box of `world`", seat.object),
                         "name a `Box` object of `world` with rpy (0, 0, 0)",
                     ));
@@ -328,7 +317,6 @@ impl MotionSpec {
         {
             return Err(err(
                 "phases",
-                "FeetAndSeat",
                 "a phase is supported by a seat but there is no seat".into(),
                 "add `seat: Some((object: ..., contacts: [...]))` or use `support: Feet`",
             ));
@@ -338,7 +326,6 @@ impl MotionSpec {
                 let names: Vec<&str> = spec.phases.iter().map(|p| p.name.as_str()).collect();
                 return Err(err(
                     "reach.phase",
-                    &format!("\"{}\"", r.phase),
                     format!("no phase named `{}`", r.phase),
                     &format!("use one of `{}`", names.join("`, `")),
                 ));
@@ -350,7 +337,6 @@ impl MotionSpec {
                 && r.target.1.is_finite();
             if !ok {
                 return Err(err(
-                    "reach",
                     "reach",
                     "gain and tolerance must be positive, the target finite".into(),
                     "fix the reach numbers",
@@ -365,67 +351,84 @@ impl MotionSpec {
         let motors: Vec<&str> = model.motors().iter().map(|m| m.name.as_str()).collect();
         let err = |field: &str, name: &str, kind: &str, candidates: &[&str]| {
             let near = closest_names(name, candidates.iter().copied());
-            TaskError::Spec {
-                origin: origin.to_string(),
-                position: locate(text, &format!("\"{name}\"")),
-                field: field.to_string(),
-                problem: format!("unknown {kind} `{name}`"),
-                fix: if near.is_empty() {
+            WholeBodyError::spec(
+                text,
+                origin,
+                field,
+                format!("unknown {kind} `{name}`"),
+                if near.is_empty() {
                     format!("use one of `{}`", candidates.join("`, `"))
                 } else {
                     format!("did you mean `{}`?", near.join("`, `"))
                 },
-            }
+            )
         };
-        let motor_maps = std::iter::once(("start", &self.start))
-            .chain(self.phases.iter().map(|p| ("keyframe", &p.keyframe)))
-            .chain(std::iter::once(("limits.velocity", &self.limits.velocity)))
-            .chain(std::iter::once(("limits.torque", &self.limits.torque)));
+        let motor_maps = std::iter::once(("start".to_string(), &self.start))
+            .chain(
+                self.phases
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| (format!("phases[{i}].keyframe"), &p.keyframe)),
+            )
+            .chain(std::iter::once((
+                "limits.velocity".to_string(),
+                &self.limits.velocity,
+            )))
+            .chain(std::iter::once((
+                "limits.torque".to_string(),
+                &self.limits.torque,
+            )));
         for (field, map) in motor_maps {
             for (name, v) in map {
+                let at = format!("{field}.{name}");
                 if !motors.contains(&name.as_str()) {
-                    return Err(err(field, name, "motor", &motors));
+                    return Err(err(&at, name, "motor", &motors));
                 }
                 if !v.is_finite() {
-                    return Err(TaskError::Spec {
-                        origin: origin.to_string(),
-                        position: locate(text, &format!("\"{name}\"")),
-                        field: field.to_string(),
-                        problem: format!("`{name}` is {v}"),
-                        fix: "give a finite number".into(),
-                    });
+                    return Err(WholeBodyError::spec(
+                        text,
+                        origin,
+                        &at,
+                        format!("`{name}` is {v}"),
+                        "give a finite number",
+                    ));
                 }
             }
         }
-        for p in &self.phases {
-            for name in &p.locked {
+        for (i, p) in self.phases.iter().enumerate() {
+            for (j, name) in p.locked.iter().enumerate() {
                 if !motors.contains(&name.as_str()) {
-                    return Err(err("locked", name, "motor", &motors));
+                    return Err(err(
+                        &format!("phases[{i}].locked[{j}]"),
+                        name,
+                        "motor",
+                        &motors,
+                    ));
                 }
             }
         }
         for m in &motors {
             if !self.limits.torque.contains_key(*m) {
-                return Err(TaskError::Spec {
-                    origin: origin.to_string(),
-                    position: locate(text, "torque"),
-                    field: "limits.torque".into(),
-                    problem: format!("no torque limit for motor `{m}`"),
-                    fix: format!("add \"{m}\": N·m per joint"),
-                });
+                return Err(WholeBodyError::spec(
+                    text,
+                    origin,
+                    "limits.torque",
+                    format!("no torque limit for motor `{m}`"),
+                    format!("add \"{m}\": N·m per joint"),
+                ));
             }
         }
         let frames: Vec<&str> = model.frame_names().collect();
-        for f in [&self.feet.0, &self.feet.1] {
+        for (i, f) in [&self.feet.0, &self.feet.1].into_iter().enumerate() {
             if model.frame_id(f).is_err() {
-                return Err(err("feet", f, "frame", &frames));
+                return Err(err(&format!("feet[{i}]"), f, "frame", &frames));
             }
         }
         if let Some(c) = &self.seat {
             let links: Vec<&str> = model.tree().links.iter().map(|l| l.name.as_str()).collect();
-            for l in &c.contacts {
+            for (j, l) in c.contacts.iter().enumerate() {
                 if !links.contains(&l.as_str()) {
-                    return Err(err("seat.contacts", l, "link", &links));
+                    return Err(err(&format!("seat.contacts[{j}]"), l, "link", &links));
                 }
             }
         }
