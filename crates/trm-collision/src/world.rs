@@ -93,9 +93,9 @@ impl World {
         Self::build(spec, origin, None)
     }
 
-    /// Builds a world from RON data parsed out of `text`, where it sits at field path `at`
-    /// (`""` for a world file, `"world"` inside a task spec), so that an error names the line
-    /// of the object it is about.
+    /// Builds a world from RON data parsed out of `text`, where its object list sits at field
+    /// path `at` (`"objects"` in a world file, `"world.objects"` inside a task spec), so that an
+    /// error names the line of the object it is about.
     pub fn from_spec_in(spec: &WorldSpec, origin: &str, text: &str, at: &str) -> Result<Self> {
         Self::build(spec, origin, Some((text, at)))
     }
@@ -103,10 +103,7 @@ impl World {
     fn build(spec: &WorldSpec, origin: &str, located: Option<(&str, &str)>) -> Result<Self> {
         let mut world = World::new();
         for (i, o) in spec.objects.iter().enumerate() {
-            let path = match located {
-                Some((_, "")) | None => format!("objects[{i}]"),
-                Some((_, at)) => format!("{at}.objects[{i}]"),
-            };
+            let path = format!("{}[{i}]", located.map_or("objects", |(_, at)| at));
             let line = located
                 .and_then(|(text, _)| trm_kinematics::locate_ron_path(text, &path))
                 .map(|(line, _)| line);
@@ -151,7 +148,7 @@ impl World {
                 },
             }
         })?;
-        Self::from_spec_in(&spec, origin, text, "")
+        Self::from_spec_in(&spec, origin, text, "objects")
     }
 
     /// Reads a RON world file.
@@ -314,7 +311,7 @@ mod tests {
         let bad = r#"(objects: [(name: "b", shape: Sphere(radius: -1.0))])"#;
         let e = World::from_ron(bad, "w.ron").unwrap_err().to_string();
         assert!(
-            e.starts_with("w.ron: object \"b\": sphere radius -1"),
+            e.starts_with("w.ron:1: objects[0] (\"b\"): sphere radius -1"),
             "{e}"
         );
         let e = World::from_ron("(objects: [(nme: \"x\")])", "w.ron")

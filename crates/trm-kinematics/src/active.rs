@@ -170,11 +170,7 @@ impl ActiveSet {
     #[inline]
     pub fn joint_values_unchecked(&self, q: &[f64], joints: &mut [f64]) {
         for (value, (constant, terms)) in joints.iter_mut().zip(&self.rows) {
-            let mut v = *constant;
-            for &(k, f) in terms {
-                v += f * q[k];
-            }
-            *value = v;
+            *value = crate::fk::affine(*constant, terms, q);
         }
     }
 

@@ -5,8 +5,8 @@
 use nalgebra::{Matrix3xX, Matrix6xX, Point3, Vector3};
 
 use crate::ActiveSet;
+use crate::fk::FrameId;
 use crate::fk::PoseBuffer;
-use crate::model::FrameId;
 use crate::tree::JointKind;
 
 /// Standard gravity in the world frame when z is up, m/s².

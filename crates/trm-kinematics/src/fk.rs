@@ -9,7 +9,6 @@ use std::collections::HashMap;
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use crate::model::FrameId;
 use crate::tree::{JointKind, Tree};
 
 /// One link or named frame: `pose[k + 1] = pose[parent] · local`, where, with the slot's
@@ -42,13 +41,35 @@ impl Step {
     }
 }
 
+/// Index of a pose in a [`PoseBuffer`]: a link (`0..num_links`) or a named frame after them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FrameId(pub(crate) usize);
+
+impl FrameId {
+    /// Position in the pose buffer.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+/// `constant + Σ factor · input[index]`: the one evaluation of a joint's affine map over motor
+/// or active values (couplings, locked motors and the compiled FK pass all use it).
+#[inline]
+pub(crate) fn affine(constant: f64, terms: &[(usize, f64)], input: &[f64]) -> f64 {
+    let mut v = constant;
+    for &(k, f) in terms {
+        v += f * input[k];
+    }
+    v
+}
+
 /// A compiled FK pass: an affine map from an input vector to slot values, and the steps.
 #[derive(Debug, Clone)]
 pub(crate) struct Plan {
     /// Per slot: constant and range into `terms`.
     rows: Vec<(f64, u32, u32)>,
     /// `(input index, factor)`.
-    terms: Vec<(u32, f64)>,
+    terms: Vec<(usize, f64)>,
     /// Whether a slot is a revolute angle (needs its half-angle sine and cosine). Slot 0 is
     /// the constant `(0, 1, 0)` of fixed transforms.
     revolute: Vec<bool>,
@@ -95,8 +116,7 @@ impl Plan {
                         .entry((row.constant.to_bits(), key, revolute))
                         .or_insert_with(|| {
                             let start = plan.terms.len() as u32;
-                            plan.terms
-                                .extend(row.terms.iter().map(|&(k, f)| (k as u32, f)));
+                            plan.terms.extend_from_slice(row.terms);
                             plan.rows
                                 .push((row.constant, start, plan.terms.len() as u32));
                             plan.revolute.push(revolute);
@@ -148,10 +168,7 @@ impl Plan {
         for ((out, &(constant, start, end)), &revolute) in
             slots.iter_mut().zip(&self.rows).zip(&self.revolute)
         {
-            let mut v = constant;
-            for &(k, f) in &self.terms[start as usize..end as usize] {
-                v += f * input[k as usize];
-            }
+            let v = affine(constant, &self.terms[start as usize..end as usize], input);
             *out = if revolute {
                 let (s, c) = (0.5 * v).sin_cos();
                 [s, c, 0.0]
@@ -234,6 +251,21 @@ pub struct PoseBuffer {
 }
 
 impl PoseBuffer {
+    /// Whether the buffer was made for a model with these many joints and frames.
+    pub(crate) fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
+        self.poses.len() == num_frames && self.slots.len() == num_joints + 1
+    }
+
+    /// Number of poses (links and named frames).
+    pub fn len(&self) -> usize {
+        self.poses.len()
+    }
+
+    /// Whether the buffer holds no pose.
+    pub fn is_empty(&self) -> bool {
+        self.poses.is_empty()
+    }
+
     pub(crate) fn new(num_joints: usize, num_frames: usize) -> Self {
         PoseBuffer {
             slots: vec![[0.0, 1.0, 0.0]; num_joints + 1],

@@ -38,6 +38,7 @@ mod description;
 mod error;
 mod files;
 mod fk;
+pub mod ik;
 mod model;
 mod posture;
 mod ron_path;
@@ -51,8 +52,8 @@ pub use description::{
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use files::{FileError, load_versioned, parse_versioned, save_json, write_atomic};
-pub use fk::PoseBuffer;
-pub use model::{Coupling, DisabledCollision, FrameId, Motor, NamedFrame, RobotModel};
+pub use fk::{FrameId, PoseBuffer};
+pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
 pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use ron_path::{RonProblem, explain_ron_error, locate_ron_path};

@@ -8,19 +8,8 @@ use nalgebra::Isometry3;
 
 use crate::description::{DisableReason, FrameSpec, ModelDescription};
 use crate::error::{KinematicsError, NameKind, Result, unknown};
-use crate::fk::{AffineRow, Plan, PoseBuffer};
+use crate::fk::{AffineRow, FrameId, Plan, PoseBuffer, affine};
 use crate::tree::{Ctx, JointKind, Limits, Tree, pose_from_xyz_rpy};
-
-/// Index of a pose in a [`PoseBuffer`]: a link (`0..num_links`) or a named frame after them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct FrameId(pub(crate) usize);
-
-impl FrameId {
-    /// Position in the pose buffer.
-    pub fn index(self) -> usize {
-        self.0
-    }
-}
 
 /// A motor: one optimisation variable, driving one or more joints.
 #[derive(Debug, Clone, PartialEq)]
@@ -463,7 +452,7 @@ impl RobotModel {
             });
         }
         for (value, c) in joints.iter_mut().zip(&self.data.couplings) {
-            *value = c.offset + c.terms.iter().map(|&(m, f)| f * motors[m]).sum::<f64>();
+            *value = affine(c.offset, &c.terms, motors);
         }
         Ok(())
     }
@@ -490,11 +479,11 @@ impl RobotModel {
     }
 
     pub(crate) fn check_buffer(&self, buffer: &PoseBuffer) -> Result<()> {
-        if buffer.poses.len() != self.num_frames() || buffer.slots.len() != self.num_joints() + 1 {
+        if !buffer.fits(self.num_joints(), self.num_frames()) {
             return Err(KinematicsError::WrongLength {
                 what: "pose buffer (make it with RobotModel::pose_buffer)",
                 expected: self.num_frames(),
-                got: buffer.poses.len(),
+                got: buffer.len(),
             });
         }
         Ok(())

@@ -20,8 +20,10 @@ mod explore;
 mod grasp;
 mod map;
 mod motion;
+mod spec;
 
 pub use explore::{ExploreSettings, explore};
 pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
 pub use motion::{Motion, MotionGoal, MotionSettings, ReachProblem};
+pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};

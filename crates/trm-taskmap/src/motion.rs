@@ -6,7 +6,7 @@
 //! an exact target or the task-map cost c_map. The attractor points are optimised with iRprop−
 //! on central-difference gradients.
 
-use nalgebra::{DMatrix, DVector, Isometry3, Matrix6, Matrix6xX, Vector6};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX, Vector6};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{ActiveSet, FrameId};
 use trm_optim::{Rprop, RpropOptions, Start, StopOptions, by_name, minimize_fn};
@@ -148,16 +148,15 @@ impl ReachProblem<'_> {
             let dr = (want.rotation * have.rotation.inverse()).scaled_axis();
             let err = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z) * s.gain;
             self.active.jacobian(&poses, self.hand, &mut jac);
-            // damped pseudo-inverse J⁺ = Jᵀ (J Jᵀ + λ² I)⁻¹
-            let jjt: Matrix6<f64> = &jac * jac.transpose() + Matrix6::identity() * 1e-4;
-            let Some(inv) = jjt.try_inverse() else { break };
-            let pinv: DMatrix<f64> =
-                DMatrix::from_iterator(n, 6, (jac.transpose() * inv).iter().copied());
             let jd = DMatrix::from_iterator(6, n, jac.iter().copied());
+            if jd.iter().any(|v| !v.is_finite()) {
+                break;
+            }
             limits += joint_limit_proximity(&q, &lower, &upper, Some(&mut limit_grad));
             let xi = DVector::from_iterator(n, limit_grad.iter().map(|g| -s.limit_gain * g));
-            let null = &xi - &pinv * (&jd * &xi);
-            let dq = &pinv * DVector::from_column_slice(err.as_slice()) + null;
+            // resolved rate: q̇ = J⁺ e + (I − J⁺ J) ξ, damped least squares (λ = 0.01)
+            let task = [(jd, DVector::from_column_slice(err.as_slice()))];
+            let dq = trm_kinematics::ik::prioritised_velocities(&task, &xi, 0.01);
             let previous = q.clone();
             for i in 0..n {
                 q[i] = (q[i] + s.dt * dq[i]).clamp(lower[i], upper[i]);

@@ -495,7 +495,7 @@ impl Problem {
             }
             robot.active_set(&spec.active, &motors)?
         };
-        let world = World::from_spec_in(&spec.world, origin, text, "world")?;
+        let world = World::from_spec_in(&spec.world, origin, text, "world.objects")?;
         let collision = CollisionModel::new(&robot)?;
         let start = active.from_motors(&motors);
         if spec.costs.is_empty() {

@@ -309,7 +309,7 @@ impl WholeBody {
             -half_gap - width / 2.0,
             half_gap + width / 2.0,
         ];
-        let ground_world = World::from_spec_in(&spec.world, origin, text, "world")?;
+        let ground_world = World::from_spec_in(&spec.world, origin, text, "world.objects")?;
         let seat = spec.seat.as_ref().and_then(|seat| {
             spec.world
                 .objects
@@ -579,7 +579,7 @@ impl WholeBody {
                     ctl.posture_gain * (from[k] + (to[k] - from[k]) * blend - q[k])
                 }
             });
-            let command = prioritised(&tasks, &posture, ctl.damping);
+            let command = trm_kinematics::ik::prioritised_velocities(&tasks, &posture, ctl.damping);
             let filter = if ctl.smoothing > 0.0 {
                 (dt / ctl.smoothing).min(1.0)
             } else {
@@ -828,29 +828,6 @@ fn costs(r: &Rollout) -> Costs {
         }
     }
     c
-}
-
-/// Joint velocities for tasks in strict priority (each `(J, v)` solved in the null space of the
-/// ones before, damped least squares) and a posture velocity in the null space of all of them.
-fn prioritised(
-    tasks: &[(DMatrix<f64>, DVector<f64>)],
-    posture: &DVector<f64>,
-    damping: f64,
-) -> DVector<f64> {
-    let n = posture.len();
-    let mut qdot = DVector::zeros(n);
-    let mut null = DMatrix::<f64>::identity(n, n);
-    for (j, v) in tasks {
-        let jn = j * &null;
-        let rows = jn.nrows();
-        let inverse = (&jn * jn.transpose() + DMatrix::identity(rows, rows) * damping * damping)
-            .try_inverse()
-            .unwrap_or_else(|| DMatrix::zeros(rows, rows));
-        let pinv = jn.transpose() * inverse;
-        qdot += &pinv * (v - j * &qdot);
-        null -= &pinv * &jn;
-    }
-    qdot + null * posture
 }
 
 /// Per-sample kinematic quantities in the ground frame.

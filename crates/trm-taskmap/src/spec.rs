@@ -1,0 +1,297 @@
+//! Task-map specs: which hand grasps which object, where to start and how to explore (RON) —
+//! what `cargo xtask explore-task-map` reads.
+//!
+//! ```ron
+//! (
+//!     model: None,                 // a .urdf/.ron model relative to the spec; the iCub upper body when absent
+//!     hand: "r",                   // which iCub hand: "r" or "l"
+//!     object: [                    // the object's parts in its own frame (world objects)
+//!         (name: "stick", shape: Cylinder(radius: 0.015, length: 0.3)),
+//!     ],
+//!     start: None,                 // the first grasp g₀ (position and rotation vector of the hand
+//!                                  // in the object frame); found by random search when absent
+//!     metric: Some((position: 1.0, orientation: 0.01)),
+//!     explore: (iterations: 3000, step: 0.015, restarts: 300,
+//!               half_widths: (0.1, 0.1, 0.2, 1.0, 1.0, 1.0), seed: 0),
+//!     search: (samples: 5000, lower: (-0.15, -0.12, -0.08), upper: (0.05, 0.12, 0.15), seed: 0),
+//! )
+//! ```
+//!
+//! Every field but `object` has a default. Errors name the file, the line and the field.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use trm_collision::{CollisionModel, ObjectSpec, World, WorldSpec};
+use trm_kinematics::RobotModel;
+
+use crate::{ExploreSettings, Hand, Metric, TaskMap, TaskMapError, explore, find_grasp};
+
+fn right() -> String {
+    "r".into()
+}
+
+/// A task-map spec (format in the [module docs](self)).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TaskMapSpec {
+    /// A model file relative to the spec; the embedded iCub upper body when absent.
+    #[serde(default)]
+    pub model: Option<PathBuf>,
+    /// Which iCub hand: "r" or "l".
+    #[serde(default = "right")]
+    pub hand: String,
+    /// The object's parts in its own frame.
+    pub object: Vec<ObjectSpec>,
+    /// The first grasp g₀ (hand position and rotation vector in the object frame); found by
+    /// random search when absent.
+    #[serde(default)]
+    pub start: Option<[f64; 6]>,
+    /// The metric W.
+    #[serde(default)]
+    pub metric: Option<Metric>,
+    /// RRT settings.
+    #[serde(default)]
+    pub explore: ExploreSpec,
+    /// Random search for g₀.
+    #[serde(default)]
+    pub search: SearchSpec,
+}
+
+/// The RRT settings of a [`TaskMapSpec`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExploreSpec {
+    /// RRT iterations.
+    pub iterations: usize,
+    /// RRT step (in the metric's units).
+    pub step: f64,
+    /// Restarts from random feasible samples, for disjoint clusters.
+    pub restarts: usize,
+    /// Half widths of the sampling box around g₀ (m, m, m, rad, rad, rad).
+    pub half_widths: [f64; 6],
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for ExploreSpec {
+    fn default() -> Self {
+        ExploreSpec {
+            iterations: 3000,
+            step: 0.015,
+            restarts: 300,
+            half_widths: [0.1, 0.1, 0.2, 1.0, 1.0, 1.0],
+            seed: 0,
+        }
+    }
+}
+
+/// The random search for a first grasp of a [`TaskMapSpec`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SearchSpec {
+    /// Random hand poses tried.
+    pub samples: usize,
+    /// Lower corner of the hand-position box in the object frame, m.
+    pub lower: [f64; 3],
+    /// Upper corner, m.
+    pub upper: [f64; 3],
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for SearchSpec {
+    fn default() -> Self {
+        SearchSpec {
+            samples: 5000,
+            lower: [-0.15, -0.12, -0.08],
+            upper: [0.05, 0.12, 0.15],
+            seed: 0,
+        }
+    }
+}
+
+/// An explored task map with the robot and hand it was explored for.
+#[derive(Debug)]
+pub struct Explored {
+    /// The robot.
+    pub model: RobotModel,
+    /// Its collision model.
+    pub collision: CollisionModel,
+    /// The map.
+    pub map: TaskMap,
+    /// The first grasp g₀ the exploration started from.
+    pub start: [f64; 6],
+    /// Exploration wall time, s.
+    pub seconds: f64,
+}
+
+/// A spec with where it came from (for errors and relative paths).
+#[derive(Debug, Clone)]
+pub struct LoadedTaskMapSpec {
+    /// The spec.
+    pub spec: TaskMapSpec,
+    /// Its origin (file name or `<string>`).
+    pub origin: String,
+    /// Its text, for locating errors.
+    pub text: String,
+    /// The directory relative paths start from.
+    pub base: PathBuf,
+}
+
+impl TaskMapSpec {
+    /// Reads a spec file.
+    pub fn load(path: impl AsRef<Path>) -> Result<LoadedTaskMapSpec, TaskMapError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| TaskMapError::File {
+            path: path.display().to_string(),
+            problem: e.to_string(),
+        })?;
+        let base = path.parent().map(PathBuf::from).unwrap_or_default();
+        Self::from_ron(&text, &path.display().to_string(), &base)
+    }
+
+    /// Parses and checks spec text; `origin` names it in errors, `base` resolves the model path.
+    pub fn from_ron(
+        text: &str,
+        origin: &str,
+        base: &Path,
+    ) -> Result<LoadedTaskMapSpec, TaskMapError> {
+        let spec: TaskMapSpec = ron::from_str(text).map_err(|e| {
+            let p = trm_kinematics::explain_ron_error(&e);
+            TaskMapError::Spec {
+                origin: origin.to_string(),
+                position: Some((p.line, p.column)),
+                field: "spec".into(),
+                problem: p.problem,
+                fix: p.fix,
+            }
+        })?;
+        let loaded = LoadedTaskMapSpec {
+            spec,
+            origin: origin.to_string(),
+            text: text.to_string(),
+            base: base.to_path_buf(),
+        };
+        loaded.check()?;
+        Ok(loaded)
+    }
+}
+
+impl LoadedTaskMapSpec {
+    fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskMapError {
+        TaskMapError::Spec {
+            origin: self.origin.clone(),
+            position: trm_kinematics::locate_ron_path(&self.text, field),
+            field: field.to_string(),
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+
+    fn check(&self) -> Result<(), TaskMapError> {
+        let s = &self.spec;
+        if s.hand != "r" && s.hand != "l" {
+            return Err(self.err(
+                "hand",
+                format!("{:?} is no iCub hand", s.hand),
+                "write \"r\" or \"l\"",
+            ));
+        }
+        if s.object.is_empty() {
+            return Err(self.err("object", "the object has no parts", "add at least one part"));
+        }
+        let e = &s.explore;
+        if !(e.step.is_finite() && e.step > 0.0) {
+            return Err(self.err(
+                "explore.step",
+                format!("{} is not a positive step", e.step),
+                "give a positive step",
+            ));
+        }
+        if let Some(k) = e
+            .half_widths
+            .iter()
+            .position(|w| !(w.is_finite() && *w > 0.0))
+        {
+            return Err(self.err(
+                &format!("explore.half_widths[{k}]"),
+                "must be positive",
+                "give positive half widths",
+            ));
+        }
+        let q = &s.search;
+        if let Some(k) = (0..3).find(|&k| {
+            !(q.lower[k].is_finite() && q.upper[k].is_finite() && q.lower[k] < q.upper[k])
+        }) {
+            return Err(self.err(
+                &format!("search.lower[{k}]"),
+                format!("lower {} is not below upper {}", q.lower[k], q.upper[k]),
+                "give a box with lower < upper on every axis",
+            ));
+        }
+        if let Some(g) = &s.start {
+            if g.iter().any(|v| !v.is_finite()) {
+                return Err(self.err("start", "holds a non-finite value", "write finite numbers"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Loads the robot, finds the first grasp if the spec gives none, and explores the map.
+    pub fn explore(&self) -> Result<Explored, TaskMapError> {
+        let s = &self.spec;
+        let model = match &s.model {
+            None => trm_models::icub_upper_body(),
+            Some(m) => trm_models::load(&m.to_string_lossy(), &self.base)?,
+        };
+        let collision = CollisionModel::new(&model)?;
+        let hand = Hand::icub(&model, &collision, &s.hand)?;
+        let object = World::from_spec_in(
+            &WorldSpec {
+                objects: s.object.clone(),
+            },
+            &self.origin,
+            &self.text,
+            "object",
+        )
+        .map_err(|e| self.err("object", e.to_string(), "fix the object's parts"))?;
+        let start = match s.start {
+            Some(g) => g,
+            None => {
+                let q = &s.search;
+                find_grasp(&hand, &object, q.lower, q.upper, q.samples, q.seed)
+                    .map(|(g, _)| g)
+                    .ok_or_else(|| {
+                        self.err(
+                            "search",
+                            format!(
+                                "no grasp found in {} random hand poses: the hand cannot grasp this object anywhere in the search box",
+                                q.samples
+                            ),
+                            "widen the search box, raise samples, or give `start`",
+                        )
+                    })?
+            }
+        };
+        let e = &s.explore;
+        let settings = ExploreSettings {
+            iterations: e.iterations,
+            step: e.step,
+            restarts: e.restarts,
+            seed: e.seed,
+            ..ExploreSettings::around(start, e.half_widths)
+        };
+        let started = std::time::Instant::now();
+        let map = explore(&[start], &settings, &s.metric.unwrap_or_default(), |g| {
+            hand.quality(&object, g)
+        })?;
+        Ok(Explored {
+            seconds: started.elapsed().as_secs_f64(),
+            model,
+            collision,
+            map,
+            start,
+        })
+    }
+}
