@@ -24,7 +24,11 @@ fn a_crate_outside_the_workspace_uses_the_library_end_to_end() {
         .expect("cargo runs");
     let stdout = String::from_utf8_lossy(&run.stdout);
     let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success(), "stdout:\n{stdout}\nstderr:\n{stderr}");
+    assert!(
+        run.status.success(),
+        "stdout:\n{stdout}\nstderr:\n{stderr}\n(a library crate's dependencies changed? refresh the example's lock file: \
+         `cargo metadata --manifest-path examples/library-user/Cargo.toml > /dev/null`)"
+    );
     for line in [
         "map:",
         "plan:",

@@ -10,6 +10,7 @@ pub type Result<T, E = CollisionError> = std::result::Result<T, E>;
 
 /// Everything that can go wrong while building collision models or worlds.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum CollisionError {
     /// A name or description problem reported by the kinematics layer.
     #[error(transparent)]

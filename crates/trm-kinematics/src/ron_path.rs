@@ -92,6 +92,66 @@ pub fn explain_ron_error(e: &ron::error::SpannedError) -> RonProblem {
     }
 }
 
+/// An error located in a spec file (task specs, motion specs, task-map specs): the file, the
+/// line and column, the field path, the problem and its fix. The one shape of every spec error
+/// of trm.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{origin}{}: {field}: {problem}{}", position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
+pub struct SpecError {
+    /// The spec file (or `<string>`).
+    pub origin: String,
+    /// 1-based (line, column) of the field, when the text spells it out.
+    pub position: Option<(usize, usize)>,
+    /// Field path, e.g. `costs[2].cost.part`.
+    pub field: String,
+    /// What is wrong.
+    pub problem: String,
+    /// What to do about it (may be empty).
+    pub fix: String,
+}
+
+impl SpecError {
+    /// An error at field path `field` of spec `text`, located at that path or at the nearest
+    /// ancestor the text spells out (a field left at its default is not written).
+    pub fn at(
+        text: &str,
+        origin: &str,
+        field: &str,
+        problem: impl Into<String>,
+        fix: impl Into<String>,
+    ) -> Self {
+        let mut path = field;
+        let position = loop {
+            if let Some(at) = locate_ron_path(text, path) {
+                break Some(at);
+            }
+            match path.rfind(['.', '[']) {
+                Some(i) => path = &path[..i],
+                None => break None,
+            }
+        };
+        SpecError {
+            origin: origin.to_string(),
+            position,
+            field: field.to_string(),
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+
+    /// A RON parse error of spec `origin`, explained ([`explain_ron_error`]).
+    pub fn from_ron(e: &ron::error::SpannedError, origin: &str) -> Self {
+        let p = explain_ron_error(e);
+        SpecError {
+            origin: origin.to_string(),
+            position: Some((p.line, p.column)),
+            field: "spec".into(),
+            problem: p.problem,
+            fix: p.fix,
+        }
+    }
+}
+
 /// One step of a path.
 #[derive(Debug, PartialEq)]
 enum Segment {

@@ -8,6 +8,7 @@ use crate::error::{OptimError, Result, invalid};
 
 /// Why an optimiser stopped. `stop()` returns every reason that fired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum StopReason {
     /// The evaluation budget is spent.
     MaxEvaluations,

@@ -7,6 +7,7 @@ pub type Result<T, E = OptimError> = std::result::Result<T, E>;
 
 /// Invalid settings or calls.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum OptimError {
     /// A setting is out of range.
     #[error("invalid {field}: {problem}")]

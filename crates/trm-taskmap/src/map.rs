@@ -14,20 +14,10 @@ pub enum TaskMapError {
     /// A task-map file could not be read or written.
     #[error(transparent)]
     MapFile(#[from] trm_kinematics::FileError),
-    /// A task-map spec holds something invalid: where (file, line:column, field path), what, fix.
-    #[error("{origin}{}: {field}: {problem}{}", position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
-    Spec {
-        /// The spec file (or `<string>`).
-        origin: String,
-        /// 1-based (line, column) of the field, when the text spells it out.
-        position: Option<(usize, usize)>,
-        /// Field path, e.g. `explore.step`.
-        field: String,
-        /// What is wrong.
-        problem: String,
-        /// What to do about it.
-        fix: String,
-    },
+    /// A task-map spec holds something invalid: where (file, line:column, field path), what,
+    /// fix (boxed: errors stay small).
+    #[error(transparent)]
+    Spec(Box<trm_kinematics::SpecError>),
     /// From the kinematics (model loading, hand motors and links).
     #[error(transparent)]
     Kinematics(#[from] trm_kinematics::KinematicsError),

@@ -158,14 +158,7 @@ impl TaskMapSpec {
         base: &Path,
     ) -> Result<LoadedTaskMapSpec, TaskMapError> {
         let spec: TaskMapSpec = ron::from_str(text).map_err(|e| {
-            let p = trm_kinematics::explain_ron_error(&e);
-            TaskMapError::Spec {
-                origin: origin.to_string(),
-                position: Some((p.line, p.column)),
-                field: "spec".into(),
-                problem: p.problem,
-                fix: p.fix,
-            }
+            TaskMapError::Spec(Box::new(trm_kinematics::SpecError::from_ron(&e, origin)))
         })?;
         let loaded = LoadedTaskMapSpec {
             spec,
@@ -180,13 +173,13 @@ impl TaskMapSpec {
 
 impl LoadedTaskMapSpec {
     fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskMapError {
-        TaskMapError::Spec {
-            origin: self.origin.clone(),
-            position: trm_kinematics::locate_ron_path(&self.text, field),
-            field: field.to_string(),
-            problem: problem.into(),
-            fix: fix.into(),
-        }
+        TaskMapError::Spec(Box::new(trm_kinematics::SpecError::at(
+            &self.text,
+            &self.origin,
+            field,
+            problem,
+            fix,
+        )))
     }
 
     fn check(&self) -> Result<(), TaskMapError> {

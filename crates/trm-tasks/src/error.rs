@@ -7,21 +7,11 @@ pub type Result<T, E = TaskError> = std::result::Result<T, E>;
 
 /// Spec and catalogue errors.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum TaskError {
-    /// A spec file problem, located in the file.
-    #[error("{origin}{}: {field}: {problem}{}", position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
-    Spec {
-        /// The spec file.
-        origin: String,
-        /// 1-based (line, column), when known.
-        position: Option<(usize, usize)>,
-        /// The field or element.
-        field: String,
-        /// What is wrong.
-        problem: String,
-        /// How to fix it.
-        fix: String,
-    },
+    /// A spec file problem, located in the file (boxed: errors stay small).
+    #[error(transparent)]
+    Spec(Box<trm_kinematics::SpecError>),
     /// An invalid value given in code.
     #[error("{what}: {problem}")]
     Invalid {
@@ -40,11 +30,11 @@ pub enum TaskError {
     #[error(transparent)]
     Optim(#[from] trm_optim::OptimError),
     /// A file could not be read.
-    #[error("{path}: {message}")]
+    #[error("{}: {source}", path.display())]
     Io {
         /// The file.
-        path: String,
-        /// The reason.
-        message: String,
+        path: std::path::PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
     },
 }

@@ -377,19 +377,6 @@ pub struct Problem {
     pub start: Vec<f64>,
 }
 
-/// 1-based (line, column) of field path `field` (`solver.sigma`, `costs[2].cost.part`) in spec
-/// text, or of the nearest ancestor the text spells out (a field left at its default is not
-/// written): [`trm_kinematics::locate_ron_path`].
-pub fn locate_field(text: &str, field: &str) -> Option<(usize, usize)> {
-    let mut path = field;
-    loop {
-        if let Some(at) = trm_kinematics::locate_ron_path(text, path) {
-            return Some(at);
-        }
-        path = &path[..path.rfind(['.', '['])?];
-    }
-}
-
 struct Ctx<'a> {
     origin: &'a str,
     text: &'a str,
@@ -399,13 +386,13 @@ impl Ctx<'_> {
     /// A spec error at field path `field` (`costs[2].cost.part`), located in the text by that
     /// path — or by its nearest ancestor the text spells out.
     fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskError {
-        TaskError::Spec {
-            origin: self.origin.to_string(),
-            position: locate_field(self.text, field),
-            field: field.to_string(),
-            problem: problem.into(),
-            fix: fix.into(),
-        }
+        TaskError::Spec(Box::new(trm_kinematics::SpecError::at(
+            self.text,
+            self.origin,
+            field,
+            problem,
+            fix,
+        )))
     }
 
     fn suggest<'a>(
@@ -427,9 +414,9 @@ impl Problem {
     /// Reads and builds a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| TaskError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        let text = std::fs::read_to_string(path).map_err(|source| TaskError::Io {
+            path: path.to_path_buf(),
+            source,
         })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_ron(&text, &path.display().to_string(), &base)
@@ -954,12 +941,5 @@ fn anchor_name(a: &AnchorSpec) -> String {
 
 /// A RON error with its position and, for unknown names, the closest valid ones.
 pub fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
-    let p = trm_kinematics::explain_ron_error(e);
-    TaskError::Spec {
-        origin: origin.to_string(),
-        position: Some((p.line, p.column)),
-        field: "spec".into(),
-        problem: p.problem,
-        fix: p.fix,
-    }
+    TaskError::Spec(Box::new(trm_kinematics::SpecError::from_ron(e, origin)))
 }

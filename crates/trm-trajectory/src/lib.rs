@@ -24,6 +24,7 @@ use thiserror::Error;
 
 /// Bad settings or inputs.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum TrajectoryError {
     /// An invalid setting.
     #[error("invalid {what}: {problem}")]

@@ -7,20 +7,10 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum WholeBodyError {
-    /// A motion spec holds something invalid: where (file, line:column, field path), what, fix.
-    #[error("{origin}{}: {field}: {problem}{}", position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if fix.is_empty() { String::new() } else { format!("; fix: {fix}") })]
-    Spec {
-        /// The spec file (or `<string>`).
-        origin: String,
-        /// 1-based (line, column) of the field, when the text spells it out.
-        position: Option<(usize, usize)>,
-        /// Field path, e.g. `phases[1].keyframe.r_knee`.
-        field: String,
-        /// What is wrong.
-        problem: String,
-        /// What to do about it.
-        fix: String,
-    },
+    /// A motion spec holds something invalid: where (file, line:column, field path), what,
+    /// fix (boxed: errors stay small).
+    #[error(transparent)]
+    Spec(Box<trm_kinematics::SpecError>),
     /// A file could not be read.
     #[error("{}: {source}", path.display())]
     Io {
@@ -60,22 +50,8 @@ impl WholeBodyError {
         problem: impl Into<String>,
         fix: impl Into<String>,
     ) -> Self {
-        let mut path = field;
-        let position = loop {
-            if let Some(at) = trm_kinematics::locate_ron_path(text, path) {
-                break Some(at);
-            }
-            match path.rfind(['.', '[']) {
-                Some(i) => path = &path[..i],
-                None => break None,
-            }
-        };
-        WholeBodyError::Spec {
-            origin: origin.to_string(),
-            position,
-            field: field.to_string(),
-            problem: problem.into(),
-            fix: fix.into(),
-        }
+        WholeBodyError::Spec(Box::new(trm_kinematics::SpecError::at(
+            text, origin, field, problem, fix,
+        )))
     }
 }

@@ -36,7 +36,6 @@
 //! ```
 
 // errors carry the file, place and fix of a spec problem; they are cold, so their size is fine
-#![allow(clippy::result_large_err)]
 
 mod error;
 pub mod motion;

@@ -202,14 +202,7 @@ impl MotionSpec {
     /// [`MotionSpec::check_names`]).
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
         let spec: MotionSpec = ron::from_str(text).map_err(|e| {
-            let p = trm_kinematics::explain_ron_error(&e);
-            WholeBodyError::Spec {
-                origin: origin.to_string(),
-                position: Some((p.line, p.column)),
-                field: "spec".into(),
-                problem: p.problem,
-                fix: p.fix,
-            }
+            WholeBodyError::Spec(Box::new(trm_kinematics::SpecError::from_ron(&e, origin)))
         })?;
         let err = |field: &str, problem: String, fix: &str| {
             WholeBodyError::spec(text, origin, field, problem, fix)
