@@ -1,0 +1,116 @@
+//! A shape compiled for the hot path (bounding radius, segment or box form, parry form where
+//! needed) and placed at a pose.
+
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+use parry3d_f64::shape::{Ball, Capsule, Shape as ParryShape, SharedShape};
+
+/// A shape in the form the hot path uses, fixed in a parent frame (a link or the world).
+#[derive(Clone)]
+pub(crate) struct Compiled {
+    /// Bounding-sphere centre in the parent frame.
+    pub center: Point3<f64>,
+    /// Bounding-sphere radius.
+    pub bound: f64,
+    pub geometry: Geometry,
+}
+
+#[derive(Clone)]
+pub(crate) enum Geometry {
+    /// A segment swept by a ball (a ball when `a == b`), end points in the parent frame:
+    /// tested analytically.
+    Round {
+        a: Point3<f64>,
+        b: Point3<f64>,
+        radius: f64,
+    },
+    /// Any other convex shape at `local`: tested by parry, except boxes (`half_extents`)
+    /// against round shapes, which are tested analytically.
+    General {
+        local: Isometry3<f64>,
+        shape: SharedShape,
+        half_extents: Option<Vector3<f64>>,
+    },
+}
+
+impl std::fmt::Debug for Compiled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Compiled")
+            .field("center", &self.center)
+            .field("bound", &self.bound)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A compiled shape moved into the world frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Placed {
+    /// Bounding-sphere centre.
+    pub center: Point3<f64>,
+    /// Bounding-sphere radius.
+    pub bound: f64,
+    /// Round shapes: segment ends; general shapes: unused.
+    pub a: Point3<f64>,
+    pub b: Point3<f64>,
+    /// General shapes: the shape's pose; round shapes: unused.
+    pub iso: Isometry3<f64>,
+}
+
+impl Default for Placed {
+    fn default() -> Self {
+        Placed {
+            center: Point3::origin(),
+            bound: 0.0,
+            a: Point3::origin(),
+            b: Point3::origin(),
+            iso: Isometry3::identity(),
+        }
+    }
+}
+
+impl Compiled {
+    /// Moves the shape by the parent frame's world pose.
+    #[inline]
+    pub fn place(&self, parent: &Isometry3<f64>, out: &mut Placed) {
+        match &self.geometry {
+            Geometry::Round { a, b, .. } => {
+                out.a = parent * a;
+                out.b = parent * b;
+                out.center = nalgebra::center(&out.a, &out.b);
+            }
+            Geometry::General { local, .. } => {
+                out.iso = parent * local;
+                out.center = parent * self.center;
+            }
+        }
+        out.bound = self.bound;
+    }
+
+    /// A parry shape and pose for a round shape placed at `p` (ball when degenerate).
+    pub(crate) fn round_as_parry(p: &Placed, radius: f64) -> (Isometry3<f64>, RoundShape) {
+        if p.a == p.b {
+            (
+                Isometry3::from_parts(Translation3::from(p.a.coords), Default::default()),
+                RoundShape::Ball(Ball::new(radius)),
+            )
+        } else {
+            (
+                Isometry3::identity(),
+                RoundShape::Capsule(Capsule::new(p.a, p.b, radius)),
+            )
+        }
+    }
+}
+
+pub(crate) enum RoundShape {
+    Ball(Ball),
+    Capsule(Capsule),
+}
+
+impl RoundShape {
+    pub(crate) fn shape(&self) -> &dyn ParryShape {
+        match self {
+            RoundShape::Ball(b) => b,
+            RoundShape::Capsule(c) => c,
+        }
+    }
+}

@@ -1,0 +1,232 @@
+//! Collision shapes: the [`Shape`] type with its checks, its compiled hot-path form placed at a
+//! pose (`compiled`), the pairwise tests between placed shapes (`pair`: bounding-sphere reject,
+//! analytic round shapes, parry for the rest) and the exact segment–box distance those tests
+//! use (`segment_box`).
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use parry3d_f64::shape::SharedShape;
+use serde::{Deserialize, Serialize};
+
+mod compiled;
+mod pair;
+mod segment_box;
+
+pub(crate) use compiled::{Compiled, Geometry, Placed};
+pub(crate) use pair::{bounds_apart, intersects, signed_distance};
+
+/// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
+/// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Shape {
+    /// A ball.
+    Sphere {
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A box with full side lengths `size` (each > 0).
+    Box {
+        /// Full side lengths along x, y, z.
+        size: [f64; 3],
+    },
+    /// A cylinder along z.
+    Cylinder {
+        /// Radius (> 0).
+        radius: f64,
+        /// Full length (> 0).
+        length: f64,
+    },
+    /// A capsule along z: a segment of `length` (≥ 0) swept by a ball of `radius` (> 0).
+    Capsule {
+        /// Radius (> 0).
+        radius: f64,
+        /// Distance between the two cap centres.
+        length: f64,
+    },
+    /// The convex hull of points (at least 4, not coplanar); meshes become this.
+    Convex {
+        /// The points, in the shape frame.
+        points: Vec<[f64; 3]>,
+    },
+}
+
+/// What is wrong with a shape, and how to fix it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShapeProblem {
+    /// What is wrong.
+    pub problem: String,
+    /// How to fix it.
+    pub fix: String,
+}
+
+fn problem(problem: impl Into<String>, fix: impl Into<String>) -> ShapeProblem {
+    ShapeProblem {
+        problem: problem.into(),
+        fix: fix.into(),
+    }
+}
+
+impl Shape {
+    /// The shape's kind as written in files.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Shape::Sphere { .. } => "sphere",
+            Shape::Box { .. } => "box",
+            Shape::Cylinder { .. } => "cylinder",
+            Shape::Capsule { .. } => "capsule",
+            Shape::Convex { .. } => "convex",
+        }
+    }
+
+    /// Checks that every size is finite and the shape has a volume.
+    pub fn check(&self) -> Result<(), ShapeProblem> {
+        let positive = |what: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(problem(
+                    format!("{} {what} {v} is not a positive finite number", self.kind()),
+                    format!("give the {what} a positive size in metres"),
+                ))
+            }
+        };
+        match self {
+            Shape::Sphere { radius } => positive("radius", *radius),
+            Shape::Box { size } => size.iter().try_for_each(|&s| positive("size", s)),
+            Shape::Cylinder { radius, length } => {
+                positive("radius", *radius)?;
+                positive("length", *length)
+            }
+            Shape::Capsule { radius, length } => {
+                positive("radius", *radius)?;
+                if length.is_finite() && *length >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(problem(
+                        format!("capsule length {length} is negative or not finite"),
+                        "give a length ≥ 0 (0 makes a sphere)",
+                    ))
+                }
+            }
+            Shape::Convex { points } => {
+                if points.iter().flatten().any(|v| !v.is_finite()) {
+                    return Err(problem(
+                        "convex shape has a non-finite point",
+                        "remove NaN/inf vertices",
+                    ));
+                }
+                let pts: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
+                if !spans_volume(&pts) || SharedShape::convex_hull(&pts).is_none() {
+                    return Err(problem(
+                        format!(
+                            "convex shape of {} points has no volume (all points coplanar?)",
+                            points.len()
+                        ),
+                        "give at least 4 points that span a volume",
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// A parry shape of the same geometry (for queries parry offers and this crate does not).
+    pub fn to_parry(&self) -> Option<SharedShape> {
+        self.check().ok()?;
+        Some(match self {
+            Shape::Sphere { radius } => SharedShape::ball(*radius),
+            Shape::Box { size } => SharedShape::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0),
+            Shape::Cylinder { radius, length } => SharedShape::cylinder(length / 2.0, *radius),
+            Shape::Capsule { radius, length } => SharedShape::capsule_z(length / 2.0, *radius),
+            Shape::Convex { points } => {
+                let pts: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
+                SharedShape::convex_hull(&pts)?
+            }
+        })
+    }
+
+    /// The shape placed at `local` in its parent frame, in the form the queries use.
+    /// `None` when [`Shape::check`] fails.
+    pub(crate) fn compile(&self, local: &Isometry3<f64>) -> Option<Compiled> {
+        self.check().ok()?;
+        let round = |half: f64, radius: f64| {
+            let a = local * Point3::new(0.0, 0.0, -half);
+            let b = local * Point3::new(0.0, 0.0, half);
+            Compiled {
+                center: nalgebra::center(&a, &b),
+                bound: half + radius,
+                geometry: Geometry::Round { a, b, radius },
+            }
+        };
+        Some(match self {
+            Shape::Sphere { radius } => round(0.0, *radius),
+            Shape::Capsule { radius, length } => round(length / 2.0, *radius),
+            _ => {
+                let shape = self.to_parry()?;
+                let sphere = shape.compute_local_bounding_sphere();
+                let half_extents = match self {
+                    Shape::Box { size } => Some(Vector3::from(*size) / 2.0),
+                    _ => None,
+                };
+                Compiled {
+                    center: local * sphere.center,
+                    bound: sphere.radius,
+                    geometry: Geometry::General {
+                        local: *local,
+                        shape,
+                        half_extents,
+                    },
+                }
+            }
+        })
+    }
+}
+
+/// Whether the points span a volume (not all on one plane), relative to their extent.
+pub(crate) fn spans_volume(points: &[Point3<f64>]) -> bool {
+    let Some(p0) = points.first() else {
+        return false;
+    };
+    let farthest = |score: &dyn Fn(&Point3<f64>) -> f64| {
+        points
+            .iter()
+            .map(|p| (score(p), p))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(d, p)| (d, *p))
+            .unwrap_or((0.0, *p0))
+    };
+    let (extent, p1) = farthest(&|p| (p - p0).norm());
+    if extent <= 0.0 {
+        return false;
+    }
+    let axis = (p1 - p0) / extent;
+    let (_, p2) = farthest(&|p| (p - p0).cross(&axis).norm());
+    let normal = (p1 - p0).cross(&(p2 - p0));
+    if normal.norm() <= 1e-12 * extent * extent {
+        return false;
+    }
+    let normal = normal.normalize();
+    let (height, _) = farthest(&|p| (p - p0).dot(&normal).abs());
+    height > 1e-9 * extent
+}
+
+/// Converts a URDF `<geometry>` into a [`Shape`]; meshes are loaded by the caller.
+pub(crate) fn from_urdf(geometry: &trm_kinematics::urdf_rs::Geometry) -> Option<Shape> {
+    use trm_kinematics::urdf_rs::Geometry as G;
+    Some(match geometry {
+        G::Box { size } => Shape::Box { size: size.0 },
+        G::Cylinder { radius, length } => Shape::Cylinder {
+            radius: *radius,
+            length: *length,
+        },
+        G::Capsule { radius, length } => Shape::Capsule {
+            radius: *radius,
+            length: *length,
+        },
+        G::Sphere { radius } => Shape::Sphere { radius: *radius },
+        G::Mesh { .. } => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,166 @@
+//! Pairwise tests between placed shapes: a bounding-sphere reject, then spheres and capsules
+//! analytically (segment distance minus radii), capsule/sphere against box by the exact
+//! segment–box distance, everything else through parry's SAT/GJK.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use parry3d_f64::query;
+use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
+use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape};
+
+use super::compiled::{Compiled, Geometry, Placed, RoundShape};
+use super::segment_box::segment_box_distance_squared;
+
+#[inline]
+fn point_on(a: &Point3<f64>, b: &Point3<f64>, loc: SegmentPointLocation) -> Point3<f64> {
+    match loc {
+        SegmentPointLocation::OnVertex(0) => *a,
+        SegmentPointLocation::OnVertex(_) => *b,
+        SegmentPointLocation::OnEdge([u, v]) => Point3::from(a.coords * u + b.coords * v),
+    }
+}
+
+/// Squared distance between segments `[a1, b1]` and `[a2, b2]`.
+#[inline]
+fn segment_distance_squared(
+    a1: &Point3<f64>,
+    b1: &Point3<f64>,
+    a2: &Point3<f64>,
+    b2: &Point3<f64>,
+) -> f64 {
+    let (l1, l2) = closest_points_segment_segment_with_locations_nD((a1, b1), (a2, b2));
+    (point_on(a1, b1, l1) - point_on(a2, b2, l2)).norm_squared()
+}
+
+/// True when a round shape's bounding sphere lies outside one of a box's slabs: a cheap reject
+/// for large boxes such as tables, which pass the bounding-sphere test for most bodies.
+#[inline]
+fn round_box_apart(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> bool {
+    let c = cuboid.iso.inverse_transform_point(&round.center);
+    (0..3).any(|i| c[i].abs() > half[i] + round.bound)
+}
+
+/// Squared distance between the segment of a placed round shape and a placed box.
+#[inline]
+fn round_box_distance_squared(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> f64 {
+    let a = cuboid.iso.inverse_transform_point(&round.a);
+    let b = cuboid.iso.inverse_transform_point(&round.b);
+    segment_box_distance_squared(&a, &b, half)
+}
+
+/// True when the bounding spheres of two placed shapes are disjoint.
+#[inline(always)]
+pub(crate) fn bounds_apart(p: &Placed, q: &Placed) -> bool {
+    let r = p.bound + q.bound;
+    (p.center - q.center).norm_squared() > r * r
+}
+
+/// Whether two placed shapes touch or overlap (call after [`bounds_apart`] said no).
+#[inline]
+pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> bool {
+    match (&c1.geometry, &c2.geometry) {
+        (Geometry::Round { radius: r1, .. }, Geometry::Round { radius: r2, .. }) => {
+            let r = r1 + r2;
+            segment_distance_squared(&p1.a, &p1.b, &p2.a, &p2.b) <= r * r
+        }
+        (
+            Geometry::Round { radius, .. },
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+        ) => {
+            !round_box_apart(p1, p2, h) && round_box_distance_squared(p1, p2, h) <= radius * radius
+        }
+        (
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+            Geometry::Round { radius, .. },
+        ) => {
+            !round_box_apart(p2, p1, h) && round_box_distance_squared(p2, p1, h) <= radius * radius
+        }
+        (Geometry::Round { radius, .. }, Geometry::General { shape, .. }) => {
+            let (iso, round) = Compiled::round_as_parry(p1, *radius);
+            parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref())
+        }
+        (Geometry::General { shape, .. }, Geometry::Round { radius, .. }) => {
+            let (iso, round) = Compiled::round_as_parry(p2, *radius);
+            parry_intersects(&p1.iso, shape.as_ref(), &iso, round.shape())
+        }
+        (Geometry::General { shape: s1, .. }, Geometry::General { shape: s2, .. }) => {
+            parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref())
+        }
+    }
+}
+
+fn parry_intersects(
+    i1: &Isometry3<f64>,
+    s1: &dyn ParryShape,
+    i2: &Isometry3<f64>,
+    s2: &dyn ParryShape,
+) -> bool {
+    // Every shape this crate builds is convex with a support map, which parry always supports.
+    query::intersection_test(i1, s1, i2, s2).unwrap_or(true)
+}
+
+/// Signed distance between two placed shapes: the gap when apart, minus the penetration depth
+/// when they overlap.
+pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> f64 {
+    if let (Geometry::Round { radius: r1, .. }, Geometry::Round { radius: r2, .. }) =
+        (&c1.geometry, &c2.geometry)
+    {
+        return segment_distance_squared(&p1.a, &p1.b, &p2.a, &p2.b).sqrt() - r1 - r2;
+    }
+    let round_box = match (&c1.geometry, &c2.geometry) {
+        (
+            Geometry::Round { radius, .. },
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+        ) => Some((round_box_distance_squared(p1, p2, h), *radius)),
+        (
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            },
+            Geometry::Round { radius, .. },
+        ) => Some((round_box_distance_squared(p2, p1, h), *radius)),
+        _ => None,
+    };
+    if let Some((squared, radius)) = round_box {
+        if squared > 0.0 {
+            return squared.sqrt() - radius;
+        }
+    }
+    let own = |c: &Compiled, p: &Placed| -> (Isometry3<f64>, Option<RoundShape>) {
+        match &c.geometry {
+            Geometry::Round { radius, .. } => {
+                let (iso, s) = Compiled::round_as_parry(p, *radius);
+                (iso, Some(s))
+            }
+            Geometry::General { .. } => (p.iso, None),
+        }
+    };
+    let (i1, r1) = own(c1, p1);
+    let (i2, r2) = own(c2, p2);
+    let s1: &dyn ParryShape = match (&r1, &c1.geometry) {
+        (Some(r), _) => r.shape(),
+        (None, Geometry::General { shape, .. }) => shape.as_ref(),
+        (None, Geometry::Round { .. }) => unreachable!("round shapes always get a parry twin"),
+    };
+    let s2: &dyn ParryShape = match (&r2, &c2.geometry) {
+        (Some(r), _) => r.shape(),
+        (None, Geometry::General { shape, .. }) => shape.as_ref(),
+        (None, Geometry::Round { .. }) => unreachable!("round shapes always get a parry twin"),
+    };
+    let gap = query::distance(&i1, s1, &i2, s2).unwrap_or(0.0);
+    if gap > 0.0 {
+        return gap;
+    }
+    query::contact(&i1, s1, &i2, s2, 0.0)
+        .ok()
+        .flatten()
+        .map_or(0.0, |c| c.dist.min(0.0))
+}

@@ -1,0 +1,141 @@
+//! Pairwise tests checked against parry, and shape checks.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use parry3d_f64::query;
+
+use super::segment_box::segment_box_distance_squared;
+use super::*;
+
+fn placed(shape: &Shape, pose: Isometry3<f64>) -> (Compiled, Placed) {
+    let c = shape.compile(&Isometry3::identity()).unwrap();
+    let mut p = Placed::default();
+    c.place(&pose, &mut p);
+    (c, p)
+}
+
+fn at(x: f64, y: f64, z: f64) -> Isometry3<f64> {
+    Isometry3::translation(x, y, z)
+}
+
+#[test]
+fn capsule_capsule_distance_is_segment_distance_minus_radii() {
+    let cap = Shape::Capsule {
+        radius: 0.1,
+        length: 1.0,
+    };
+    let (c1, p1) = placed(&cap, at(0.0, 0.0, 0.0));
+    let (c2, p2) = placed(&cap, at(0.5, 0.0, 0.0));
+    assert!((signed_distance(&c1, &p1, &c2, &p2) - 0.3).abs() < 1e-12);
+    assert!(!intersects(&c1, &p1, &c2, &p2));
+    let (c3, p3) = placed(&cap, at(0.15, 0.0, 0.0));
+    assert!((signed_distance(&c1, &p1, &c3, &p3) + 0.05).abs() < 1e-12);
+    assert!(intersects(&c1, &p1, &c3, &p3));
+}
+
+#[test]
+fn analytic_and_parry_agree_on_round_pairs() {
+    let cap = Shape::Capsule {
+        radius: 0.05,
+        length: 0.3,
+    };
+    let parry_cap = cap.to_parry().unwrap();
+    for k in 0..50 {
+        let t = k as f64 * 0.37;
+        let pose = Isometry3::new(
+            Vector3::new(0.1 * t.sin(), 0.08 * t.cos(), 0.05 * (2.0 * t).sin()),
+            Vector3::new(t, 0.5 * t, -0.3 * t),
+        );
+        let (c1, p1) = placed(&cap, Isometry3::identity());
+        let (c2, p2) = placed(&cap, pose);
+        let ours = signed_distance(&c1, &p1, &c2, &p2);
+        let theirs = query::distance(
+            &Isometry3::identity(),
+            parry_cap.as_ref(),
+            &pose,
+            parry_cap.as_ref(),
+        )
+        .unwrap();
+        if ours > 0.0 {
+            assert!((ours - theirs).abs() < 1e-9, "{ours} vs {theirs}");
+        } else {
+            assert_eq!(theirs, 0.0);
+        }
+        let hit = query::intersection_test(
+            &Isometry3::identity(),
+            parry_cap.as_ref(),
+            &pose,
+            parry_cap.as_ref(),
+        )
+        .unwrap();
+        assert_eq!(intersects(&c1, &p1, &c2, &p2), hit);
+    }
+}
+
+#[test]
+fn box_and_sphere_penetration_is_negative() {
+    let table = Shape::Box {
+        size: [1.0, 1.0, 0.1],
+    };
+    let ball = Shape::Sphere { radius: 0.1 };
+    let (c1, p1) = placed(&table, at(0.0, 0.0, 0.0));
+    let (c2, p2) = placed(&ball, at(0.0, 0.0, 0.1));
+    assert!((signed_distance(&c1, &p1, &c2, &p2) + 0.05).abs() < 1e-9);
+    let (c3, p3) = placed(&ball, at(0.0, 0.0, 0.3));
+    assert!((signed_distance(&c1, &p1, &c3, &p3) - 0.15).abs() < 1e-9);
+    assert!(intersects(&c1, &p1, &c2, &p2));
+    assert!(!intersects(&c1, &p1, &c3, &p3));
+}
+
+#[test]
+fn segment_box_distance_matches_parry() {
+    let cuboid = Shape::Box {
+        size: [0.3, 0.2, 0.1],
+    };
+    let parry_box = cuboid.to_parry().unwrap();
+    let h = Vector3::new(0.15, 0.1, 0.05);
+    let mut state = 12345u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) * 0.8 - 0.4
+    };
+    for _ in 0..2000 {
+        let a = Point3::new(uniform(), uniform(), uniform());
+        let b = Point3::new(uniform(), uniform(), uniform());
+        let ours = segment_box_distance_squared(&a, &b, &h).sqrt();
+        let segment = parry3d_f64::shape::Segment::new(a, b);
+        let theirs = query::distance(
+            &Isometry3::identity(),
+            &segment,
+            &Isometry3::identity(),
+            parry_box.as_ref(),
+        )
+        .unwrap();
+        assert!((ours - theirs).abs() < 1e-9, "{a} {b}: {ours} vs {theirs}");
+    }
+}
+
+#[test]
+fn degenerate_shapes_are_rejected() {
+    for s in [
+        Shape::Sphere { radius: 0.0 },
+        Shape::Box {
+            size: [1.0, -1.0, 1.0],
+        },
+        Shape::Cylinder {
+            radius: 0.1,
+            length: f64::NAN,
+        },
+        Shape::Capsule {
+            radius: 0.1,
+            length: -0.2,
+        },
+        Shape::Convex {
+            points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+        },
+    ] {
+        assert!(s.check().is_err(), "{s:?}");
+        assert!(s.compile(&Isometry3::identity()).is_none());
+    }
+}
