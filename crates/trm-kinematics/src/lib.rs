@@ -41,6 +41,7 @@ mod fk;
 pub mod ik;
 mod model;
 mod posture;
+mod resolve;
 mod ron_path;
 mod tree;
 
