@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use trm_collision::{AcmSettings, DisableReason, generate_acm};
+use trm_collision::{AcmOptions, DisableReason, generate_acm};
 
 /// Arguments of `gen-acm`.
 #[derive(clap::Args)]
@@ -35,7 +35,7 @@ pub fn run(args: &Args) -> Result<()> {
     let collision = args.meshes.collision_model(&model)?;
     let report = generate_acm(
         &collision,
-        &AcmSettings {
+        &AcmOptions {
             samples: args.samples,
             seed: args.seed,
             always_fraction: args.always_fraction,

@@ -537,7 +537,7 @@ fn disabled_collisions(urdf: &str, ron_head: &str) -> Result<String> {
     let collision = trm_collision::CollisionModel::new(&model)?;
     let report = trm_collision::generate_acm(
         &collision,
-        &trm_collision::AcmSettings {
+        &trm_collision::AcmOptions {
             samples: ACM_SAMPLES,
             seed: 0,
             ..Default::default()

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use trm_collision::World;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_plan::{Trajectory, time_parametrise};
-use trm_taskmap::{MotionGoal, MotionSettings, ReachProblem};
+use trm_taskmap::{MotionGoal, MotionOptions, ReachProblem};
 
 use crate::explore_task_map::explore_spec;
 
@@ -62,10 +62,10 @@ pub fn run(args: &Args) -> Result<()> {
         object: at,
         start: active.from_motors(home),
         goal,
-        settings: MotionSettings::default(),
+        settings: MotionOptions::default(),
     };
     let started = std::time::Instant::now();
-    let (m, trace) = problem.optimise(args.iterations, 1e-3);
+    let (m, trace) = problem.optimize(args.iterations, 1e-3);
     println!(
         "{} goal, {} map grasps: cost {:.4} (from {:.4}), joint-limit proximity {:.4}, collisions {:.2}, path {:.3} rad, end cost {:.5}; {:.2} s",
         if args.exact { "exact" } else { "task-map" },

@@ -72,7 +72,7 @@ pub fn run(args: &Args) -> Result<()> {
         trm_wholebody::constraint_names(&problem).len()
     );
     let started = Instant::now();
-    let result = trm_wholebody::optimise(&problem, args.seed, |n, best| {
+    let result = trm_wholebody::optimize(&problem, args.seed, |n, best| {
         if n % 100 == 0 {
             eprintln!("  rollout {n}: best φ_co {best:.4}");
         }

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use trm_collision::World;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
-use trm_taskmap::{MotionGoal, MotionSettings, ReachProblem};
+use trm_taskmap::{MotionGoal, MotionOptions, ReachProblem};
 
 use crate::explore_task_map::{Explored, explore_spec};
 
@@ -43,7 +43,7 @@ fn reach<'a>(
         object,
         start: active.from_motors(home),
         goal,
-        settings: MotionSettings::default(),
+        settings: MotionOptions::default(),
     }
 }
 
@@ -60,9 +60,9 @@ pub fn run(args: &Args) -> Result<()> {
     // the exact target: the map's grasp nearest the stick's centre
     let centre = stick.map.centre_grasp().expect("a non-empty map");
     let (exact, exact_trace) = reach(&stick, &active, &world, place, MotionGoal::Target(centre))
-        .optimise(args.iterations, 1e-3);
+        .optimize(args.iterations, 1e-3);
     let (mapped, map_trace) = reach(&stick, &active, &world, place, MotionGoal::Map(&stick.map))
-        .optimise(args.iterations, 1e-3);
+        .optimize(args.iterations, 1e-3);
     let mut md = format!(
         "## (a) Stick ({} feasible grasps), {} RPROP iterations\n\n| goal | total cost | joint-limit proximity | end cost | path length (rad) | grasp position along the stick (m) |\n|---|---|---|---|---|---|\n",
         stick.map.points.len(),
@@ -88,7 +88,7 @@ pub fn run(args: &Args) -> Result<()> {
     for yaw in [-0.6f64, 0.0, 0.6] {
         let at = Isometry3::new(Vector3::new(-0.3, 0.2, -0.05), Vector3::z() * yaw);
         let (m, _) = reach(&handle, &active, &world, at, MotionGoal::Map(&handle.map))
-            .optimise(args.iterations, 1e-3);
+            .optimize(args.iterations, 1e-3);
         let angle = m.final_pose[2].atan2(m.final_pose[0]).to_degrees();
         let _ = writeln!(
             md,

@@ -14,7 +14,7 @@ const SAMPLES_PER_CHUNK: usize = 4096;
 
 /// Settings of [`generate_acm`].
 #[derive(Debug, Clone, PartialEq)]
-pub struct AcmSettings {
+pub struct AcmOptions {
     /// Random configurations sampled uniformly within the motor limits (MoveIt uses 10 000;
     /// a 41-DOF robot needs far more before rare contacts show up, hence the default).
     pub samples: usize,
@@ -27,9 +27,9 @@ pub struct AcmSettings {
     pub default_posture: Option<Vec<f64>>,
 }
 
-impl Default for AcmSettings {
+impl Default for AcmOptions {
     fn default() -> Self {
-        AcmSettings {
+        AcmOptions {
             samples: 1_000_000,
             seed: 0,
             always_fraction: 0.95,
@@ -53,7 +53,7 @@ pub struct AcmReport {
 /// default posture, pairs colliding in almost every and in none of `samples` random
 /// configurations are disabled. Pairs the description disables by hand (`user`) stay disabled;
 /// pairs it enables stay enabled. Other entries of the model's current matrix are ignored.
-pub fn generate_acm(model: &CollisionModel, settings: &AcmSettings) -> Result<AcmReport> {
+pub fn generate_acm(model: &CollisionModel, settings: &AcmOptions) -> Result<AcmReport> {
     let robot = model.robot();
     if !(0.0..=1.0).contains(&settings.always_fraction) {
         return Err(CollisionError::InvalidValue {

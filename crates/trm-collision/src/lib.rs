@@ -40,7 +40,7 @@ mod world;
 
 pub use acm::AllowedCollisionMatrix;
 pub use error::{CollisionError, Result};
-pub use generate::{AcmReport, AcmSettings, generate_acm};
+pub use generate::{AcmOptions, AcmReport, generate_acm};
 pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
 pub use query::{CollidingPair, CollisionCount, Other, PairDistance};
 pub use shape::{Shape, ShapeProblem};

@@ -4,7 +4,7 @@
 //! `.ci/run` installs them and sets `TRM_ICUB_MESHES` to the directory that holds `iCub/`.
 //! Without it, the mesh test says so and checks only that the missing meshes are reported.
 
-use trm_collision::{AcmSettings, CollisionError, CollisionModel, CollisionOptions, generate_acm};
+use trm_collision::{AcmOptions, CollisionError, CollisionModel, CollisionOptions, generate_acm};
 
 fn meshes() -> Option<std::path::PathBuf> {
     let dir = std::path::PathBuf::from(std::env::var_os("TRM_ICUB_MESHES")?);
@@ -49,7 +49,7 @@ fn the_official_urdfs_with_their_meshes_can_be_collision_checked() {
     // A generated matrix leaves the neutral posture free; crossing the forearms collides.
     let report = generate_acm(
         &collision,
-        &AcmSettings {
+        &AcmOptions {
             samples: 300,
             ..Default::default()
         },

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use trm_collision::{
-    AcmSettings, CollisionError, CollisionModel, CollisionOptions, DisableReason, Shape,
+    AcmOptions, CollisionError, CollisionModel, CollisionOptions, DisableReason, Shape,
     generate_acm,
 };
 use trm_kinematics::{ModelDescription, RobotModel};
@@ -103,7 +103,7 @@ fn generated_matrices_are_reproducible_and_respect_forced_pairs() {
     let urdf = arm(r#"<sphere radius="0.05"/>"#);
     let robot = model(&urdf);
     let c = CollisionModel::new(&robot).unwrap();
-    let settings = AcmSettings {
+    let settings = AcmOptions {
         samples: 10_000,
         seed: 7,
         ..Default::default()

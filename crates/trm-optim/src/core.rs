@@ -24,7 +24,7 @@ pub enum StopReason {
     TolFun,
     /// Parallel E-TRM's rule: the mean of the last `recent` fitness values at the distribution
     /// centre exceeds the mean of the last `window`.
-    CentreStagnation,
+    CenterStagnation,
     /// A fitness value was NaN or −∞ (+∞ is allowed: it ranks last).
     InvalidFitness,
     /// The distribution degenerated numerically (e.g. a covariance lost positive definiteness).
@@ -49,8 +49,8 @@ pub struct StopOptions {
     pub tol_fun: Option<f64>,
     /// Parallel E-TRM's rule `(recent, window)`, usually `(20, 40)`: stagnation when the mean of
     /// the last `recent` centre values exceeds the mean of the last `window`. Needs centre values
-    /// ([`Optimizer::record_centre_fitness`]; `minimize` evaluates the centre when it is set).
-    pub centre_stagnation: Option<(usize, usize)>,
+    /// ([`Optimizer::record_center_fitness`]; `minimize` evaluates the centre when it is set).
+    pub center_stagnation: Option<(usize, usize)>,
 }
 
 impl Default for StopOptions {
@@ -62,17 +62,17 @@ impl Default for StopOptions {
             no_improvement_evaluations: None,
             tol_x: Some(1e-12),
             tol_fun: Some(1e-12),
-            centre_stagnation: None,
+            center_stagnation: None,
         }
     }
 }
 
 impl StopOptions {
     fn check(&self) -> Result<()> {
-        if let Some((recent, window)) = self.centre_stagnation {
+        if let Some((recent, window)) = self.center_stagnation {
             if recent == 0 || window <= recent {
                 return Err(invalid(
-                    "centre_stagnation",
+                    "center_stagnation",
                     format!("({recent}, {window}) needs 0 < recent < window"),
                 ));
             }
@@ -266,7 +266,7 @@ impl State {
             history: vec![f64::INFINITY; history],
             history_len: 0,
             last_range: f64::INFINITY,
-            centre: vec![0.0; start.stop.centre_stagnation.map_or(0, |c| c.1)],
+            centre: vec![0.0; start.stop.center_stagnation.map_or(0, |c| c.1)],
             centre_len: 0,
             pending: 0,
         }
@@ -327,7 +327,7 @@ impl State {
     }
 
     /// Records the value `f` of the distribution centre `x` (counts as an evaluation).
-    pub fn record_centre(&mut self, x: &[f64], f: f64) {
+    pub fn record_center(&mut self, x: &[f64], f: f64) {
         self.evaluations += 1;
         if f.is_nan() || f == f64::NEG_INFINITY {
             self.invalid = true;
@@ -375,7 +375,7 @@ impl State {
                 out.push(StopReason::TolFun);
             }
         }
-        if let Some((recent, window)) = s.centre_stagnation {
+        if let Some((recent, window)) = s.center_stagnation {
             if self.centre_len >= window {
                 let mean_last = |k: usize| {
                     (0..k)
@@ -384,7 +384,7 @@ impl State {
                         / k as f64
                 };
                 if mean_last(recent) > mean_last(window) {
-                    out.push(StopReason::CentreStagnation);
+                    out.push(StopReason::CenterStagnation);
                 }
             }
         }
@@ -454,7 +454,7 @@ pub trait Optimizer {
     fn spread(&self) -> f64;
     /// Counts, best point and stopping histories.
     fn state(&self) -> &State;
-    /// Mutable bookkeeping (for [`Optimizer::record_centre_fitness`]).
+    /// Mutable bookkeeping (for [`Optimizer::record_center_fitness`]).
     fn state_mut(&mut self) -> &mut State;
 
     /// Every stopping reason that holds now (empty: go on).
@@ -464,7 +464,7 @@ pub trait Optimizer {
 
     /// Records the fitness `f` of the distribution centre `centre` (a copy of [`Optimizer::mean`])
     /// for the centre-stagnation rule; it counts as an evaluation.
-    fn record_centre_fitness(&mut self, centre: &[f64], f: f64) {
-        self.state_mut().record_centre(centre, f);
+    fn record_center_fitness(&mut self, centre: &[f64], f: f64) {
+        self.state_mut().record_center(centre, f);
     }
 }

@@ -60,7 +60,7 @@ where
     let mut fitness = Vec::new();
     let mut centre = vec![vec![0.0; optimizer.dim()]];
     let mut centre_f = [0.0];
-    let with_centre = optimizer.state().stop_options().centre_stagnation.is_some();
+    let with_centre = optimizer.state().stop_options().center_stagnation.is_some();
     let mut trace = Vec::new();
     loop {
         if !optimizer.stop().is_empty() {
@@ -75,7 +75,7 @@ where
         if with_centre {
             centre[0].copy_from_slice(optimizer.mean());
             objective(&centre, &mut centre_f);
-            optimizer.record_centre_fitness(&centre[0], centre_f[0]);
+            optimizer.record_center_fitness(&centre[0], centre_f[0]);
         }
         let s = optimizer.state();
         trace.push((s.evaluations(), s.best_f()));

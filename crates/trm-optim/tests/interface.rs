@@ -127,7 +127,7 @@ fn budgets_targets_and_no_improvement_stop_the_run() {
 fn the_centre_rule_stops_a_stagnating_search_and_counts_centre_evaluations() {
     let f = TestFunction::by_name("sphere", 4, 0).unwrap();
     let start = Start::new(f.start(), 0.5).with_stop(StopOptions {
-        centre_stagnation: Some((20, 40)),
+        center_stagnation: Some((20, 40)),
         max_evaluations: Some(1_000_000),
         tol_x: None,
         tol_fun: None,
@@ -140,7 +140,7 @@ fn the_centre_rule_stops_a_stagnating_search_and_counts_centre_evaluations() {
     let r = minimize_fn(&mut o, &mut rng, |x| {
         f.eval(x) + 1e-3 * rand::RngExt::random::<f64>(&mut noise)
     });
-    assert_eq!(r.reasons, [StopReason::CentreStagnation]);
+    assert_eq!(r.reasons, [StopReason::CenterStagnation]);
     assert!(r.best_f < 0.01);
     assert_eq!(r.evaluations, r.generations * (o.population() as u64 + 1));
 }

@@ -172,7 +172,7 @@ pub fn build(
             let start = Start::new(q0, sigma)
                 .with_bounds(bounds.clone())
                 .with_stop(StopOptions {
-                    centre_stagnation: Some((20, 40)),
+                    center_stagnation: Some((20, 40)),
                     max_generations: Some(options.max_generations),
                     tol_x: None,
                     tol_fun: None,
@@ -263,7 +263,7 @@ pub fn build(
                     let mut q = s.xnes.mean().to_vec();
                     bounds.clamp(&mut q);
                     let f = h_star(i, &q, scratch, t, nn);
-                    s.xnes.record_centre_fitness(&q, f);
+                    s.xnes.record_center_fitness(&q, f);
                     s.centre_f = f;
                     s.centre_t.clone_from(t);
                     Ok(())

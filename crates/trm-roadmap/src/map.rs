@@ -78,13 +78,15 @@ pub struct Roadmap {
 
 impl Roadmap {
     /// Writes the map as JSON through a temporary file and a rename.
-    pub fn save(&self, path: &Path) -> Result<()> {
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
         Ok(trm_kinematics::save_json(path, self, FORMAT)?)
     }
 
     /// Reads a map file; a truncated, foreign or newer file, or one whose points and edges do
     /// not fit together, is a clear error.
-    pub fn load(path: &Path) -> Result<Self> {
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
         let map: Roadmap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
         map.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),

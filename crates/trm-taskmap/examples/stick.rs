@@ -4,7 +4,7 @@
 //!
 //! `cargo run -p trm-taskmap --example stick`
 
-use trm_taskmap::{ExploreSettings, Metric, TaskMapError, explore};
+use trm_taskmap::{ExploreOptions, Metric, TaskMapError, explore};
 
 fn main() -> Result<(), TaskMapError> {
     let feasible = |g: &[f64; 6]| {
@@ -15,9 +15,9 @@ fn main() -> Result<(), TaskMapError> {
             .max(g[5].abs() / 20.0)
             .max(g[0].abs() - 0.1)
     };
-    let settings = ExploreSettings {
+    let settings = ExploreOptions {
         iterations: 4000,
-        ..ExploreSettings::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3])
+        ..ExploreOptions::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3])
     };
     let map = explore(&[[0.0; 6]], &settings, &Metric::default(), feasible)?;
     println!("{} feasible grasps", map.points.len());

@@ -8,7 +8,7 @@ use crate::map::{Metric, TaskMap, TaskMapError, TaskPoint};
 
 /// Exploration settings.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ExploreSettings {
+pub struct ExploreOptions {
     /// Step ε from the nearest tree node towards the sample, in metric units.
     pub step: f64,
     /// RRT iterations (one evaluation each).
@@ -26,11 +26,11 @@ pub struct ExploreSettings {
     pub seed: u64,
 }
 
-impl ExploreSettings {
+impl ExploreOptions {
     /// A box of half-widths `half` around `centre`, with ε = 0.01, 2000 iterations, θ = 0,
     /// 500 restart probes, seed 0.
     pub fn around(centre: [f64; 6], half: [f64; 6]) -> Self {
-        ExploreSettings {
+        ExploreOptions {
             step: 0.01,
             iterations: 2000,
             lower: std::array::from_fn(|i| centre[i] - half[i]),
@@ -47,7 +47,7 @@ impl ExploreSettings {
 /// feasible (with a tree link to its origin). Restart probes are interleaved with the RRT steps.
 pub fn explore(
     starts: &[[f64; 6]],
-    settings: &ExploreSettings,
+    settings: &ExploreOptions,
     metric: &Metric,
     mut evaluate: impl FnMut(&[f64; 6]) -> f64,
 ) -> Result<TaskMap, TaskMapError> {

@@ -6,11 +6,11 @@
 //! nearest map element, with its gradient.
 //!
 //! ```
-//! use trm_taskmap::{ExploreSettings, Metric, explore};
+//! use trm_taskmap::{ExploreOptions, Metric, explore};
 //! // feasible: anywhere along a 20 cm stick (x), within 1 cm of its axis, any roll about it
 //! let feasible = |g: &[f64; 6]| 0.01 - g[1].abs().max(g[2].abs()).max(g[4].abs() / 20.0).max(g[5].abs() / 20.0)
 //!     .max(g[0].abs() - 0.1);
-//! let settings = ExploreSettings { iterations: 3000, ..ExploreSettings::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3]) };
+//! let settings = ExploreOptions { iterations: 3000, ..ExploreOptions::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3]) };
 //! let map = explore(&[[0.0; 6]], &settings, &Metric::default(), feasible)?;
 //! assert!(map.points.len() > 50);
 //! # Ok::<(), trm_taskmap::TaskMapError>(())
@@ -22,8 +22,8 @@ mod map;
 mod motion;
 mod spec;
 
-pub use explore::{ExploreSettings, explore};
+pub use explore::{ExploreOptions, explore};
 pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
-pub use motion::{Motion, MotionGoal, MotionSettings, ReachProblem};
+pub use motion::{Motion, MotionGoal, MotionOptions, ReachProblem};
 pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};

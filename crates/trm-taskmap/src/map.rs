@@ -270,7 +270,8 @@ impl TaskMap {
     }
 
     /// Writes the map as JSON (atomically).
-    pub fn save(&self, path: &Path) -> Result<(), TaskMapError> {
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TaskMapError> {
+        let path = path.as_ref();
         let fail = |problem: String| TaskMapError::File {
             path: path.display().to_string(),
             problem,
@@ -284,7 +285,8 @@ impl TaskMap {
     }
 
     /// Reads a map; truncated, foreign or newer files are clear errors.
-    pub fn load(path: &Path) -> Result<Self, TaskMapError> {
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, TaskMapError> {
+        let path = path.as_ref();
         let mut map: TaskMap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
         map.metric.check()?;
         map.reindex();

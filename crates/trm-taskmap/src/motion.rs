@@ -24,7 +24,7 @@ pub enum MotionGoal<'a> {
 
 /// Motion settings.
 #[derive(Debug, Clone, PartialEq)]
-pub struct MotionSettings {
+pub struct MotionOptions {
     /// Controller steps.
     pub steps: usize,
     /// Step length, s.
@@ -41,9 +41,9 @@ pub struct MotionSettings {
     pub metric: Metric,
 }
 
-impl Default for MotionSettings {
+impl Default for MotionOptions {
     fn default() -> Self {
-        MotionSettings {
+        MotionOptions {
             steps: 30,
             dt: 0.05,
             gain: 4.0,
@@ -91,7 +91,7 @@ pub struct ReachProblem<'a> {
     /// Goal.
     pub goal: MotionGoal<'a>,
     /// Settings.
-    pub settings: MotionSettings,
+    pub settings: MotionOptions,
 }
 
 fn joint_limit_proximity(q: &[f64], lower: &[f64], upper: &[f64], grad: Option<&mut [f64]>) -> f64 {
@@ -215,7 +215,7 @@ impl ReachProblem<'_> {
 
     /// Optimises the attractors with iRprop− on central-difference gradients (step `h`), for
     /// `iterations`; returns the best motion and the cost trace `(total, joint-limit proximity)`.
-    pub fn optimise(&self, iterations: usize, h: f64) -> (Motion, Vec<(f64, f64)>) {
+    pub fn optimize(&self, iterations: usize, h: f64) -> (Motion, Vec<(f64, f64)>) {
         let x0 = self.initial_attractors();
         let mut rprop = Rprop::new(
             &x0,
@@ -249,7 +249,7 @@ impl ReachProblem<'_> {
 
     /// Optimises the attractors with a sampling optimiser of `trm-optim` instead (`algo`, e.g.
     /// `xnes` or `cmaes`; initial step `sigma` in goal-space units), for `evaluations`.
-    pub fn optimise_sampling(
+    pub fn optimize_sampling(
         &self,
         algo: &str,
         sigma: f64,

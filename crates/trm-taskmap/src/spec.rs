@@ -25,7 +25,7 @@ use serde::Deserialize;
 use trm_collision::{CollisionModel, ObjectSpec, World, WorldSpec};
 use trm_kinematics::RobotModel;
 
-use crate::{ExploreSettings, Hand, Metric, TaskMap, TaskMapError, explore, find_grasp};
+use crate::{ExploreOptions, Hand, Metric, TaskMap, TaskMapError, explore, find_grasp};
 
 fn right() -> String {
     "r".into()
@@ -268,12 +268,12 @@ impl LoadedTaskMapSpec {
             }
         };
         let e = &s.explore;
-        let settings = ExploreSettings {
+        let settings = ExploreOptions {
             iterations: e.iterations,
             step: e.step,
             restarts: e.restarts,
             seed: e.seed,
-            ..ExploreSettings::around(start, e.half_widths)
+            ..ExploreOptions::around(start, e.half_widths)
         };
         let started = std::time::Instant::now();
         let map = explore(&[start], &settings, &s.metric.unwrap_or_default(), |g| {

@@ -1,6 +1,6 @@
 //! Exploration, files and the task-map cost on synthetic feasible sets with known shapes.
 
-use trm_taskmap::{ExploreSettings, Metric, TaskMap, TaskMapError, explore, to_params, to_pose};
+use trm_taskmap::{ExploreOptions, Metric, TaskMap, TaskMapError, explore, to_params, to_pose};
 
 /// Feasible: along a 20 cm stick (|x| ≤ 0.1), within 1 cm of its axis, tilted at most 0.2 rad,
 /// any roll about the axis (rotation vector component 3 free).
@@ -10,10 +10,10 @@ fn stick(g: &[f64; 6]) -> f64 {
     (0.01 - off_axis).min(0.2 - tilt).min(0.1 - g[0].abs())
 }
 
-fn settings() -> ExploreSettings {
-    ExploreSettings {
+fn settings() -> ExploreOptions {
+    ExploreOptions {
         iterations: 4000,
-        ..ExploreSettings::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3])
+        ..ExploreOptions::around([0.0; 6], [0.15, 0.02, 0.02, 3.2, 0.3, 0.3])
     }
 }
 
@@ -50,9 +50,9 @@ fn restarts_find_disjoint_clusters() {
         h[1] = if g[1] > 0.1 { g[1] - 0.2 } else { g[1] };
         stick(&h)
     };
-    let mut s = ExploreSettings {
+    let mut s = ExploreOptions {
         iterations: 6000,
-        ..ExploreSettings::around(
+        ..ExploreOptions::around(
             [0.0, 0.1, 0.0, 0.0, 0.0, 0.0],
             [0.15, 0.13, 0.02, 3.2, 0.3, 0.3],
         )
@@ -100,7 +100,7 @@ fn bad_starts_and_metrics_are_clear_errors() {
     assert!(e.to_string().contains("degenerate"), "{e}");
     let empty = explore(
         &[[0.0; 6]],
-        &ExploreSettings {
+        &ExploreOptions {
             iterations: 0,
             ..settings()
         },

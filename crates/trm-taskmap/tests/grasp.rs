@@ -5,7 +5,7 @@ use trm_collision::CollisionModel;
 mod common;
 use common::stick;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
-use trm_taskmap::{ExploreSettings, Hand, Metric, explore, to_params, to_pose};
+use trm_taskmap::{ExploreOptions, Hand, Metric, explore, to_params, to_pose};
 
 /// A power grasp found by sampling (object pose in the hand frame).
 fn known_grasp() -> Isometry3<f64> {
@@ -59,11 +59,11 @@ fn grasps_along_the_stick_form_a_task_map() {
     // sliding along the stick (its z axis) keeps the grasp feasible
     let slid = to_params(&(Isometry3::translation(0.0, 0.0, 0.05) * known_grasp()));
     assert!(hand.evaluate(&stick(), &to_pose(&slid)).success);
-    let settings = ExploreSettings {
+    let settings = ExploreOptions {
         iterations: 250,
         restarts: 0,
         step: 0.015,
-        ..ExploreSettings::around(g0, [0.05, 0.05, 0.12, 0.3, 0.3, 0.3])
+        ..ExploreOptions::around(g0, [0.05, 0.05, 0.12, 0.3, 0.3, 0.3])
     };
     let quality = |g: &[f64; 6]| hand.quality(&stick(), g);
     let map = explore(&[g0], &settings, &Metric::default(), quality).unwrap();

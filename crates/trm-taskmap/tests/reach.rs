@@ -5,7 +5,7 @@ use trm_collision::{CollisionModel, World};
 mod common;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_taskmap::{
-    ExploreSettings, Hand, Metric, MotionGoal, MotionSettings, ReachProblem, explore, find_grasp,
+    ExploreOptions, Hand, Metric, MotionGoal, MotionOptions, ReachProblem, explore, find_grasp,
 };
 
 #[test]
@@ -23,10 +23,10 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
         0,
     )
     .unwrap();
-    let settings = ExploreSettings {
+    let settings = ExploreOptions {
         iterations: 600,
         restarts: 0,
-        ..ExploreSettings::around(g0, [0.1, 0.1, 0.2, 1.0, 1.0, 1.0])
+        ..ExploreOptions::around(g0, [0.1, 0.1, 0.2, 1.0, 1.0, 1.0])
     };
     let quality = |g: &[f64; 6]| hand.quality(&stick, g);
     let map = explore(&[g0], &settings, &Metric::default(), quality).unwrap();
@@ -45,12 +45,12 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
         object,
         start: start.clone(),
         goal,
-        settings: MotionSettings::default(),
+        settings: MotionOptions::default(),
     };
     let exact = problem(MotionGoal::Target(g0));
     let with_map = problem(MotionGoal::Map(&map));
-    let (a, trace_a) = exact.optimise(12, 1e-3);
-    let (b, trace_b) = with_map.optimise(12, 1e-3);
+    let (a, trace_a) = exact.optimize(12, 1e-3);
+    let (b, trace_b) = with_map.optimize(12, 1e-3);
     println!(
         "exact: cost {:.4} limits {:.4} end {:.5}; map: cost {:.4} limits {:.4} end {:.5}; {} map points",
         a.cost,
@@ -68,7 +68,7 @@ fn reaching_with_a_task_map_ends_on_the_map_and_costs_less() {
     );
     assert!(a.trajectory.len() == 31 && b.trajectory.len() == 31);
     // a sampling optimiser works as an alternative
-    let c = with_map.optimise_sampling("xnes", 0.02, 300, 1).unwrap();
+    let c = with_map.optimize_sampling("xnes", 0.02, 300, 1).unwrap();
     assert!(c.cost <= with_map.simulate(&with_map.initial_attractors()).cost);
 }
 
@@ -91,7 +91,7 @@ fn central_difference_gradients_are_consistent_across_step_sizes() {
         object: Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::zeros()),
         start: active.from_motors(model.posture("home").unwrap()),
         goal: MotionGoal::Target(target),
-        settings: MotionSettings::default(),
+        settings: MotionOptions::default(),
     };
     let x = problem.initial_attractors();
     let gradient = |h: f64| -> Vec<f64> {

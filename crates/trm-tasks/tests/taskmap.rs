@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use trm_taskmap::{ExploreSettings, Metric, explore, to_params};
+use trm_taskmap::{ExploreOptions, Metric, explore, to_params};
 use trm_tasks::{Problem, solve};
 
 #[test]
@@ -36,9 +36,9 @@ fn ngik_brings_the_hand_onto_a_task_map() {
     };
     let g0 = [0.0, 0.0, 0.0, home_rel[3], home_rel[4], home_rel[5]];
     let half = [0.02, 0.02, 0.1, 0.4, 0.4, 0.4];
-    let settings = ExploreSettings {
+    let settings = ExploreOptions {
         iterations: 3000,
-        ..ExploreSettings::around(g0, half)
+        ..ExploreOptions::around(g0, half)
     };
     let map = explore(&[g0], &settings, &Metric::default(), feasible).unwrap();
     let dir = std::env::temp_dir().join(format!("trm-tasks-taskmap-{}", std::process::id()));

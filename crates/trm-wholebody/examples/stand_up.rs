@@ -5,7 +5,7 @@
 //! `cargo run -p trm-wholebody --example stand_up [-- MOTION_SPEC.ron [SEED]]` (default: the
 //! repository's `specs/wholebody/standup.ron`)
 
-use trm_wholebody::{WholeBody, optimise};
+use trm_wholebody::{WholeBody, optimize};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     });
     let seed: u64 = args.next().map_or(Ok(1), |s| s.parse())?;
     let problem = WholeBody::load(&spec)?;
-    let result = optimise(&problem, seed, |_, _| {})?;
+    let result = optimize(&problem, seed, |_, _| {})?;
     for s in &result.solutions {
         println!(
             "{:<13} φ_co {:.3}, {} violated samples, independent re-check: {}",

@@ -39,11 +39,11 @@
 
 mod error;
 pub mod motion;
-pub mod optimise;
+pub mod optimize;
 pub mod spec;
 
 pub use motion::{Costs, Rollout, WholeBody, constraint_names};
-pub use optimise::{Comparison, StandUpResult, optimise};
+pub use optimize::{Comparison, StandUpResult, optimize};
 pub use spec::{MotionSpec, Support};
 
 pub use error::WholeBodyError;

@@ -51,7 +51,7 @@ pub struct MotionSpec {
     /// Weights of the cost terms (the paper: 1.3, 1, 3).
     pub weights: WeightsSpec,
     /// Optimisation settings.
-    pub optimiser: OptimiserSpec,
+    pub optimiser: OptimizerSpec,
     /// The hand-tuned reference trajectory the results are normalised by.
     pub hand_tuned: TrajectorySpec,
 }
@@ -163,7 +163,7 @@ pub struct WeightsSpec {
 /// Optimisation settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct OptimiserSpec {
+pub struct OptimizerSpec {
     /// Rollouts of the unconstrained bootstrap (the paper: 500).
     pub bootstrap_rollouts: u64,
     /// Rollouts of the constrained search (the paper: 500).

@@ -123,7 +123,7 @@ fn bootstrap_then_cca_finds_a_feasible_better_trajectory_reproducibly() {
     spec.optimiser.rollouts = 60;
     let text = std::fs::read_to_string(SPEC).unwrap();
     let p = WholeBody::new(spec, trm_models::icub_sagittal(), SPEC, &text).unwrap();
-    let a = trm_wholebody::optimise(&p, 1, |_, _| {}).unwrap();
+    let a = trm_wholebody::optimize(&p, 1, |_, _| {}).unwrap();
     assert!(a.feasible);
     let best = a.solutions.last().unwrap();
     assert_eq!(best.name, "constrained");
@@ -140,7 +140,7 @@ fn bootstrap_then_cca_finds_a_feasible_better_trajectory_reproducibly() {
         .unwrap();
     assert!(best.phi_co <= boot.phi_co);
     assert!(best.normalised.com_error < 1.0 && best.normalised.effort < 1.0);
-    let b = trm_wholebody::optimise(&p, 1, |_, _| {}).unwrap();
+    let b = trm_wholebody::optimize(&p, 1, |_, _| {}).unwrap();
     assert_eq!(a, b, "same seed, same result");
 }
 

@@ -88,7 +88,7 @@ impl WholeBody {
 
 /// Runs the bootstrap and the constrained search with `seed`; `progress(rollouts, best φ_co)`
 /// is called after every constrained rollout (φ_co is NaN until a feasible rollout exists).
-pub fn optimise(
+pub fn optimize(
     problem: &WholeBody,
     seed: u64,
     mut progress: impl FnMut(u64, f64),
