@@ -13,7 +13,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = args
         .next()
         .ok_or("give a map file (cargo xtask build-map specs/reach.ron)")?;
-    let map = Roadmap::load(path.as_ref())?;
+    let map = Roadmap::load(&path)?;
     let problem = map.problem()?;
     let t: Vec<f64> = match args.next() {
         Some(text) => text.split(',').map(str::parse).collect::<Result<_, _>>()?,

@@ -26,8 +26,8 @@ fn main() -> Result<(), RoadmapError> {
     })?;
     eprintln!();
     trm_roadmap::connect(&mut map, &problem.objective, 6, 0.05);
-    map.save(out.as_ref())?;
-    let back = Roadmap::load(out.as_ref())?;
+    map.save(&out)?;
+    let back = Roadmap::load(&out)?;
     let s = back.summary();
     println!(
         "{out}: {} points, {} edges, {} components, spacing mean {:.3} m, coverage {:?}",
