@@ -47,7 +47,7 @@ fn a_crate_outside_the_workspace_uses_the_library_end_to_end() {
     ] {
         assert!(out.join(file).is_file(), "{file} not written");
     }
-    let map = trm_roadmap::Roadmap::load(&out.join("right_hand.map.json")).unwrap();
+    let map = trm_roadmap::Roadmap::load(out.join("right_hand.map.json")).unwrap();
     assert!(map.points.len() >= 20, "{} points", map.points.len());
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -43,7 +43,7 @@ fn ngik_brings_the_hand_onto_a_task_map() {
     let map = explore(&[g0], &settings, &Metric::default(), feasible).unwrap();
     let dir = std::env::temp_dir().join(format!("trm-tasks-taskmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    map.save(&dir.join("stick.taskmap.json")).unwrap();
+    map.save(dir.join("stick.taskmap.json")).unwrap();
     let spec = format!(
         "(model: \"icub_upper_body\", active: [\"torso\", \"right_arm\"],
           world: (objects: [(name: \"stick\", shape: Capsule(radius: 0.01, length: 0.16), xyz: ({}, {}, {}), rpy: (1.5707963267948966, 0, 0))]),
