@@ -525,11 +525,22 @@ fn disabled_collisions(urdf: &str, ron_head: &str) -> Result<String> {
             .copied()
             .filter(|l| l.starts_with(&format!("{side}_hand")))
             .collect();
-        for (i, a) in hand.iter().enumerate() {
-            for b in &hand[i + 1..] {
-                let _ = writeln!(s, "        (a: \"{a}\", b: \"{b}\", reason: user),");
-            }
-        }
+        let pairs: Vec<trm_kinematics::DisabledCollisionSpec> = hand
+            .iter()
+            .enumerate()
+            .flat_map(|(i, a)| {
+                hand[i + 1..]
+                    .iter()
+                    .map(move |b| trm_kinematics::DisabledCollisionSpec {
+                        a: a.to_string(),
+                        b: b.to_string(),
+                        reason: trm_kinematics::DisableReason::User,
+                    })
+            })
+            .collect();
+        s.push_str(&trm_kinematics::DisabledCollisionSpec::list_to_ron(
+            &pairs, "        ",
+        ));
     }
     let head = format!("{ron_head}{s}    ],\n)\n");
     let description = trm_kinematics::ModelDescription::from_ron(&head, "<generated>")?;
@@ -543,21 +554,15 @@ fn disabled_collisions(urdf: &str, ron_head: &str) -> Result<String> {
             ..Default::default()
         },
     )?;
-    let names: Vec<&str> = model.tree().links.iter().map(|l| l.name.as_str()).collect();
-    for ([a, b], reason) in report.acm.disabled_pairs() {
-        if !matches!(
-            reason,
-            trm_kinematics::DisableReason::Adjacent | trm_kinematics::DisableReason::User
-        ) {
-            let _ = writeln!(
-                s,
-                "        (a: \"{}\", b: \"{}\", reason: {}),",
-                names[a],
-                names[b],
-                reason.as_str()
-            );
-        }
-    }
+    s.push_str(&trm_kinematics::DisabledCollisionSpec::list_to_ron(
+        &report.acm.to_spec(&model, |r| {
+            !matches!(
+                r,
+                trm_kinematics::DisableReason::Adjacent | trm_kinematics::DisableReason::User
+            )
+        }),
+        "        ",
+    ));
     s.push_str("    ],\n");
     Ok(s)
 }

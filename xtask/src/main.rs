@@ -129,14 +129,8 @@ pub struct MeshArgs {
 impl MeshArgs {
     /// The model's collision model, meshes found through the package paths.
     fn collision_model(&self, model: &RobotModel) -> Result<trm_collision::CollisionModel> {
-        let mut package_paths = self.package_paths.clone();
-        if let Some(ros) = std::env::var_os("ROS_PACKAGE_PATH") {
-            package_paths.extend(std::env::split_paths(&ros));
-        }
-        let options = trm_collision::CollisionOptions {
-            package_paths,
-            ..Default::default()
-        };
+        let options =
+            trm_collision::CollisionOptions::with_ros_package_path(self.package_paths.clone());
         Ok(trm_collision::CollisionModel::with_options(
             model, &options,
         )?)

@@ -1,6 +1,6 @@
 //! The allowed-collision matrix: which link pairs collision checking skips, and why.
 
-use trm_kinematics::{DisableReason, RobotModel};
+use trm_kinematics::{DisableReason, DisabledCollisionSpec, RobotModel};
 
 /// A symmetric link × link table: `None` = the pair is checked, `Some(reason)` = skipped.
 /// A link is never checked against itself.
@@ -105,5 +105,25 @@ impl AllowedCollisionMatrix {
             (a + 1..self.links)
                 .filter_map(move |b| self.entries[a * self.links + b].map(|r| ([a, b], r)))
         })
+    }
+
+    /// The skipped pairs whose reason `keep` accepts, by link name, as a model description's
+    /// `disabled_collisions` entries (adjacent pairs need no entry: pass
+    /// `|r| r != DisableReason::Adjacent`). Write them with
+    /// [`DisabledCollisionSpec::list_to_ron`].
+    pub fn to_spec(
+        &self,
+        model: &RobotModel,
+        keep: impl Fn(DisableReason) -> bool,
+    ) -> Vec<DisabledCollisionSpec> {
+        let links = &model.tree().links;
+        self.disabled_pairs()
+            .filter(|&(_, r)| keep(r))
+            .map(|([a, b], reason)| DisabledCollisionSpec {
+                a: links[a].name.clone(),
+                b: links[b].name.clone(),
+                reason,
+            })
+            .collect()
     }
 }

@@ -22,6 +22,21 @@ pub struct CollisionOptions {
     pub urdf_dir: Option<PathBuf>,
 }
 
+impl CollisionOptions {
+    /// Options that search `package_paths`, then the directories of the `ROS_PACKAGE_PATH`
+    /// environment variable, as ROS resolves `package://` URIs.
+    pub fn with_ros_package_path(package_paths: Vec<PathBuf>) -> Self {
+        let mut package_paths = package_paths;
+        if let Some(ros) = std::env::var_os("ROS_PACKAGE_PATH") {
+            package_paths.extend(std::env::split_paths(&ros));
+        }
+        CollisionOptions {
+            package_paths,
+            ..Default::default()
+        }
+    }
+}
+
 /// One collision body: a convex shape rigidly attached to a link.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Body {

@@ -90,6 +90,22 @@ pub struct DisabledCollisionSpec {
     pub reason: DisableReason,
 }
 
+impl DisabledCollisionSpec {
+    /// `entries` as the lines of a RON list, one `(a: "…", b: "…", reason: …)` per line, each
+    /// indented by `indent` — serialised by ron, read back by [`ModelDescription::from_ron`].
+    pub fn list_to_ron(entries: &[DisabledCollisionSpec], indent: &str) -> String {
+        let compact = ron::ser::PrettyConfig::new().compact_structs(true);
+        entries
+            .iter()
+            .map(|e| {
+                let line = ron::ser::to_string_pretty(e, compact.clone())
+                    .expect("names and a reason serialise");
+                format!("{indent}{line},\n")
+            })
+            .collect()
+    }
+}
+
 /// A motor declared for couplings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
