@@ -15,7 +15,7 @@ pub struct Args {
     /// Input, as for `fk`: {"joint_names": [...], "samples": [{"q": [...]}, ...]}.
     #[arg(long)]
     configs: PathBuf,
-    /// World objects (RON, see specs/README.md), checked as well.
+    /// World objects (RON; format: crates/trm-collision/docs/world.md), checked as well.
     #[arg(long)]
     world: Option<PathBuf>,
     #[command(flatten)]

@@ -12,7 +12,7 @@ use trm_taskmap::TaskMapSpec;
 /// Arguments of `explore-task-map`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The task-map spec (RON, see specs/README.md).
+    /// The task-map spec (RON; format: crates/trm-taskmap/docs/task-map-spec.md).
     spec: PathBuf,
     /// Output file (default: target/taskmaps/<spec name>.taskmap.json; an .svg goes beside it).
     #[arg(long)]

@@ -9,7 +9,7 @@ use trm_tasks::{Problem, solve};
 /// Arguments of `solve`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The task spec (RON, see specs/README.md).
+    /// The task spec (RON; format: crates/trm-tasks/docs/task-spec.md).
     spec: PathBuf,
     /// Optimiser, overriding the spec's solver.algo.
     #[arg(long)]

@@ -46,3 +46,9 @@ pub use query::{CollidingPair, CollisionCount, Other, PairDistance};
 pub use shape::{Shape, ShapeProblem};
 pub use trm_kinematics::DisableReason;
 pub use world::{ObjectSpec, World, WorldObject, WorldSpec};
+
+/// The file formats this crate reads and writes.
+pub mod formats {
+    #[doc = include_str!("../docs/world.md")]
+    pub mod world {}
+}

@@ -60,3 +60,9 @@ pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_path};
 pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use urdf_rs;
+
+/// The file formats this crate reads and writes.
+pub mod formats {
+    #[doc = include_str!("../docs/model-description.md")]
+    pub mod model_description {}
+}

@@ -1,5 +1,23 @@
 //! Roadmaps and their files: versioned JSON with the spec, seed, settings, software version and
 //! statistics inside, written atomically.
+//!
+//! File format (`trm-roadmap`, version 1; the fields of [`Roadmap`]):
+//!
+//! ```json
+//! { "format": "trm-roadmap", "version": 1, "software": "trm 0.1.0",
+//!   "spec_path": "specs/reach.ron", "spec": "<the spec text, verbatim>",
+//!   "seed": 0, "searches": 4, "settings": { "spacing": 0.025, … },
+//!   "active": ["torso_pitch", …],            // the columns of every q
+//!   "task": "position r_palm_center",
+//!   "points": [ { "q": [ … ], "t": [x, y, z], "cost": 0.03 }, … ],
+//!   "edges": [ [i, j, length], … ],           // i < j, checked collision-free
+//!   "edge_resolution": 0.05,
+//!   "stats": { "build_seconds": 2.7, "evaluations": 123456, … } }
+//! ```
+//!
+//! [`Roadmap::load`] refuses another format or version, a truncated file, and points and edges
+//! that do not fit together (lengths, indices, non-finite values); [`Roadmap::problem`]
+//! rebuilds the task from the embedded spec.
 
 use std::path::Path;
 

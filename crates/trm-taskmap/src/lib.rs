@@ -27,3 +27,9 @@ pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
 pub use motion::{Motion, MotionGoal, MotionOptions, ReachProblem};
 pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};
+
+/// The file formats this crate reads and writes.
+pub mod formats {
+    #[doc = include_str!("../docs/task-map-spec.md")]
+    pub mod task_map_spec {}
+}

@@ -1,23 +1,6 @@
 //! Task-map specs: which hand grasps which object, where to start and how to explore (RON) —
-//! what `cargo xtask explore-task-map` reads.
-//!
-//! ```ron
-//! (
-//!     model: None,                 // a .urdf/.ron model relative to the spec; the iCub upper body when absent
-//!     hand: "r",                   // which iCub hand: "r" or "l"
-//!     object: [                    // the object's parts in its own frame (world objects)
-//!         (name: "stick", shape: Cylinder(radius: 0.015, length: 0.3)),
-//!     ],
-//!     start: None,                 // the first grasp g₀ (position and rotation vector of the hand
-//!                                  // in the object frame); found by random search when absent
-//!     metric: Some((position: 1.0, orientation: 0.01)),
-//!     explore: (iterations: 3000, step: 0.015, restarts: 300,
-//!               half_widths: (0.1, 0.1, 0.2, 1.0, 1.0, 1.0), seed: 0),
-//!     search: (samples: 5000, lower: (-0.15, -0.12, -0.08), upper: (0.05, 0.12, 0.15), seed: 0),
-//! )
-//! ```
-//!
-//! Every field but `object` has a default. Errors name the file, the line and the field.
+//! what `cargo xtask explore-task-map` reads. Format: [`crate::formats::task_map_spec`]. Errors
+//! name the file, the line and the field.
 
 use std::path::{Path, PathBuf};
 

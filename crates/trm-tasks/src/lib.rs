@@ -3,7 +3,7 @@
 //! A posture is whatever minimises a weighted sum of cost functions h = Σ aᵢ hᵢ(p, q, w) over the
 //! robot's poses p, its active motors q and the world w (Table I of Stollenga et al., IROS
 //! 2013); a task function g(p, q, w) (Table II) maps it to the task space roadmaps cover.
-//! [`Problem::load`] reads a spec (format: `specs/README.md`); [`solve`] runs NGIK:
+//! [`Problem::load`] reads a spec (format: [`formats::task_spec`]); [`solve`] runs NGIK:
 //!
 //! ```
 //! let spec = r#"(
@@ -42,3 +42,9 @@ pub use ngik::{Solution, solve, solve_with, solver_start};
 pub use objective::{Objective, Scratch, TermValue};
 pub use spec::{Problem, Spec};
 pub use tasks::TaskFunction;
+
+/// The file formats this crate reads and writes.
+pub mod formats {
+    #[doc = include_str!("../docs/task-spec.md")]
+    pub mod task_spec {}
+}

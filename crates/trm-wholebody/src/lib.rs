@@ -25,8 +25,8 @@
 //!
 //! Constraints along the whole motion: position, velocity and static-torque limits, ZMP,
 //! self-collision and collision with the world (the seat's contact links excepted while it
-//! supports); [`WholeBody::verify`] re-checks a rollout independently. Specs: `specs/README.md`,
-//! "Whole-body motions".
+//! supports); [`WholeBody::verify`] re-checks a rollout independently. Spec format:
+//! [`formats::motion_spec`].
 //!
 //! ```no_run
 //! let problem = trm_wholebody::WholeBody::load("specs/wholebody/standup.ron")?;
@@ -47,6 +47,12 @@ pub use optimize::{Comparison, StandUpResult, optimize};
 pub use spec::{MotionSpec, Support};
 
 pub use error::WholeBodyError;
+
+/// The file formats this crate reads and writes.
+pub mod formats {
+    #[doc = include_str!("../docs/motion-spec.md")]
+    pub mod motion_spec {}
+}
 
 /// Result alias of this crate.
 pub type Result<T, E = WholeBodyError> = std::result::Result<T, E>;

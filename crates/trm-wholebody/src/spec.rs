@@ -1,4 +1,4 @@
-//! Whole-body motion specs in RON (format: `specs/README.md`, section "Whole-body motions").
+//! Whole-body motion specs in RON (format: [`crate::formats::motion_spec`]).
 //! [`MotionSpec::load`] reads a file and checks every name and number, with errors that name the
 //! file, line and field and say how to fix them.
 
