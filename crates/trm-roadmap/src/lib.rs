@@ -7,7 +7,7 @@
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
 //! let mut map = trm_roadmap::build(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
 //! trm_roadmap::connect(&mut map, &problem.objective, 8, 0.05);
-//! map.save("reach.map.json".as_ref())?;
+//! map.save("reach.map.json")?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
