@@ -5,7 +5,7 @@
 //!
 //! ```no_run
 //! use trm_plan::{Goal, Planner, PlanOptions};
-//! let map = trm_roadmap::Roadmap::load("target/maps/reach.map.json".as_ref())?;
+//! let map = trm_roadmap::Roadmap::load("target/maps/reach.map.json")?;
 //! let problem = map.problem()?;
 //! let mut planner = Planner::new(&problem.objective, &[&map])?;
 //! let plan = planner.plan(&problem.start, &Goal::TaskPoint { t: vec![-0.3, 0.1, 0.1], tolerance: 0.03 }, &PlanOptions::default())?;
