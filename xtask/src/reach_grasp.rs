@@ -48,7 +48,7 @@ pub fn run(args: &Args) -> Result<()> {
     let home = e.model.posture("home")?;
     let active = e.model.active_set(&["torso", "right_arm"], home)?;
     let world = World::new();
-    let centre = e.map.centre_grasp().context("the task map is empty")?;
+    let centre = e.map.center_grasp().context("the task map is empty")?;
     let goal = if args.exact {
         MotionGoal::Target(centre)
     } else {

@@ -58,7 +58,7 @@ pub fn run(args: &Args) -> Result<()> {
     let world = World::new();
     let place = Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::zeros());
     // the exact target: the map's grasp nearest the stick's centre
-    let centre = stick.map.centre_grasp().expect("a non-empty map");
+    let centre = stick.map.center_grasp().expect("a non-empty map");
     let (exact, exact_trace) = reach(&stick, &active, &world, place, MotionGoal::Target(centre))
         .optimize(args.iterations, 1e-3);
     let (mapped, map_trace) = reach(&stick, &active, &world, place, MotionGoal::Map(&stick.map))

@@ -141,11 +141,7 @@ impl World {
                 origin: origin.to_string(),
                 line: p.line,
                 column: p.column,
-                message: if p.fix.is_empty() {
-                    p.problem
-                } else {
-                    format!("{}; {}", p.problem, p.fix)
-                },
+                message: p.message(),
             }
         })?;
         Self::from_spec_in(&spec, origin, text, "objects")

@@ -179,11 +179,7 @@ impl ModelDescription {
                 origin: origin.to_string(),
                 line: p.line,
                 column: p.column,
-                message: if p.fix.is_empty() {
-                    p.problem
-                } else {
-                    format!("{}; {}", p.problem, p.fix)
-                },
+                message: p.message(),
             }
         })
     }

@@ -3,6 +3,14 @@
 use std::io::Write as _;
 use std::path::Path;
 
+/// Reads a text file, naming it in the error.
+pub(crate) fn read_text(path: &Path) -> crate::Result<String> {
+    std::fs::read_to_string(path).map_err(|source| crate::KinematicsError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
 /// crash never leaves a half-written file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {

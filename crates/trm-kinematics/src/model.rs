@@ -97,13 +97,6 @@ impl TryFrom<&urdf_rs::Robot> for RobotModel {
     }
 }
 
-fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
 fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
     urdf_rs::read_from_string(text).map_err(|e| KinematicsError::MalformedUrdf {
         origin: origin.to_string(),
@@ -129,7 +122,7 @@ impl RobotModel {
     /// Mesh files are never opened.
     pub fn from_urdf_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_urdf_str(&read(path)?, &path.display().to_string())
+        Self::from_urdf_str(&crate::files::read_text(path)?, &path.display().to_string())
     }
 
     /// Parses URDF text; `origin` names the text in errors (a file name or `<string>`).
@@ -140,14 +133,14 @@ impl RobotModel {
     /// Loads a model description (RON) and the URDF it names (relative to the description).
     pub fn from_description_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = read(path)?;
+        let text = crate::files::read_text(path)?;
         let origin = path.display().to_string();
         let description = ModelDescription::from_ron(&text, &origin)?;
         let urdf_path = path
             .parent()
             .unwrap_or(Path::new("."))
             .join(&description.urdf);
-        let urdf = read(&urdf_path)?;
+        let urdf = crate::files::read_text(&urdf_path)?;
         Self::from_parts(
             &urdf,
             &urdf_path.display().to_string(),

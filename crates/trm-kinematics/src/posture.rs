@@ -74,10 +74,7 @@ impl PostureFile {
     /// Reads a posture file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::files::read_text(path)?;
         Self::from_json(&text, path)
     }
 
@@ -205,10 +202,7 @@ impl ConfigurationsFile {
     /// Reads a configurations file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| KinematicsError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::files::read_text(path)?;
         serde_json::from_str(&text).map_err(|e| {
             invalid(
                 path,

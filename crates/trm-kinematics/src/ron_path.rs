@@ -46,6 +46,17 @@ pub struct RonProblem {
     pub fix: String,
 }
 
+impl RonProblem {
+    /// The problem and its fix in one line (`unknown field `x`; did you mean `y`?`).
+    pub fn message(&self) -> String {
+        if self.fix.is_empty() {
+            self.problem.clone()
+        } else {
+            format!("{}; {}", self.problem, self.fix)
+        }
+    }
+}
+
 /// Explains a RON parse error (the one reader behind every RON file of trm: model
 /// descriptions, worlds, task specs, motion specs).
 pub fn explain_ron_error(e: &ron::error::SpannedError) -> RonProblem {

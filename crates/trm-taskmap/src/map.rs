@@ -227,7 +227,7 @@ impl TaskMap {
 
     /// The grasp whose position lies closest to the object's origin (the "exact target at the
     /// centre" of the paper's comparison).
-    pub fn centre_grasp(&self) -> Option<[f64; 6]> {
+    pub fn center_grasp(&self) -> Option<[f64; 6]> {
         self.points
             .iter()
             .min_by(|a, b| {

@@ -47,7 +47,7 @@ fn invalid(what: &'static str, problem: impl Into<String>) -> TrajectoryError {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Basis {
     /// Centres μ_k.
-    pub centres: Vec<f64>,
+    pub centers: Vec<f64>,
     /// Widths σ_k.
     pub widths: Vec<f64>,
 }
@@ -61,7 +61,7 @@ impl Basis {
             (t1 - t0).max(1e-9)
         };
         Basis {
-            centres: (0..n)
+            centers: (0..n)
                 .map(|k| {
                     if n > 1 {
                         t0 + spacing * k as f64
@@ -77,18 +77,18 @@ impl Basis {
     /// ψ_k(t).
     #[inline]
     pub fn value(&self, k: usize, t: f64) -> f64 {
-        let z = (t - self.centres[k]) / self.widths[k];
+        let z = (t - self.centers[k]) / self.widths[k];
         (-0.5 * z * z).exp()
     }
 
     /// Number of functions.
     pub fn len(&self) -> usize {
-        self.centres.len()
+        self.centers.len()
     }
 
     /// True without functions.
     pub fn is_empty(&self) -> bool {
-        self.centres.is_empty()
+        self.centers.is_empty()
     }
 }
 
@@ -156,7 +156,7 @@ impl RbfTrajectory {
         }
         let n = waypoints.len();
         let waypoint_basis = Basis {
-            centres: waypoints.iter().map(|w| w.0).collect(),
+            centers: waypoints.iter().map(|w| w.0).collect(),
             widths: vec![waypoint_width; n],
         };
         let a = DMatrix::from_fn(n, n, |j, l| waypoint_basis.value(l, waypoints[j].0));

@@ -5,7 +5,7 @@
 //!    write the trajectory (CSV and JSON) and the start and goal postures;
 //! 3. run a Table III comparison of optimisers on our posture spec;
 //! 4. plug in our own cost (keep the right forearm above a plane) and our own optimiser (a
-//!    (1+1)-ES) into NGIK on the same spec.
+//!    compass search) into NGIK on the same spec.
 //!
 //! `cargo run --manifest-path examples/library-user/Cargo.toml -- OUT_DIR`
 
@@ -36,54 +36,62 @@ impl Cost for StayAbove {
     }
 }
 
-/// Our own optimiser: a (1+1)-ES with the 1/5 success rule.
-struct OnePlusOneEs {
+/// Our own optimiser: a compass (pattern) search — try ± step along one randomly chosen
+/// coordinate per generation, keep what improves, halve the step after every coordinate failed
+/// in a row. Not in trm-optim; it only has to implement `Optimizer`.
+struct CompassSearch {
     state: State,
     current: Vec<f64>,
     current_f: f64,
-    sigma: f64,
-    candidate: Vec<Vec<f64>>,
+    step: f64,
+    failures: usize,
+    candidates: Vec<Vec<f64>>,
 }
 
-impl OnePlusOneEs {
+impl CompassSearch {
     fn new(start: &Start) -> Result<Self, OptimError> {
-        let steps = start.check()?;
-        Ok(OnePlusOneEs {
-            state: State::new(start, 1),
+        let steps = start.check()?; // validates the start, gives the initial step per coordinate
+        Ok(CompassSearch {
+            state: State::new(start, 2),
             current: start.mean.clone(),
             current_f: f64::INFINITY,
-            sigma: steps.iter().copied().fold(0.0, f64::max),
-            candidate: vec![start.mean.clone()],
+            step: steps.iter().copied().fold(0.0, f64::max),
+            failures: 0,
+            candidates: vec![start.mean.clone(); 2],
         })
     }
 }
 
-impl Optimizer for OnePlusOneEs {
+impl Optimizer for CompassSearch {
     fn name(&self) -> &'static str {
-        "one-plus-one-es"
+        "compass-search"
     }
     fn dim(&self) -> usize {
         self.current.len()
     }
     fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
-        if self.current_f.is_finite() {
-            for (x, c) in self.candidate[0].iter_mut().zip(&self.current) {
-                // a uniform step in [-σ√3, σ√3]: variance σ²
-                *x = c + self.sigma * 3f64.sqrt() * (2.0 * rng.random::<f64>() - 1.0);
-            }
+        let axis = rng.random_range(0..self.current.len());
+        for (c, sign) in self.candidates.iter_mut().zip([1.0, -1.0]) {
+            c.copy_from_slice(&self.current);
+            c[axis] += sign * self.step;
+            self.state.clamp(c);
         }
-        self.state.clamp(&mut self.candidate[0]);
-        self.state.asked(1);
-        &self.candidate
+        self.state.asked(2);
+        &self.candidates
     }
     fn tell(&mut self, fitness: &[f64]) -> Result<(), OptimError> {
-        self.state.told(&self.candidate, fitness)?;
-        if fitness[0] <= self.current_f {
-            self.current.copy_from_slice(&self.candidate[0]);
-            self.current_f = fitness[0];
-            self.sigma *= 1.5;
+        self.state.told(&self.candidates, fitness)?;
+        let (best, f) = if fitness[0] <= fitness[1] { (0, fitness[0]) } else { (1, fitness[1]) };
+        if f < self.current_f {
+            self.current.copy_from_slice(&self.candidates[best]);
+            self.current_f = f;
+            self.failures = 0;
         } else {
-            self.sigma *= 1.5f64.powf(-0.25);
+            self.failures += 1;
+            if self.failures >= self.current.len() {
+                self.step *= 0.5;
+                self.failures = 0;
+            }
         }
         Ok(())
     }
@@ -91,7 +99,7 @@ impl Optimizer for OnePlusOneEs {
         &self.current
     }
     fn spread(&self) -> f64 {
-        self.sigma
+        self.step
     }
     fn state(&self) -> &State {
         &self.state
@@ -196,7 +204,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     problem.objective.add(20.0, Box::new(StayAbove { frame: elbow, height: -0.05 }))?;
     let solver = problem.spec.solver.clone();
     let start = trm_tasks::solver_start(&problem.objective, &problem.start, &solver)?;
-    let mut mine = OnePlusOneEs::new(&start)?;
+    let mut mine = CompassSearch::new(&start)?;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
     let solution = trm_tasks::solve_with(&problem.objective, &problem.start, &mut mine, &mut rng)?;
     let ours = solution.breakdown.iter().find(|t| t.label.starts_with("stay above")).expect("our term");
