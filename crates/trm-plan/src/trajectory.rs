@@ -88,6 +88,18 @@ impl Trajectory {
 
     /// Reads a CSV trajectory of `robot` (format in the [module docs](self)); `origin` names the
     /// text in errors, with line numbers. The task path is empty.
+    ///
+    /// ```
+    /// use trm_plan::Trajectory;
+    /// let arm = trm_models::planar_arm();
+    /// let csv = "time,joint1,joint2,note\n0,0.0,0.1,start\n0.5,0.2,0.3,end\n";
+    /// let t = Trajectory::from_csv(csv, "a.csv".as_ref(), &arm)?;
+    /// assert_eq!((t.names.len(), t.positions[1][0]), (2, 0.2)); // `note` names no motor
+    /// let late = "time,joint1\n1,0\n0.5,0\n";
+    /// let e = Trajectory::from_csv(late, "b.csv".as_ref(), &arm).unwrap_err().to_string();
+    /// assert!(e.starts_with("b.csv:3:"), "{e}");
+    /// # Ok::<(), trm_plan::PlanError>(())
+    /// ```
     pub fn from_csv(text: &str, origin: &Path, robot: &RobotModel) -> Result<Self, PlanError> {
         let mut lines = text.lines();
         let header: Vec<&str> = lines

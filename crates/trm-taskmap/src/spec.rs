@@ -135,6 +135,13 @@ impl TaskMapSpec {
     }
 
     /// Parses and checks spec text; `origin` names it in errors, `base` resolves the model path.
+    ///
+    /// ```
+    /// use trm_taskmap::TaskMapSpec;
+    /// let text = "(object: [(name: \"stick\", shape: Capsule(radius: 0.02, length: 0.3))],\n explore: (step: -1.0))";
+    /// let e = TaskMapSpec::from_ron(text, "stick.ron", ".".as_ref()).unwrap_err().to_string();
+    /// assert!(e.starts_with("stick.ron:2:12: explore.step:"), "{e}");
+    /// ```
     pub fn from_ron(
         text: &str,
         origin: &str,
