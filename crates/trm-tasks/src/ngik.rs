@@ -75,14 +75,14 @@ pub fn solve(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Resul
 /// ```
 /// use rand::SeedableRng;
 /// let spec = r#"(model: "planar_arm",
-///     costs: [(weight: 1.0, cost: Position(part: "tool", target: Point((0.4, 0.4, 0.0))))])"#;
+///     costs: [(weight: 1.0, cost: Position(part: "tool", target: Point((0.4, 0.9, 0.1))))])"#;
 /// let problem = trm_tasks::Problem::from_ron(spec, "<example>", ".".as_ref())?;
 /// let start = trm_tasks::solver_start(&problem.objective, &problem.start, &problem.spec.solver)?;
 /// // any Optimizer: here CMA-ES from trm-optim; yours works the same
 /// let mut cmaes = trm_optim::Cmaes::new(&start, &Default::default())?;
 /// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
 /// let s = trm_tasks::solve_with(&problem.objective, &problem.start, &mut cmaes, &mut rng)?;
-/// assert!(s.cost < 1e-6);
+/// assert!(s.cost < 1e-6, "{}", s.cost);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn solve_with(
