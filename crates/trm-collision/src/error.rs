@@ -12,6 +12,14 @@ pub type Result<T, E = CollisionError> = std::result::Result<T, E>;
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum CollisionError {
+    /// A file could not be read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
     /// A name or description problem reported by the kinematics layer.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),

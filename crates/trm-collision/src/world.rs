@@ -150,9 +150,9 @@ impl World {
     /// Reads a RON world file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| CollisionError::InvalidValue {
-            what: path.display().to_string(),
-            problem: e.to_string(),
+        let text = std::fs::read_to_string(path).map_err(|source| CollisionError::Io {
+            path: path.to_path_buf(),
+            source,
         })?;
         Self::from_ron(&text, &path.display().to_string())
     }

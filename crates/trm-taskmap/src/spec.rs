@@ -126,9 +126,11 @@ impl TaskMapSpec {
     /// Reads a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<LoadedTaskMapSpec, TaskMapError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| TaskMapError::File {
-            path: path.display().to_string(),
-            problem: e.to_string(),
+        let text = std::fs::read_to_string(path).map_err(|source| {
+            TaskMapError::MapFile(trm_kinematics::FileError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
         })?;
         let base = path.parent().map(PathBuf::from).unwrap_or_default();
         Self::from_ron(&text, &path.display().to_string(), &base)
