@@ -6,6 +6,7 @@ use nalgebra::{Point3, Vector3};
 /// Squared distance between the segment `[a, b]` and the box `|x_i| ≤ h_i`, exactly: the squared
 /// distance is convex and piecewise quadratic along the segment, with pieces separated where the
 /// segment crosses a face plane; each piece is minimised in closed form.
+#[inline]
 pub(crate) fn segment_box_distance_squared(
     a: &Point3<f64>,
     b: &Point3<f64>,
