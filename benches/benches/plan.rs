@@ -22,7 +22,7 @@ fn plan(c: &mut Criterion) {
         |_| {},
     )
     .expect("map");
-    connect(&mut map, &problem.objective, 8, 0.05);
+    connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let goals: Vec<Goal> = (0..16)
         .map(|k| Goal::TaskPoint {
             t: map.points[(k * 97) % map.points.len()].t.clone(),

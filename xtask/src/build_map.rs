@@ -38,6 +38,13 @@ pub struct Args {
 
 /// Builds, connects and saves a map.
 pub fn run(args: &Args) -> Result<()> {
+    // checked before minutes of map building
+    anyhow::ensure!(
+        args.edge_resolution.is_finite() && args.edge_resolution >= trm_roadmap::MIN_RESOLUTION,
+        "--edge-resolution {}: give a finite step of at least {} rad",
+        args.edge_resolution,
+        trm_roadmap::MIN_RESOLUTION
+    );
     let problem = Problem::load(&args.spec)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
@@ -46,12 +53,7 @@ pub fn run(args: &Args) -> Result<()> {
             .map_or("map".into(), |s| s.to_string_lossy().to_string());
         PathBuf::from("target/maps").join(format!("{stem}.map.json"))
     });
-    let threads = args
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()?;
+    let pool = crate::thread_pool(args.threads)?;
     let options = BuildOptions {
         points: args.points,
         searches: args.searches,
@@ -83,7 +85,7 @@ pub fn run(args: &Args) -> Result<()> {
             eprintln!();
         }
         let neighbours = map.settings.edge_neighbours;
-        connect(&mut map, &problem.objective, neighbours, args.edge_resolution);
+        connect(&mut map, &problem.objective, neighbours, args.edge_resolution)?;
         Ok(map)
     })?;
     map.save(&out)

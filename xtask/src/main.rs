@@ -140,9 +140,31 @@ impl MeshArgs {
 /// Comma-separated numbers given to a flag (`--to 0.1,0.2,0.3`); `expected` says what fits.
 fn numbers(flag: &str, text: &str, expected: &str) -> Result<Vec<f64>> {
     text.split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("{flag} `{text}`: expected {expected}"))
+        .map(|s| s.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .with_context(|| format!("{flag} `{text}`: expected {expected} (finite numbers)"))
+}
+
+/// A thread pool for `--threads`: all cores when absent; 0 is an error; more threads than
+/// cores are capped to the cores (more only slow the build down) with a note.
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = match threads {
+        None => cores,
+        Some(0) => {
+            anyhow::bail!("--threads 0: give at least 1 (or leave it out for all {cores} cores)")
+        }
+        Some(t) if t > cores => {
+            eprintln!(
+                "note: --threads {t} capped to the {cores} cores of this machine (more only slow the work down)"
+            );
+            cores
+        }
+        Some(t) => t,
+    };
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?)
 }
 
 /// A fresh scratch directory for a test, named after it and this process.
@@ -163,4 +185,23 @@ fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
 /// Writes `bytes` to `path` atomically (temporary file + rename), naming the file on error.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     trm_kinematics::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn flags_refuse_non_finite_numbers_and_zero_threads_and_cap_absurd_ones() {
+        for bad in ["nan,0,0", "1,inf,0", "1,,2", "x"] {
+            let e = super::numbers("--to", bad, "\"x,y,z\"").unwrap_err();
+            assert!(e.to_string().contains("finite numbers"), "{e}");
+        }
+        assert_eq!(
+            super::numbers("--to", "1, 2,-3e-1", "\"x,y,z\"").unwrap(),
+            [1.0, 2.0, -0.3]
+        );
+        assert!(super::thread_pool(Some(0)).is_err());
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let pool = super::thread_pool(Some(100_000)).unwrap();
+        assert_eq!(pool.current_num_threads(), cores);
+    }
 }

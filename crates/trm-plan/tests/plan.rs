@@ -31,7 +31,7 @@ fn map() -> &'static Roadmap {
             |_| {},
         )
         .unwrap();
-        connect(&mut map, &p.objective, 8, 0.05);
+        connect(&mut map, &p.objective, 8, 0.05).unwrap();
         map
     })
 }

@@ -25,7 +25,7 @@ fn main() -> Result<(), RoadmapError> {
         eprint!("\r{} / {} points", p.points, p.target)
     })?;
     eprintln!();
-    trm_roadmap::connect(&mut map, &problem.objective, 6, 0.05);
+    trm_roadmap::connect(&mut map, &problem.objective, 6, 0.05)?;
     map.save(&out)?;
     let back = Roadmap::load(&out)?;
     let s = back.summary();

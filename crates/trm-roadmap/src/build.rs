@@ -108,7 +108,14 @@ impl Growing {
     }
 }
 
+/// The most points a map may ask for (a bound that names itself rather than an allocation
+/// failure).
+pub const MAX_POINTS: usize = 10_000_000;
+/// The most concurrent searches P.
+pub const MAX_SEARCHES: usize = 4096;
+
 /// Builds the map of a spec (it needs a task function and `map` settings, or their defaults).
+/// Zero or absurd point and search counts are errors.
 pub fn build(
     problem: &Problem,
     options: &BuildOptions,
@@ -124,7 +131,17 @@ pub fn build(
     let dim = task.dim();
     let settings: MapSpec = problem.spec.map.clone().unwrap_or_default();
     let target = options.points.unwrap_or(settings.max_points);
-    let p_searches = options.searches.unwrap_or(settings.searches).max(1);
+    if target == 0 || target > MAX_POINTS {
+        return Err(RoadmapError::Unsuitable(format!(
+            "{target} points: give 1 to {MAX_POINTS} (spec `map.max_points` or the points option)"
+        )));
+    }
+    let p_searches = options.searches.unwrap_or(settings.searches);
+    if p_searches == 0 || p_searches > MAX_SEARCHES {
+        return Err(RoadmapError::Unsuitable(format!(
+            "{p_searches} concurrent searches: give 1 to {MAX_SEARCHES} (spec `map.searches` or the searches option)"
+        )));
+    }
     let seed = options.seed.unwrap_or(problem.spec.solver.seed);
     let d = settings.spacing;
     let m = dim; // the number of neighbours is tied to the task-space dimension

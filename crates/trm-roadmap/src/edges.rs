@@ -6,11 +6,37 @@ use std::time::Instant;
 use rayon::prelude::*;
 use trm_tasks::Objective;
 
+use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
 
-/// Adds edges to `map` (replacing any): `neighbours` per point, segments checked every
-/// `resolution` radians of the largest joint change.
-pub fn connect(map: &mut Roadmap, objective: &Objective, neighbours: usize, resolution: f64) {
+/// The finest edge-checking step, rad: below it a check costs more than it can find.
+pub const MIN_RESOLUTION: f64 = 1e-4;
+
+/// Adds edges to `map` (replacing any): `neighbours` per point (≥ 1), segments checked every
+/// `resolution` radians of the largest joint change (finite, ≥ [`MIN_RESOLUTION`]).
+pub fn connect(
+    map: &mut Roadmap,
+    objective: &Objective,
+    neighbours: usize,
+    resolution: f64,
+) -> Result<()> {
+    if neighbours == 0 {
+        return Err(RoadmapError::Unsuitable(
+            "0 edge neighbours: give at least 1 (spec `map.edge_neighbours`)".into(),
+        ));
+    }
+    if !(resolution.is_finite() && resolution >= MIN_RESOLUTION) {
+        return Err(RoadmapError::Unsuitable(format!(
+            "edge resolution {resolution}: give a finite step of at least {MIN_RESOLUTION} rad"
+        )));
+    }
+    if objective.dim() != map.active.len() {
+        return Err(RoadmapError::Unsuitable(format!(
+            "the objective has {} active motors, the map {}",
+            objective.dim(),
+            map.active.len()
+        )));
+    }
     let started = Instant::now();
     let points = &map.points;
     let mut edges: Vec<(usize, usize, f64)> = (0..points.len())
@@ -41,6 +67,7 @@ pub fn connect(map: &mut Roadmap, objective: &Objective, neighbours: usize, reso
     map.edges = edges;
     map.edge_resolution = resolution;
     map.stats.edge_seconds = started.elapsed().as_secs_f64();
+    Ok(())
 }
 
 /// Euclidean distance between two vectors (joint or task space).

@@ -6,7 +6,7 @@
 //! ```no_run
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
 //! let mut map = trm_roadmap::build(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
-//! trm_roadmap::connect(&mut map, &problem.objective, 8, 0.05);
+//! trm_roadmap::connect(&mut map, &problem.objective, 8, 0.05)?;
 //! map.save("reach.map.json")?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -17,8 +17,8 @@ mod error;
 mod index;
 mod map;
 
-pub use build::{BuildOptions, Progress, build};
-pub use edges::{connect, distance, segment_is_free};
+pub use build::{BuildOptions, MAX_POINTS, MAX_SEARCHES, Progress, build};
+pub use edges::{MIN_RESOLUTION, connect, distance, segment_is_free};
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Roadmap, VERSION};

@@ -20,7 +20,7 @@ fn small(problem: &Problem, threads: usize) -> Roadmap {
         .unwrap()
         .install(|| {
             let mut map = build(problem, &options, |_| {}).unwrap();
-            connect(&mut map, &problem.objective, 6, 0.05);
+            connect(&mut map, &problem.objective, 6, 0.05).unwrap();
             map
         })
 }
@@ -155,5 +155,31 @@ fn every_fig6_spec_builds_a_non_trivial_map() {
             "{}: extent {spread}",
             spec.display()
         );
+    }
+}
+
+#[test]
+fn zero_counts_and_a_zero_step_are_errors_not_hangs() {
+    let problem = reach();
+    for options in [
+        BuildOptions {
+            points: Some(0),
+            ..Default::default()
+        },
+        BuildOptions {
+            searches: Some(0),
+            ..Default::default()
+        },
+        BuildOptions {
+            points: Some(usize::MAX),
+            ..Default::default()
+        },
+    ] {
+        let e = build(&problem, &options, |_| {}).unwrap_err().to_string();
+        assert!(e.contains("give 1 to"), "{e}");
+    }
+    let mut map = small(&problem, 1);
+    for (neighbours, resolution) in [(6, 0.0), (6, f64::NAN), (6, -0.1), (0, 0.05)] {
+        assert!(connect(&mut map, &problem.objective, neighbours, resolution).is_err());
     }
 }
