@@ -57,7 +57,7 @@ pub use fk::{FrameId, PoseBuffer};
 pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
 pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
-pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_path};
+pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_field, locate_ron_path};
 pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
 pub use urdf_rs;
 

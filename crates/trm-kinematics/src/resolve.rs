@@ -21,14 +21,19 @@ impl DescCtx<'_> {
         problem: impl Into<String>,
         fix: impl Into<String>,
     ) -> KinematicsError {
+        // the element starts with its field path (`motors[3] ("r_thumb")`): locate that, else
+        // fall back to the first line naming `quoted`
+        let path = element.split(" (").next().unwrap_or("");
         let needle = format!("\"{quoted}\"");
-        let line = self
-            .text
-            .and_then(|t| {
-                t.lines()
-                    .position(|l| l.contains(&needle) && !l.trim_start().starts_with("//"))
-            })
-            .map(|i| i + 1);
+        let line = self.text.and_then(|t| {
+            crate::ron_path::locate_ron_field(t, path)
+                .map(|(line, _)| line)
+                .or_else(|| {
+                    t.lines()
+                        .position(|l| l.contains(&needle) && !l.trim_start().starts_with("//"))
+                        .map(|i| i + 1)
+                })
+        });
         KinematicsError::InvalidModel {
             origin: self.origin.to_string(),
             line,
@@ -36,6 +41,14 @@ impl DescCtx<'_> {
             problem: problem.into(),
             fix: fix.into(),
         }
+    }
+}
+
+/// `couplings[i] (joint "name")`: the element of the coupling of joint `joint`.
+fn coupling_element(desc: &ModelDescription, joint: &str) -> String {
+    match desc.couplings.iter().position(|c| c.joint == joint) {
+        Some(i) => format!("couplings[{i}] (joint \"{joint}\")"),
+        None => format!("coupling of joint \"{joint}\""),
     }
 }
 
@@ -78,7 +91,7 @@ pub(crate) fn resolve_motors(
         let name = tree.joints[j].name.as_str();
         if own_motor(j) && declared.contains_key(name) {
             return Err(ctx.invalid(
-                format!("motor \"{name}\""),
+                format!("motors[{}] (\"{name}\")", declared[name].0),
                 name,
                 "has the name of an uncoupled joint, which is already a motor of its own",
                 "rename the motor, or add a coupling for the joint",
@@ -95,7 +108,7 @@ pub(crate) fn resolve_motors(
         &own_motor,
     )?;
     let couplings = follow_mimics(tree, couplings);
-    check_coupling_limits(tree, ctx, &coupled, &motors, &couplings)?;
+    check_coupling_limits(tree, desc, ctx, &coupled, &motors, &couplings)?;
     Ok((motors, couplings))
 }
 
@@ -103,7 +116,7 @@ pub(crate) fn resolve_motors(
 fn declared_motors<'a>(desc: &'a ModelDescription, ctx: &DescCtx) -> Result<Declared<'a>> {
     let mut declared: HashMap<&str, (usize, &crate::description::MotorSpec)> = HashMap::new();
     for (i, m) in desc.motors.iter().enumerate() {
-        let element = format!("motor \"{}\"", m.name);
+        let element = format!("motors[{i}] (\"{}\")", m.name);
         if !(m.lower.is_finite() && m.upper.is_finite())
             || m.velocity.is_some_and(|v| v.is_nan() || v <= 0.0)
         {
@@ -142,8 +155,8 @@ fn coupled_joints<'a>(
     joint_names: &[&str],
 ) -> Result<Coupled<'a>> {
     let mut coupled: HashMap<&str, &crate::description::CouplingSpec> = HashMap::new();
-    for c in &desc.couplings {
-        let element = format!("coupling of joint \"{}\"", c.joint);
+    for (i, c) in desc.couplings.iter().enumerate() {
+        let element = format!("couplings[{i}] (joint \"{}\")", c.joint);
         let Some(j) = tree.joint_index(&c.joint) else {
             return Err(ctx.invalid(
                 element,
@@ -243,7 +256,7 @@ fn assign_motors(
                         .map(|m| m.name.as_str())
                         .chain(joint_names.iter().copied());
                     return Err(ctx.invalid(
-                        format!("coupling of joint \"{}\"", joint.name),
+                        coupling_element(desc, &joint.name),
                         mname,
                         format!("names motor `{mname}`, which is neither declared in `motors` nor an uncoupled joint"),
                         suggestion_fix(mname, candidates, "declare the motor in `motors`"),
@@ -263,10 +276,10 @@ fn assign_motors(
             });
         }
     }
-    for m in &desc.motors {
+    for (i, m) in desc.motors.iter().enumerate() {
         if !index_of.contains_key(&m.name) {
             return Err(ctx.invalid(
-                format!("motor \"{}\"", m.name),
+                format!("motors[{i}] (\"{}\")", m.name),
                 &m.name,
                 "drives no joint",
                 "use it in a coupling or remove it",
@@ -307,6 +320,7 @@ fn follow_mimics(tree: &Tree, mut couplings: Vec<Option<Coupling>>) -> Vec<Coupl
 /// Explicit couplings must keep their joints within the URDF limits over the motor box.
 fn check_coupling_limits(
     tree: &Tree,
+    desc: &ModelDescription,
     ctx: &DescCtx,
     coupled: &Coupled,
     motors: &[Motor],
@@ -326,7 +340,7 @@ fn check_coupling_limits(
         let tol = 1e-9;
         if lo < joint.limits.lower - tol || hi > joint.limits.upper + tol {
             return Err(ctx.invalid(
-                format!("coupling of joint \"{}\"", joint.name),
+                coupling_element(desc, &joint.name),
                 &joint.name,
                 format!(
                     "drives the joint over [{lo:.6}, {hi:.6}], outside its URDF limits [{:.6}, {:.6}]",
@@ -359,8 +373,8 @@ pub(crate) fn resolve_frames(
     ctx: &DescCtx,
 ) -> Result<Vec<NamedFrame>> {
     let mut frames = existing;
-    for f in specs {
-        let element = format!("frame \"{}\"", f.name);
+    for (i, f) in specs.iter().enumerate() {
+        let element = format!("frames[{i}] (\"{}\")", f.name);
         if tree.link_index(&f.name).is_some() || frames.iter().any(|g| g.name == f.name) {
             return Err(ctx.invalid(
                 element,
@@ -413,8 +427,8 @@ pub(crate) fn resolve_groups(
     ctx: &DescCtx,
 ) -> Result<Vec<(String, Vec<usize>)>> {
     let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
-    for g in &desc.groups {
-        let element = format!("group \"{}\"", g.name);
+    for (i, g) in desc.groups.iter().enumerate() {
+        let element = format!("groups[{i}] (\"{}\")", g.name);
         if groups.iter().any(|(n, _)| *n == g.name) {
             return Err(ctx.invalid(
                 element,
@@ -486,16 +500,16 @@ pub(crate) fn resolve_collision_pairs(
         Ok([i.min(j), i.max(j)])
     };
     let mut disabled = Vec::new();
-    for d in &desc.disabled_collisions {
-        let links = pair(&d.a, &d.b, "disabled_collisions entry")?;
+    for (i, d) in desc.disabled_collisions.iter().enumerate() {
+        let links = pair(&d.a, &d.b, &format!("disabled_collisions[{i}]"))?;
         disabled.push(DisabledCollision {
             links,
             reason: d.reason,
         });
     }
     let mut enabled = Vec::new();
-    for (a, b) in &desc.enabled_collisions {
-        enabled.push(pair(a, b, "enabled_collisions entry")?);
+    for (i, (a, b)) in desc.enabled_collisions.iter().enumerate() {
+        enabled.push(pair(a, b, &format!("enabled_collisions[{i}]"))?);
     }
     Ok((disabled, enabled))
 }
@@ -506,8 +520,8 @@ pub(crate) fn resolve_postures(
     ctx: &DescCtx,
 ) -> Result<Vec<(String, Vec<f64>)>> {
     let mut postures: Vec<(String, Vec<f64>)> = Vec::new();
-    for p in &desc.postures {
-        let element = format!("posture \"{}\"", p.name);
+    for (i, p) in desc.postures.iter().enumerate() {
+        let element = format!("postures[{i}] (\"{}\")", p.name);
         if postures.iter().any(|(n, _)| *n == p.name) {
             return Err(ctx.invalid(
                 element,

@@ -131,19 +131,9 @@ impl SpecError {
         problem: impl Into<String>,
         fix: impl Into<String>,
     ) -> Self {
-        let mut path = field;
-        let position = loop {
-            if let Some(at) = locate_ron_path(text, path) {
-                break Some(at);
-            }
-            match path.rfind(['.', '[']) {
-                Some(i) => path = &path[..i],
-                None => break None,
-            }
-        };
         SpecError {
             origin: origin.to_string(),
-            position,
+            position: locate_ron_field(text, field),
             field: field.to_string(),
             problem: problem.into(),
             fix: fix.into(),
@@ -160,6 +150,18 @@ impl SpecError {
             problem: p.problem,
             fix: p.fix,
         }
+    }
+}
+
+/// [`locate_ron_path`] of `field`, or of its nearest ancestor the text spells out (a field left
+/// at its default is not written): where an error about `field` should point.
+pub fn locate_ron_field(text: &str, field: &str) -> Option<(usize, usize)> {
+    let mut path = field;
+    loop {
+        if let Some(at) = locate_ron_path(text, path) {
+            return Some(at);
+        }
+        path = &path[..path.rfind(['.', '['])?];
     }
 }
 

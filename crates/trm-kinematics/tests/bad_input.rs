@@ -255,3 +255,23 @@ fn official_icub_urdf_loads_without_its_meshes() {
     assert_eq!(model.num_links(), 102);
     assert_eq!(model.motors().len(), 75);
 }
+
+#[test]
+fn description_errors_point_at_their_entry_not_the_first_line_naming_it() {
+    // `m` is named in a coupling on line 2 before its (wrong) declaration on line 3
+    let message = description_error(
+        "(urdf: \"x\",\n couplings: [(joint: \"j2\", motors: [(\"m\", 1.0)])],\n motors: [(name: \"m\", lower: 1.0, upper: 0.0)])",
+    );
+    assert!(
+        message.contains("model.ron:3: motors[0] (\"m\"): lower 1 is above upper 0"),
+        "{message}"
+    );
+    // the second disabled pair is the bad one; its links appear on line 2 already
+    let message = description_error(
+        "(urdf: \"x\",\n disabled_collisions: [(a: \"a\", b: \"b\", reason: user),\n   (a: \"b\", b: \"b\", reason: user)])",
+    );
+    assert!(
+        message.contains("model.ron:3: disabled_collisions[1]"),
+        "{message}"
+    );
+}
