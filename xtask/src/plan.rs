@@ -56,6 +56,16 @@ fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
 
 /// Plans and reports.
 pub fn run(args: &Args) -> Result<()> {
+    anyhow::ensure!(
+        args.velocity.is_finite() && args.velocity > 0.0,
+        "--velocity {}: give a finite positive joint speed (rad/s)",
+        args.velocity
+    );
+    anyhow::ensure!(
+        args.tolerance.is_finite() && args.tolerance > 0.0,
+        "--tolerance {}: give a finite positive task-space distance",
+        args.tolerance
+    );
     let maps: Vec<Roadmap> = args
         .maps
         .iter()

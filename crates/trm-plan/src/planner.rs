@@ -48,6 +48,14 @@ pub enum PlanError {
         /// What differs.
         problem: String,
     },
+    /// A query setting out of range.
+    #[error("plan options: {what} {problem}")]
+    InvalidOptions {
+        /// The setting.
+        what: String,
+        /// What is wrong and what to give.
+        problem: String,
+    },
     /// The start configuration collides in the current world, or has the wrong length.
     #[error("the start configuration is invalid: {0}")]
     InvalidStart(String),
@@ -113,6 +121,50 @@ impl Default for PlanOptions {
             default_velocity: 1.0,
             acceleration: None,
         }
+    }
+}
+
+impl PlanOptions {
+    /// Checks the settings: a finite resolution of at least `trm_roadmap::MIN_RESOLUTION`, at
+    /// least one attachment neighbour, a finite positive default velocity and acceleration.
+    pub fn check(&self) -> Result<(), PlanError> {
+        let bad = |what: &str, problem: String| {
+            Err(PlanError::InvalidOptions {
+                what: what.to_string(),
+                problem,
+            })
+        };
+        if !(self.resolution.is_finite() && self.resolution >= trm_roadmap::MIN_RESOLUTION) {
+            return bad(
+                "resolution",
+                format!(
+                    "{}: give a finite step of at least {} rad",
+                    self.resolution,
+                    trm_roadmap::MIN_RESOLUTION
+                ),
+            );
+        }
+        if self.attach_neighbours == 0 {
+            return bad("attach_neighbours", "0: give at least 1".into());
+        }
+        if !(self.default_velocity.is_finite() && self.default_velocity > 0.0) {
+            return bad(
+                "default_velocity",
+                format!(
+                    "{} rad/s: give a finite positive speed",
+                    self.default_velocity
+                ),
+            );
+        }
+        if let Some(a) = self.acceleration {
+            if !(a.is_finite() && a > 0.0) {
+                return bad(
+                    "acceleration",
+                    format!("{a} rad/s²: give a finite positive limit"),
+                );
+            }
+        }
+        Ok(())
     }
 }
 
@@ -272,6 +324,7 @@ impl<'a> Planner<'a> {
         goal: &Goal,
         options: &PlanOptions,
     ) -> Result<Planned, PlanError> {
+        options.check()?;
         let began = Instant::now();
         let mut stats = PlanStats::default();
         if start.len() != self.active.len() {

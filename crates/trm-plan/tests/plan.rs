@@ -275,3 +275,34 @@ fn a_region_goal_ends_inside_the_region() {
         "{end:?}"
     );
 }
+
+#[test]
+fn out_of_range_options_are_refused_before_planning() {
+    let (problem, map) = (problem(), map());
+    let mut planner = Planner::new(&problem.objective, &[map]).unwrap();
+    let goal = Goal::TaskPoint {
+        t: map.points[0].t.clone(),
+        tolerance: 0.03,
+    };
+    for options in [
+        PlanOptions {
+            default_velocity: 0.0,
+            ..Default::default()
+        },
+        PlanOptions {
+            resolution: 0.0,
+            ..Default::default()
+        },
+        PlanOptions {
+            acceleration: Some(f64::NAN),
+            ..Default::default()
+        },
+        PlanOptions {
+            attach_neighbours: 0,
+            ..Default::default()
+        },
+    ] {
+        let e = planner.plan(&problem.start, &goal, &options).unwrap_err();
+        assert!(matches!(e, PlanError::InvalidOptions { .. }), "{e}");
+    }
+}

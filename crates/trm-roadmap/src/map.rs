@@ -96,8 +96,14 @@ pub struct Roadmap {
 
 impl Roadmap {
     /// Writes the map as JSON through a temporary file and a rename.
+    /// A map whose points and edges do not fit together (or hold NaN) is refused: every file
+    /// written here reads back.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
+        self.check().map_err(|problem| RoadmapError::File {
+            path: path.display().to_string(),
+            problem: format!("not written: {problem}"),
+        })?;
         Ok(trm_kinematics::save_json(path, self, FORMAT)?)
     }
 

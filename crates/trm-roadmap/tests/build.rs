@@ -179,6 +179,17 @@ fn zero_counts_and_a_zero_step_are_errors_not_hangs() {
         assert!(e.contains("give 1 to"), "{e}");
     }
     let mut map = small(&problem, 1);
+    let mut broken = map.clone();
+    broken.points[0].cost = f64::NAN;
+    let path = tmp("nan.map.json");
+    assert!(
+        broken
+            .save(&path)
+            .unwrap_err()
+            .to_string()
+            .contains("not written")
+    );
+    assert!(!path.exists(), "no file for a map that cannot be read back");
     for (neighbours, resolution) in [(6, 0.0), (6, f64::NAN), (6, -0.1), (0, 0.05)] {
         assert!(connect(&mut map, &problem.objective, neighbours, resolution).is_err());
     }
