@@ -39,12 +39,7 @@ pub struct Args {
 /// Builds, connects and saves a map.
 pub fn run(args: &Args) -> Result<()> {
     // checked before minutes of map building
-    anyhow::ensure!(
-        args.edge_resolution.is_finite() && args.edge_resolution >= trm_roadmap::MIN_RESOLUTION,
-        "--edge-resolution {}: give a finite step of at least {} rad",
-        args.edge_resolution,
-        trm_roadmap::MIN_RESOLUTION
-    );
+    trm_roadmap::check_edge_resolution(args.edge_resolution).context("--edge-resolution")?;
     let problem = Problem::load(&args.spec)?;
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
@@ -209,4 +204,27 @@ fn print_summary(map: &Roadmap) {
         s.failures,
         s.stopped_because
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_zero_or_nan_edge_resolution_is_refused_before_building() {
+        for resolution in [0.0, f64::NAN, -0.05, 1e-9] {
+            let e = run(&Args {
+                spec: crate::models_dir().join("../specs/reach.ron"),
+                out: Some(crate::test_dir("bm").join("never.map.json")),
+                points: Some(5),
+                threads: Some(1),
+                searches: None,
+                seed: None,
+                edge_resolution: resolution,
+                view: false,
+            })
+            .unwrap_err();
+            assert!(format!("{e:#}").contains("--edge-resolution"), "{e:#}");
+        }
+    }
 }

@@ -12,6 +12,18 @@ use crate::map::Roadmap;
 /// The finest edge-checking step, rad: below it a check costs more than it can find.
 pub const MIN_RESOLUTION: f64 = 1e-4;
 
+/// Checks an edge-checking step: finite and at least [`MIN_RESOLUTION`] rad (a zero or tiny
+/// step would never finish). [`connect`] calls it; call it yourself before long work.
+pub fn check_edge_resolution(resolution: f64) -> Result<()> {
+    if resolution.is_finite() && resolution >= MIN_RESOLUTION {
+        Ok(())
+    } else {
+        Err(RoadmapError::Unsuitable(format!(
+            "edge resolution {resolution}: give a finite step of at least {MIN_RESOLUTION} rad"
+        )))
+    }
+}
+
 /// Adds edges to `map` (replacing any): `neighbours` per point (≥ 1), segments checked every
 /// `resolution` radians of the largest joint change (finite, ≥ [`MIN_RESOLUTION`]).
 pub fn connect(
@@ -25,11 +37,7 @@ pub fn connect(
             "0 edge neighbours: give at least 1 (spec `map.edge_neighbours`)".into(),
         ));
     }
-    if !(resolution.is_finite() && resolution >= MIN_RESOLUTION) {
-        return Err(RoadmapError::Unsuitable(format!(
-            "edge resolution {resolution}: give a finite step of at least {MIN_RESOLUTION} rad"
-        )));
-    }
+    check_edge_resolution(resolution)?;
     if objective.dim() != map.active.len() {
         return Err(RoadmapError::Unsuitable(format!(
             "the objective has {} active motors, the map {}",
