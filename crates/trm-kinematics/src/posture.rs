@@ -378,6 +378,82 @@ mod tests {
     }
 
     #[test]
+    fn malformed_posture_and_configuration_files_are_located_errors() {
+        let robot = arm();
+        let origin = Path::new("p.json");
+        for (text, expected) in [
+            ("", "p.json: EOF"),
+            ("{\"motors\": {\"j\": ", "p.json: EOF"),
+            ("{\"motors\": {\"j\": \"x\"}}", "p.json: invalid type"),
+            ("[1, 2]", "p.json: invalid type"),
+        ] {
+            let e = PostureFile::from_json(text, origin)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(expected), "{text:?}: {e}");
+        }
+        let e = PostureFile::from_json("{\"cost\": 1}", origin)
+            .unwrap()
+            .to_motors(&robot, None, &[0.0], origin)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("neither \"motors\" nor \"q\""), "{e}");
+        let e = PostureFile::from_json("{\"q\": [0.1, 0.2]}", origin)
+            .unwrap()
+            .to_motors(&robot, Some(&robot.all_active()), &[0.0], origin)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("p.json: q: has 2 values for 1 active motors"),
+            "{e}"
+        );
+        let configs = |text: &str| {
+            let c: ConfigurationsFile = serde_json::from_str(text).unwrap();
+            c.joint_vectors(&robot, Path::new("c.json"))
+                .unwrap_err()
+                .to_string()
+        };
+        let e = configs("{\"joint_names\": [\"j\", \"j\"], \"samples\": []}");
+        assert!(
+            e.contains("c.json: joint_names[1]: `j` is named twice"),
+            "{e}"
+        );
+        let e = configs("{\"joint_names\": [\"jj\"], \"samples\": []}");
+        assert!(
+            e.contains("joint_names[0]") && e.contains("did you mean `j`"),
+            "{e}"
+        );
+        let e = configs("{\"joint_names\": [\"j\"], \"samples\": [{\"q\": [0.1, 0.2]}]}");
+        assert!(
+            e.contains("samples[0].q: has 2 values for 1 joint_names"),
+            "{e}"
+        );
+        // JSON cannot carry inf or NaN: a number out of range is a parse error
+        assert!(
+            serde_json::from_str::<ConfigurationsFile>(
+                "{\"joint_names\": [\"j\"], \"samples\": [{\"q\": [1e400]}]}"
+            )
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn a_posture_is_not_written_over_a_directory() {
+        let robot = arm();
+        let dir = std::env::temp_dir().join(format!("trm-posture-dir-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("taken")).unwrap();
+        let file = PostureFile::from_motors(&robot, &[0.1]).unwrap();
+        assert!(file.save(dir.join("taken")).is_err());
+        assert!(dir.join("taken").is_dir());
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            1,
+            "no temporary file left"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn non_finite_values_are_not_written() {
         let robot = arm();
         let dir = std::env::temp_dir().join(format!("trm-posture-{}", std::process::id()));

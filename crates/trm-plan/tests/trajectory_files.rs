@@ -1,0 +1,102 @@
+//! Trajectory files: what trm writes reads back; malformed files are located errors.
+
+use std::path::Path;
+
+use trm_plan::Trajectory;
+
+fn csv_error(text: &str) -> String {
+    let arm = trm_models::planar_arm();
+    match Trajectory::from_csv(text, Path::new("t.csv"), &arm) {
+        Err(e) => e.to_string(),
+        Ok(t) => panic!("accepted {text:?}: {t:?}"),
+    }
+}
+
+fn json_error(text: &str) -> String {
+    match Trajectory::from_json(text, Path::new("t.json")) {
+        Err(e) => e.to_string(),
+        Ok(t) => panic!("accepted {text:?}: {t:?}"),
+    }
+}
+
+#[test]
+fn what_is_written_reads_back() {
+    let arm = trm_models::planar_arm();
+    let t = Trajectory {
+        names: vec!["joint1".into(), "joint2".into()],
+        times: vec![0.0, 0.25, 0.5],
+        positions: vec![vec![0.0, 0.1], vec![0.1, -0.2], vec![0.3, 1e-9]],
+        task_path: vec![vec![1.0, 2.0, 3.0]; 3],
+    };
+    let csv = Trajectory::from_csv(&t.to_csv(), Path::new("t.csv"), &arm).unwrap();
+    assert_eq!(
+        (csv.names, csv.times, csv.positions),
+        (t.names.clone(), t.times.clone(), t.positions.clone())
+    );
+    assert_eq!(
+        Trajectory::from_json(&t.to_json(), Path::new("t.json")).unwrap(),
+        t
+    );
+}
+
+#[test]
+fn malformed_csv_is_a_located_error() {
+    for (text, expected) in [
+        ("", "t.csv:1: empty file"),
+        ("joint1,joint2\n0,0\n", "t.csv:1: no `time` column"),
+        ("time,x,y\n0,1,2\n", "t.csv:1: no column names a motor"),
+        (
+            "time,joint1,joint1\n0,0,0\n",
+            "t.csv:1: motor `joint1` has two columns",
+        ),
+        ("time,joint1\n0,NaN\n", "t.csv:2: column 2"),
+        ("time,joint1\n0,inf\n", "t.csv:2: column 2"),
+        ("time,joint1\n0,0\n0.5\n", "t.csv:3: column 2"),
+        ("time,joint1\n0,zero\n", "t.csv:2: column 2"),
+        ("time,joint1\n1,0\n0.5,0\n", "t.csv:3: time"),
+        ("time,joint1\n-inf,0\n", "t.csv:2: column 1"),
+    ] {
+        let e = csv_error(text);
+        assert!(e.starts_with(expected), "{text:?}: {e}");
+    }
+}
+
+#[test]
+fn malformed_json_is_a_located_error() {
+    for (text, expected) in [
+        ("", "t.json"),
+        ("{\"names\": [\"a\"], \"times\": [0", "t.json:1"),
+        (
+            "{\"names\": [\"a\"], \"times\": [0], \"positions\": [[null]], \"task_path\": []}",
+            "t.json:1",
+        ),
+        (
+            "{\"names\": [\"a\"], \"times\": [0, 1], \"positions\": [[0]], \"task_path\": []}",
+            "2 times for 1 positions",
+        ),
+        (
+            "{\"names\": [\"a\"], \"times\": [0], \"positions\": [[0, 1]], \"task_path\": []}",
+            "positions[0] has 2 values for 1 names",
+        ),
+        (
+            "{\"names\": [\"a\"], \"times\": [1, 0], \"positions\": [[0], [0]], \"task_path\": []}",
+            "times[1]",
+        ),
+        (
+            "{\"names\": \"a\", \"times\": [], \"positions\": [], \"task_path\": []}",
+            "t.json:1",
+        ),
+    ] {
+        let e = json_error(text);
+        assert!(e.contains(expected), "{text:?}: {e}");
+    }
+}
+
+#[test]
+fn a_missing_file_is_an_error_naming_it() {
+    let arm = trm_models::planar_arm();
+    let e = Trajectory::load("/nonexistent/t.csv", &arm)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("/nonexistent/t.csv:"), "{e}");
+}
