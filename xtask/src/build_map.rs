@@ -36,18 +36,19 @@ pub struct Args {
     view: bool,
 }
 
+impl Args {
+    /// Where the map goes: `--out`, or target/maps/<spec name>.map.json.
+    pub fn out_path(&self) -> PathBuf {
+        crate::default_out(&self.out, &self.spec, "target/maps", "map.json")
+    }
+}
+
 /// Builds, connects and saves a map.
 pub fn run(args: &Args) -> Result<()> {
     // checked before minutes of map building
     trm_roadmap::check_edge_resolution(args.edge_resolution).context("--edge-resolution")?;
     let problem = Problem::load(&args.spec)?;
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .spec
-            .file_stem()
-            .map_or("map".into(), |s| s.to_string_lossy().to_string());
-        PathBuf::from("target/maps").join(format!("{stem}.map.json"))
-    });
+    let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
     let options = BuildOptions {
         points: args.points,
@@ -83,8 +84,7 @@ pub fn run(args: &Args) -> Result<()> {
         connect(&mut map, &problem.objective, neighbours, args.edge_resolution)?;
         Ok(map)
     })?;
-    map.save(&out)
-        .with_context(|| format!("saving {}", out.display()))?;
+    crate::write_atomic(&out, map.to_json(&out)?.as_bytes())?;
     print_summary(&map);
     let svg = out.with_extension("svg");
     crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;

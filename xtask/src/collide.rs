@@ -12,9 +12,8 @@ use trm_collision::{Other, World};
 pub struct Args {
     /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
     model: Option<PathBuf>,
-    /// Input, as for `fk`: {"joint_names": [...], "samples": [{"q": [...]}, ...]}.
-    #[arg(long)]
-    configs: PathBuf,
+    #[command(flatten)]
+    configs: crate::fk::ConfigsArgs,
     /// World objects (RON; format: crates/trm-collision/docs/world.md), checked as well.
     #[arg(long)]
     world: Option<PathBuf>,
@@ -22,7 +21,7 @@ pub struct Args {
     meshes: crate::MeshArgs,
     /// Also write the results as JSON to this file.
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 /// Checks every configuration and prints (and optionally writes) the results.
@@ -33,7 +32,7 @@ pub fn run(args: &Args) -> Result<()> {
         Some(path) => World::load(path)?,
         None => World::new(),
     };
-    let (_, all) = crate::fk::read_configurations(&model, &args.configs)?;
+    let (_, all) = args.configs.read(&model)?;
     let mut poses = model.pose_buffer();
     let mut placed = collision.placed_bodies();
     let mut results = Vec::new();
@@ -47,7 +46,7 @@ pub fn run(args: &Args) -> Result<()> {
     for (s, joints) in all.iter().enumerate() {
         model
             .forward_joints(joints, &mut poses)
-            .with_context(|| format!("{}: sample {s}", args.configs.display()))?;
+            .with_context(|| format!("{}: sample {s}", args.configs.path.display()))?;
         collision.place(&poses, &mut placed);
         let count = collision.count(&placed, &world);
         let pairs = collision.colliding_pairs(&placed, &world);
@@ -94,7 +93,7 @@ pub fn run(args: &Args) -> Result<()> {
             out,
             &json!({
                 "model": model.origin(),
-                "configs": args.configs,
+                "configs": args.configs.path,
                 "world": args.world,
                 "samples": results,
             }),
@@ -155,7 +154,10 @@ mod tests {
         let out = dir.join("out.json");
         run(&Args {
             model: None,
-            configs: input,
+            configs: crate::fk::ConfigsArgs {
+                path: input,
+                outside_limits: false,
+            },
             world: Some(world),
             meshes: crate::MeshArgs::default(),
             out: Some(out.clone()),

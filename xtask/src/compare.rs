@@ -39,7 +39,7 @@ pub struct Args {
     pub view: bool,
     /// Output directory for table.md, runs.csv and convergence.svg.
     #[arg(long, default_value = "target/compare-optimisers")]
-    out_dir: PathBuf,
+    pub out_dir: PathBuf,
 }
 
 /// Runs the comparison and writes its outputs.

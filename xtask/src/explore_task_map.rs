@@ -29,18 +29,19 @@ pub fn explore_spec(path: &std::path::Path) -> Result<Explored> {
     Ok(explored)
 }
 
+impl Args {
+    /// Where the task map goes: `--out`, or target/taskmaps/<spec name>.taskmap.json.
+    pub fn out_path(&self) -> PathBuf {
+        crate::default_out(&self.out, &self.spec, "target/taskmaps", "taskmap.json")
+    }
+}
+
 /// Explores and writes the map.
 pub fn run(args: &Args) -> Result<()> {
     let Explored { map, seconds, .. } = explore_spec(&args.spec)?;
 
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args
-            .spec
-            .file_stem()
-            .map_or("taskmap".into(), |s| s.to_string_lossy().to_string());
-        PathBuf::from("target/taskmaps").join(format!("{stem}.taskmap.json"))
-    });
-    map.save(&out)?;
+    let out = args.out_path();
+    crate::write_atomic(&out, map.to_json(&out)?.as_bytes())?;
     let points: Vec<[f64; 3]> = map
         .points
         .iter()

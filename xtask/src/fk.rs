@@ -11,13 +11,12 @@ use trm_kinematics::ConfigurationsFile;
 pub struct Args {
     /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
     model: Option<PathBuf>,
-    /// Input: {"joint_names": [...], "samples": [{"q": [...]}, ...]} (URDF joint names, radians).
-    #[arg(long)]
-    configs: PathBuf,
+    #[command(flatten)]
+    configs: ConfigsArgs,
     /// Output file: the input plus, per sample, "links": {"<link>": {"p": [x,y,z], "R": [[...],[...],[...]]}}
     /// (and "frames" for named frames). Printed to stdout when absent.
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
@@ -29,35 +28,53 @@ fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
     })
 }
 
-/// Reads a configurations file: the parsed file and, per sample, the full joint vector (joints
-/// not named are 0; mimic joints not named follow their leader).
-pub fn read_configurations(
-    model: &trm_kinematics::RobotModel,
-    path: &std::path::Path,
-) -> Result<(ConfigurationsFile, Vec<Vec<f64>>)> {
-    let configs = ConfigurationsFile::load(path)?;
-    let missing = configs.missing_joints(model);
-    if !missing.is_empty() {
-        eprintln!(
-            "note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}",
-            missing.len(),
-            missing.join(", ")
-        );
+/// The configurations a command reads (`fk`, `collide`).
+#[derive(clap::Args)]
+pub struct ConfigsArgs {
+    /// Input: {"joint_names": [...], "samples": [{"q": [...]}, ...]} (URDF joint names, radians).
+    #[arg(long = "configs")]
+    pub path: PathBuf,
+    /// Accept joint values outside the URDF limits (refused by default).
+    #[arg(long)]
+    pub outside_limits: bool,
+}
+
+impl ConfigsArgs {
+    /// The parsed file and, per sample, the full joint vector (joints not named are 0; mimic
+    /// joints not named follow their leader).
+    pub fn read(
+        &self,
+        model: &trm_kinematics::RobotModel,
+    ) -> Result<(ConfigurationsFile, Vec<Vec<f64>>)> {
+        let path = &self.path;
+        let configs = ConfigurationsFile::load(path)?;
+        let missing = configs.missing_joints(model);
+        if !missing.is_empty() {
+            eprintln!(
+                "note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}",
+                missing.len(),
+                missing.join(", ")
+            );
+        }
+        let all = if self.outside_limits {
+            configs.joint_vectors_outside_limits(model, path)?
+        } else {
+            configs.joint_vectors(model, path)?
+        };
+        Ok((configs, all))
     }
-    let all = configs.joint_vectors(model, path)?;
-    Ok((configs, all))
 }
 
 /// Computes and writes the poses.
 pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(args.model.as_deref())?;
-    let (configs, all) = read_configurations(&model, &args.configs)?;
+    let (configs, all) = args.configs.read(&model)?;
     let mut buffer = model.pose_buffer();
     let mut samples_out = Vec::with_capacity(configs.samples.len());
     for (s, (sample, joints)) in configs.samples.iter().zip(&all).enumerate() {
         model
             .forward_joints(joints, &mut buffer)
-            .with_context(|| format!("{}: sample {s}", args.configs.display()))?;
+            .with_context(|| format!("{}: sample {s}", args.configs.path.display()))?;
         let mut links = Map::new();
         let mut frames = Map::new();
         for (i, name) in model.frame_names().enumerate() {
@@ -113,7 +130,11 @@ mod tests {
         let out = dir.join("out.json");
         let args = Args {
             model: Some(crate::models_dir().join("icub-visuomanip/model.urdf")),
-            configs: input,
+            // Pinocchio's samples include values outside the limits
+            configs: ConfigsArgs {
+                path: input,
+                outside_limits: true,
+            },
             out: Some(out.clone()),
         };
         run(&args).unwrap();
@@ -156,7 +177,10 @@ mod tests {
         .unwrap();
         let err = run(&Args {
             model: None,
-            configs: input,
+            configs: ConfigsArgs {
+                path: input,
+                outside_limits: false,
+            },
             out: Some(dir.join("out.json")),
         })
         .unwrap_err();

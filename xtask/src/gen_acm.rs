@@ -26,7 +26,7 @@ pub struct Args {
     meshes: crate::MeshArgs,
     /// Write the section to this file instead of stdout.
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 /// Generates and prints (or writes) the section.

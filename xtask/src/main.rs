@@ -75,9 +75,74 @@ enum Command {
     View(view::Args),
 }
 
+impl Command {
+    /// The files and directories the command writes to, checked before it starts work.
+    fn outputs(&self) -> (Vec<PathBuf>, Vec<PathBuf>) {
+        let file = |p: &Option<PathBuf>| p.iter().cloned().collect::<Vec<_>>();
+        match self {
+            Command::BuildMap(a) => (vec![a.out_path()], vec![]),
+            Command::ExploreTaskMap(a) => (vec![a.out_path()], vec![]),
+            Command::Collide(a) => (file(&a.out), vec![]),
+            Command::Fk(a) => (file(&a.out), vec![]),
+            Command::GenAcm(a) => (file(&a.out), vec![]),
+            Command::Plan(a) => (file(&a.out), vec![]),
+            Command::ReachGrasp(a) => (file(&a.out), vec![]),
+            Command::Solve(a) => (file(&a.out), vec![]),
+            Command::View(a) => (vec![a.out.clone()], vec![]),
+            Command::CompareOptimisers(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::Speedup(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::StandUp(a) => (vec![], vec![a.out.clone()]),
+            Command::TaskMapStudies(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::GenIcub => (vec![], vec![models_dir()]),
+            Command::ModelInfo(_) | Command::MapInfo(_) | Command::Optimise(_) => (vec![], vec![]),
+        }
+    }
+}
+
+/// Checks the command's output locations, runs it with its outputs staged, and puts them in
+/// place only when it succeeds: a failed run writes nothing.
+fn run(command: Command) -> Result<()> {
+    let (files, dirs) = command.outputs();
+    for f in &files {
+        trm_kinematics::check_output(f).with_context(|| format!("output {}", f.display()))?;
+    }
+    for d in &dirs {
+        if !d.is_dir() {
+            trm_kinematics::check_output(d)
+                .with_context(|| format!("output directory {}", d.display()))?;
+        }
+    }
+    *staged() = Some(Vec::new());
+    let result = dispatch(command);
+    let files = staged().take().unwrap_or_default();
+    result?;
+    for f in files {
+        let path = f.path().to_path_buf();
+        f.commit()
+            .with_context(|| format!("putting {} in place", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Output files written by this run but not yet in place (`None`: write directly, as tests
+/// calling a command's `run` do).
+fn staged() -> std::sync::MutexGuard<'static, Option<Vec<trm_kinematics::StagedFile>>> {
+    static STAGED: std::sync::Mutex<Option<Vec<trm_kinematics::StagedFile>>> =
+        std::sync::Mutex::new(None);
+    STAGED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn main() {
     let cli = Cli::parse();
-    let result = match cli.command {
+    if let Err(e) = run(cli.command) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Runs the command.
+fn dispatch(command: Command) -> Result<()> {
+    match command {
         Command::ModelInfo(args) => model_info::run(&args),
         Command::Fk(args) => fk::run(&args),
         Command::BuildMap(args) => build_map::run(&args),
@@ -95,10 +160,6 @@ fn main() {
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),
-    };
-    if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
     }
 }
 
@@ -115,6 +176,16 @@ fn load_model(path: Option<&Path>) -> Result<RobotModel> {
         None => Ok(trm_models::icub_upper_body()),
         Some(p) => Ok(trm_models::load(&p.to_string_lossy(), Path::new(""))?),
     }
+}
+
+/// `out`, or `<dir>/<spec's stem>.<extension>`.
+fn default_out(out: &Option<PathBuf>, spec: &Path, dir: &str, extension: &str) -> PathBuf {
+    out.clone().unwrap_or_else(|| {
+        let stem = spec
+            .file_stem()
+            .map_or("out".into(), |s| s.to_string_lossy().to_string());
+        Path::new(dir).join(format!("{stem}.{extension}"))
+    })
 }
 
 /// Where mesh files are looked for.
@@ -183,8 +254,18 @@ fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
 }
 
 /// Writes `bytes` to `path` atomically (temporary file + rename), naming the file on error.
+/// Under `cargo xtask` the file is staged and put in place when the command succeeds.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    trm_kinematics::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+    let context = || format!("writing {}", path.display());
+    match staged().as_mut() {
+        Some(files) => {
+            let file = trm_kinematics::StagedFile::new(path, bytes).with_context(context)?;
+            files.retain(|f| f.path() != path);
+            files.push(file);
+            Ok(())
+        }
+        None => trm_kinematics::write_atomic(path, bytes).with_context(context),
+    }
 }
 
 #[cfg(test)]

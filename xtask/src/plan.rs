@@ -30,7 +30,7 @@ pub struct Args {
     tolerance: f64,
     /// Trajectory output (CSV; a .json with the task-space path is written beside it).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
     /// Seed of the shortcutting.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -127,9 +127,9 @@ pub fn run(args: &Args) -> Result<()> {
         println!("reached task point {last:?}");
     }
     if let Some(out) = &args.out {
-        crate::write_atomic(out, plan.trajectory.to_csv().as_bytes())?;
+        crate::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
         let json = out.with_extension("json");
-        crate::write_json(&json, &serde_json::to_value(&plan.trajectory)?)?;
+        crate::write_atomic(&json, plan.trajectory.to_json(&json)?.as_bytes())?;
         let svg = out.with_extension("svg");
         crate::write_atomic(
             &svg,

@@ -29,7 +29,7 @@ pub struct Args {
     iterations: usize,
     /// Trajectory output (CSV; a .json beside it).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 /// Optimises the reach and reports it.
@@ -88,11 +88,9 @@ pub fn run(args: &Args) -> Result<()> {
             positions: m.trajectory.iter().map(|q| active.to_motors(q)).collect(),
             task_path: Vec::new(),
         };
-        crate::write_atomic(out, trajectory.to_csv().as_bytes())?;
-        crate::write_json(
-            &out.with_extension("json"),
-            &serde_json::to_value(&trajectory)?,
-        )?;
+        crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;
+        let json = out.with_extension("json");
+        crate::write_atomic(&json, trajectory.to_json(&json)?.as_bytes())?;
         println!("wrote {}", out.display());
     }
     Ok(())

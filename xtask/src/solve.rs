@@ -22,7 +22,7 @@ pub struct Args {
     max_evals: Option<u64>,
     /// Write the posture (motor values by name, active values, cost breakdown, frame poses).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
 }
 
 /// Solves and reports.
@@ -118,7 +118,7 @@ pub fn run(args: &Args) -> Result<()> {
             )
             .with("task", s.task.clone())
             .with("frames", frames);
-        file.save(out)?;
+        crate::write_atomic(out, file.to_json(out)?.as_bytes())?;
         eprintln!("wrote {}", out.display());
     }
     Ok(())

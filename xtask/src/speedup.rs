@@ -30,7 +30,7 @@ pub struct Args {
     seed: u64,
     /// Output directory for speedup.md and speedup.svg.
     #[arg(long, default_value = "target/speedup")]
-    out_dir: PathBuf,
+    pub out_dir: PathBuf,
 }
 
 /// Seconds at which each point count was first reached, evaluations and points in the end.

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use plotters::style::{BLACK, Color, RGBColor};
 use trm_wholebody::{Comparison, StandUpResult, WholeBody};
 
@@ -30,7 +30,7 @@ pub struct Args {
     view: bool,
     /// Output directory (figures, trajectory, JSON).
     #[arg(long, default_value = "results/stand-up")]
-    out: PathBuf,
+    pub out: PathBuf,
 }
 
 /// The paper's Table II (hand-tuned, unconstrained, constrained): CoM error, effort, backward.
@@ -51,7 +51,8 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(r) = args.rollouts {
             spec.optimiser.rollouts = r;
         }
-        let text = std::fs::read_to_string(&args.spec)?;
+        let text = trm_kinematics::read_input(&args.spec)
+            .with_context(|| format!("reading {}", args.spec.display()))?;
         problem = WholeBody::new(
             spec,
             problem.model().clone(),
@@ -394,7 +395,7 @@ fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
 
 /// The optimised motion as CSV ([`trm_wholebody::Rollout::to_csv`]).
 fn write_trajectory(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
-    crate::write_atomic(path, s.rollout.to_csv(problem.model()).as_bytes())?;
+    crate::write_atomic(path, s.rollout.to_csv(problem.model())?.as_bytes())?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

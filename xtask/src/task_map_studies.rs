@@ -21,7 +21,7 @@ pub struct Args {
     iterations: usize,
     /// Output directory (table.md, joint_limits.svg).
     #[arg(long, default_value = "target/taskmap-studies")]
-    out_dir: PathBuf,
+    pub out_dir: PathBuf,
 }
 
 fn reach<'a>(

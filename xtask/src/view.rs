@@ -37,7 +37,7 @@ pub struct Args {
     world: Option<PathBuf>,
     /// The page; the JSON scene is written beside it.
     #[arg(long, default_value = "target/view/scene.html")]
-    out: PathBuf,
+    pub out: PathBuf,
     /// Meshes for models that use them.
     #[command(flatten)]
     mesh: crate::MeshArgs,
@@ -67,7 +67,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
         (Some(path), _) => {
             let title = path.display().to_string();
             let text = if path.extension().is_some_and(|e| e == "ron") {
-                std::fs::read_to_string(path)
+                trm_kinematics::read_input(path)
                     .with_context(|| format!("reading {}", path.display()))?
             } else {
                 String::new()
@@ -450,10 +450,10 @@ mod tests {
         std::fs::write(&csv, "time,r_elbow\n0,0.5\n0.1,x\n").unwrap();
         let e = super::run(&args).unwrap_err().to_string();
         assert!(e.contains("traj.csv:3") && e.contains("column 2"), "{e}");
-        // a CSV with no motor column says which names it expects
+        // a column naming no motor says which names it could mean
         std::fs::write(&csv, "time,elbow\n0,0.5\n").unwrap();
         let e = super::run(&args).unwrap_err().to_string();
-        assert!(e.contains("no column names a motor"), "{e}");
+        assert!(e.contains("did you mean `r_elbow`"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

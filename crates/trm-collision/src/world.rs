@@ -150,7 +150,7 @@ impl World {
     /// Reads a RON world file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| CollisionError::Io {
+        let text = trm_kinematics::read_input(path).map_err(|source| CollisionError::Io {
             path: path.to_path_buf(),
             source,
         })?;

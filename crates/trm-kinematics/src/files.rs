@@ -5,35 +5,234 @@ use std::path::Path;
 
 /// Reads a text file, naming it in the error.
 pub(crate) fn read_text(path: &Path) -> crate::Result<String> {
-    std::fs::read_to_string(path).map_err(|source| crate::KinematicsError::Io {
+    read_input(path).map_err(|source| crate::KinematicsError::Io {
         path: path.to_path_buf(),
         source,
     })
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
-/// crash never leaves a half-written file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
+/// The largest input file trm reads (1 GiB): anything bigger is refused rather than exhausting
+/// memory.
+pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+
+/// Reads a UTF-8 input file (a model, spec, map, trajectory…). Refuses what is not a regular
+/// file (a directory, a device such as `/dev/zero`, a pipe that may never end) and files over
+/// [`MAX_INPUT_BYTES`], with a message saying so; the one reader of every trm input.
+pub fn read_input(path: &Path) -> std::io::Result<String> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file (a device, socket or pipe)"
+        };
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("is {what}\n  fix: give a file"),
+        ));
+    }
+    if meta.len() > MAX_INPUT_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "is {} bytes, over the {MAX_INPUT_BYTES}-byte limit for inputs\n  fix: give the right file",
+                meta.len()
+            ),
+        ));
+    }
+    std::fs::read_to_string(path)
+}
+
+/// Checks, before any work is done, that an output file can go to `path`: if something is there
+/// it must be a regular file (trm never replaces a symlink, directory or device with a file),
+/// and the nearest existing directory above it must be a directory this process can write in.
+pub fn check_output(path: &Path) -> std::io::Result<()> {
+    refuse_non_regular(path)?;
+    let mut dir = parent_dir(path);
+    while !dir.exists() {
+        dir = parent_dir(dir);
+    }
+    if !dir.is_dir() {
+        return Err(std::io::Error::other(format!(
+            "{} is not a directory\n  fix: choose an output path inside a directory",
+            dir.display()
+        )));
+    }
+    let probe = dir.join(format!(".trm-probe.{}.tmp", std::process::id()));
+    std::fs::File::create(&probe)
+        .and_then(|_| std::fs::remove_file(&probe))
+        .map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!(
+                    "cannot write in {}: {e}\n  fix: choose a directory you can write in",
+                    dir.display()
+                ),
+            )
+        })
+}
+
+/// The directory `path` is in (`.` for a bare name).
+fn parent_dir(path: &Path) -> &Path {
+    path.parent()
         .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
+        .unwrap_or(Path::new("."))
+}
+
+/// Refuses a `path` that exists and is not a regular file.
+fn refuse_non_regular(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if !m.file_type().is_file() => {
+            let what = if m.file_type().is_symlink() {
+                "a symbolic link"
+            } else if m.is_dir() {
+                "a directory"
+            } else {
+                "not a regular file (a device, socket or pipe)"
+            };
+            Err(std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                format!(
+                    "{} is {what}; trm replaces only regular files\n  fix: remove it or choose another output path",
+                    path.display()
+                ),
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// An output file written in full beside its destination but not yet in place: [`commit`]
+/// renames it over the destination in one step; dropping it uncommitted deletes it. Lets a
+/// command that writes several files put them all in place only once all of them are ready.
+///
+/// [`commit`]: StagedFile::commit
+#[derive(Debug)]
+pub struct StagedFile {
+    tmp: std::path::PathBuf,
+    path: std::path::PathBuf,
+    committed: bool,
+}
+
+impl StagedFile {
+    /// Writes `bytes` (synced to disk) to a temporary file in `path`'s directory, creating the
+    /// directory if needed. Refuses a `path` that exists and is not a regular file.
+    pub fn new(path: &Path, bytes: &[u8]) -> std::io::Result<Self> {
+        refuse_non_regular(path)?;
+        let dir = parent_dir(path);
+        std::fs::create_dir_all(dir)?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let staged = StagedFile {
+            tmp: dir.join(format!(".{name}.{}.{n}.tmp", std::process::id())),
+            path: path.to_path_buf(),
+            committed: false,
+        };
+        let mut f = std::fs::File::create(&staged.tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        Ok(staged)
     }
-    result
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Puts the file in place (an atomic rename over the destination).
+    pub fn commit(mut self) -> std::io::Result<()> {
+        refuse_non_regular(&self.path)?;
+        std::fs::rename(&self.tmp, &self.path)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for StagedFile {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
+/// crash never leaves a half-written file. Refuses to replace anything but a regular file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    StagedFile::new(path, bytes)?.commit()
+}
+
+/// Checks that no JSON object in `text` names a key twice (serde keeps the last silently); the
+/// error carries the line and column of the second one.
+pub fn check_unique_keys(text: &str) -> Result<(), serde_json::Error> {
+    use serde::de::Deserializer as _;
+    serde_json::Deserializer::from_str(text).deserialize_any(UniqueKeys("".into()))
+}
+
+/// Walks a JSON value (the field path so far in `.0`), refusing a repeated key.
+struct UniqueKeys(String);
+
+impl<'de> serde::de::DeserializeSeed<'de> for UniqueKeys {
+    type Value = ();
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for UniqueKeys {
+    type Value = ();
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("JSON")
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let mut i = 0;
+        while seq
+            .next_element_seed(UniqueKeys(format!("{}[{i}]", self.0)))?
+            .is_some()
+        {
+            i += 1;
+        }
+        Ok(())
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        let mut seen = std::collections::HashSet::new();
+        while let Some(key) = map.next_key::<String>()? {
+            let path = if self.0.is_empty() {
+                key.clone()
+            } else {
+                format!("{}.{key}", self.0)
+            };
+            if !seen.insert(key) {
+                return Err(serde::de::Error::custom(format!(
+                    "`{path}` is given twice (keep one)"
+                )));
+            }
+            map.next_value_seed(UniqueKeys(path))?;
+        }
+        Ok(())
+    }
 }
 
 /// Why a versioned JSON file (`{"format": NAME, "version": N, …}`) could not be read or written.
@@ -110,20 +309,22 @@ pub fn parse_versioned<T: serde::de::DeserializeOwned>(
     version: u32,
 ) -> Result<T, FileError> {
     let path_buf = || path.to_path_buf();
-    let value: serde_json::Value = serde_json::from_str(text).map_err(|source| {
-        if source.is_eof() {
-            FileError::Truncated {
-                path: path_buf(),
-                source,
+    let value: serde_json::Value = check_unique_keys(text)
+        .and_then(|()| serde_json::from_str(text))
+        .map_err(|source| {
+            if source.is_eof() {
+                FileError::Truncated {
+                    path: path_buf(),
+                    source,
+                }
+            } else {
+                FileError::WrongFormat {
+                    path: path_buf(),
+                    format,
+                    detail: Some(source.to_string()),
+                }
             }
-        } else {
-            FileError::WrongFormat {
-                path: path_buf(),
-                format,
-                detail: Some(source.to_string()),
-            }
-        }
-    })?;
+        })?;
     match value.get("format").and_then(|f| f.as_str()) {
         Some(f) if f == format => {}
         found => {
@@ -161,11 +362,24 @@ pub fn load_versioned<T: serde::de::DeserializeOwned>(
     format: &'static str,
     version: u32,
 ) -> Result<T, FileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FileError::Io {
+    let text = read_input(path).map_err(|source| FileError::Io {
         path: path.to_path_buf(),
         source,
     })?;
     parse_versioned(path, &text, format, version)
+}
+
+/// `value` as compact JSON (`path` names the file it is for in errors).
+pub fn json_text<T: serde::Serialize>(
+    path: &Path,
+    value: &T,
+    format: &'static str,
+) -> Result<String, FileError> {
+    serde_json::to_string(value).map_err(|source| FileError::Serialize {
+        path: path.to_path_buf(),
+        format,
+        source,
+    })
 }
 
 /// Writes `value` as compact JSON to `path` atomically ([`write_atomic`]).
@@ -174,11 +388,7 @@ pub fn save_json<T: serde::Serialize>(
     value: &T,
     format: &'static str,
 ) -> Result<(), FileError> {
-    let text = serde_json::to_string(value).map_err(|source| FileError::Serialize {
-        path: path.to_path_buf(),
-        format,
-        source,
-    })?;
+    let text = json_text(path, value, format)?;
     write_atomic(path, text.as_bytes()).map_err(|source| FileError::Io {
         path: path.to_path_buf(),
         source,

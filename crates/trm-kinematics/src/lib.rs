@@ -52,13 +52,18 @@ pub use description::{
     MotorSpec, PostureSpec,
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
-pub use files::{FileError, load_versioned, parse_versioned, save_json, write_atomic};
+pub use files::{
+    FileError, MAX_INPUT_BYTES, StagedFile, check_output, check_unique_keys, json_text,
+    load_versioned, parse_versioned, read_input, save_json, write_atomic,
+};
 pub use fk::{FrameId, PoseBuffer};
 pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};
 pub use nalgebra;
 pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_field, locate_ron_path};
-pub use tree::{Inertial, Joint, JointKind, Limits, Link, Mimic, Tree, pose_from_xyz_rpy};
+pub use tree::{
+    Inertial, Joint, JointKind, LIMIT_TOLERANCE, Limits, Link, Mimic, Tree, pose_from_xyz_rpy,
+};
 pub use urdf_rs;
 
 /// The file formats this crate reads and writes.

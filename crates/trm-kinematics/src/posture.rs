@@ -68,7 +68,9 @@ impl PostureFile {
 
     /// Parses posture-file JSON; `origin` names it in errors.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
-        serde_json::from_str(text).map_err(|e| invalid(origin, "", e.to_string(), FIX))
+        crate::check_unique_keys(text)
+            .and_then(|()| serde_json::from_str(text))
+            .map_err(|e| invalid(origin, "", e.to_string(), FIX))
     }
 
     /// Reads a posture file.
@@ -78,9 +80,8 @@ impl PostureFile {
         Self::from_json(&text, path)
     }
 
-    /// Writes the file atomically (pretty JSON).
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
+    /// The file as pretty JSON; refuses non-finite values (`path` names the file it is for).
+    pub fn to_json(&self, path: &Path) -> Result<String> {
         for (field, values) in [
             (
                 "motors",
@@ -101,13 +102,19 @@ impl PostureFile {
                 ));
             }
         }
-        let text = serde_json::to_string_pretty(self).map_err(|source| {
+        serde_json::to_string_pretty(self).map_err(|source| {
             KinematicsError::File(FileError::Serialize {
                 path: path.to_path_buf(),
                 format: "posture",
                 source,
             })
-        })?;
+        })
+    }
+
+    /// Writes the file atomically ([`PostureFile::to_json`]).
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let text = self.to_json(path)?;
         crate::write_atomic(path, text.as_bytes()).map_err(|source| KinematicsError::Io {
             path: path.to_path_buf(),
             source,
@@ -116,7 +123,8 @@ impl PostureFile {
 
     /// The motor vector of `robot` this file describes: `start` (one value per motor) with the
     /// file's `motors` set by name, or with `active`'s motors set from `q`. `origin` names the
-    /// file in errors. Unknown motor names get suggestions; non-finite values are refused.
+    /// file in errors. Unknown motor names get suggestions; non-finite values and values outside
+    /// the motor's limits are refused.
     pub fn to_motors(
         &self,
         robot: &RobotModel,
@@ -136,14 +144,14 @@ impl PostureFile {
                         "use the model's motor names (`cargo xtask model-info`)",
                     )
                 })?;
-                if !value.is_finite() {
-                    return Err(invalid(
+                robot.motors()[i].limits.check(value).map_err(|problem| {
+                    invalid(
                         origin,
                         &format!("motors.{name}"),
-                        format!("is {value}"),
-                        "give a finite value",
-                    ));
-                }
+                        problem,
+                        "give a value within the motor's limits (`cargo xtask model-info`)",
+                    )
+                })?;
                 motors[i] = value;
             }
             return Ok(motors);
@@ -165,7 +173,15 @@ impl PostureFile {
                     "write one value per active motor of the task",
                 ));
             }
-            for (&m, &v) in active.motor_indices().iter().zip(q) {
+            for (k, (&m, &v)) in active.motor_indices().iter().zip(q).enumerate() {
+                robot.motors()[m].limits.check(v).map_err(|problem| {
+                    invalid(
+                        origin,
+                        &format!("q[{k}] ({})", robot.motors()[m].name),
+                        problem,
+                        "give a value within the motor's limits (`cargo xtask model-info`)",
+                    )
+                })?;
                 motors[m] = v;
             }
             return Ok(motors);
@@ -202,15 +218,7 @@ impl ConfigurationsFile {
     /// Reads a configurations file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = crate::files::read_text(path)?;
-        serde_json::from_str(&text).map_err(|e| {
-            invalid(
-                path,
-                "",
-                e.to_string(),
-                "expected {\"joint_names\": [...], \"samples\": [{\"q\": [...]}]}",
-            )
-        })
+        Self::from_json(&crate::files::read_text(path)?, path)
     }
 
     /// The joint names of `robot` the file leaves out (they are 0, or follow their leader when
@@ -224,8 +232,37 @@ impl ConfigurationsFile {
 
     /// Per sample, the full joint vector of `robot` (one value per movable joint, the order of
     /// [`RobotModel::joint_names`]): joints not named are 0, mimic joints not named follow their
-    /// leader. `origin` names the file in errors.
+    /// leader. `origin` names the file in errors. Every joint, named or not, must lie within its
+    /// URDF limits ([`ConfigurationsFile::joint_vectors_outside_limits`] lets them go past).
     pub fn joint_vectors(&self, robot: &RobotModel, origin: &Path) -> Result<Vec<Vec<f64>>> {
+        self.vectors(robot, origin, true)
+    }
+
+    /// [`ConfigurationsFile::joint_vectors`] without the limit check (kinematics and collision
+    /// are defined outside the limits too, e.g. for cross-checks with other libraries).
+    pub fn joint_vectors_outside_limits(
+        &self,
+        robot: &RobotModel,
+        origin: &Path,
+    ) -> Result<Vec<Vec<f64>>> {
+        self.vectors(robot, origin, false)
+    }
+
+    /// Parses configurations-file JSON; `origin` names it in errors.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Self> {
+        crate::check_unique_keys(text)
+            .and_then(|()| serde_json::from_str(text))
+            .map_err(|e| {
+                invalid(
+                    origin,
+                    "",
+                    e.to_string(),
+                    "expected {\"joint_names\": [...], \"samples\": [{\"q\": [...]}]}",
+                )
+            })
+    }
+
+    fn vectors(&self, robot: &RobotModel, origin: &Path, limits: bool) -> Result<Vec<Vec<f64>>> {
         let columns: Vec<usize> = self
             .joint_names
             .iter()
@@ -278,7 +315,7 @@ impl ConfigurationsFile {
                 if let Some(k) = sample.q.iter().position(|v| !v.is_finite()) {
                     return Err(invalid(
                         origin,
-                        &format!("samples[{s}].q[{k}]"),
+                        &format!("samples[{s}].q[{k}] ({})", self.joint_names[k]),
                         format!("is {}", sample.q[k]),
                         "give finite joint values",
                     ));
@@ -289,6 +326,26 @@ impl ConfigurationsFile {
                 }
                 for &(j, leader, multiplier, offset) in &followers {
                     joints[j] = multiplier * joints[leader] + offset;
+                }
+                if limits {
+                    for (j, &v) in joints.iter().enumerate() {
+                        robot.joint(j).limits.check(v).map_err(|problem| {
+                            let name = &robot.joint(j).name;
+                            let (field, problem) = match columns.iter().position(|&c| c == j) {
+                                Some(k) => (format!("samples[{s}].q[{k}] ({name})"), problem),
+                                None => (
+                                    format!("samples[{s}]"),
+                                    format!("`{name}` is not in joint_names and its value {problem}"),
+                                ),
+                            };
+                            invalid(
+                                origin,
+                                &field,
+                                problem,
+                                "give joint values within the URDF's limits (name every joint whose limits exclude 0)",
+                            )
+                        })?;
+                    }
                 }
                 Ok(joints)
             })

@@ -44,7 +44,25 @@ impl Limits {
     pub fn contains(&self, value: f64) -> bool {
         value >= self.lower && value <= self.upper
     }
+
+    /// Checks a value read from a file: finite and within `[lower, upper]` up to
+    /// [`LIMIT_TOLERANCE`] (values written with fewer digits may round just past a limit).
+    pub fn check(&self, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err(format!("is {value}, not a finite number"));
+        }
+        if value < self.lower - LIMIT_TOLERANCE || value > self.upper + LIMIT_TOLERANCE {
+            return Err(format!(
+                "is {value}, outside its limits [{}, {}]",
+                self.lower, self.upper
+            ));
+        }
+        Ok(())
+    }
 }
+
+/// How far past a limit a value read from a file may lie and still count as inside it.
+pub const LIMIT_TOLERANCE: f64 = 1e-6;
 
 /// A link of the tree.
 #[derive(Debug, Clone)]

@@ -45,9 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
         Err(e) => println!("with a box on the old path: {e}"),
     }
-    trm_kinematics::write_atomic(
-        "target/plan_in_a_map.csv".as_ref(),
-        plan.trajectory.to_csv().as_bytes(),
-    )?;
+    let out = std::path::Path::new("target/plan_in_a_map.csv");
+    trm_kinematics::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
     Ok(())
 }

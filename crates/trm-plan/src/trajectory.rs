@@ -3,9 +3,10 @@
 //! Two formats, one [`Trajectory`]:
 //! * **CSV** ([`Trajectory::to_csv`], [`Trajectory::from_csv`]): a header `time,<motor names…>`
 //!   then one row per waypoint (seconds, then motor values). The reader also takes a `t` column
-//!   for the time and ignores columns that name no motor of the robot (so the whole-body CSV of
-//!   `cargo xtask stand-up`, with its phase, CoM and ZMP columns, reads too); times must not
-//!   decrease and every value must be a finite number.
+//!   for the time and skips the extra columns of the whole-body CSV of `cargo xtask stand-up`
+//!   ([`WHOLE_BODY_COLUMNS`]: phase, CoM and ZMP), so that file reads too; any other column must
+//!   name a motor of the robot. Times start at 0 or later and never decrease; every value is a
+//!   finite number within its motor's limits.
 //! * **JSON** ([`Trajectory::to_json`], [`Trajectory::from_json`]): the struct's fields, with the
 //!   task-space path.
 
@@ -15,6 +16,17 @@ use serde::{Deserialize, Serialize};
 use trm_kinematics::RobotModel;
 
 use crate::PlanError;
+
+/// Columns of the whole-body CSV (`cargo xtask stand-up`) that name no motor; the CSV reader
+/// skips them.
+pub const WHOLE_BODY_COLUMNS: &[&str] = &[
+    "phase",
+    "com_x",
+    "com_z",
+    "com_desired_x",
+    "com_desired_z",
+    "zmp_x",
+];
 
 /// A timed joint trajectory (full motor vectors) with its task-space path.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -30,60 +42,163 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
-    /// CSV: `time,<names…>` then one row per waypoint.
-    pub fn to_csv(&self) -> String {
+    /// CSV: `time,<names…>` then one row per waypoint (shortest exact decimals). Refuses what
+    /// the reader refuses ([`Trajectory::check`]); `path` names the file it is for.
+    pub fn to_csv(&self, path: &Path) -> Result<String, PlanError> {
+        self.check(path)?;
         let mut out = format!("time,{}\n", self.names.join(","));
         for (t, q) in self.times.iter().zip(&self.positions) {
             let row: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
             out.push_str(&format!("{t},{}\n", row.join(",")));
         }
-        out
+        Ok(out)
     }
 
-    /// The trajectory as JSON (names, times, positions, task path).
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a trajectory of numbers and names serialises")
-    }
-
-    /// Reads [`Trajectory::to_json`]'s output; `origin` names the text in errors. Checks that
-    /// every row has one value per name and that times do not decrease.
-    pub fn from_json(text: &str, origin: &Path) -> Result<Self, PlanError> {
-        let t: Trajectory = serde_json::from_str(text).map_err(|e| {
+    /// The trajectory as JSON (names, times, positions, task path). Refuses what the reader
+    /// refuses ([`Trajectory::check`]); `path` names the file it is for.
+    pub fn to_json(&self, path: &Path) -> Result<String, PlanError> {
+        self.check(path)?;
+        serde_json::to_string_pretty(self).map_err(|e| {
             invalid(
-                origin,
-                e.line(),
+                path,
+                0,
                 e.to_string(),
-                "give a trajectory written by trm (`plan --out x.json`)",
+                "report this: a checked trajectory serialises",
             )
-        })?;
-        if t.times.len() != t.positions.len() {
+        })
+    }
+
+    /// Reads [`Trajectory::to_json`]'s output; `origin` names the text in errors. Checks it as
+    /// [`Trajectory::check`] does.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Self, PlanError> {
+        let t: Trajectory = trm_kinematics::check_unique_keys(text)
+            .and_then(|()| serde_json::from_str(text))
+            .map_err(|e| {
+                invalid(
+                    origin,
+                    e.line(),
+                    e.to_string(),
+                    "give a trajectory written by trm (`plan --out x.json`)",
+                )
+            })?;
+        t.check(origin)?;
+        Ok(t)
+    }
+
+    /// Checks the trajectory's shape: names given once, one time and one value per name at
+    /// every waypoint, a task path empty or one finite vector per waypoint of one dimension,
+    /// finite values, times from 0 up that never decrease. `origin` names the file in errors.
+    pub fn check(&self, origin: &Path) -> Result<(), PlanError> {
+        for (i, name) in self.names.iter().enumerate() {
+            if self.names[..i].contains(name) {
+                return Err(invalid(
+                    origin,
+                    0,
+                    format!("names[{i}]: `{name}` is named twice"),
+                    "name every motor once",
+                ));
+            }
+        }
+        if self.times.len() != self.positions.len() {
             return Err(invalid(
                 origin,
                 0,
                 format!(
                     "{} times for {} positions",
-                    t.times.len(),
-                    t.positions.len()
+                    self.times.len(),
+                    self.positions.len()
                 ),
                 "give one time per waypoint",
             ));
         }
-        for (i, row) in t.positions.iter().enumerate() {
-            if row.len() != t.names.len() {
+        for (i, row) in self.positions.iter().enumerate() {
+            if row.len() != self.names.len() {
                 return Err(invalid(
                     origin,
                     0,
                     format!(
                         "positions[{i}] has {} values for {} names",
                         row.len(),
-                        t.names.len()
+                        self.names.len()
                     ),
                     "give one value per name",
                 ));
             }
+            if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+                return Err(invalid(
+                    origin,
+                    0,
+                    format!("positions[{i}][{k}] is {}", row[k]),
+                    "give finite values",
+                ));
+            }
         }
-        check_times(&t.times, origin, |i| (0, format!("times[{i}]")))?;
-        Ok(t)
+        if !self.task_path.is_empty() {
+            let dim = self.task_path[0].len();
+            if self.task_path.len() != self.times.len() {
+                return Err(invalid(
+                    origin,
+                    0,
+                    format!(
+                        "task_path has {} points for {} waypoints",
+                        self.task_path.len(),
+                        self.times.len()
+                    ),
+                    "give one task vector per waypoint, or none",
+                ));
+            }
+            for (i, t) in self.task_path.iter().enumerate() {
+                if t.len() != dim || t.iter().any(|v| !v.is_finite()) {
+                    return Err(invalid(
+                        origin,
+                        0,
+                        format!("task_path[{i}] = {t:?} is not {dim} finite numbers"),
+                        "give task vectors of one dimension",
+                    ));
+                }
+            }
+        }
+        check_times(&self.times, origin, |i| (0, format!("times[{i}]")))
+    }
+
+    /// Checks the trajectory against `robot`: every name is a motor (with suggestions), every
+    /// value within its motor's limits. `origin` names the file; `line(i)` gives waypoint `i`'s
+    /// line in it (0 when unknown).
+    pub fn check_robot(
+        &self,
+        robot: &RobotModel,
+        origin: &Path,
+        line: impl Fn(usize) -> usize,
+    ) -> Result<(), PlanError> {
+        let motors: Vec<usize> = self
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                robot.motor_index(n).map_err(|e| {
+                    invalid(
+                        origin,
+                        0,
+                        format!("names[{i}]: {e}"),
+                        "use the model's motor names (`cargo xtask model-info`)",
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()?;
+        for (i, row) in self.positions.iter().enumerate() {
+            for (&m, &v) in motors.iter().zip(row) {
+                let motor = &robot.motors()[m];
+                motor.limits.check(v).map_err(|problem| {
+                    invalid(
+                        origin,
+                        line(i),
+                        format!("waypoint {i}: `{}` {problem}", motor.name),
+                        "keep every motor within its limits (`cargo xtask model-info`)",
+                    )
+                })?;
+            }
+        }
+        Ok(())
     }
 
     /// Reads a CSV trajectory of `robot` (format in the [module docs](self)); `origin` names the
@@ -92,9 +207,12 @@ impl Trajectory {
     /// ```
     /// use trm_plan::Trajectory;
     /// let arm = trm_models::planar_arm();
-    /// let csv = "time,joint1,joint2,note\n0,0.0,0.1,start\n0.5,0.2,0.3,end\n";
+    /// let csv = "time,joint1,joint2,phase\n0,0.0,0.1,0\n0.5,0.2,0.3,1\n";
     /// let t = Trajectory::from_csv(csv, "a.csv".as_ref(), &arm)?;
-    /// assert_eq!((t.names.len(), t.positions[1][0]), (2, 0.2)); // `note` names no motor
+    /// assert_eq!((t.names.len(), t.positions[1][0]), (2, 0.2)); // `phase` is skipped
+    /// let typo = "time,joint1,jiont2\n0,0,0\n";
+    /// let e = Trajectory::from_csv(typo, "c.csv".as_ref(), &arm).unwrap_err().to_string();
+    /// assert!(e.contains("joint2"), "{e}"); // did you mean
     /// let late = "time,joint1\n1,0\n0.5,0\n";
     /// let e = Trajectory::from_csv(late, "b.csv".as_ref(), &arm).unwrap_err().to_string();
     /// assert!(e.starts_with("b.csv:3:"), "{e}");
@@ -126,12 +244,21 @@ impl Trajectory {
                     "name the time column `time`",
                 )
             })?;
-        let columns: Vec<(usize, &str)> = header
-            .iter()
-            .enumerate()
-            .filter(|(_, h)| robot.motor_index(h).is_ok())
-            .map(|(c, h)| (c, *h))
-            .collect();
+        let mut columns: Vec<(usize, &str)> = Vec::new();
+        for (c, h) in header.iter().enumerate() {
+            if c == time || WHOLE_BODY_COLUMNS.contains(h) {
+                continue;
+            }
+            robot.motor_index(h).map_err(|e| {
+                invalid(
+                    origin,
+                    1,
+                    format!("column {} (`{h}`): {e}", c + 1),
+                    "name every column after a motor (`cargo xtask model-info`), or `time`",
+                )
+            })?;
+            columns.push((c, h));
+        }
         if columns.is_empty() {
             return Err(invalid(
                 origin,
@@ -159,12 +286,21 @@ impl Trajectory {
             positions: Vec::new(),
             task_path: Vec::new(),
         };
+        let mut line_of = Vec::new();
         for (n, line) in lines.enumerate() {
             let line_no = n + 2;
             if line.trim().is_empty() {
                 continue;
             }
             let fields: Vec<&str> = line.split(',').collect();
+            if fields.len() != header.len() {
+                return Err(invalid(
+                    origin,
+                    line_no,
+                    format!("{} fields for {} columns", fields.len(), header.len()),
+                    "give one value per column of the header",
+                ));
+            }
             let number = |c: usize| -> Result<f64, PlanError> {
                 fields
                     .get(c)
@@ -179,6 +315,7 @@ impl Trajectory {
                         )
                     })
             };
+            line_of.push(line_no);
             t.times.push(number(time)?);
             t.positions.push(
                 columns
@@ -187,14 +324,15 @@ impl Trajectory {
                     .collect::<Result<_, _>>()?,
             );
         }
-        check_times(&t.times, origin, |i| (i + 2, "time".into()))?;
+        check_times(&t.times, origin, |i| (line_of[i], "time".into()))?;
+        t.check_robot(robot, origin, |i| line_of[i])?;
         Ok(t)
     }
 
     /// Reads a trajectory file of `robot`: JSON when the extension is `.json`, else CSV.
     pub fn load(path: impl AsRef<Path>, robot: &RobotModel) -> Result<Self, PlanError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Io {
+        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -202,7 +340,9 @@ impl Trajectory {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
         {
-            Self::from_json(&text, path)
+            let t = Self::from_json(&text, path)?;
+            t.check_robot(robot, path, |_| 0)?;
+            Ok(t)
         } else {
             Self::from_csv(&text, path, robot)
         }
@@ -249,20 +389,21 @@ fn check_times(
     origin: &Path,
     at: impl Fn(usize) -> (usize, String),
 ) -> Result<(), PlanError> {
-    for i in 1..times.len() {
-        if times[i] < times[i - 1] || !times[i].is_finite() {
-            let (line, field) = at(i);
-            return Err(invalid(
-                origin,
-                line,
-                format!(
-                    "{field} = {} comes before the previous {}",
-                    times[i],
-                    times[i - 1]
-                ),
-                "times must not decrease",
-            ));
-        }
+    for (i, &t) in times.iter().enumerate() {
+        let problem = if !t.is_finite() || t < 0.0 {
+            format!("is {t}")
+        } else if i > 0 && t < times[i - 1] {
+            format!("= {t} comes before the previous {}", times[i - 1])
+        } else {
+            continue;
+        };
+        let (line, field) = at(i);
+        return Err(invalid(
+            origin,
+            line,
+            format!("{field} {problem}"),
+            "give finite times from 0 up that never decrease",
+        ));
     }
     Ok(())
 }

@@ -28,13 +28,22 @@ fn what_is_written_reads_back() {
         positions: vec![vec![0.0, 0.1], vec![0.1, -0.2], vec![0.3, 1e-9]],
         task_path: vec![vec![1.0, 2.0, 3.0]; 3],
     };
-    let csv = Trajectory::from_csv(&t.to_csv(), Path::new("t.csv"), &arm).unwrap();
+    let csv = Trajectory::from_csv(
+        &t.to_csv(Path::new("t.csv")).unwrap(),
+        Path::new("t.csv"),
+        &arm,
+    )
+    .unwrap();
     assert_eq!(
         (csv.names, csv.times, csv.positions),
         (t.names.clone(), t.times.clone(), t.positions.clone())
     );
     assert_eq!(
-        Trajectory::from_json(&t.to_json(), Path::new("t.json")).unwrap(),
+        Trajectory::from_json(
+            &t.to_json(Path::new("t.json")).unwrap(),
+            Path::new("t.json")
+        )
+        .unwrap(),
         t
     );
 }
@@ -44,14 +53,28 @@ fn malformed_csv_is_a_located_error() {
     for (text, expected) in [
         ("", "t.csv:1: empty file"),
         ("joint1,joint2\n0,0\n", "t.csv:1: no `time` column"),
-        ("time,x,y\n0,1,2\n", "t.csv:1: no column names a motor"),
+        (
+            "time,x,y\n0,1,2\n",
+            "t.csv:1: column 2 (`x`): unknown motor",
+        ),
+        ("time,phase\n0,1\n", "t.csv:1: no column names a motor"),
+        ("time,joint1,jont2\n0,1,2\n", "t.csv:1: column 3 (`jont2`)"),
+        (
+            "time,joint1\n0,0\n0.1,0,7\n",
+            "t.csv:3: 3 fields for 2 columns",
+        ),
+        ("time,joint1\n0,0\n\n-0.5,9\n", "t.csv:4: time is -0.5"),
+        (
+            "time,joint1\n0,0\n\n0.5,9\n",
+            "t.csv:4: waypoint 1: `joint1` is 9, outside its limits",
+        ),
         (
             "time,joint1,joint1\n0,0,0\n",
             "t.csv:1: motor `joint1` has two columns",
         ),
         ("time,joint1\n0,NaN\n", "t.csv:2: column 2"),
         ("time,joint1\n0,inf\n", "t.csv:2: column 2"),
-        ("time,joint1\n0,0\n0.5\n", "t.csv:3: column 2"),
+        ("time,joint1\n0,0\n0.5\n", "t.csv:3: 1 fields for 2 columns"),
         ("time,joint1\n0,zero\n", "t.csv:2: column 2"),
         ("time,joint1\n1,0\n0.5,0\n", "t.csv:3: time"),
         ("time,joint1\n-inf,0\n", "t.csv:2: column 1"),
@@ -86,9 +109,59 @@ fn malformed_json_is_a_located_error() {
             "{\"names\": \"a\", \"times\": [], \"positions\": [], \"task_path\": []}",
             "t.json:1",
         ),
+        (
+            "{\"names\": [\"a\"], \"times\": [0], \"times\": [1], \"positions\": [[0]], \"task_path\": []}",
+            "`times` is given twice",
+        ),
+        (
+            "{\"names\": [\"a\", \"a\"], \"times\": [0], \"positions\": [[0, 0]], \"task_path\": []}",
+            "names[1]: `a` is named twice",
+        ),
+        (
+            "{\"names\": [\"a\"], \"times\": [0], \"positions\": [[0]], \"task_path\": [[1], [2]]}",
+            "task_path has 2 points for 1 waypoints",
+        ),
     ] {
         let e = json_error(text);
         assert!(e.contains(expected), "{text:?}: {e}");
+    }
+}
+
+#[test]
+fn json_trajectories_are_checked_against_the_robot() {
+    let arm = trm_models::planar_arm();
+    let dir = std::env::temp_dir().join(format!("trm-traj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (text, expected) in [
+        (
+            "{\"names\": [\"joint9\"], \"times\": [0], \"positions\": [[0]], \"task_path\": []}",
+            "names[0]: unknown motor `joint9`",
+        ),
+        (
+            "{\"names\": [\"joint1\"], \"times\": [0], \"positions\": [[7]], \"task_path\": []}",
+            "waypoint 0: `joint1` is 7, outside its limits",
+        ),
+    ] {
+        let path = dir.join("t.json");
+        std::fs::write(&path, text).unwrap();
+        let e = Trajectory::load(&path, &arm).unwrap_err().to_string();
+        assert!(e.contains(expected) && e.contains("t.json"), "{e}");
+    }
+}
+
+#[test]
+fn writers_refuse_what_readers_refuse() {
+    let t = Trajectory {
+        names: vec!["joint1".into()],
+        times: vec![0.0, f64::INFINITY],
+        positions: vec![vec![0.0], vec![0.1]],
+        task_path: vec![],
+    };
+    for e in [
+        t.to_csv(Path::new("out.csv")).unwrap_err(),
+        t.to_json(Path::new("out.json")).unwrap_err(),
+    ] {
+        assert!(e.to_string().contains("times[1] is inf"), "{e}");
     }
 }
 

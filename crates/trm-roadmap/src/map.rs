@@ -100,18 +100,42 @@ impl Roadmap {
     /// written here reads back.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
+        let text = self.to_json(path)?;
+        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|source| {
+            trm_kinematics::FileError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+            .into()
+        })
+    }
+
+    /// The map as JSON, refused as [`Roadmap::save`] refuses it; `path` names the file it is
+    /// for.
+    pub fn to_json(&self, path: &Path) -> Result<String> {
         self.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),
             problem: format!("not written: {problem}"),
         })?;
-        Ok(trm_kinematics::save_json(path, self, FORMAT)?)
+        Ok(trm_kinematics::json_text(path, self, FORMAT)?)
     }
 
     /// Reads a map file; a truncated, foreign or newer file, or one whose points and edges do
     /// not fit together, is a clear error.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let map: Roadmap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
+        let text =
+            trm_kinematics::read_input(path).map_err(|source| trm_kinematics::FileError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Reads a map from JSON text (`path` names it in errors), checked as [`Roadmap::load`]
+    /// checks a file.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self> {
+        let map: Roadmap = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
         map.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),
             problem: format!("{problem}; rebuild the map"),
@@ -168,6 +192,27 @@ impl Roadmap {
                 names.len(),
                 self.active.len()
             )));
+        }
+        let dim = problem.objective.task().map_or(0, |t| t.dim());
+        let robot = problem.objective.active().model();
+        let motors = problem.objective.active().motor_indices();
+        for (i, p) in self.points.iter().enumerate() {
+            if p.t.len() != dim {
+                return Err(RoadmapError::Unsuitable(format!(
+                    "points[{i}].t has {} dimensions, the task of the spec stored in the map ({}) {dim}: rebuild the map",
+                    p.t.len(),
+                    self.spec_path
+                )));
+            }
+            for (&m, &v) in motors.iter().zip(&p.q) {
+                let motor = &robot.motors()[m];
+                motor.limits.check(v).map_err(|problem| {
+                    RoadmapError::Unsuitable(format!(
+                        "points[{i}]: `{}` {problem}: rebuild the map",
+                        motor.name
+                    ))
+                })?;
+            }
         }
         Ok(problem)
     }

@@ -269,26 +269,78 @@ impl TaskMap {
         (d * d, grad)
     }
 
-    /// Writes the map as JSON (atomically).
+    /// The map as JSON; a map that would not read back ([`TaskMap::load`]'s checks) is refused.
+    /// `path` names the file it is for.
+    pub fn to_json(&self, path: &Path) -> Result<String, TaskMapError> {
+        self.check().map_err(|problem| TaskMapError::File {
+            path: path.display().to_string(),
+            problem: format!("not written: {problem}"),
+        })?;
+        Ok(trm_kinematics::json_text(path, self, FORMAT)?)
+    }
+
+    /// Writes the map as JSON (atomically); see [`TaskMap::to_json`].
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TaskMapError> {
         let path = path.as_ref();
-        let fail = |problem: String| TaskMapError::File {
-            path: path.display().to_string(),
-            problem,
-        };
+        let text = self.to_json(path)?;
+        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|source| {
+            trm_kinematics::FileError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+            .into()
+        })
+    }
+
+    /// Checks that the map holds something and that its points fit together: finite goal
+    /// parameters and values, parents and clusters naming points of the map, a positive θ.
+    fn check(&self) -> Result<(), String> {
         if self.points.is_empty() {
-            return Err(fail(
-                "the task map is empty: nothing feasible was found, no file written".into(),
-            ));
+            return Err("the task map is empty: nothing feasible was found".into());
         }
-        Ok(trm_kinematics::save_json(path, self, FORMAT)?)
+        if !self.threshold.is_finite() {
+            return Err(format!("threshold {} is not finite", self.threshold));
+        }
+        let n = self.points.len();
+        for (i, p) in self.points.iter().enumerate() {
+            if !(p.g.iter().all(|v| v.is_finite()) && p.value.is_finite()) {
+                return Err(format!("points[{i}] holds a non-finite value"));
+            }
+            if let Some(k) = p.parent.filter(|&k| k >= i) {
+                return Err(format!(
+                    "points[{i}].parent = {k} does not name an earlier point"
+                ));
+            }
+            if p.cluster >= n {
+                return Err(format!(
+                    "points[{i}].cluster = {} is not below the {n} points",
+                    p.cluster
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Reads a map; truncated, foreign or newer files are clear errors.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, TaskMapError> {
         let path = path.as_ref();
-        let mut map: TaskMap = trm_kinematics::load_versioned(path, FORMAT, VERSION)?;
+        let text =
+            trm_kinematics::read_input(path).map_err(|source| trm_kinematics::FileError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Reads a task map from JSON text (`path` names it in errors), checked as
+    /// [`TaskMap::load`] checks a file.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, TaskMapError> {
+        let mut map: TaskMap = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
         map.metric.check()?;
+        map.check().map_err(|problem| TaskMapError::File {
+            path: path.display().to_string(),
+            problem: format!("{problem}; explore the task map again"),
+        })?;
         map.reindex();
         Ok(map)
     }

@@ -126,7 +126,7 @@ impl TaskMapSpec {
     /// Reads a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<LoadedTaskMapSpec, TaskMapError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| {
+        let text = trm_kinematics::read_input(path).map_err(|source| {
             TaskMapError::MapFile(trm_kinematics::FileError::Io {
                 path: path.to_path_buf(),
                 source,

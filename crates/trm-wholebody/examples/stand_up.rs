@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .expect("at least the hand-tuned motion");
     trm_kinematics::write_atomic(
         "target/stand_up.csv".as_ref(),
-        best.rollout.to_csv(problem.model()).as_bytes(),
+        best.rollout.to_csv(problem.model())?.as_bytes(),
     )?;
     println!("wrote target/stand_up.csv");
     Ok(())

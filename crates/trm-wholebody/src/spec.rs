@@ -190,7 +190,7 @@ impl MotionSpec {
     /// Reads and checks a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| WholeBodyError::Io {
+        let text = trm_kinematics::read_input(path).map_err(|source| WholeBodyError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -151,8 +151,9 @@ fn main() -> Result<(), Box<dyn Error>> {
         &PlanOptions::default(),
     )?;
     let csv = out.join("plan.csv");
-    trm_kinematics::write_atomic(&csv, plan.trajectory.to_csv().as_bytes())?;
-    trm_kinematics::write_atomic(&out.join("plan.json"), plan.trajectory.to_json().as_bytes())?;
+    trm_kinematics::write_atomic(&csv, plan.trajectory.to_csv(&csv)?.as_bytes())?;
+    let json = out.join("plan.json");
+    trm_kinematics::write_atomic(&json, plan.trajectory.to_json(&json)?.as_bytes())?;
     let back = Trajectory::load(&csv, &problem.robot)?;
     assert_eq!(back.positions.len(), plan.trajectory.positions.len());
     let robot = &problem.robot;

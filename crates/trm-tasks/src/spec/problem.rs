@@ -71,7 +71,7 @@ impl Problem {
     /// Reads and builds a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| TaskError::Io {
+        let text = trm_kinematics::read_input(path).map_err(|source| TaskError::Io {
             path: path.to_path_buf(),
             source,
         })?;

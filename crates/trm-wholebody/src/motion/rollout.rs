@@ -61,9 +61,20 @@ impl Rollout {
     /// The motion as CSV: a header `t,phase,<motor names of model>,com_x,com_z,com_desired_x,
     /// com_desired_z,zmp_x`, then one row per control step (seconds, phase index, motor
     /// positions in rad, CoM, desired CoM and ZMP in m, ground frame). `trm_plan::Trajectory`
-    /// reads it back (time and motor columns).
-    pub fn to_csv(&self, model: &RobotModel) -> String {
+    /// reads it back (time and motor columns). A rollout holding a non-finite value (a diverged
+    /// simulation) is refused: the reader would refuse the file.
+    pub fn to_csv(&self, model: &RobotModel) -> Result<String, crate::WholeBodyError> {
         use std::fmt::Write as _;
+        if let Some(i) = (0..self.times.len()).find(|&i| {
+            let row = (self.q[i].iter().chain(&self.com[i]))
+                .chain(self.com_desired[i].iter().chain(&self.zmp[i]));
+            !self.times[i].is_finite() || row.into_iter().any(|v| !v.is_finite())
+        }) {
+            return Err(crate::WholeBodyError::Invalid {
+                what: format!("the rollout at t = {}", self.times[i]),
+                problem: "holds a non-finite value; not written as CSV".into(),
+            });
+        }
         let mut text = String::from("t,phase");
         for m in model.motors() {
             text.push(',');
@@ -85,7 +96,7 @@ impl Rollout {
                 self.zmp[i][0]
             );
         }
-        text
+        Ok(text)
     }
 
     /// Number of (sample, constraint) violations.

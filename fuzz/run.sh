@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Fuzzes trm's file readers with cargo-fuzz (libFuzzer; needs the nightly toolchain).
+#
+#   fuzz/run.sh TARGET [libFuzzer flags…]   one target, e.g. `fuzz/run.sh map -runs=10000000`
+#   fuzz/run.sh --all [libFuzzer flags…]    every target in turn with the same flags
+#   fuzz/run.sh --smoke                     every target for a few seconds (≤ 2 min in all);
+#                                           skips with a message where nightly is missing
+#   fuzz/run.sh --list                      the targets
+#
+# Each target's corpus (fuzz/corpus/TARGET, not committed) is seeded from the files in specs/
+# and models/ and from fuzz/seeds/TARGET; crashes land in fuzz/artifacts/TARGET.
+set -euo pipefail
+cd "$(dirname "$0")"
+root=..
+
+targets=(urdf model_description task_spec world motion_spec taskmap_spec map taskmap scene
+         configurations posture trajectory_csv trajectory_json)
+
+# The seed files of a target, one per line.
+seeds() {
+  case "$1" in
+    urdf) ls "$root"/models/*.urdf ;;
+    model_description) ls "$root"/models/*.ron ;;
+    task_spec) ls "$root"/specs/*.ron "$root"/specs/fig6/*.ron "$root"/specs/table_iii/*.ron ;;
+    world) ls "$root"/specs/worlds/*.ron ;;
+    motion_spec) ls "$root"/specs/wholebody/*.ron ;;
+    taskmap_spec) ls "$root"/specs/taskmaps/*.ron ;;
+    configurations) ls "$root"/specs/configs/*.json ;;
+  esac
+  if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
+}
+
+prepare() {
+  mkdir -p "corpus/$1"
+  seeds "$1" | while read -r f; do cp "$f" "corpus/$1/"; done
+}
+
+run() {
+  local target=$1
+  shift
+  prepare "$target"
+  cargo +nightly fuzz run --release "$target" "corpus/$target" -- "$@"
+}
+
+case "${1:-}" in
+  --list) printf '%s\n' "${targets[@]}" ;;
+  --all)
+    shift
+    for t in "${targets[@]}"; do run "$t" "$@"; done ;;
+  --smoke)
+    if ! cargo +nightly --version >/dev/null 2>&1; then
+      echo "fuzz smoke run skipped: no nightly toolchain (rustup toolchain install nightly)"
+      exit 0
+    fi
+    if ! cargo fuzz --version >/dev/null 2>&1; then
+      cargo install cargo-fuzz --locked --version 0.13.2
+    fi
+    cargo +nightly fuzz build --release
+    for t in "${targets[@]}"; do
+      run "$t" -max_total_time=8 -print_final_stats=1 2>&1 | grep -E "stat::number_of_executed_units|Done|ERROR|panicked" || true
+      if [ -n "$(ls "artifacts/$t" 2>/dev/null)" ]; then
+        echo "fuzz target $t crashed: see fuzz/artifacts/$t"; exit 1
+      fi
+    done ;;
+  ""|-h|--help) sed -n 2,13p "$0" | sed 's/^# \{0,1\}//' ;;
+  *) run "$@" ;;
+esac
