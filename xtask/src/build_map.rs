@@ -17,13 +17,13 @@ pub struct Args {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Number of points (default: the spec's map.max_points).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::parse::count(1, trm_roadmap::MAX_POINTS))]
     points: Option<usize>,
     /// Worker threads (an execution setting: the map does not depend on it).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::parse::count(1, 4096))]
     threads: Option<usize>,
     /// Concurrent searches P (an algorithm setting; default: the spec's map.searches).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::parse::count(1, trm_roadmap::MAX_SEARCHES))]
     searches: Option<usize>,
     /// Seed (default: the spec's solver.seed).
     #[arg(long)]
@@ -131,30 +131,29 @@ pub fn info(args: &InfoArgs) -> Result<()> {
         map.software,
         map.spec_path
     );
+    // the spec travels inside the map: rebuild its objective (checking every point against
+    // it) for the cost breakdown
+    let problem = map
+        .problem()
+        .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
     print_summary(&map);
-    // the spec travels inside the map: rebuild its objective for the cost breakdown
-    match map.problem() {
-        Ok(problem) => {
-            let mut scratch = problem.objective.scratch();
-            let mut sums: Vec<(String, f64)> = Vec::new();
-            for p in &map.points {
-                let (_, terms) = problem.objective.breakdown(&p.q, &mut scratch);
-                if sums.is_empty() {
-                    sums = terms.iter().map(|t| (t.label.clone(), 0.0)).collect();
-                }
-                for (s, t) in sums.iter_mut().zip(&terms) {
-                    s.1 += t.weight * t.value;
-                }
-            }
-            println!("mean cost breakdown (weighted):");
-            for (label, total) in sums {
-                println!(
-                    "  {label:<36} {:.5}",
-                    total / map.points.len().max(1) as f64
-                );
-            }
+    let mut scratch = problem.objective.scratch();
+    let mut sums: Vec<(String, f64)> = Vec::new();
+    for p in &map.points {
+        let (_, terms) = problem.objective.breakdown(&p.q, &mut scratch);
+        if sums.is_empty() {
+            sums = terms.iter().map(|t| (t.label.clone(), 0.0)).collect();
         }
-        Err(e) => println!("(no cost breakdown: {e})"),
+        for (s, t) in sums.iter_mut().zip(&terms) {
+            s.1 += t.weight * t.value;
+        }
+    }
+    println!("mean cost breakdown (weighted):");
+    for (label, total) in sums {
+        println!(
+            "  {label:<36} {:.5}",
+            total / map.points.len().max(1) as f64
+        );
     }
     Ok(())
 }

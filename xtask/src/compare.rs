@@ -22,16 +22,16 @@ pub struct Args {
     )]
     algos: Vec<String>,
     /// Runs per algorithm and posture (run k uses seed S + k).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     runs: u64,
     /// Base seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Evaluation budget per run.
-    #[arg(long, default_value_t = 400_000)]
+    #[arg(long, default_value_t = 400_000, value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     max_evals: u64,
     /// Stop a run when its best has not improved for this many evaluations.
-    #[arg(long, default_value_t = 30_000)]
+    #[arg(long, default_value_t = 30_000, value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     no_improvement: u64,
     /// Also write a 3-D view per posture (`posture<N>.scene.html`): one frame per algorithm,
     /// its best run's posture.
@@ -63,11 +63,6 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         args.specs.clone()
     };
-    let problems: Vec<Problem> = specs
-        .iter()
-        .map(|p| Problem::load(p).with_context(|| format!("loading {}", p.display())))
-        .collect::<Result<_>>()?;
-    let labels: Vec<String> = specs.iter().map(|s| s.display().to_string()).collect();
     let comparison = Comparison {
         algorithms: args.algos.clone(),
         runs: args.runs,
@@ -75,6 +70,19 @@ pub fn run(args: &Args) -> Result<()> {
         max_evaluations: args.max_evals,
         no_improvement: args.no_improvement,
     };
+    comparison.check().with_context(|| {
+        format!(
+            "--algos {} --runs {} --seed {}",
+            args.algos.join(","),
+            args.runs,
+            args.seed
+        )
+    })?;
+    let problems: Vec<Problem> = specs
+        .iter()
+        .map(|p| Problem::load(p).with_context(|| format!("loading {}", p.display())))
+        .collect::<Result<_>>()?;
+    let labels: Vec<String> = specs.iter().map(|s| s.display().to_string()).collect();
     eprintln!(
         "{} runs ({} postures × {} algorithms × {}) on {} threads…",
         problems.len() as u64 * args.algos.len() as u64 * args.runs,

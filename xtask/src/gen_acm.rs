@@ -14,13 +14,13 @@ pub struct Args {
     /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
     model: Option<PathBuf>,
     /// Random configurations sampled within the motor limits.
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::parse::count(1, 100_000_000))]
     samples: usize,
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// A pair colliding in at least this fraction of the samples is disabled as `always`.
-    #[arg(long, default_value_t = 0.95)]
+    #[arg(long, default_value_t = 0.95, value_parser = crate::parse::fraction)]
     always_fraction: f64,
     #[command(flatten)]
     meshes: crate::MeshArgs,

@@ -107,7 +107,13 @@ fn run(command: Command) -> Result<()> {
         trm_kinematics::check_output(f).with_context(|| format!("output {}", f.display()))?;
     }
     for d in &dirs {
-        if !d.is_dir() {
+        if d.exists() && !d.is_dir() {
+            anyhow::bail!(
+                "output directory {} is not a directory\n  fix: remove it or choose another directory",
+                d.display()
+            );
+        }
+        if !d.exists() {
             trm_kinematics::check_output(d)
                 .with_context(|| format!("output directory {}", d.display()))?;
         }
@@ -133,11 +139,35 @@ fn staged() -> std::sync::MutexGuard<'static, Option<Vec<trm_kinematics::StagedF
 }
 
 fn main() {
-    let cli = Cli::parse();
+    use clap::{CommandFactory, FromArgMatches};
+    // `--seed -1` is a value clap checks (and names the flag), not an unknown option
+    let command = Cli::command().mut_subcommands(|sub| {
+        sub.mut_args(|arg| {
+            if arg.get_action().takes_values() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+    });
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(cli.command) {
-        eprintln!("error: {e:#}");
+        eprintln!("error: {}", message(&e));
         std::process::exit(1);
     }
+}
+
+/// The error and its causes, each cause once (a message that already quotes its cause is not
+/// followed by it again).
+fn message(e: &anyhow::Error) -> String {
+    let mut text = e.to_string();
+    for cause in e.chain().skip(1) {
+        let cause = cause.to_string();
+        if !text.contains(&cause) {
+            text = format!("{text}: {cause}");
+        }
+    }
+    text
 }
 
 /// Runs the command.
@@ -205,6 +235,53 @@ impl MeshArgs {
         Ok(trm_collision::CollisionModel::with_options(
             model, &options,
         )?)
+    }
+}
+
+/// Value parsers for flags: out-of-range values are refused by clap with the flag's name.
+mod parse {
+    /// A count in `min..=max`.
+    pub fn count(min: u64, max: usize) -> clap::builder::RangedU64ValueParser<usize> {
+        clap::builder::RangedU64ValueParser::new().range(min..=max as u64)
+    }
+
+    fn number(text: &str) -> Result<f64, String> {
+        text.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("`{text}` is not a number"))
+    }
+
+    /// A finite number.
+    pub fn finite(text: &str) -> Result<f64, String> {
+        number(text).and_then(|v| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("{v} is not finite"))
+            }
+        })
+    }
+
+    /// A finite number above 0.
+    pub fn positive(text: &str) -> Result<f64, String> {
+        finite(text).and_then(|v| {
+            if v > 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{v} is not above 0"))
+            }
+        })
+    }
+
+    /// A number in [0, 1].
+    pub fn fraction(text: &str) -> Result<f64, String> {
+        finite(text).and_then(|v| {
+            if (0.0..=1.0).contains(&v) {
+                Ok(v)
+            } else {
+                Err(format!("{v} is not in [0, 1]"))
+            }
+        })
     }
 }
 

@@ -21,11 +21,12 @@ pub struct Args {
     meshes: crate::MeshArgs,
 }
 
-fn deg(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.1}", x.to_degrees())
-    } else {
-        format!("{x}")
+/// A limit for the tables: degrees, or metres marked `m` for a prismatic joint.
+fn limit(x: f64, prismatic: bool) -> String {
+    match (x.is_finite(), prismatic) {
+        (false, _) => format!("{x}"),
+        (true, true) => format!("{x:.3} m"),
+        (true, false) => format!("{:.1}", x.to_degrees()),
     }
 }
 
@@ -78,7 +79,7 @@ pub fn run(args: &Args) -> Result<()> {
     println!("  root (world frame): {}", tree.links[0].name);
 
     println!(
-        "\nmotors ({}), limits in degrees (rad for prismatic):",
+        "\nmotors ({}), limits in degrees (metres, marked m, for prismatic joints):",
         model.motors().len()
     );
     println!(
@@ -86,12 +87,16 @@ pub fn run(args: &Args) -> Result<()> {
         "#", "name", "lower", "upper"
     );
     for (i, m) in model.motors().iter().enumerate() {
-        let driven: Vec<&str> = model
-            .couplings()
-            .iter()
-            .enumerate()
+        let driven: Vec<usize> = (model.couplings().iter().enumerate())
             .filter(|(_, c)| c.terms.iter().any(|&(k, _)| k == i))
-            .map(|(j, _)| model.joint(j).name.as_str())
+            .map(|(j, _)| j)
+            .collect();
+        let prismatic = driven
+            .iter()
+            .any(|&j| model.joint(j).kind == JointKind::Prismatic);
+        let driven: Vec<&str> = driven
+            .iter()
+            .map(|&j| model.joint(j).name.as_str())
             .collect();
         let driven = if driven.len() == 1 && driven[0] == m.name {
             String::from("(itself)")
@@ -101,8 +106,8 @@ pub fn run(args: &Args) -> Result<()> {
         println!(
             "  {i:>3}  {:<28} {:>9} {:>9}  {driven}",
             m.name,
-            deg(m.limits.lower),
-            deg(m.limits.upper)
+            limit(m.limits.lower, prismatic),
+            limit(m.limits.upper, prismatic)
         );
     }
 
@@ -122,8 +127,8 @@ pub fn run(args: &Args) -> Result<()> {
         println!(
             "  {j:>3}  {:<28} {kind:<10} {:>9} {:>9}  {}",
             joint.name,
-            deg(joint.limits.lower),
-            deg(joint.limits.upper),
+            limit(joint.limits.lower, joint.kind == JointKind::Prismatic),
+            limit(joint.limits.upper, joint.kind == JointKind::Prismatic),
             coupling_formula(&model, j)
         );
     }
@@ -230,5 +235,15 @@ fn print_collision(collision: &CollisionModel, list_pairs: bool) {
         }
     } else {
         println!("  (list them with --collisions)");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn prismatic_limits_are_shown_in_metres_and_revolute_ones_in_degrees() {
+        assert_eq!(super::limit(0.2, true), "0.200 m");
+        assert_eq!(super::limit(std::f64::consts::FRAC_PI_2, false), "90.0");
+        assert_eq!(super::limit(f64::INFINITY, false), "inf");
     }
 }

@@ -1,7 +1,7 @@
 //! `cargo xtask optimise --algo A --function F --dim D --target T --runs R --seed S`: evaluations
 //! to target per run and a summary, as a table or JSON.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde_json::json;
@@ -18,25 +18,25 @@ pub struct Args {
     #[arg(long, default_value = "sphere")]
     function: String,
     /// Dimension.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = crate::parse::count(1, 10_000))]
     dim: usize,
     /// Target value: a run succeeds when its best value is ≤ this.
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value_t = 1e-8, value_parser = crate::parse::finite)]
     target: f64,
     /// Independent runs (run k uses seed S + k; the rotation of rotated functions uses S).
-    #[arg(long, default_value_t = 11)]
+    #[arg(long, default_value_t = 11, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     runs: u64,
     /// Base seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Evaluation budget per run.
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     max_evals: u64,
     /// Initial step size (start: the origin for Rosenbrock, (1, …, 1) otherwise).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = crate::parse::positive)]
     sigma: f64,
     /// Population size (particles for SIR/SIRD); the algorithm's default when absent.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::parse::count(2, 1_000_000))]
     population: Option<usize>,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -61,7 +61,8 @@ pub fn run(args: &Args) -> Result<()> {
             ALGORITHMS.join(", ")
         );
     }
-    let f = TestFunction::by_name(&args.function, args.dim, args.seed)?;
+    let f = TestFunction::by_name(&args.function, args.dim, args.seed)
+        .with_context(|| format!("--function {}", args.function))?;
     let mut runs = Vec::new();
     for k in 0..args.runs {
         let start = Start::new(f.start(), args.sigma).with_stop(StopOptions {
@@ -162,7 +163,7 @@ mod tests {
             run(&args(algo, "sphere")).unwrap();
         }
         assert!(run(&args("xnse", "sphere")).is_err());
-        let e = run(&args("xnes", "spere")).unwrap_err().to_string();
+        let e = format!("{:#}", run(&args("xnes", "spere")).unwrap_err());
         assert!(e.contains("rotated-sphere"), "{e}");
     }
 }

@@ -89,6 +89,14 @@ pub fn run(args: &Args) -> Result<()> {
         Goal::Configuration(posture(Path::new(&args.to), &problem)?)
     } else {
         let t = crate::numbers("--to", &args.to, "\"x,y,z\" or a posture file")?;
+        let dim = first.points.first().map_or(t.len(), |p| p.t.len());
+        if t.len() != dim {
+            anyhow::bail!(
+                "--to `{}`: {} values for the map's {dim}-dimensional task space",
+                args.to,
+                t.len()
+            );
+        }
         Goal::TaskPoint {
             t,
             tolerance: args.tolerance,

@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long)]
     exact: bool,
     /// RPROP iterations.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
     iterations: usize,
     /// Trajectory output (CSV; a .json beside it).
     #[arg(long)]

@@ -18,7 +18,7 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// Evaluation budget, overriding the spec's solver.max_evaluations.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000_000))]
     max_evals: Option<u64>,
     /// Write the posture (motor values by name, active values, cost breakdown, frame poses).
     #[arg(long)]
@@ -27,6 +27,16 @@ pub struct Args {
 
 /// Solves and reports.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(a) = args
+        .algo
+        .as_ref()
+        .filter(|a| !trm_optim::ALGORITHMS.contains(&a.as_str()))
+    {
+        anyhow::bail!(
+            "--algo {a}: unknown algorithm\n  fix: give one of {}",
+            trm_optim::ALGORITHMS.join(", ")
+        );
+    }
     let problem = Problem::load(&args.spec)?;
     let mut solver = problem.spec.solver.clone();
     if let Some(a) = &args.algo {

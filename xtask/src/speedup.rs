@@ -17,13 +17,13 @@ pub struct Args {
     /// The task spec.
     spec: PathBuf,
     /// Point counts to time, comma-separated.
-    #[arg(long, default_value = "200,400", value_delimiter = ',')]
+    #[arg(long, default_value = "200,400", value_delimiter = ',', value_parser = crate::parse::count(1, trm_roadmap::MAX_POINTS))]
     points: Vec<usize>,
     /// Thread counts, comma-separated.
-    #[arg(long, default_value = "1,2", value_delimiter = ',')]
+    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = crate::parse::count(1, 1024))]
     threads: Vec<usize>,
     /// Values of P for the evaluations-per-point table (built with the largest thread count).
-    #[arg(long, default_value = "1,2,4,8", value_delimiter = ',')]
+    #[arg(long, default_value = "1,2,4,8", value_delimiter = ',', value_parser = crate::parse::count(1, trm_roadmap::MAX_SEARCHES))]
     searches: Vec<usize>,
     /// Seed.
     #[arg(long, default_value_t = 0)]
@@ -69,6 +69,12 @@ fn timed(
 
 /// Runs the measurements and writes the table and plot.
 pub fn run(args: &Args) -> Result<()> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if let Some(t) = args.threads.iter().find(|&&t| t > cores) {
+        anyhow::bail!(
+            "--threads {t}: this machine has {cores} cores; more threads than cores only time oversubscription\n  fix: give thread counts from 1 to {cores}"
+        );
+    }
     let problem = Problem::load(&args.spec)?;
     let mut md = format!(
         "Time to reach each map size ({} , seed {}, P from the spec), on {} available cores.\n\n| threads |",

@@ -13,17 +13,16 @@ use crate::plot::{Panel, Series, lines, panels};
 /// Arguments of `stand-up`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The motion spec.
-    #[arg(default_value = "specs/wholebody/standup.ron")]
-    spec: PathBuf,
+    /// The motion spec (default: the repository's specs/wholebody/standup.ron).
+    spec: Option<PathBuf>,
     /// Seed of the optimiser (ChaCha).
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Override the spec's bootstrap budget (rollouts).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=10_000_000))]
     bootstrap_rollouts: Option<u64>,
     /// Override the spec's constrained budget (rollouts).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
     rollouts: Option<u64>,
     /// Also write a 3-D view of the optimised motion (`scene.html`, `scene.json` in --out).
     #[arg(long)]
@@ -42,7 +41,11 @@ const PAPER: [(&str, f64, f64, f64); 3] = [
 
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
-    let mut problem = WholeBody::load(&args.spec)?;
+    let spec_path = args
+        .spec
+        .clone()
+        .unwrap_or_else(|| crate::models_dir().join("../specs/wholebody/standup.ron"));
+    let mut problem = WholeBody::load(&spec_path)?;
     if args.bootstrap_rollouts.is_some() || args.rollouts.is_some() {
         let mut spec = problem.spec().clone();
         if let Some(b) = args.bootstrap_rollouts {
@@ -51,18 +54,18 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(r) = args.rollouts {
             spec.optimiser.rollouts = r;
         }
-        let text = trm_kinematics::read_input(&args.spec)
-            .with_context(|| format!("reading {}", args.spec.display()))?;
+        let text = trm_kinematics::read_input(&spec_path)
+            .with_context(|| format!("reading {}", spec_path.display()))?;
         problem = WholeBody::new(
             spec,
             problem.model().clone(),
-            &args.spec.display().to_string(),
+            &spec_path.display().to_string(),
             &text,
         )?;
     }
     println!(
         "{}: {} motors, {:.1} kg, CoM from ({:.3}, {:.3}) to ({:.3}, {:.3}) m (x forward, z up), {} parameters, {} constraints",
-        args.spec.display(),
+        spec_path.display(),
         problem.model().motors().len(),
         problem.mass(),
         problem.com_waypoints().0.x,
@@ -88,7 +91,7 @@ pub fn run(args: &Args) -> Result<()> {
         1e3 * elapsed / result.rollouts.max(1) as f64,
         result.feasible
     );
-    let is_stand_up = args.spec.file_stem().is_some_and(|s| s == "standup");
+    let is_stand_up = spec_path.file_stem().is_some_and(|s| s == "standup");
     print_table(&problem, &result, is_stand_up);
     std::fs::create_dir_all(&args.out)?;
     write_figures(&problem, &result, &args.out)?;
@@ -113,7 +116,7 @@ pub fn run(args: &Args) -> Result<()> {
             "no feasible trajectory found with seed {} in {} rollouts: raise optimiser.bootstrap_rollouts in {} or try another --seed",
             args.seed,
             result.rollouts,
-            args.spec.display()
+            spec_path.display()
         );
     }
     Ok(())

@@ -17,7 +17,7 @@ use crate::explore_task_map::{Explored, explore_spec};
 #[derive(clap::Args)]
 pub struct Args {
     /// RPROP iterations per optimisation.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
     iterations: usize,
     /// Output directory (table.md, joint_limits.svg).
     #[arg(long, default_value = "target/taskmap-studies")]

@@ -97,9 +97,13 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             }
         }
         (None, Some(map)) => {
-            let p = map
-                .problem()
-                .with_context(|| format!("the spec stored in the map ({})", map.spec_path))?;
+            let p = map.problem().with_context(|| {
+                format!(
+                    "{}: the spec stored in the map ({})",
+                    args.map.as_deref().unwrap_or(Path::new("")).display(),
+                    map.spec_path
+                )
+            })?;
             Ok(from_problem(p, format!("map of {}", map.spec_path)))
         }
         (None, None) => {

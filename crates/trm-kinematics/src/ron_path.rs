@@ -346,6 +346,11 @@ impl Scanner<'_> {
                 }) {
                     self.at += 1;
                 }
+                if self.at == start {
+                    // a delimiter where a value belongs (`(:`, `[}`): malformed, and no
+                    // progress would be made
+                    return None;
+                }
                 Kind::Atom
             }
         };
@@ -510,5 +515,16 @@ mod tests {
         }
         let deep = "(".repeat(100_000);
         assert_eq!(locate_ron_path(&deep, "a"), None);
+    }
+
+    #[test]
+    fn a_delimiter_where_a_value_belongs_ends_the_walk() {
+        // found by fuzzing (fuzz/artifacts/world/oom-57fb…): `(x: [1, :` once looped forever,
+        // filling memory with empty nodes
+        for text in ["(x: [1, :])", "(a: (1, }))", "[(nam: x back, ght\", 1)]"] {
+            assert_eq!(locate_ron_path(text, "x[5]"), None, "{text}");
+        }
+        let found = include_str!("../tests/fixtures/fuzz_world_oom.ron");
+        assert_eq!(locate_ron_path(found, "objects[3].name"), None);
     }
 }

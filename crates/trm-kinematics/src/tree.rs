@@ -192,6 +192,22 @@ fn check_finite(ctx: &Ctx, tag: &str, name: &str, what: &str, values: &[f64]) ->
     Ok(())
 }
 
+/// The six numbers of a URDF `<origin>`.
+fn pose_numbers(p: &urdf_rs::Pose) -> [f64; 6] {
+    [p.xyz[0], p.xyz[1], p.xyz[2], p.rpy[0], p.rpy[1], p.rpy[2]]
+}
+
+/// The sizes of a URDF `<geometry>` (a mesh's scale).
+fn geometry_numbers(g: &urdf_rs::Geometry) -> Vec<f64> {
+    match g {
+        urdf_rs::Geometry::Box { size } => size.to_vec(),
+        urdf_rs::Geometry::Cylinder { radius, length }
+        | urdf_rs::Geometry::Capsule { radius, length } => vec![*radius, *length],
+        urdf_rs::Geometry::Sphere { radius } => vec![*radius],
+        urdf_rs::Geometry::Mesh { scale, .. } => scale.as_ref().map_or(Vec::new(), |s| s.to_vec()),
+    }
+}
+
 /// The pose a URDF `<origin xyz rpy>` describes (R = Rz(yaw)·Ry(pitch)·Rx(roll)).
 pub fn pose_from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -235,6 +251,30 @@ impl Tree {
                 "inertial",
                 &[i.mass.value, t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz],
             )?;
+            check_finite(
+                ctx,
+                "link",
+                &l.name,
+                "inertial origin",
+                &pose_numbers(&i.origin),
+            )?;
+            let shapes = (l
+                .collision
+                .iter()
+                .map(|c| ("collision", &c.origin, &c.geometry)))
+            .chain(l.visual.iter().map(|v| ("visual", &v.origin, &v.geometry)));
+            for (what, origin, geometry) in shapes {
+                check_finite(
+                    ctx,
+                    "link",
+                    &l.name,
+                    &format!("{what} origin"),
+                    &pose_numbers(origin),
+                )?;
+                // (sizes are checked where shapes are made: trm-collision)
+                let size = geometry_numbers(geometry);
+                check_finite(ctx, "link", &l.name, &format!("{what} geometry"), &size)?;
+            }
             if i.mass.value < 0.0 {
                 return Err(ctx.invalid(
                     "link",

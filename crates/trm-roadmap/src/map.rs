@@ -196,6 +196,7 @@ impl Roadmap {
         let dim = problem.objective.task().map_or(0, |t| t.dim());
         let robot = problem.objective.active().model();
         let motors = problem.objective.active().motor_indices();
+        let mut scratch = problem.objective.scratch();
         for (i, p) in self.points.iter().enumerate() {
             if p.t.len() != dim {
                 return Err(RoadmapError::Unsuitable(format!(
@@ -212,6 +213,19 @@ impl Roadmap {
                         motor.name
                     ))
                 })?;
+            }
+            // the stored task point is the task function at the stored posture
+            let t = problem.objective.task_value(&p.q, &mut scratch);
+            let gap = t
+                .iter()
+                .zip(&p.t)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if gap > 1e-6 {
+                return Err(RoadmapError::Unsuitable(format!(
+                    "points[{i}].t is {gap:.3e} away from the task value of points[{i}].q: the map does not fit the spec stored in it ({}); rebuild the map",
+                    self.spec_path
+                )));
             }
         }
         Ok(problem)

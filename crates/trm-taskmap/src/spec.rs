@@ -220,7 +220,32 @@ impl LoadedTaskMapSpec {
                 return Err(self.err("start", "holds a non-finite value", "write finite numbers"));
             }
         }
+        if let Some(m) = &s.metric {
+            for (field, w) in [("position", m.position), ("orientation", m.orientation)] {
+                if !(w.is_finite() && w > 0.0) {
+                    return Err(self.err(
+                        &format!("metric.{field}"),
+                        format!("{w} is not a positive weight (a degenerate metric)"),
+                        "give a positive finite weight",
+                    ));
+                }
+            }
+        }
+        self.object()?;
         Ok(())
+    }
+
+    /// The object as a world of its parts, checked like a world file.
+    fn object(&self) -> Result<World, TaskMapError> {
+        World::from_spec_in(
+            &WorldSpec {
+                objects: self.spec.object.clone(),
+            },
+            &self.origin,
+            &self.text,
+            "object",
+        )
+        .map_err(|e| self.err("object", e.to_string(), "fix the object's parts"))
     }
 
     /// Loads the robot, finds the first grasp if the spec gives none, and explores the map.
@@ -232,15 +257,7 @@ impl LoadedTaskMapSpec {
         };
         let collision = CollisionModel::new(&model)?;
         let hand = Hand::icub(&model, &collision, &s.hand)?;
-        let object = World::from_spec_in(
-            &WorldSpec {
-                objects: s.object.clone(),
-            },
-            &self.origin,
-            &self.text,
-            "object",
-        )
-        .map_err(|e| self.err("object", e.to_string(), "fix the object's parts"))?;
+        let object = self.object()?;
         let start = match s.start {
             Some(g) => g,
             None => {

@@ -146,7 +146,9 @@ impl Comparison {
         }
     }
 
-    fn check(&self) -> Result<()> {
+    /// Checks the settings (known algorithms named once, 1 to 100 000 runs whose seeds do not
+    /// wrap around, budgets of at least one evaluation); [`Comparison::run`] checks them too.
+    pub fn check(&self) -> Result<()> {
         let invalid = |problem: String| {
             Err(TaskError::Invalid {
                 what: "comparison".into(),

@@ -205,15 +205,7 @@ impl Problem {
                 "give an initial step in radians",
             ));
         }
-        if let Some(m) = &spec.map {
-            if !(m.spacing.is_finite() && m.spacing > 0.0) {
-                return Err(ctx.err(
-                    "map.spacing",
-                    "must be positive",
-                    "give the task-space spacing d",
-                ));
-            }
-        }
+        check_numbers(&spec, &ctx)?;
         Ok(Problem {
             origin: origin.to_string(),
             text: text.to_string(),
@@ -223,6 +215,74 @@ impl Problem {
             start,
         })
     }
+}
+
+/// Range checks of the solver's and the map's numbers, each error at its field.
+fn check_numbers(spec: &Spec, ctx: &Ctx) -> Result<()> {
+    let s = &spec.solver;
+    let count = |field: &str, v: usize, lo: usize, hi: usize| {
+        if (lo..=hi).contains(&v) {
+            Ok(())
+        } else {
+            Err(ctx.err(
+                field,
+                format!("{v} is not in {lo}..={hi}"),
+                "give a count in that range",
+            ))
+        }
+    };
+    let number = |field: &str, v: f64, positive: bool| {
+        if v.is_finite() && (v > 0.0 || (!positive && v >= 0.0)) {
+            Ok(())
+        } else {
+            let what = if positive { "above 0" } else { "0 or more" };
+            Err(ctx.err(
+                field,
+                format!("{v} is not a finite number {what}"),
+                "give a finite number",
+            ))
+        }
+    };
+    if let Some(p) = s.population {
+        count("solver.population", p, 2, 1_000_000)?;
+    }
+    if !(1..=10_000_000_000).contains(&s.max_evaluations) {
+        return Err(ctx.err(
+            "solver.max_evaluations",
+            format!("{} is not in 1..=10000000000", s.max_evaluations),
+            "give an evaluation budget in that range",
+        ));
+    }
+    if s.no_improvement == Some(0) {
+        return Err(ctx.err(
+            "solver.no_improvement",
+            "0 stops at once",
+            "give at least 1, or leave it out",
+        ));
+    }
+    if let Some(t) = s.target {
+        if !t.is_finite() {
+            return Err(ctx.err(
+                "solver.target",
+                format!("{t} is not finite"),
+                "give a finite cost, or leave it out",
+            ));
+        }
+    }
+    if let Some(m) = &spec.map {
+        number("map.spacing", m.spacing, true)?;
+        number("map.construct_weight", m.construct_weight, false)?;
+        number("map.smoothness", m.smoothness, false)?;
+        count("map.failure_limit", m.failure_limit, 1, 10_000_000)?;
+        count("map.max_points", m.max_points, 1, 10_000_000)?;
+        count("map.first_search", m.first_search.0, 2, 1_000_000)?;
+        number("map.first_search", m.first_search.1, true)?;
+        count("map.later_search", m.later_search.0, 2, 1_000_000)?;
+        number("map.later_search", m.later_search.1, true)?;
+        count("map.searches", m.searches, 1, 4096)?;
+        count("map.edge_neighbours", m.edge_neighbours, 1, 10_000)?;
+    }
+    Ok(())
 }
 
 /// The spec's model: an embedded one by name or a file relative to the spec

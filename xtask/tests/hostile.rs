@@ -1,0 +1,814 @@
+//! The hostile-input battery: several hundred malformed files, flag values and output paths
+//! across the commands, each run through the `xtask` binary. Every one must end in a clear
+//! error: exit code 1–100, no panic, within 30 s, naming the file (or flag) at fault, and
+//! writing nothing.
+//!
+//! Files are mutated mechanically from valid ones (specs/, models/, and a map, posture and
+//! trajectory this test makes): every number of a file (or an even sample of them) replaced by a
+//! non-finite or out-of-range value, truncations, duplicated and unknown keys, wrong types,
+//! numeric arrays one element short.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+/// One run of the binary that must fail cleanly.
+struct Case {
+    /// What is wrong, for the report.
+    what: String,
+    /// The command line after `xtask`.
+    args: Vec<String>,
+    /// Text the error message must contain (the file or flag at fault).
+    names: String,
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Runs the binary with `args` in `dir`: (exit code, stderr, seconds); killed after 30 s.
+fn run(dir: &Path, args: &[String]) -> (Option<i32>, String, f64) {
+    let start = Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .env("RUST_BACKTRACE", "0")
+        .spawn()
+        .expect("xtask starts");
+    let stderr = child.stderr.take().expect("piped");
+    let reader = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap_or_default());
+    let code = loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status.code();
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    (
+        code,
+        reader.join().unwrap_or_default(),
+        start.elapsed().as_secs_f64(),
+    )
+}
+
+/// Byte ranges of the number tokens of `text`, outside strings and `//` comments.
+fn numbers(text: &str) -> Vec<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+                i += 1;
+            }
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            c if (c.is_ascii_digit() || c == b'-')
+                && !(i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_'))
+                && (c != b'-' || b.get(i + 1).is_some_and(u8::is_ascii_digit)) =>
+            {
+                let start = i;
+                i += 1;
+                while i < b.len() && (b[i].is_ascii_digit() || b".eE+-".contains(&b[i])) {
+                    i += 1;
+                }
+                out.push((start, i));
+            }
+            _ => i += 1,
+        }
+    }
+    out
+}
+
+/// At most `n` items of `items`, evenly spread.
+fn spread<T: Clone>(items: &[T], n: usize) -> Vec<T> {
+    if items.len() <= n {
+        return items.to_vec();
+    }
+    (0..n).map(|k| items[k * items.len() / n].clone()).collect()
+}
+
+/// Mutations of a file's text: (what, new text).
+fn mutations(text: &str, json: bool, per_value: usize, values: &[&str]) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for (s, e) in spread(&numbers(text), per_value) {
+        for v in values {
+            out.push((
+                format!("{} → {v} at byte {s}", &text[s..e]),
+                format!("{}{v}{}", &text[..s], &text[e..]),
+            ));
+        }
+    }
+    for k in [1, 3, 5, 7, 9] {
+        let cut = text.floor_char_boundary(text.len() * k / 10);
+        out.push((format!("truncated at byte {cut}"), text[..cut].to_string()));
+    }
+    let open = opening(text, if json { b'{' } else { b'(' });
+    let unknown = if json {
+        "\"no_such_key\": 1, "
+    } else {
+        "no_such_field: 1, "
+    };
+    if !json {
+        out.push((
+            "an unknown field".into(),
+            format!("{}{unknown}{}", &text[..open], &text[open..]),
+        ));
+    }
+    // the first key again, with a value of another type
+    if let Some(key) = first_key(&text[open..], json) {
+        let dup = if json {
+            format!("\"{key}\": \"twice\", ")
+        } else {
+            format!("{key}: \"twice\", ")
+        };
+        out.push((
+            format!("`{key}` given twice"),
+            format!("{}{dup}{}", &text[..open], &text[open..]),
+        ));
+    }
+    // a numeric array one element short
+    if let Some((s, e)) = numbers(text)
+        .windows(2)
+        .find(|w| text[w[0].1..w[1].0].trim() == ",")
+        .map(|w| (w[0].1, w[1].1))
+    {
+        out.push((
+            format!("an array without its element at byte {s}"),
+            format!("{}{}", &text[..s], &text[e..]),
+        ));
+    }
+    out
+}
+
+/// Just after the first `bracket` outside strings and `//` comments.
+fn opening(text: &str, bracket: u8) -> usize {
+    let b = text.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            c if c == bracket => return i + 1,
+            _ => {}
+        }
+        i += 1;
+    }
+    0
+}
+
+/// Byte ranges of the numbers in the attribute values of an XML text (`xyz="0 0.1 0"`).
+fn attribute_numbers(text: &str) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    // after the XML declaration (`<?xml version="1.0"?>`)
+    let mut from = text.find("?>").map_or(0, |k| k + 2);
+    while let Some(k) = text[from..].find("=\"") {
+        let start = from + k + 2;
+        let end = start + text[start..].find('"').unwrap_or(0);
+        let value = &text[start..end];
+        if let Some(n) = value.find(|c: char| c.is_ascii_digit() || c == '-') {
+            let len = value[n..]
+                .find(|c: char| !(c.is_ascii_digit() || ".eE+-".contains(c)))
+                .unwrap_or(value.len() - n);
+            out.push((start + n, start + n + len));
+        }
+        from = end + 1;
+    }
+    out
+}
+
+/// The first key (JSON) or field name (RON) after an opening bracket.
+fn first_key(text: &str, json: bool) -> Option<String> {
+    let t = text.trim_start();
+    if json {
+        let t = t.strip_prefix('"')?;
+        Some(t[..t.find('"')?].to_string())
+    } else {
+        let end = t.find(|c: char| !(c.is_alphanumeric() || c == '_'))?;
+        (end > 0 && t[end..].trim_start().starts_with(':')).then(|| t[..end].to_string())
+    }
+}
+
+/// Writes each mutation of `source` to `dir` as `name_<k>.<ext>` and makes a case running
+/// `args` with `{}` replaced by that file.
+fn file_cases(
+    dir: &Path,
+    source: &Path,
+    mutated: Vec<(String, String)>,
+    args: &[&str],
+) -> Vec<Case> {
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let stem = source
+        .file_stem()
+        .unwrap()
+        .to_string_lossy()
+        .replace('.', "_");
+    let ext = source.extension().unwrap().to_string_lossy().to_string();
+    mutated
+        .into_iter()
+        .map(|(what, text)| {
+            let k = NEXT.fetch_add(1, Ordering::Relaxed);
+            let name = format!("{stem}_{k}.{ext}");
+            std::fs::write(dir.join(&name), text).unwrap();
+            Case {
+                what: format!("{}: {what}", source.display()),
+                args: args.iter().map(|a| a.replace("{}", &name)).collect(),
+                names: name,
+            }
+        })
+        .collect()
+}
+
+/// Cases running `command` with `flag` set to each of `values`; the error must name the flag.
+fn flag_cases(command: &[&str], flag: &str, values: &[&str]) -> Vec<Case> {
+    let mut cases = file_flag_cases(command, flag, values);
+    for c in &mut cases {
+        c.names = flag.to_string();
+    }
+    cases
+}
+
+/// Cases running `command` with `flag` set to each of `values` (files); the error must name the
+/// file.
+fn file_flag_cases(command: &[&str], flag: &str, values: &[&str]) -> Vec<Case> {
+    values
+        .iter()
+        .map(|v| Case {
+            what: format!("{} {flag} {v}", command[0]),
+            args: command
+                .iter()
+                .map(|s| s.to_string())
+                .chain([flag.to_string(), v.to_string()])
+                .collect(),
+            names: v.to_string(),
+        })
+        .collect()
+}
+
+/// Makes the valid files the battery mutates: a 4-point map, a posture, trajectories.
+fn valid_files(dir: &Path) {
+    let root = root();
+    let make = |args: &[&str]| {
+        let (code, stderr, _) = run(dir, &args.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        assert_eq!(code, Some(0), "{args:?}: {stderr}");
+    };
+    let spec = root.join("specs/reach.ron");
+    let spec = spec.to_str().unwrap();
+    make(&["build-map", spec, "--points", "4", "--out", "map.json"]);
+    make(&["solve", spec, "--out", "posture.json"]);
+    let map: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("map.json")).unwrap()).unwrap();
+    let t = &map["points"][3]["t"];
+    let to = format!("{},{},{}", t[0], t[1], t[2]);
+    make(&[
+        "plan", "--map", "map.json", "--to", &to, "--out", "traj.csv",
+    ]);
+    std::fs::write(dir.join("to.txt"), &to).unwrap();
+    // the posture without its metadata (free-form, not checked): the motor values only
+    let posture: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("posture.json")).unwrap()).unwrap();
+    let motors = serde_json::json!({ "motors": posture["motors"] });
+    std::fs::write(
+        dir.join("posture.json"),
+        serde_json::to_string_pretty(&motors).unwrap(),
+    )
+    .unwrap();
+    for (from, to) in [
+        ("specs/configs/icub_arms.json", "configs.json"),
+        ("specs/worlds/reach_with_box.ron", "world.ron"),
+        ("models/icub_upper_body.urdf", "icub_upper_body.urdf"),
+        ("models/icub_upper_body.ron", "icub_upper_body.ron"),
+    ] {
+        std::fs::copy(root.join(from), dir.join(to)).unwrap();
+    }
+}
+
+#[test]
+fn hostile_inputs_get_clear_errors_and_write_nothing() {
+    let dir = std::env::temp_dir().join(format!("trm-hostile-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    valid_files(&dir);
+    let root = root();
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+    let at = |p: &str| root.join(p);
+    let non_finite = ["NaN", "inf", "-inf"];
+    let mut cases = Vec::new();
+
+    // RON files, each through a command that reads it
+    for (source, args) in [
+        (
+            at("specs/reach.ron"),
+            vec!["solve", "{}", "--out", "o.json"],
+        ),
+        (at("specs/fig6/c_bimanual_grab.ron"), vec!["solve", "{}"]),
+        (at("specs/table_iii/posture1.ron"), vec!["solve", "{}"]),
+        (
+            dir.join("world.ron"),
+            vec!["collide", "--configs", "configs.json", "--world", "{}"],
+        ),
+        (
+            at("specs/wholebody/standup.ron"),
+            vec!["stand-up", "{}", "--out", "standup"],
+        ),
+        (
+            at("specs/taskmaps/stick.ron"),
+            vec!["explore-task-map", "{}", "--out", "o.taskmap.json"],
+        ),
+    ] {
+        let text = read(&source);
+        cases.extend(file_cases(
+            &dir,
+            &source,
+            mutations(&text, false, 12, &non_finite),
+            &args,
+        ));
+    }
+    // the model description (next to its URDF) and the URDF
+    let text = read(&dir.join("icub_upper_body.ron"));
+    cases.extend(file_cases(
+        &dir,
+        &dir.join("icub_upper_body.ron"),
+        mutations(&text, false, 10, &non_finite),
+        &["model-info", "{}"],
+    ));
+    let urdf = read(&dir.join("icub_upper_body.urdf"));
+    let mut bad_urdf: Vec<(String, String)> = spread(&attribute_numbers(&urdf), 30)
+        .into_iter()
+        .map(|(s, e)| {
+            (
+                format!("{} → nan at byte {s}", &urdf[s..e]),
+                format!("{}nan{}", &urdf[..s], &urdf[e..]),
+            )
+        })
+        .collect();
+    for k in [1, 5, 9] {
+        let cut = urdf.len() * k / 10;
+        bad_urdf.push((format!("truncated at byte {cut}"), urdf[..cut].to_string()));
+    }
+    bad_urdf.push((
+        "a joint named twice".into(),
+        urdf.replacen("name=\"r_elbow\"", "name=\"r_shoulder_pitch\"", 1),
+    ));
+    bad_urdf.push((
+        "a parent link that does not exist".into(),
+        urdf.replacen("<parent link=\"", "<parent link=\"no_such_", 1),
+    ));
+    cases.extend(file_cases(
+        &dir,
+        &dir.join("icub_upper_body.urdf"),
+        bad_urdf,
+        &["model-info", "{}"],
+    ));
+
+    // JSON and CSV files
+    let huge = ["1e999", "null", "\"x\""];
+    let to = read(&dir.join("to.txt"));
+    let to = to.as_str();
+    for (name, args, values, per_value) in [
+        ("map.json", vec!["map-info", "{}"], &huge[..], 12),
+        (
+            "map.json",
+            vec!["plan", "--map", "{}", "--to", "0,0,0", "--tolerance", "9"],
+            &["1e999", "99"][..],
+            12,
+        ),
+        (
+            "posture.json",
+            vec!["plan", "--map", "map.json", "--from", "{}", "--to", to],
+            &["1e999", "99", "\"x\""][..],
+            12,
+        ),
+        (
+            "configs.json",
+            vec!["fk", "--configs", "{}"],
+            &["1e999", "99"][..],
+            12,
+        ),
+        ("traj.json", vec!["view", "--traj", "{}"], &huge[..], 12),
+    ] {
+        let source = dir.join(name);
+        let text = read(&source);
+        let mut file = file_cases(
+            &dir,
+            &source,
+            mutations(&text, true, per_value, values),
+            &args,
+        );
+        cases.append(&mut file);
+    }
+    let csv = read(&dir.join("traj.csv"));
+    let row = csv.lines().nth(1).unwrap();
+    let mut bad_csv = vec![
+        ("no header".to_string(), String::new()),
+        (
+            "a NaN".into(),
+            csv.replacen(row, &row.replacen(",", ",NaN,", 1), 1),
+        ),
+        ("a value outside its limits".into(), {
+            let mut fields: Vec<&str> = row.split(',').collect();
+            fields[1] = "99";
+            csv.replacen(row, &fields.join(","), 1)
+        }),
+        ("a row too short".into(), csv.replacen(row, "0", 1)),
+        (
+            "a negative time".into(),
+            csv.replacen(row, &format!("-1{}", &row[1..]), 1),
+        ),
+        (
+            "an unknown column".into(),
+            csv.replacen("time,", "time,r_elbw,", 1),
+        ),
+    ];
+    for k in [1, 5] {
+        let cut = csv.len() * k / 10;
+        bad_csv.push((format!("truncated at byte {cut}"), csv[..cut].to_string()));
+    }
+    cases.extend(file_cases(
+        &dir,
+        &dir.join("traj.csv"),
+        bad_csv,
+        &["view", "--traj", "{}"],
+    ));
+
+    // flag values
+    let spec = at("specs/reach.ron").to_string_lossy().to_string();
+    let spec = spec.as_str();
+    let counts = ["0", "-1", "x", "1e3", "18446744073709551616"];
+    cases.extend(flag_cases(&["build-map", spec], "--points", &counts));
+    cases.extend(flag_cases(&["build-map", spec], "--points", &["100000000"]));
+    cases.extend(flag_cases(
+        &["build-map", spec],
+        "--searches",
+        &["0", "5000", "-2"],
+    ));
+    cases.extend(flag_cases(
+        &["build-map", spec],
+        "--threads",
+        &["0", "-1", "x"],
+    ));
+    cases.extend(flag_cases(
+        &["build-map", spec],
+        "--seed",
+        &["-1", "x", "1.5"],
+    ));
+    cases.extend(flag_cases(
+        &["build-map", spec],
+        "--edge-resolution",
+        &["0", "-0.1", "NaN", "inf", "1e-300", "x"],
+    ));
+    let plan = ["plan", "--map", "map.json"];
+    cases.extend(flag_cases(
+        &plan,
+        "--to",
+        &[
+            "nan,0,0",
+            "1,2",
+            "a,b,c",
+            "1,2,3,4",
+            "inf,0,0",
+            "no_such.json",
+        ],
+    ));
+    let plan_to = ["plan", "--map", "map.json", "--to", "0.1,0.2,0.3"];
+    cases.extend(flag_cases(
+        &plan_to,
+        "--tolerance",
+        &["-1", "NaN", "inf", "0"],
+    ));
+    cases.extend(flag_cases(
+        &plan_to,
+        "--velocity",
+        &["0", "-1", "NaN", "inf"],
+    ));
+    cases.extend(flag_cases(&plan_to, "--seed", &["-5", "x"]));
+    cases.extend(file_flag_cases(
+        &plan_to,
+        "--from",
+        &["no_such.json", "map.json"],
+    ));
+    cases.extend(file_flag_cases(
+        &plan_to,
+        "--world",
+        &["no_such.ron", "map.json"],
+    ));
+    cases.extend(file_flag_cases(
+        &["plan", "--to", "0,0,0"],
+        "--map",
+        &[
+            "no_such.json",
+            "posture.json",
+            "world.ron",
+            "/dev/zero",
+            ".",
+        ],
+    ));
+    let compare = ["compare-optimisers", "--spec", spec, "--out-dir", "cmp"];
+    cases.extend(flag_cases(
+        &compare,
+        "--runs",
+        &["0", "-1", "18446744073709551616"],
+    ));
+    cases.extend(flag_cases(&compare, "--runs", &["100000000"]));
+    cases.extend(flag_cases(
+        &compare,
+        "--algos",
+        &["", "xnes,nope", "xnes,xnes"],
+    ));
+    cases.extend(flag_cases(&compare, "--max-evals", &["0", "-1"]));
+    cases.extend(flag_cases(&compare, "--seed", &["18446744073709551615"]));
+    let optimise = ["optimise"];
+    cases.extend(flag_cases(&optimise, "--algo", &["nope", ""]));
+    cases.extend(flag_cases(
+        &optimise,
+        "--function",
+        &["nope", "rotated-nope"],
+    ));
+    cases.extend(flag_cases(&optimise, "--dim", &["0", "-1", "100000000"]));
+    cases.extend(flag_cases(&optimise, "--target", &["NaN", "x"]));
+    cases.extend(flag_cases(
+        &optimise,
+        "--runs",
+        &["0", "18446744073709551615"],
+    ));
+    cases.extend(flag_cases(
+        &optimise,
+        "--max-evals",
+        &["0", "18446744073709551615"],
+    ));
+    cases.extend(flag_cases(&optimise, "--sigma", &["0", "-1", "NaN", "inf"]));
+    cases.extend(flag_cases(
+        &optimise,
+        "--population",
+        &["0", "1", "10000000000000"],
+    ));
+    let speedup = ["speedup", spec, "--out-dir", "sp"];
+    cases.extend(flag_cases(&speedup, "--points", &["0", "", "1,x", "-4"]));
+    cases.extend(flag_cases(&speedup, "--threads", &["0", "1,0", "1000"]));
+    cases.extend(flag_cases(&speedup, "--searches", &["0", "5000"]));
+    let stand = ["stand-up", "--out", "su"];
+    cases.extend(flag_cases(
+        &stand,
+        "--rollouts",
+        &["0", "-1", "18446744073709551615"],
+    ));
+    cases.extend(flag_cases(
+        &stand,
+        "--bootstrap-rollouts",
+        &["18446744073709551615"],
+    ));
+    let solve = ["solve", spec];
+    cases.extend(flag_cases(&solve, "--algo", &["nope", "XNES2"]));
+    cases.extend(flag_cases(
+        &solve,
+        "--max-evals",
+        &["0", "-1", "18446744073709551615"],
+    ));
+    let stick = at("specs/taskmaps/stick.ron").to_string_lossy().to_string();
+    let grasp = ["reach-grasp", stick.as_str()];
+    cases.extend(flag_cases(&grasp, "--at", &["1,2", "nan,0,0", "0,0,0,0,0"]));
+    cases.extend(flag_cases(
+        &grasp,
+        "--iterations",
+        &["0", "-1", "18446744073709551615"],
+    ));
+    let studies = ["task-map-studies", "--out-dir", "st"];
+    cases.extend(flag_cases(
+        &studies,
+        "--iterations",
+        &["0", "18446744073709551615"],
+    ));
+    let acm = ["gen-acm"];
+    cases.extend(flag_cases(
+        &acm,
+        "--samples",
+        &["0", "-1", "18446744073709551615"],
+    ));
+    cases.extend(flag_cases(
+        &acm,
+        "--always-fraction",
+        &["-0.1", "1.5", "NaN"],
+    ));
+    cases.extend(file_flag_cases(
+        &["view", "--out", "v.html"],
+        "--posture",
+        &["no_such.json", "map.json", "/dev/zero"],
+    ));
+    cases.extend(file_flag_cases(
+        &["view", "--out", "v.html"],
+        "--map",
+        &["posture.json"],
+    ));
+    cases.extend(file_flag_cases(
+        &["view", "--out", "v.html"],
+        "--world",
+        &["map.json", "/dev/zero"],
+    ));
+    cases.extend(file_flag_cases(
+        &["fk"],
+        "--configs",
+        &["map.json", "no_such.json", "."],
+    ));
+
+    // output paths: a symlink, a device, a directory, a path under a regular file
+    std::os::unix::fs::symlink("/etc/hostname", dir.join("link.json")).unwrap();
+    std::fs::create_dir_all(dir.join("a_directory")).unwrap();
+    for out in [
+        "link.json",
+        "/dev/null",
+        "a_directory",
+        "posture.json/x.json",
+    ] {
+        for command in [
+            vec!["solve", spec, "--out"],
+            vec!["build-map", spec, "--points", "2", "--out"],
+            vec!["plan", "--map", "map.json", "--to", "0.1,0.2,0.3", "--out"],
+            vec!["fk", "--configs", "configs.json", "--out"],
+            vec!["collide", "--configs", "configs.json", "--out"],
+            vec!["gen-acm", "--samples", "10", "--out"],
+            vec!["view", "--out"],
+            vec!["explore-task-map", stick.as_str(), "--out"],
+        ] {
+            cases.push(Case {
+                what: format!("{} --out {out}", command[0]),
+                args: command
+                    .iter()
+                    .map(|s| s.to_string())
+                    .chain([out.to_string()])
+                    .collect(),
+                names: out.to_string(),
+            });
+        }
+    }
+    for command in [
+        vec![
+            "compare-optimisers",
+            "--spec",
+            spec,
+            "--runs",
+            "1",
+            "--out-dir",
+        ],
+        vec!["stand-up", "--rollouts", "1", "--out"],
+        vec!["task-map-studies", "--out-dir"],
+        vec!["speedup", spec, "--points", "2", "--out-dir"],
+    ] {
+        cases.push(Case {
+            what: format!("{} into a regular file", command[0]),
+            args: command
+                .iter()
+                .map(|s| s.to_string())
+                .chain(["posture.json".to_string()])
+                .collect(),
+            names: "posture.json".into(),
+        });
+    }
+
+    // run them, two at a time
+    let before: Vec<_> = listing(&dir);
+    let next = AtomicUsize::new(0);
+    let failures = Mutex::new(Vec::new());
+    let slowest = Mutex::new((0.0f64, String::new()));
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| {
+                while let Some(case) = cases.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let (code, stderr, secs) = run(&dir, &case.args);
+                    let mut slow = slowest.lock().unwrap();
+                    if secs > slow.0 {
+                        *slow = (secs, case.what.clone());
+                    }
+                    drop(slow);
+                    let problem = match code {
+                        None => Some(format!("no exit within 30 s (or killed)")),
+                        Some(0) => Some("accepted".to_string()),
+                        Some(c) if c > 100 => Some(format!("exit code {c}")),
+                        _ if stderr.contains("panicked") => Some("panicked".into()),
+                        _ if !stderr.contains(&case.names) => {
+                            Some(format!("the error does not name `{}`", case.names))
+                        }
+                        _ => None,
+                    };
+                    if let Some(p) = problem {
+                        failures.lock().unwrap().push(format!(
+                            "{} ({}): {p}\n    xtask {}\n    {}",
+                            case.what,
+                            case.names,
+                            case.args.join(" "),
+                            stderr.trim().replace('\n', "\n    ")
+                        ));
+                    }
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap();
+    let (secs, what) = slowest.into_inner().unwrap();
+    eprintln!(
+        "{} hostile inputs, {} without a clear error; slowest {secs:.1} s ({what})",
+        cases.len(),
+        failures.len()
+    );
+    assert!(cases.len() >= 400, "only {} cases", cases.len());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // failed runs wrote nothing: the directory holds only the inputs
+    let after = listing(&dir);
+    let new: Vec<_> = after.iter().filter(|p| !before.contains(p)).collect();
+    assert!(new.is_empty(), "failed runs left files behind: {new:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every path under `dir`.
+fn listing(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                stack.push(p.clone());
+            }
+            out.push(p);
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `kill -9` at any moment of `build-map` leaves the earlier map or a complete new one, and the
+/// next run clears the temporary files the killed ones left.
+#[test]
+fn a_killed_build_leaves_the_old_map_or_a_complete_new_one() {
+    let dir = std::env::temp_dir().join(format!("trm-kill-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = root().join("specs/reach.ron");
+    let build = |points: &str, seed: &str| {
+        Command::new(env!("CARGO_BIN_EXE_xtask"))
+            .args(["build-map", spec.to_str().unwrap(), "--points", points])
+            .args(["--seed", seed, "--out", "map.json"])
+            .current_dir(&dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("xtask starts")
+    };
+    assert!(build("3", "1").wait().unwrap().success());
+    let old = std::fs::read(dir.join("map.json")).unwrap();
+    let mut outcomes = (0, 0);
+    for (k, delay) in [30u64, 120, 250, 400, 600, 900, 1300, 1800]
+        .iter()
+        .enumerate()
+    {
+        let mut child = build("40", &(k + 2).to_string());
+        std::thread::sleep(Duration::from_millis(*delay));
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+        let now = std::fs::read(dir.join("map.json")).unwrap();
+        if now == old {
+            outcomes.0 += 1;
+        } else {
+            trm_roadmap::Roadmap::load(dir.join("map.json"))
+                .expect("a changed map file is a complete map");
+            outcomes.1 += 1;
+        }
+    }
+    eprintln!(
+        "killed builds: {} left the old map, {} a complete new one",
+        outcomes.0, outcomes.1
+    );
+    // a run that finishes clears what the killed ones left
+    assert!(build("3", "1").wait().unwrap().success());
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
