@@ -348,6 +348,146 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             &args,
         ));
     }
+    // values that parse but make no sense: zero or huge counts, inverted or degenerate ranges,
+    // duplicated names
+    for (source, from, to, args) in [
+        (
+            "specs/reach.ron",
+            "max_points: 400",
+            "max_points: 0",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "max_points: 400",
+            "max_points: 99999999999",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "searches: 4",
+            "searches: 0",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "(150, 0.15)",
+            "(10000000000000, 0.15)",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "(30, 0.03)",
+            "(30, -0.03)",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "seed: 0)",
+            "seed: 0, population: Some(10000000000000))",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "seed: 0)",
+            "seed: 0, max_evaluations: 0)",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "weight: 5.0",
+            "weight: -5.0",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "radius: 0.05",
+            "radius: -0.05",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "axis: (0, 1, 0)",
+            "axis: (0, 0, 0)",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "\"l_palm_center\"",
+            "\"l_palm_centre\"",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "\"xnes\"",
+            "\"xnse\"",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "\"torso\": 3.0",
+            "\"torso\": 3.0, \"torso\": 1.0",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/reach.ron",
+            "size: (0.5, 0.8, 0.04)",
+            "size: (0.5, 0.0, 0.04)",
+            vec!["solve", "{}"],
+        ),
+        (
+            "specs/worlds/reach_with_box.ron",
+            "\"new_box\"",
+            "\"table\"",
+            vec!["collide", "--configs", "configs.json", "--world", "{}"],
+        ),
+        (
+            "specs/wholebody/standup.ron",
+            "dt: 0.01",
+            "dt: 1e-300",
+            vec!["stand-up", "{}", "--out", "su"],
+        ),
+        (
+            "specs/wholebody/standup.ron",
+            "rbfs: 5",
+            "rbfs: 0",
+            vec!["stand-up", "{}", "--out", "su"],
+        ),
+        (
+            "specs/wholebody/standup.ron",
+            "rbfs: 5",
+            "rbfs: 100000000",
+            vec!["stand-up", "{}", "--out", "su"],
+        ),
+        (
+            "specs/wholebody/standup.ron",
+            "\"standing\"",
+            "\"seated\"",
+            vec!["stand-up", "{}", "--out", "su"],
+        ),
+        (
+            "specs/wholebody/standup.ron",
+            "end: 4.5",
+            "end: 1.0",
+            vec!["stand-up", "{}", "--out", "su"],
+        ),
+        (
+            "specs/taskmaps/stick.ron",
+            "samples: 5000",
+            "samples: 0",
+            vec!["explore-task-map", "{}"],
+        ),
+    ] {
+        let text = read(&at(source));
+        assert!(text.contains(from), "{source} has no `{from}`");
+        cases.extend(file_cases(
+            &dir,
+            &at(source),
+            vec![(format!("`{from}` → `{to}`"), text.replacen(from, to, 1))],
+            &args,
+        ));
+    }
+
     // the model description (next to its URDF) and the URDF
     let text = read(&dir.join("icub_upper_body.ron"));
     cases.extend(file_cases(
@@ -704,7 +844,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
                     }
                     drop(slow);
                     let problem = match code {
-                        None => Some(format!("no exit within 30 s (or killed)")),
+                        None => Some("no exit within 30 s (or killed)".to_string()),
                         Some(0) => Some("accepted".to_string()),
                         Some(c) if c > 100 => Some(format!("exit code {c}")),
                         _ if stderr.contains("panicked") => Some("panicked".into()),

@@ -167,6 +167,7 @@ pub struct PostureSpec {
     /// Unique posture name.
     pub name: String,
     /// Motor values by motor name.
+    #[serde(deserialize_with = "crate::unique_names")]
     pub values: BTreeMap<String, f64>,
 }
 

@@ -200,6 +200,40 @@ pub fn check_unique_keys(text: &str) -> Result<(), serde_json::Error> {
     serde_json::Deserializer::from_str(text).deserialize_any(UniqueKeys("".into()))
 }
 
+/// Deserialises a map of names (`{"torso": 3.0, …}` in RON or JSON), refusing a name given twice
+/// (serde would keep the last one silently). Use as
+/// `#[serde(deserialize_with = "trm_kinematics::unique_names")]`.
+pub fn unique_names<'de, D, V>(d: D) -> Result<std::collections::BTreeMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: serde::Deserialize<'de>,
+{
+    struct Names<V>(std::marker::PhantomData<V>);
+    impl<'de, V: serde::Deserialize<'de>> serde::de::Visitor<'de> for Names<V> {
+        type Value = std::collections::BTreeMap<String, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map of names")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = std::collections::BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "`{key}` is given twice (keep one)"
+                    )));
+                }
+                let value = map.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Names(std::marker::PhantomData))
+}
+
 /// Walks a JSON value (the field path so far in `.0`), refusing a repeated key.
 struct UniqueKeys(String);
 

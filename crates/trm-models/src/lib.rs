@@ -78,38 +78,54 @@ pub const PLANAR_ARM_URDF: &str = include_str!("../models/planar_arm.urdf");
 /// models/branched_tree.urdf: a small tree with continuous, prismatic, mimic and fixed joints.
 pub const BRANCHED_TREE_URDF: &str = include_str!("../models/branched_tree.urdf");
 
+/// `load()`'s model, parsed once per process (models are immutable and share their data, so a
+/// clone is cheap).
+fn once(cell: &'static std::sync::OnceLock<RobotModel>, load: fn() -> RobotModel) -> RobotModel {
+    cell.get_or_init(load).clone()
+}
+
 /// The 41-motor iCub upper body (the default model of trm).
 pub fn icub_upper_body() -> RobotModel {
-    let description = ModelDescription::from_ron(ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")
-        .expect("the shipped description parses (checked by tests)");
-    RobotModel::from_parts(
-        ICUB_UPPER_BODY_URDF,
-        "models/icub_upper_body.urdf",
-        &description,
-        Some((ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")),
-    )
-    .expect("the shipped model is valid (checked by tests)")
+    static MODEL: std::sync::OnceLock<RobotModel> = std::sync::OnceLock::new();
+    once(&MODEL, || {
+        let description =
+            ModelDescription::from_ron(ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")
+                .expect("the shipped description parses (checked by tests)");
+        RobotModel::from_parts(
+            ICUB_UPPER_BODY_URDF,
+            "models/icub_upper_body.urdf",
+            &description,
+            Some((ICUB_UPPER_BODY_RON, "models/icub_upper_body.ron")),
+        )
+        .expect("the shipped model is valid (checked by tests)")
+    })
 }
 
 /// The whole iCub moving symmetrically in its sagittal plane: 8 motors (hip pitch, knee, ankle
 /// pitch, torso pitch, shoulder pitch/roll/yaw, elbow), each driving the left and right joint
 /// alike; every other joint held at 0. The model of `cargo xtask stand-up`.
 pub fn icub_sagittal() -> RobotModel {
-    let description = ModelDescription::from_ron(ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")
-        .expect("the shipped description parses (checked by tests)");
-    RobotModel::from_parts(
-        ICUB_FULL_BODY_URDF,
-        "models/icub_full_body.urdf",
-        &description,
-        Some((ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")),
-    )
-    .expect("the shipped model is valid (checked by tests)")
+    static MODEL: std::sync::OnceLock<RobotModel> = std::sync::OnceLock::new();
+    once(&MODEL, || {
+        let description = ModelDescription::from_ron(ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")
+            .expect("the shipped description parses (checked by tests)");
+        RobotModel::from_parts(
+            ICUB_FULL_BODY_URDF,
+            "models/icub_full_body.urdf",
+            &description,
+            Some((ICUB_SAGITTAL_RON, "models/icub_sagittal.ron")),
+        )
+        .expect("the shipped model is valid (checked by tests)")
+    })
 }
 
 /// The official 75-joint iCub URDF, every joint its own motor.
 pub fn icub_official() -> RobotModel {
-    RobotModel::from_urdf_str(ICUB_OFFICIAL_URDF, "models/icub-visuomanip/model.urdf")
-        .expect("the official URDF loads")
+    static MODEL: std::sync::OnceLock<RobotModel> = std::sync::OnceLock::new();
+    once(&MODEL, || {
+        RobotModel::from_urdf_str(ICUB_OFFICIAL_URDF, "models/icub-visuomanip/model.urdf")
+            .expect("the official URDF loads")
+    })
 }
 
 /// The official iCubGenova04 URDF.

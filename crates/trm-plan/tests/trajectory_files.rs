@@ -173,3 +173,51 @@ fn a_missing_file_is_an_error_naming_it() {
         .to_string();
     assert!(e.starts_with("/nonexistent/t.csv:"), "{e}");
 }
+
+/// A value as a careless writer might produce it: ordinary, at a limit, past it, non-finite.
+fn value() -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    prop_oneof![
+        8 => -3.0..3.0f64,
+        1 => Just(f64::NAN),
+        1 => Just(f64::INFINITY),
+        1 => Just(-1e300),
+    ]
+}
+
+proptest::proptest! {
+    /// Whatever a trajectory holds, its writers either refuse it or write what the readers read
+    /// back unchanged (CSV: names, times and positions; JSON: everything).
+    #[test]
+    fn every_trajectory_written_reads_back(
+        rows in proptest::collection::vec((value(), value(), value()), 0..6),
+        task in proptest::bool::ANY,
+    ) {
+        let arm = trm_models::planar_arm();
+        let mut time = 0.0;
+        let t = Trajectory {
+            names: vec!["joint1".into(), "joint2".into()],
+            times: rows.iter().map(|r| { time += r.0.abs(); if r.0.is_nan() { r.0 } else { time } }).collect(),
+            positions: rows.iter().map(|r| vec![r.1, r.2]).collect(),
+            task_path: if task { rows.iter().map(|r| vec![r.1, 0.0, r.2]).collect() } else { vec![] },
+        };
+        let (csv_path, json_path) = (Path::new("t.csv"), Path::new("t.json"));
+        match t.to_csv(csv_path) {
+            Ok(csv) => {
+                // what the writer accepts, the reader takes unless the robot's limits refuse it
+                match Trajectory::from_csv(&csv, csv_path, &arm) {
+                    Ok(back) => proptest::prop_assert_eq!(
+                        (back.names, back.times, back.positions),
+                        (t.names.clone(), t.times.clone(), t.positions.clone())
+                    ),
+                    Err(e) => proptest::prop_assert!(e.to_string().contains("outside its limits"), "{e}"),
+                }
+            }
+            Err(_) => proptest::prop_assert!(t.check(csv_path).is_err()),
+        }
+        match t.to_json(json_path) {
+            Ok(json) => proptest::prop_assert_eq!(Trajectory::from_json(&json, json_path).unwrap(), t),
+            Err(_) => proptest::prop_assert!(t.check(json_path).is_err()),
+        }
+    }
+}

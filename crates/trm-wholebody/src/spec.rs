@@ -37,6 +37,7 @@ pub struct MotionSpec {
     #[serde(default)]
     pub reach: Option<ReachSpec>,
     /// Start posture, degrees, by motor name (motors left out: 0 clamped into limits).
+    #[serde(deserialize_with = "trm_kinematics::unique_names")]
     pub start: BTreeMap<String, f64>,
     /// The phases, in order; each ends at a keyframe posture.
     pub phases: Vec<PhaseSpec>,
@@ -108,6 +109,7 @@ pub struct PhaseSpec {
     pub locked: Vec<String>,
     /// Keyframe posture reached at the phase's end (posture task), degrees by motor name;
     /// motors left out keep the previous keyframe's value.
+    #[serde(deserialize_with = "trm_kinematics::unique_names")]
     pub keyframe: BTreeMap<String, f64>,
 }
 
@@ -134,8 +136,10 @@ pub struct ControllerSpec {
 pub struct LimitsSpec {
     /// Velocity limits, rad/s, by motor (overriding or completing the model's).
     #[serde(default)]
+    #[serde(deserialize_with = "trm_kinematics::unique_names")]
     pub velocity: BTreeMap<String, f64>,
     /// Static torque limits per joint, N·m, by motor (every motor needs one).
+    #[serde(deserialize_with = "trm_kinematics::unique_names")]
     pub torque: BTreeMap<String, f64>,
     /// Check self-collision along the motion.
     #[serde(default = "yes")]
@@ -185,6 +189,9 @@ pub struct TrajectorySpec {
     /// Parameters: `rbfs` x fractions, `rbfs` z fractions, `rbfs` time-law log-speeds.
     pub params: Vec<f64>,
 }
+
+/// The most control steps a rollout may simulate (duration / dt).
+pub const MAX_STEPS: usize = 1_000_000;
 
 impl MotionSpec {
     /// Reads and checks a spec file.
@@ -262,6 +269,48 @@ impl MotionSpec {
         }
         let ends: Vec<f64> = spec.phases.iter().map(|p| p.end).collect();
         check_ends(&ends).map_err(|p| err("phases", p, "phase ends must increase from > 0"))?;
+        for (i, p) in spec.phases.iter().enumerate() {
+            if spec.phases[..i].iter().any(|q| q.name == p.name) {
+                return Err(err(
+                    &format!("phases[{i}].name"),
+                    format!("`{}` names two phases", p.name),
+                    "give every phase its own name",
+                ));
+            }
+        }
+        // every rollout simulates duration / dt control steps
+        let steps = ends.last().copied().unwrap_or(0.0) / spec.dt;
+        if steps > MAX_STEPS as f64 {
+            return Err(err(
+                "dt",
+                format!(
+                    "{} s in steps of {} s is {steps:.3e} control steps",
+                    ends.last().copied().unwrap_or(0.0),
+                    spec.dt
+                ),
+                &format!(
+                    "give a time step that makes at most {MAX_STEPS} steps (the paper uses 0.01 s)"
+                ),
+            ));
+        }
+        if spec.rbfs > 1000 {
+            return Err(err(
+                "rbfs",
+                format!("{} RBFs", spec.rbfs),
+                "give at most 1000 (the paper uses 5)",
+            ));
+        }
+        for (field, n) in [
+            (
+                "optimiser.bootstrap_rollouts",
+                spec.optimiser.bootstrap_rollouts,
+            ),
+            ("optimiser.rollouts", spec.optimiser.rollouts),
+        ] {
+            if n > 10_000_000 {
+                return Err(err(field, format!("{n} rollouts"), "give at most 10000000"));
+            }
+        }
         check_ends(&spec.hand_tuned.ends)
             .map_err(|p| err("hand_tuned.ends", p, "ends must increase from > 0"))?;
         if spec.hand_tuned.ends.len() != spec.phases.len() {

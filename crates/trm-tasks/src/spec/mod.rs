@@ -46,6 +46,7 @@ pub struct Spec {
     pub start: Option<String>,
     /// Motor values overriding the start posture, by motor name.
     #[serde(default)]
+    #[serde(deserialize_with = "trm_kinematics::unique_names")]
     pub start_values: BTreeMap<String, f64>,
     /// World objects.
     #[serde(default)]
@@ -136,6 +137,7 @@ pub enum CostKind {
         posture: Option<String>,
         /// Weights by motor or group name; 1 for the rest.
         #[serde(default)]
+        #[serde(deserialize_with = "trm_kinematics::unique_names")]
         weights: BTreeMap<String, f64>,
     },
     /// Number of colliding pairs.
