@@ -205,6 +205,19 @@ impl LoadedTaskMapSpec {
                 "give positive half widths",
             ));
         }
+        for (field, n, lo) in [
+            ("explore.iterations", e.iterations, 1),
+            ("explore.restarts", e.restarts, 0),
+            ("search.samples", s.search.samples, 1),
+        ] {
+            if !(lo..=100_000_000).contains(&n) {
+                return Err(self.err(
+                    field,
+                    format!("{n} is not in {lo}..=100000000"),
+                    "give a count in that range",
+                ));
+            }
+        }
         let q = &s.search;
         if let Some(k) = (0..3).find(|&k| {
             !(q.lower[k].is_finite() && q.upper[k].is_finite() && q.lower[k] < q.upper[k])

@@ -357,29 +357,126 @@ impl Scene {
         self.path = path;
     }
 
-    /// The scene as JSON.
+    /// The scene as JSON; a scene that would not read back ([`Scene::check`]) is refused.
     pub fn to_json(&self) -> Result<String> {
+        self.check()?;
         Ok(serde_json::to_string(self)?)
     }
 
     /// Reads a scene, checking its format and version (the one versioned-JSON reader of trm,
-    /// [`trm_kinematics::parse_versioned`]).
+    /// [`trm_kinematics::parse_versioned`]) and its content ([`Scene::check`]).
     pub fn from_json(text: &str) -> Result<Self> {
-        Ok(trm_kinematics::parse_versioned(
-            std::path::Path::new("<scene>"),
-            text,
-            FORMAT,
-            VERSION,
-        )?)
+        Self::parse(std::path::Path::new("<scene>"), text)
     }
 
     /// Reads a scene file.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
-        Ok(trm_kinematics::load_versioned(
-            path.as_ref(),
-            FORMAT,
-            VERSION,
-        )?)
+        let path = path.as_ref();
+        let text = trm_kinematics::read_input(path).map_err(|e| ViewError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Self::parse(path, &text)
+    }
+
+    fn parse(path: &std::path::Path, text: &str) -> Result<Self> {
+        let scene: Scene = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
+        scene.check().map_err(|e| match e {
+            ViewError::Invalid { what, problem } => ViewError::Invalid {
+                what: format!("{}: {what}", path.display()),
+                problem,
+            },
+            other => other,
+        })?;
+        Ok(scene)
+    }
+
+    /// Checks that the parts fit together: bodies on existing links, one pose per link in every
+    /// frame and one value per movable joint, map arrays of one length with edges between its
+    /// points, a tree whose parents come first, and finite numbers everywhere.
+    pub fn check(&self) -> Result<()> {
+        let bad = |what: String, problem: &str| {
+            Err(ViewError::Invalid {
+                what,
+                problem: problem.to_string(),
+            })
+        };
+        let finite = |values: &[f64]| values.iter().all(|v| v.is_finite());
+        let links = self.links.len();
+        let tree = self.kinematics.links.len();
+        if self.link_index.len() != links
+            || (tree > 0 && self.link_index.iter().any(|&l| l >= tree))
+        {
+            return bad(
+                "link_index".into(),
+                "needs one tree index per link, each naming a link of the tree",
+            );
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            if b.link >= links || !finite(&b.local) {
+                return bad(
+                    format!("bodies[{i}]"),
+                    "names no link or has a non-finite pose",
+                );
+            }
+        }
+        let coordinates = self
+            .kinematics
+            .joints
+            .iter()
+            .filter(|j| j.coordinate.is_some())
+            .count();
+        for (i, j) in self.kinematics.joints.iter().enumerate() {
+            let ok = j.parent <= i
+                && j.coordinate.is_none_or(|c| c < coordinates)
+                && finite(&j.origin)
+                && finite(&j.axis);
+            if !ok {
+                return bad(
+                    format!("kinematics.joints[{i}]"),
+                    "has a parent after it, a coordinate out of range or a non-finite number",
+                );
+            }
+        }
+        for (i, f) in self.frames.iter().enumerate() {
+            let joints_ok = self.kinematics.joints.is_empty() || f.joints.len() == coordinates;
+            let ok = f.poses.len() == links
+                && joints_ok
+                && f.t.is_finite()
+                && finite(&f.base)
+                && finite(&f.joints)
+                && f.poses.iter().all(|p| finite(p));
+            if !ok {
+                return bad(
+                    format!("frames[{i}]"),
+                    "needs one finite pose per link and one finite value per movable joint",
+                );
+            }
+        }
+        for (i, o) in self.world.iter().enumerate() {
+            if !finite(&o.pose) {
+                return bad(format!("world[{i}]"), "has a non-finite pose");
+            }
+        }
+        if let Some(m) = &self.map {
+            let n = m.points.len();
+            let ok = m.cost.len() == n
+                && m.joints.len() == n
+                && m.points.iter().all(|p| finite(p))
+                && finite(&m.cost)
+                && m.joints.iter().all(|q| finite(q))
+                && m.edges.iter().all(|e| e[0] < n && e[1] < n);
+            if !ok {
+                return bad(
+                    "map".into(),
+                    "needs one finite cost and posture per point and edges between its points",
+                );
+            }
+        }
+        if !self.path.iter().all(|p| finite(p)) {
+            return bad("path".into(), "holds a non-finite point");
+        }
+        Ok(())
     }
 
     /// One self-contained HTML page that renders the scene. `bundle`: the built viewer

@@ -111,6 +111,43 @@ fn scenes_round_trip_and_name_their_format() {
 }
 
 #[test]
+fn scenes_whose_parts_do_not_fit_are_neither_written_nor_read() {
+    let (scene, _) = icub_scene(2);
+    let json = scene.to_json().unwrap();
+    let mut broken = Vec::new();
+    let mut s = scene.clone();
+    s.bodies[0].link = s.links.len();
+    broken.push((s, "bodies[0]"));
+    let mut s = scene.clone();
+    s.frames[1].poses.pop();
+    broken.push((s, "frames[1]"));
+    let mut s = scene.clone();
+    s.frames[0].joints[3] = f64::NAN;
+    broken.push((s, "frames[0]"));
+    let mut s = scene.clone();
+    s.set_path(vec![[0.0, f64::INFINITY, 0.0]]);
+    broken.push((s, "path"));
+    for (s, what) in broken {
+        let e = s.to_json().unwrap_err().to_string();
+        assert!(e.starts_with(what), "{e}");
+    }
+    // the reader refuses the same, naming the file
+    let dir = std::env::temp_dir().join(format!("trm-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("s.scene.json");
+    let first_body = json.find("\"link\":").unwrap();
+    let end = first_body + json[first_body..].find(',').unwrap();
+    std::fs::write(
+        &path,
+        format!("{}\"link\":9999{}", &json[..first_body], &json[end..]),
+    )
+    .unwrap();
+    let e = Scene::load(&path).unwrap_err().to_string();
+    assert!(e.contains("s.scene.json: bodies[0]"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_page_inlines_the_bundle_or_falls_back_to_the_pinned_cdn() {
     let (scene, _) = icub_scene(1);
     let offline = scene
