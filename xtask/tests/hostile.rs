@@ -59,12 +59,13 @@ fn run(dir: &Path, args: &[String]) -> (Option<i32>, String, f64) {
     )
 }
 
-/// Byte ranges of the number tokens of `text`, outside strings and `//` comments.
-fn numbers(text: &str) -> Vec<(usize, usize)> {
+/// For each byte of `text`, whether it is code: outside strings and `//` comments.
+fn code(text: &str) -> Vec<bool> {
     let b = text.as_bytes();
-    let mut out = Vec::new();
+    let mut mask = vec![true; b.len()];
     let mut i = 0;
     while i < b.len() {
+        let start = i;
         match b[i] {
             b'"' => {
                 i += 1;
@@ -78,19 +79,39 @@ fn numbers(text: &str) -> Vec<(usize, usize)> {
                     i += 1;
                 }
             }
-            c if (c.is_ascii_digit() || c == b'-')
-                && !(i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_'))
-                && (c != b'-' || b.get(i + 1).is_some_and(u8::is_ascii_digit)) =>
-            {
-                let start = i;
+            _ => {
                 i += 1;
-                while i < b.len() && (b[i].is_ascii_digit() || b".eE+-".contains(&b[i])) {
-                    i += 1;
-                }
-                out.push((start, i));
+                continue;
             }
-            _ => i += 1,
         }
+        for m in &mut mask[start..i.min(b.len())] {
+            *m = false;
+        }
+    }
+    mask
+}
+
+/// Byte ranges of the number tokens of `text`, outside strings and `//` comments.
+fn numbers(text: &str) -> Vec<(usize, usize)> {
+    let (b, code) = (text.as_bytes(), code(text));
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        let starts = code[i]
+            && (c.is_ascii_digit() || c == b'-')
+            && !(i > 0 && (b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_'))
+            && (c != b'-' || b.get(i + 1).is_some_and(u8::is_ascii_digit));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        i += 1;
+        while i < b.len() && (b[i].is_ascii_digit() || b".eE+-".contains(&b[i])) {
+            i += 1;
+        }
+        out.push((start, i));
     }
     out
 }
@@ -158,27 +179,10 @@ fn mutations(text: &str, json: bool, per_value: usize, values: &[&str]) -> Vec<(
 
 /// Just after the first `bracket` outside strings and `//` comments.
 fn opening(text: &str, bracket: u8) -> usize {
-    let b = text.as_bytes();
-    let mut i = 0;
-    while i < b.len() {
-        match b[i] {
-            b'"' => {
-                i += 1;
-                while i < b.len() && b[i] != b'"' {
-                    i += if b[i] == b'\\' { 2 } else { 1 };
-                }
-            }
-            b'/' if b.get(i + 1) == Some(&b'/') => {
-                while i < b.len() && b[i] != b'\n' {
-                    i += 1;
-                }
-            }
-            c if c == bracket => return i + 1,
-            _ => {}
-        }
-        i += 1;
-    }
-    0
+    let code = code(text);
+    (text.bytes().enumerate())
+        .find(|&(i, c)| code[i] && c == bracket)
+        .map_or(0, |(i, _)| i + 1)
 }
 
 /// Byte ranges of the numbers in the attribute values of an XML text (`xyz="0 0.1 0"`).
@@ -350,132 +354,116 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     }
     // values that parse but make no sense: zero or huge counts, inverted or degenerate ranges,
     // duplicated names
+    let solve = ["solve", "{}"];
+    let stand = ["stand-up", "{}", "--out", "su"];
+    let collide = ["collide", "--configs", "configs.json", "--world", "{}"];
+    let explore = ["explore-task-map", "{}"];
     for (source, from, to, args) in [
         (
             "specs/reach.ron",
             "max_points: 400",
             "max_points: 0",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/reach.ron",
             "max_points: 400",
             "max_points: 99999999999",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
-        (
-            "specs/reach.ron",
-            "searches: 4",
-            "searches: 0",
-            vec!["solve", "{}"],
-        ),
+        ("specs/reach.ron", "searches: 4", "searches: 0", &solve[..]),
         (
             "specs/reach.ron",
             "(150, 0.15)",
             "(10000000000000, 0.15)",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
-        (
-            "specs/reach.ron",
-            "(30, 0.03)",
-            "(30, -0.03)",
-            vec!["solve", "{}"],
-        ),
+        ("specs/reach.ron", "(30, 0.03)", "(30, -0.03)", &solve[..]),
         (
             "specs/reach.ron",
             "seed: 0)",
             "seed: 0, population: Some(10000000000000))",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/reach.ron",
             "seed: 0)",
             "seed: 0, max_evaluations: 0)",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
-        (
-            "specs/reach.ron",
-            "weight: 5.0",
-            "weight: -5.0",
-            vec!["solve", "{}"],
-        ),
+        ("specs/reach.ron", "weight: 5.0", "weight: -5.0", &solve[..]),
         (
             "specs/reach.ron",
             "radius: 0.05",
             "radius: -0.05",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/reach.ron",
             "axis: (0, 1, 0)",
             "axis: (0, 0, 0)",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/reach.ron",
             "\"l_palm_center\"",
             "\"l_palm_centre\"",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
-        (
-            "specs/reach.ron",
-            "\"xnes\"",
-            "\"xnse\"",
-            vec!["solve", "{}"],
-        ),
+        ("specs/reach.ron", "\"xnes\"", "\"xnse\"", &solve[..]),
         (
             "specs/reach.ron",
             "\"torso\": 3.0",
             "\"torso\": 3.0, \"torso\": 1.0",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/reach.ron",
             "size: (0.5, 0.8, 0.04)",
             "size: (0.5, 0.0, 0.04)",
-            vec!["solve", "{}"],
+            &solve[..],
         ),
         (
             "specs/worlds/reach_with_box.ron",
             "\"new_box\"",
             "\"table\"",
-            vec!["collide", "--configs", "configs.json", "--world", "{}"],
+            &collide[..],
         ),
         (
             "specs/wholebody/standup.ron",
             "dt: 0.01",
             "dt: 1e-300",
-            vec!["stand-up", "{}", "--out", "su"],
+            &stand[..],
         ),
         (
             "specs/wholebody/standup.ron",
             "rbfs: 5",
             "rbfs: 0",
-            vec!["stand-up", "{}", "--out", "su"],
+            &stand[..],
         ),
         (
             "specs/wholebody/standup.ron",
             "rbfs: 5",
             "rbfs: 100000000",
-            vec!["stand-up", "{}", "--out", "su"],
+            &stand[..],
         ),
         (
             "specs/wholebody/standup.ron",
             "\"standing\"",
             "\"seated\"",
-            vec!["stand-up", "{}", "--out", "su"],
+            &stand[..],
         ),
         (
             "specs/wholebody/standup.ron",
             "end: 4.5",
             "end: 1.0",
-            vec!["stand-up", "{}", "--out", "su"],
+            &stand[..],
         ),
         (
             "specs/taskmaps/stick.ron",
             "samples: 5000",
             "samples: 0",
-            vec!["explore-task-map", "{}"],
+            &explore[..],
         ),
     ] {
         let text = read(&at(source));
@@ -484,7 +472,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             &dir,
             &at(source),
             vec![(format!("`{from}` → `{to}`"), text.replacen(from, to, 1))],
-            &args,
+            args,
         ));
     }
 

@@ -423,11 +423,7 @@ pub fn load_versioned<T: serde::de::DeserializeOwned>(
     format: &'static str,
     version: u32,
 ) -> Result<T, FileError> {
-    let text = read_input(path).map_err(|source| FileError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_versioned(path, &text, format, version)
+    parse_versioned(path, &read_file(path)?, format, version)
 }
 
 /// `value` as compact JSON (`path` names the file it is for in errors).
@@ -443,15 +439,27 @@ pub fn json_text<T: serde::Serialize>(
     })
 }
 
+/// [`read_input`] with a [`FileError`] naming the file.
+pub fn read_file(path: &Path) -> Result<String, FileError> {
+    read_input(path).map_err(|source| FileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// [`write_atomic`] with a [`FileError`] naming the file.
+pub fn write_file(path: &Path, text: &str) -> Result<(), FileError> {
+    write_atomic(path, text.as_bytes()).map_err(|source| FileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// Writes `value` as compact JSON to `path` atomically ([`write_atomic`]).
 pub fn save_json<T: serde::Serialize>(
     path: &Path,
     value: &T,
     format: &'static str,
 ) -> Result<(), FileError> {
-    let text = json_text(path, value, format)?;
-    write_atomic(path, text.as_bytes()).map_err(|source| FileError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    write_file(path, &json_text(path, value, format)?)
 }

@@ -54,7 +54,8 @@ pub use description::{
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use files::{
     FileError, MAX_INPUT_BYTES, StagedFile, check_output, check_unique_keys, json_text,
-    load_versioned, parse_versioned, read_input, save_json, unique_names, write_atomic,
+    load_versioned, parse_versioned, read_file, read_input, save_json, unique_names, write_atomic,
+    write_file,
 };
 pub use fk::{FrameId, PoseBuffer};
 pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};

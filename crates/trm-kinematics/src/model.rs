@@ -176,6 +176,32 @@ impl RobotModel {
         desc_text: Option<(&str, &str)>,
     ) -> Result<Self> {
         let tree = Tree::from_urdf(robot, ctx)?;
+        Self::assemble(tree, ctx.origin, desc, desc_text)
+    }
+
+    /// The same URDF (kinematic tree) with another description in place of this model's:
+    /// motors, couplings, frames, groups, postures and collision pairs resolved anew, without
+    /// parsing the URDF again. `description_text` is the description's `(text, origin)` when
+    /// it came from a file, for located errors.
+    pub fn with_description(
+        &self,
+        description: &ModelDescription,
+        description_text: Option<(&str, &str)>,
+    ) -> Result<Self> {
+        Self::assemble(
+            self.data.tree.clone(),
+            &self.data.origin,
+            description,
+            description_text,
+        )
+    }
+
+    fn assemble(
+        tree: Tree,
+        origin: &str,
+        desc: &ModelDescription,
+        desc_text: Option<(&str, &str)>,
+    ) -> Result<Self> {
         let dctx = DescCtx {
             origin: desc_text.map_or("<description>", |d| d.1),
             text: desc_text.map(|d| d.0),
@@ -189,7 +215,7 @@ impl RobotModel {
         let (joint_plan, motor_plan) = compile_plans(&tree, &frames, &couplings);
         Ok(RobotModel {
             data: Arc::new(ModelData {
-                origin: ctx.origin.to_string(),
+                origin: origin.to_string(),
                 tree,
                 motors,
                 couplings,

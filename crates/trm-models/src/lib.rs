@@ -149,6 +149,34 @@ pub fn branched_tree() -> RobotModel {
 #[cfg(test)]
 mod tests {
     #[test]
+    fn a_description_applied_to_a_loaded_urdf_gives_the_same_model() {
+        use trm_kinematics::{ModelDescription, RobotModel};
+        let bare = RobotModel::from_urdf_str(super::ICUB_UPPER_BODY_URDF, "u.urdf").unwrap();
+        let description = ModelDescription::from_ron(super::ICUB_UPPER_BODY_RON, "d.ron").unwrap();
+        let described = bare.with_description(&description, None).unwrap();
+        let shipped = super::icub_upper_body();
+        let names = |m: &RobotModel| {
+            m.motors()
+                .iter()
+                .map(|m| m.name.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(names(&described), names(&shipped));
+        assert_eq!(
+            described.frame_names().count(),
+            shipped.frame_names().count()
+        );
+        assert_eq!(bare.motors().len(), bare.num_joints());
+        // errors still point into the description's text
+        let bad = super::ICUB_UPPER_BODY_RON.replacen("\"r_elbow\"", "\"r_elbw\"", 1);
+        let e = ModelDescription::from_ron(&bad, "d.ron")
+            .and_then(|d| bare.with_description(&d, Some((&bad, "d.ron"))))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("d.ron:") && e.contains("r_elbow"), "{e}");
+    }
+
+    #[test]
     fn every_embedded_model_loads() {
         assert_eq!(super::icub_upper_body().num_joints(), 63);
         assert_eq!(super::icub_official().num_joints(), 75);

@@ -100,14 +100,7 @@ impl Roadmap {
     /// written here reads back.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        let text = self.to_json(path)?;
-        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|source| {
-            trm_kinematics::FileError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-            .into()
-        })
+        Ok(trm_kinematics::write_file(path, &self.to_json(path)?)?)
     }
 
     /// The map as JSON, refused as [`Roadmap::save`] refuses it; `path` names the file it is
@@ -124,12 +117,7 @@ impl Roadmap {
     /// not fit together, is a clear error.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text =
-            trm_kinematics::read_input(path).map_err(|source| trm_kinematics::FileError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        Self::from_json(&text, path)
+        Self::from_json(&trm_kinematics::read_file(path)?, path)
     }
 
     /// Reads a map from JSON text (`path` names it in errors), checked as [`Roadmap::load`]

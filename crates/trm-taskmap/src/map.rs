@@ -282,14 +282,7 @@ impl TaskMap {
     /// Writes the map as JSON (atomically); see [`TaskMap::to_json`].
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TaskMapError> {
         let path = path.as_ref();
-        let text = self.to_json(path)?;
-        trm_kinematics::write_atomic(path, text.as_bytes()).map_err(|source| {
-            trm_kinematics::FileError::Io {
-                path: path.to_path_buf(),
-                source,
-            }
-            .into()
-        })
+        Ok(trm_kinematics::write_file(path, &self.to_json(path)?)?)
     }
 
     /// Checks that the map holds something and that its points fit together: finite goal
@@ -324,12 +317,7 @@ impl TaskMap {
     /// Reads a map; truncated, foreign or newer files are clear errors.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, TaskMapError> {
         let path = path.as_ref();
-        let text =
-            trm_kinematics::read_input(path).map_err(|source| trm_kinematics::FileError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        Self::from_json(&text, path)
+        Self::from_json(&trm_kinematics::read_file(path)?, path)
     }
 
     /// Reads a task map from JSON text (`path` names it in errors), checked as
