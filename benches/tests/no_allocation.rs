@@ -59,6 +59,21 @@ fn forward_kinematics_never_allocates() {
     }
     let after = allocations();
     assert_eq!(after - before, 0, "FK allocated {} times", after - before);
+    // four configurations at once
+    let mut batch = model.pose_batch();
+    let mut q4 = q41.repeat(trm_kinematics::LANES);
+    let mut joints4 = joints.repeat(trm_kinematics::LANES);
+    let before = allocations();
+    for k in 0..500 {
+        q4[50] = k as f64 * 1e-4;
+        joints4[70] = k as f64 * 1e-4;
+        all.forward_batch(&q4, &mut batch).unwrap();
+        all.forward_batch_unchecked(&q4, &mut batch);
+        model.forward_motors_batch(&q4, &mut batch).unwrap();
+        model.forward_joints_batch(&joints4, &mut batch).unwrap();
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "batched FK allocated {} times", after - before);
 }
 
 #[test]

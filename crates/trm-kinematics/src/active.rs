@@ -1,8 +1,9 @@
 //! [`ActiveSet`]: which motors are optimisation variables, the rest locked at given values.
 
+use crate::batch::PoseBatch;
 use crate::error::{KinematicsError, Result};
 use crate::fk::{AffineRow, Plan, PoseBuffer};
-use crate::model::{RobotModel, check_vector};
+use crate::model::{RobotModel, check_batch, check_vector};
 
 /// A selection of motors as variables (the *active values*), every other motor locked. It maps
 /// an active vector straight to joint values (couplings and locked motors folded into one sparse
@@ -191,5 +192,24 @@ impl ActiveSet {
     #[inline]
     pub fn forward_unchecked(&self, q: &[f64], buffer: &mut PoseBuffer) {
         self.plan.run(q, buffer);
+    }
+
+    /// Forward kinematics of [`LANES`](crate::LANES) active-value vectors at once, one after
+    /// the other in `q` (`LANES × len` values), into `batch` (made by
+    /// [`RobotModel::pose_batch`]). Each lane's poses equal [`ActiveSet::forward`]'s to ≤ 1e-12.
+    pub fn forward_batch(&self, q: &[f64], batch: &mut PoseBatch) -> Result<()> {
+        check_batch("active motor values", q, self.active.len(), |i| {
+            &self.model.motors()[self.active[i]].name
+        })?;
+        self.model.check_batch_buffer(batch)?;
+        self.forward_batch_unchecked(q, batch);
+        Ok(())
+    }
+
+    /// [`ActiveSet::forward_batch`] without checks, for the hot path. Panics on a wrong-sized
+    /// `q` or batch.
+    #[inline]
+    pub fn forward_batch_unchecked(&self, q: &[f64], batch: &mut PoseBatch) {
+        self.plan.run_batch(q, self.active.len(), batch);
     }
 }

@@ -17,14 +17,14 @@ use crate::tree::{JointKind, Tree};
 /// `local.rotation = c·rotation + s·axis_quat` (= rotation ⊗ (c, s·axis)) and
 /// `local.translation = translation + d·axis_in_parent`. Every step runs the same branch-free code.
 #[derive(Debug, Clone, Copy)]
-struct Step {
-    parent: u32,
-    child: u32,
-    slot: u32,
-    rotation: Quaternion<f64>,
-    axis_quat: Quaternion<f64>,
-    translation: Vector3<f64>,
-    axis_in_parent: Vector3<f64>,
+pub(crate) struct Step {
+    pub(crate) parent: u32,
+    pub(crate) child: u32,
+    pub(crate) slot: u32,
+    pub(crate) rotation: Quaternion<f64>,
+    pub(crate) axis_quat: Quaternion<f64>,
+    pub(crate) translation: Vector3<f64>,
+    pub(crate) axis_in_parent: Vector3<f64>,
 }
 
 impl Step {
@@ -67,13 +67,13 @@ pub(crate) fn affine(constant: f64, terms: &[(usize, f64)], input: &[f64]) -> f6
 #[derive(Debug, Clone)]
 pub(crate) struct Plan {
     /// Per slot: constant and range into `terms`.
-    rows: Vec<(f64, u32, u32)>,
+    pub(crate) rows: Vec<(f64, u32, u32)>,
     /// `(input index, factor)`.
-    terms: Vec<(usize, f64)>,
+    pub(crate) terms: Vec<(usize, f64)>,
     /// Whether a slot is a revolute angle (needs its half-angle sine and cosine). Slot 0 is
     /// the constant `(0, 1, 0)` of fixed transforms.
-    revolute: Vec<bool>,
-    steps: Vec<Step>,
+    pub(crate) revolute: Vec<bool>,
+    pub(crate) steps: Vec<Step>,
 }
 
 /// Identifies joints that always share a value: (constant bits, (input, factor bits) terms,

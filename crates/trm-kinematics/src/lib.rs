@@ -33,6 +33,7 @@
 //! [`RobotModel`]. Mesh files are never opened: kinematics needs none.
 
 mod active;
+mod batch;
 mod derivatives;
 mod description;
 mod error;
@@ -46,6 +47,7 @@ mod ron_path;
 mod tree;
 
 pub use active::ActiveSet;
+pub use batch::{LANES, Lanes, PoseBatch, sin_cos};
 pub use derivatives::GRAVITY;
 pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,

@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use nalgebra::Isometry3;
 
+use crate::batch::PoseBatch;
 use crate::description::{DisableReason, FrameSpec, ModelDescription};
 use crate::error::{KinematicsError, NameKind, Result, unknown};
 use crate::fk::{AffineRow, FrameId, Plan, PoseBuffer, affine};
@@ -500,6 +501,46 @@ impl RobotModel {
         Ok(())
     }
 
+    /// A pose batch sized for this model ([`LANES`](crate::LANES) configurations at once).
+    pub fn pose_batch(&self) -> PoseBatch {
+        PoseBatch::new(self.num_joints(), self.num_frames())
+    }
+
+    /// Forward kinematics of [`LANES`](crate::LANES) joint vectors at once, given one after the
+    /// other in `joints` (`LANES × num_joints` values), into `batch`. Each lane's poses equal
+    /// [`RobotModel::forward_joints`]'s to ≤ 1e-12.
+    pub fn forward_joints_batch(&self, joints: &[f64], batch: &mut PoseBatch) -> Result<()> {
+        check_batch("joint values", joints, self.num_joints(), |i| {
+            &self.joint(i).name
+        })?;
+        self.check_batch_buffer(batch)?;
+        self.data
+            .joint_plan
+            .run_batch(joints, self.num_joints(), batch);
+        Ok(())
+    }
+
+    /// Forward kinematics of [`LANES`](crate::LANES) motor vectors at once (`LANES × motors`
+    /// values, one vector after the other) into `batch`.
+    pub fn forward_motors_batch(&self, motors: &[f64], batch: &mut PoseBatch) -> Result<()> {
+        let n = self.data.motors.len();
+        check_batch("motor values", motors, n, |i| &self.data.motors[i].name)?;
+        self.check_batch_buffer(batch)?;
+        self.data.motor_plan.run_batch(motors, n, batch);
+        Ok(())
+    }
+
+    pub(crate) fn check_batch_buffer(&self, batch: &PoseBatch) -> Result<()> {
+        if !batch.fits(self.num_joints(), self.num_frames()) {
+            return Err(KinematicsError::WrongLength {
+                what: "pose batch (make it with RobotModel::pose_batch)",
+                expected: self.num_frames(),
+                got: batch.len(),
+            });
+        }
+        Ok(())
+    }
+
     pub(crate) fn check_buffer(&self, buffer: &PoseBuffer) -> Result<()> {
         if !buffer.fits(self.num_joints(), self.num_frames()) {
             return Err(KinematicsError::WrongLength {
@@ -510,6 +551,27 @@ impl RobotModel {
         }
         Ok(())
     }
+}
+
+/// Checks a batch of [`LANES`](crate::LANES) vectors of `n` values each, one after the other:
+/// length and finiteness; `name(i)` names entry `i` of a vector in errors.
+pub(crate) fn check_batch<'a>(
+    what: &'static str,
+    values: &[f64],
+    n: usize,
+    name: impl Fn(usize) -> &'a str,
+) -> Result<()> {
+    if values.len() != crate::LANES * n {
+        return Err(KinematicsError::WrongLength {
+            what,
+            expected: crate::LANES * n,
+            got: values.len(),
+        });
+    }
+    for lane in values.chunks(n.max(1)) {
+        check_vector(what, lane, n, &name)?;
+    }
+    Ok(())
 }
 
 /// Checks length and finiteness of a vector; `name(i)` names entry `i` in errors.

@@ -1,0 +1,124 @@
+//! Batched forward kinematics: every lane equals the one-configuration path to ≤ 1e-12 on the
+//! iCub (couplings), a tree with prismatic, continuous and mimic joints, and the official
+//! 75-joint iCub, for random configurations inside and outside the limits; bad input is a
+//! clear error.
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use trm_kinematics::{FrameId, LANES, RobotModel};
+
+fn model(file: &str) -> RobotModel {
+    RobotModel::load(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../models")
+            .join(file),
+    )
+    .unwrap()
+}
+
+/// Largest difference between lane poses and one-at-a-time poses over `rounds` batches of
+/// random motor vectors (within the limits widened by `overshoot` rad on each side).
+fn worst_gap(model: &RobotModel, rounds: usize, overshoot: f64, seed: u64) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut batch = model.pose_batch();
+    let mut buffer = model.pose_buffer();
+    let mut worst = 0.0f64;
+    for _ in 0..rounds {
+        let q: Vec<f64> = (0..LANES)
+            .flat_map(|_| model.motors().iter())
+            .map(|m| {
+                let (lo, hi) = (m.limits.lower.max(-4.0), m.limits.upper.min(4.0));
+                rng.random_range(lo - overshoot..=hi + overshoot)
+            })
+            .collect();
+        model.forward_motors_batch(&q, &mut batch).unwrap();
+        let n = model.motors().len();
+        for lane in 0..LANES {
+            model
+                .forward_motors(&q[lane * n..(lane + 1) * n], &mut buffer)
+                .unwrap();
+            for (k, one) in buffer.poses().iter().enumerate() {
+                let many = batch.pose(lane, frame(model, k));
+                let dq = (one.rotation.coords - many.rotation.coords).amax();
+                let dt = (one.translation.vector - many.translation.vector).amax();
+                worst = worst.max(dq).max(dt);
+            }
+        }
+    }
+    worst
+}
+
+/// The `FrameId` of pose `k` (links then named frames, in buffer order).
+fn frame(model: &RobotModel, k: usize) -> FrameId {
+    let name = model.frame_names().nth(k).unwrap();
+    model.frame_id(name).unwrap()
+}
+
+#[test]
+fn every_lane_equals_the_one_configuration_path() {
+    for (file, rounds) in [
+        ("icub_upper_body.ron", 60),
+        ("branched_tree.urdf", 200),
+        ("icub-visuomanip/model.urdf", 30),
+    ] {
+        let m = model(file);
+        for overshoot in [0.0, 1.0] {
+            let gap = worst_gap(&m, rounds, overshoot, 7);
+            assert!(gap <= 1e-12, "{file}: lanes differ by {gap:e}");
+        }
+    }
+}
+
+#[test]
+fn active_sets_run_in_batches_too() {
+    let m = model("icub_upper_body.ron");
+    let arm = m
+        .active_set(&["right_arm", "torso"], m.posture("home").unwrap())
+        .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let (lo, hi) = arm.bounds();
+    let q: Vec<f64> = (0..LANES * arm.len())
+        .map(|i| rng.random_range(lo[i % arm.len()]..hi[i % arm.len()]))
+        .collect();
+    let mut batch = m.pose_batch();
+    arm.forward_batch(&q, &mut batch).unwrap();
+    let mut buffer = m.pose_buffer();
+    let hand = m.frame_id("r_hand").unwrap();
+    for lane in 0..LANES {
+        arm.forward(&q[lane * arm.len()..(lane + 1) * arm.len()], &mut buffer)
+            .unwrap();
+        let gap = (buffer.pose(hand).translation.vector
+            - batch.pose(lane, hand).translation.vector)
+            .amax();
+        assert!(gap <= 1e-12, "lane {lane}: {gap:e}");
+        let p = batch.positions(hand);
+        let t = batch.pose(lane, hand).translation.vector;
+        assert_eq!([p[0][lane], p[1][lane], p[2][lane]], [t.x, t.y, t.z]);
+    }
+}
+
+#[test]
+fn wrong_lengths_non_finite_values_and_foreign_batches_are_errors() {
+    let m = model("icub_upper_body.ron");
+    let n = m.motors().len();
+    let mut batch = m.pose_batch();
+    let e = m
+        .forward_motors_batch(&vec![0.0; n], &mut batch)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(&format!("{}", LANES * n)), "{e}");
+    let mut q = vec![0.0; LANES * n];
+    q[2 * n + 5] = f64::NAN;
+    let e = m
+        .forward_motors_batch(&q, &mut batch)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(&m.motors()[5].name) && e.contains("NaN"), "{e}");
+    let mut other = model("planar_arm.urdf").pose_batch();
+    assert!(
+        m.forward_motors_batch(&vec![0.0; LANES * n], &mut other)
+            .is_err()
+    );
+}
