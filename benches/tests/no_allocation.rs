@@ -73,7 +73,12 @@ fn forward_kinematics_never_allocates() {
         model.forward_joints_batch(&joints4, &mut batch).unwrap();
     }
     let after = allocations();
-    assert_eq!(after - before, 0, "batched FK allocated {} times", after - before);
+    assert_eq!(
+        after - before,
+        0,
+        "batched FK allocated {} times",
+        after - before
+    );
 }
 
 #[test]

@@ -120,6 +120,14 @@ impl World {
                             fix,
                         }
                     }
+                    // in a file, the API's hint (move it with set_pose) is no help
+                    CollisionError::DuplicateObject(name) => CollisionError::InvalidShape {
+                        origin: origin.to_string(),
+                        line,
+                        element: element.clone(),
+                        problem: format!("`{name}` names an earlier object too"),
+                        fix: "give every object its own name".into(),
+                    },
                     other => CollisionError::InvalidShape {
                         origin: origin.to_string(),
                         line,

@@ -405,7 +405,11 @@ pub fn parse_versioned<T: serde::de::DeserializeOwned>(
             return Err(FileError::WrongVersion {
                 path: path_buf(),
                 format,
-                found: found.map_or("(none)".into(), |v| v.to_string()),
+                found: match found {
+                    None => "(none)".into(),
+                    Some(serde_json::Value::Number(n)) => n.to_string(),
+                    Some(other) => format!("{other} (not a number)"),
+                },
                 expected: version,
             });
         }
