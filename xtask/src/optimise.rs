@@ -61,6 +61,13 @@ pub fn run(args: &Args) -> Result<()> {
             ALGORITHMS.join(", ")
         );
     }
+    if args.seed.checked_add(args.runs - 1).is_none() {
+        anyhow::bail!(
+            "--seed {} --runs {}: run k uses seed S + k, which wraps around\n  fix: give a smaller seed",
+            args.seed,
+            args.runs
+        );
+    }
     let f = TestFunction::by_name(&args.function, args.dim, args.seed)
         .with_context(|| format!("--function {}", args.function))?;
     let mut runs = Vec::new();

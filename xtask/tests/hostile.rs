@@ -684,6 +684,21 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &["0", "18446744073709551615"],
     ));
     cases.extend(flag_cases(
+        &["optimise", "--runs", "3"],
+        "--seed",
+        &["18446744073709551615"],
+    ));
+    let map_json = read(&dir.join("map.json"));
+    cases.extend(file_cases(
+        &dir,
+        &dir.join("map.json"),
+        vec![(
+            "a version written as a string".into(),
+            map_json.replacen("\"version\":1", "\"version\":\"1\"", 1),
+        )],
+        &["map-info", "{}"],
+    ));
+    cases.extend(flag_cases(
         &optimise,
         "--max-evals",
         &["0", "18446744073709551615"],
