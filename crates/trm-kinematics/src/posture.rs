@@ -197,6 +197,7 @@ impl PostureFile {
 
 /// A configurations file: URDF joint values by joint name, one row per sample.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ConfigurationsFile {
     /// URDF joint names, one per column of every sample's `q`.
     pub joint_names: Vec<String>,

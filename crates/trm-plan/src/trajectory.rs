@@ -30,6 +30,7 @@ pub const WHOLE_BODY_COLUMNS: &[&str] = &[
 
 /// A timed joint trajectory (full motor vectors) with its task-space path.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Trajectory {
     /// Motor names, the columns of `positions`.
     pub names: Vec<String>,

@@ -33,6 +33,7 @@ pub const VERSION: u32 = 1;
 
 /// A map point: a posture and its task vector.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MapPoint {
     /// Active motor values.
     pub q: Vec<f64>,
@@ -44,6 +45,7 @@ pub struct MapPoint {
 
 /// How a map was built.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BuildStats {
     /// Wall time of construction, seconds.
     pub build_seconds: f64,
@@ -63,6 +65,7 @@ pub struct BuildStats {
 
 /// A task-relevant roadmap.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Roadmap {
     /// Always [`FORMAT`].
     pub format: String,

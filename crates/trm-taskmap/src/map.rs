@@ -56,6 +56,7 @@ pub enum TaskMapError {
 
 /// The metric W = diag(w_p, w_p, w_p, w_o, w_o, w_o): metres against radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Metric {
     /// Weight of squared position differences (1/m²).
     pub position: f64,
@@ -130,6 +131,7 @@ pub fn to_pose(g: &[f64; 6]) -> Isometry3<f64> {
 
 /// A feasible point of a task map.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TaskPoint {
     /// Goal parameters (position, rotation vector).
     pub g: [f64; 6],
@@ -143,6 +145,7 @@ pub struct TaskPoint {
 
 /// A task map.
 #[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TaskMap {
     /// Always `trm-taskmap`.
     pub format: String,

@@ -76,6 +76,7 @@ pub type Pose = [f64; 7];
 
 /// A collision body on a link.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneBody {
     /// Body name.
     pub name: String,
@@ -91,6 +92,7 @@ pub struct SceneBody {
 
 /// One frame: the link poses at a time.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneFrame {
     /// Time, seconds (or an index for a set of postures).
     pub t: f64,
@@ -105,6 +107,7 @@ pub struct SceneFrame {
 
 /// A world object.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneObject {
     /// Name.
     pub name: String,
@@ -116,6 +119,7 @@ pub struct SceneObject {
 
 /// A roadmap: task points coloured by cost, edges, and each point's posture.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneMap {
     /// Where each point is drawn (its task point, or a frame's position), metres.
     pub points: Vec<[f64; 3]>,
@@ -129,6 +133,7 @@ pub struct SceneMap {
 
 /// What the page needs to run forward kinematics for map postures: the tree.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneKinematics {
     /// Link names in tree order (parents first).
     pub links: Vec<String>,
@@ -138,6 +143,7 @@ pub struct SceneKinematics {
 
 /// A tree joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneJoint {
     /// Parent link index.
     pub parent: usize,
@@ -153,6 +159,7 @@ pub struct SceneJoint {
 
 /// A scene document.
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Always [`FORMAT`].
     pub format: String,
