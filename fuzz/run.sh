@@ -31,11 +31,11 @@ seeds() {
   if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
 }
 
-# libFuzzer flags of a target: the iCub model descriptions (70–110 kB) would make every
-# mutated input that large; smaller inputs, from the small seed in seeds/, explore faster.
+# libFuzzer flags of a target: the iCub model descriptions (70–110 kB) and scenes (30 kB) would
+# make every mutated input that large; smaller inputs (small seeds in seeds/) explore faster.
 flags() {
   case "$1" in
-    model_description) echo -max_len=8192 ;;
+    model_description | scene) echo -max_len=8192 ;;
   esac
 }
 
@@ -67,7 +67,9 @@ case "${1:-}" in
     fi
     cargo +nightly fuzz build --release -s address
     for t in "${targets[@]}"; do
-      run "$t" -max_total_time=8 -print_final_stats=1 2>&1 | grep -E "stat::number_of_executed_units|Done|ERROR|panicked" || true
+      runs=$(run "$t" -max_total_time=8 -print_final_stats=1 2>&1 |
+        grep -E "stat::number_of_executed_units|ERROR|panicked" || true)
+      echo "fuzz smoke $t: ${runs//stat::number_of_executed_units: /} executions in 8 s"
       if [ -n "$(ls "artifacts/$t" 2>/dev/null)" ]; then
         echo "fuzz target $t crashed: see fuzz/artifacts/$t"; exit 1
       fi
