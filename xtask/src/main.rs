@@ -208,6 +208,18 @@ fn load_model(path: Option<&Path>) -> Result<RobotModel> {
     }
 }
 
+/// A trajectory `--out` must not end in `.json`: the CSV goes there and the JSON beside it, at
+/// the same name with `.json`.
+fn check_csv_out(out: Option<&Path>) -> Result<()> {
+    if let Some(out) = out.filter(|o| o.extension().is_some_and(|e| e == "json")) {
+        anyhow::bail!(
+            "--out {}: the trajectory CSV goes there and its JSON beside it with a .json extension\n  fix: give a .csv path",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 /// `out`, or `<dir>/<spec's stem>.<extension>`.
 fn default_out(out: &Option<PathBuf>, spec: &Path, dir: &str, extension: &str) -> PathBuf {
     out.clone().unwrap_or_else(|| {

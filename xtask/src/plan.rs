@@ -56,6 +56,7 @@ fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
 
 /// Plans and reports.
 pub fn run(args: &Args) -> Result<()> {
+    crate::check_csv_out(args.out.as_deref())?;
     anyhow::ensure!(
         args.velocity.is_finite() && args.velocity > 0.0,
         "--velocity {}: give a finite positive joint speed (rad/s)",

@@ -34,6 +34,7 @@ pub struct Args {
 
 /// Optimises the reach and reports it.
 pub fn run(args: &Args) -> Result<()> {
+    crate::check_csv_out(args.out.as_deref())?;
     let e = explore_spec(&args.spec)?;
     let v = crate::numbers("--at", &args.at, "\"x,y,z\" or \"x,y,z,yaw\"")?;
     anyhow::ensure!(
