@@ -31,11 +31,12 @@ seeds() {
   if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
 }
 
-# libFuzzer flags of a target: the iCub model descriptions (70–110 kB) and scenes (30 kB) would
-# make every mutated input that large; smaller inputs (small seeds in seeds/) explore faster.
+# libFuzzer flags of a target: the iCub model descriptions and URDFs (50–110 kB) and scenes
+# (30 kB) would make every mutated input that large; smaller inputs (small seeds in seeds/)
+# explore faster.
 flags() {
   case "$1" in
-    model_description | scene) echo -max_len=8192 ;;
+    model_description | scene | urdf) echo -max_len=8192 ;;
   esac
 }
 
