@@ -504,6 +504,14 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         "a parent link that does not exist".into(),
         urdf.replacen("<parent link=\"", "<parent link=\"no_such_", 1),
     ));
+    // found by fuzzing: urdf-rs's XML layer panics on this one
+    bad_urdf.push((
+        "an unbound namespace".into(),
+        String::from_utf8_lossy(include_bytes!(
+            "../../crates/trm-kinematics/tests/fixtures/fuzz_urdf_namespace.urdf"
+        ))
+        .into_owned(),
+    ));
     cases.extend(file_cases(
         &dir,
         &dir.join("icub_upper_body.urdf"),

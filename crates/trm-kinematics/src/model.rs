@@ -99,10 +99,43 @@ impl TryFrom<&urdf_rs::Robot> for RobotModel {
 }
 
 fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
-    urdf_rs::read_from_string(text).map_err(|e| KinematicsError::MalformedUrdf {
+    let malformed = |message: String| KinematicsError::MalformedUrdf {
         origin: origin.to_string(),
-        message: e.to_string(),
-    })
+        message,
+    };
+    // urdf-rs's XML layer (RustyXML) panics on some malformed namespace declarations (found by
+    // fuzzing: an attribute in a namespace bound to no prefix); that is an error, not a crash
+    match quietly(|| urdf_rs::read_from_string(text)) {
+        Ok(parsed) => parsed.map_err(|e| malformed(e.to_string())),
+        Err(panic) => {
+            let why = (panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "the XML parser failed".into());
+            Err(malformed(format!(
+                "{why} (the XML is malformed; check its xmlns declarations and prefixes)"
+            )))
+        }
+    }
+}
+
+/// Runs `f`, catching a panic without the panic hook printing it (on this thread; panics
+/// elsewhere are reported as before).
+fn quietly<R>(f: impl FnOnce() -> R + std::panic::UnwindSafe) -> std::thread::Result<R> {
+    use std::cell::Cell;
+    thread_local!(static QUIET: Cell<bool> = const { Cell::new(false) });
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    QUIET.with(|q| q.set(true));
+    let result = std::panic::catch_unwind(f);
+    QUIET.with(|q| q.set(false));
+    result
 }
 
 impl RobotModel {

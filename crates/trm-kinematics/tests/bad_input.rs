@@ -275,3 +275,19 @@ fn description_errors_point_at_their_entry_not_the_first_line_naming_it() {
         "{message}"
     );
 }
+
+#[test]
+fn a_namespace_the_xml_layer_chokes_on_is_an_error_not_a_panic() {
+    // found by fuzzing (fuzz/artifacts/urdf/crash-693f…): urdf-rs's XML layer panicked with "No
+    // namespace prefix bound"
+    let text = String::from_utf8_lossy(include_bytes!("fixtures/fuzz_urdf_namespace.urdf"));
+    let e = RobotModel::from_urdf_str(&text, "fuzz.urdf").unwrap_err();
+    assert!(matches!(e, KinematicsError::MalformedUrdf { .. }), "{e}");
+    let message = e.to_string();
+    assert!(
+        message.starts_with("fuzz.urdf") && message.contains("namespace"),
+        "{message}"
+    );
+    // and the model loads as before afterwards
+    assert!(RobotModel::from_urdf_str(&urdf(r#"<link name="a"/>"#), "ok.urdf").is_ok());
+}
