@@ -62,12 +62,9 @@ impl Hand {
         side: &str,
     ) -> trm_kinematics::Result<Self> {
         let m = |n: &str| model.motor_index(&format!("{side}_{n}"));
-        let link = |n: &str| {
-            model.frame_link(
-                model
-                    .frame_id(&format!("{side}_hand{n}"))
-                    .expect("iCub hand link"),
-            )
+        // a model without the iCub's hand links is an error naming the link, not a panic
+        let link = |n: &str| -> trm_kinematics::Result<usize> {
+            Ok(model.frame_link(model.frame_id(&format!("{side}_hand{n}"))?))
         };
         let bodies_of = |parts: &[&str]| -> Vec<usize> {
             collision
@@ -83,11 +80,17 @@ impl Hand {
                 .map(|(i, _)| i)
                 .collect()
         };
-        let finger = |name: &str, motors: Vec<usize>, parts: &[&str], tip: &str| Finger {
-            name: name.into(),
-            motors,
-            bodies: bodies_of(parts),
-            tip_link: link(tip),
+        let finger = |name: &str,
+                      motors: Vec<usize>,
+                      parts: &[&str],
+                      tip: &str|
+         -> trm_kinematics::Result<Finger> {
+            Ok(Finger {
+                name: name.into(),
+                motors,
+                bodies: bodies_of(parts),
+                tip_link: link(tip)?,
+            })
         };
         let fingers = vec![
             finger(
@@ -95,22 +98,22 @@ impl Hand {
                 vec![m("thumb_proximal")?, m("thumb_distal")?],
                 &["thumb"],
                 "_thumb_3",
-            ),
+            )?,
             finger(
                 "index",
                 vec![m("index_proximal")?, m("index_distal")?],
                 &["index"],
                 "_index_3",
-            ),
+            )?,
             finger(
                 "middle",
                 vec![m("middle_proximal")?, m("middle_distal")?],
                 &["middle"],
                 "_middle_3",
-            ),
-            finger("pinky", vec![m("pinky")?], &["ring", "little"], "_little_3"),
+            )?,
+            finger("pinky", vec![m("pinky")?], &["ring", "little"], "_little_3")?,
         ];
-        let hand_link = link("");
+        let hand_link = link("")?;
         let palm_bodies = collision
             .bodies()
             .iter()

@@ -80,3 +80,15 @@ fn grasps_along_the_stick_form_a_task_map() {
     );
     assert!(map.points.iter().all(|p| p.value > 0.0));
 }
+
+#[test]
+fn a_model_without_the_icub_hand_is_an_error_not_a_panic() {
+    let arm = trm_models::planar_arm();
+    let collision = CollisionModel::new(&arm).unwrap();
+    let e = Hand::icub(&arm, &collision, "r").unwrap_err().to_string();
+    assert!(e.contains("r_thumb_proximal"), "{e}");
+    // every motor there but no hand links: the link is named
+    let icub = trm_models::icub_upper_body();
+    let collision = CollisionModel::new(&icub).unwrap();
+    assert!(Hand::icub(&icub, &collision, "x").is_err());
+}
