@@ -30,6 +30,7 @@
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
 
 mod acm;
+mod cull;
 mod error;
 mod generate;
 pub mod mesh;

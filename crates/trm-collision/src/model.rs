@@ -4,10 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Point3};
 use trm_kinematics::{PoseBuffer, RobotModel, pose_from_xyz_rpy};
 
 use crate::acm::AllowedCollisionMatrix;
+use crate::cull::Culling;
 use crate::error::{CollisionError, Result, unknown};
 use crate::mesh::{convex_hull_of_mesh, resolve_mesh};
 use crate::shape::{Compiled, Placed, Shape, from_urdf};
@@ -66,8 +67,7 @@ struct Inner {
     acm: AllowedCollisionMatrix,
     pairs: Vec<BodyPair>,
     link_pairs: usize,
-    /// Per body: index of the first body of the next link (bodies are sorted by link).
-    next_link: Vec<u32>,
+    culling: Culling,
 }
 
 /// The collision geometry of a robot with its allowed-collision matrix. Cheap to clone,
@@ -82,6 +82,8 @@ pub struct CollisionModel {
 #[derive(Debug, Clone)]
 pub struct PlacedBodies {
     pub(crate) placed: Vec<Placed>,
+    /// World origins of the links the culling spheres are centred on.
+    pub(crate) origins: Vec<Point3<f64>>,
 }
 
 impl PlacedBodies {
@@ -169,14 +171,9 @@ impl CollisionModel {
                 }
             })?);
         }
-        let next_link: Vec<u32> = (0..bodies.len())
-            .map(|i| {
-                (i + 1..bodies.len())
-                    .find(|&j| bodies[j].link != bodies[i].link)
-                    .unwrap_or(bodies.len()) as u32
-            })
-            .collect();
         let (pairs, link_pairs) = body_pairs(&bodies, &acm);
+        let links: Vec<usize> = bodies.iter().map(|b| b.link).collect();
+        let culling = Culling::new(robot.tree(), &links, &compiled, &pairs);
         Ok(CollisionModel {
             inner: Arc::new(Inner {
                 robot: robot.clone(),
@@ -185,7 +182,7 @@ impl CollisionModel {
                 acm,
                 pairs,
                 link_pairs,
-                next_link,
+                culling,
             }),
         })
     }
@@ -244,6 +241,7 @@ impl CollisionModel {
     pub fn placed_bodies(&self) -> PlacedBodies {
         PlacedBodies {
             placed: vec![Placed::default(); self.inner.bodies.len()],
+            origins: vec![Point3::origin(); self.inner.culling.origin_links.len()],
         }
     }
 
@@ -262,6 +260,9 @@ impl CollisionModel {
         {
             c.place(&links[b.link], p);
         }
+        for (o, &l) in out.origins.iter_mut().zip(&self.inner.culling.origin_links) {
+            *o = links[l as usize].translation.vector.into();
+        }
     }
 
     pub(crate) fn compiled(&self) -> &[Compiled] {
@@ -272,8 +273,8 @@ impl CollisionModel {
         &self.inner.pairs
     }
 
-    pub(crate) fn next_link(&self) -> &[u32] {
-        &self.inner.next_link
+    pub(crate) fn culling(&self) -> &Culling {
+        &self.inner.culling
     }
 }
 

@@ -1,7 +1,8 @@
 //! Queries on placed bodies: colliding-pair counts, early-exit checks, pair lists, distances.
 
+use crate::cull::Step;
 use crate::model::{CollisionModel, PlacedBodies};
-use crate::shape::{bounds_apart, intersects, signed_distance};
+use crate::shape::{bounds_apart, intersects, signed_distance, sphere_apart};
 use crate::world::World;
 
 /// Colliding pairs of one configuration.
@@ -58,26 +59,43 @@ pub struct PairDistance {
 }
 
 impl CollisionModel {
-    /// Calls `hit(k)` for every checked body pair `k` that collides; when `hit` returns true,
-    /// the rest of that link pair is skipped. Returns early when `hit` asks to stop (`None`).
+    /// Calls `hit(k)` for every checked body pair `k` that collides, in the order of the
+    /// culling steps; when `hit` returns true, the rest of that link pair is skipped. Returns
+    /// early when `hit` asks to stop (`None`).
     #[inline]
     fn walk_self(&self, placed: &PlacedBodies, mut hit: impl FnMut(usize) -> Option<bool>) {
         let (pairs, compiled, p) = (self.pairs(), self.compiled(), &placed.placed);
-        let mut k = 0;
-        while k < pairs.len() {
-            let pair = pairs[k];
-            let (a, b) = (pair.a as usize, pair.b as usize);
-            if !bounds_apart(&p[a], &p[b]) && intersects(&compiled[a], &p[a], &compiled[b], &p[b]) {
-                match hit(k) {
-                    None => return,
-                    Some(true) => {
-                        k = pair.next as usize;
+        let steps = &self.culling().self_steps;
+        let mut i = 0;
+        while i < steps.len() {
+            match steps[i] {
+                Step::Cull { a, b, end } => {
+                    if placed.apart(a, b) {
+                        i = end as usize;
                         continue;
                     }
-                    Some(false) => {}
+                }
+                Step::Test { start, end } => {
+                    for (k, pair) in pairs
+                        .iter()
+                        .enumerate()
+                        .take(end as usize)
+                        .skip(start as usize)
+                    {
+                        let (a, b) = (pair.a as usize, pair.b as usize);
+                        if !bounds_apart(&p[a], &p[b])
+                            && intersects(&compiled[a], &p[a], &compiled[b], &p[b])
+                        {
+                            match hit(k) {
+                                None => return,
+                                Some(true) => break,
+                                Some(false) => {}
+                            }
+                        }
+                    }
                 }
             }
-            k += 1;
+            i += 1;
         }
     }
 
@@ -89,23 +107,34 @@ impl CollisionModel {
         world: &World,
         mut hit: impl FnMut(usize, usize) -> Option<bool>,
     ) {
-        let (compiled, next, p) = (self.compiled(), self.next_link(), &placed.placed);
+        let (compiled, p) = (self.compiled(), &placed.placed);
+        let steps = &self.culling().world_steps;
         for (o, object) in world.objects().iter().enumerate() {
-            let mut i = 0;
-            while i < p.len() {
-                if !bounds_apart(&p[i], &object.placed)
-                    && intersects(&compiled[i], &p[i], &object.compiled, &object.placed)
-                {
-                    match hit(i, o) {
-                        None => return,
-                        Some(true) => {
-                            i = next[i] as usize;
+            let mut s = 0;
+            while s < steps.len() {
+                match steps[s] {
+                    Step::Cull { a, end, .. } => {
+                        let (c, r) = placed.sphere(a);
+                        if sphere_apart(c, r, &object.compiled, &object.placed) {
+                            s = end as usize;
                             continue;
                         }
-                        Some(false) => {}
+                    }
+                    Step::Test { start, end } => {
+                        for i in start as usize..end as usize {
+                            if !bounds_apart(&p[i], &object.placed)
+                                && intersects(&compiled[i], &p[i], &object.compiled, &object.placed)
+                            {
+                                match hit(i, o) {
+                                    None => return,
+                                    Some(true) => break,
+                                    Some(false) => {}
+                                }
+                            }
+                        }
                     }
                 }
-                i += 1;
+                s += 1;
             }
         }
     }
@@ -169,7 +198,14 @@ impl CollisionModel {
         let (bodies, compiled, p) = (self.bodies(), self.compiled(), &placed.placed);
         let mut out = Vec::new();
         let pairs = self.pairs();
+        let mut hits = Vec::new();
         self.walk_self(placed, |k| {
+            hits.push(k);
+            Some(false)
+        });
+        // in the order of the checked pairs, not of the culling steps
+        hits.sort_unstable();
+        for k in hits {
             let (a, b) = (pairs[k].a as usize, pairs[k].b as usize);
             out.push(CollidingPair {
                 body: bodies[a].name.clone(),
@@ -178,8 +214,7 @@ impl CollisionModel {
                 other_index: b,
                 distance: signed_distance(&compiled[a], &p[a], &compiled[b], &p[b]),
             });
-            Some(false)
-        });
+        }
         self.walk_world(placed, world, |i, o| {
             let object = &world.objects()[o];
             out.push(CollidingPair {
@@ -249,9 +284,12 @@ impl CollisionModel {
         let pairs = self.pairs();
         let mut out = Vec::new();
         self.walk_self(placed, |k| {
-            out.push([pairs[k].a as usize, pairs[k].b as usize]);
+            out.push(k);
             Some(true)
         });
-        out
+        out.sort_unstable();
+        out.iter()
+            .map(|&k| [pairs[k].a as usize, pairs[k].b as usize])
+            .collect()
     }
 }

@@ -31,12 +31,37 @@ fn segment_distance_squared(
     (point_on(a1, b1, l1) - point_on(a2, b2, l2)).norm_squared()
 }
 
-/// True when a round shape's bounding sphere lies outside one of a box's slabs: a cheap reject
-/// for large boxes such as tables, which pass the bounding-sphere test for most bodies.
+/// True when a sphere lies outside one of a box's slabs: a cheap reject for large boxes such as
+/// tables, which pass the bounding-sphere test for most bodies.
+#[inline]
+fn sphere_box_apart(
+    center: &Point3<f64>,
+    radius: f64,
+    cuboid: &Placed,
+    half: &Vector3<f64>,
+) -> bool {
+    let c = cuboid.iso.inverse_transform_point(center);
+    (0..3).any(|i| c[i].abs() > half[i] + radius)
+}
+
 #[inline]
 fn round_box_apart(round: &Placed, cuboid: &Placed, half: &Vector3<f64>) -> bool {
-    let c = cuboid.iso.inverse_transform_point(&round.center);
-    (0..3).any(|i| c[i].abs() > half[i] + round.bound)
+    sphere_box_apart(&round.center, round.bound, cuboid, half)
+}
+
+/// True when a sphere cannot touch a placed shape: it misses the shape's bounding sphere or,
+/// for a box, one of its slabs.
+#[inline]
+pub(crate) fn sphere_apart(center: &Point3<f64>, radius: f64, c: &Compiled, p: &Placed) -> bool {
+    let r = radius + p.bound;
+    (center - p.center).norm_squared() > r * r
+        || match &c.geometry {
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            } => sphere_box_apart(center, radius, p, h),
+            _ => false,
+        }
 }
 
 /// Squared distance between the segment of a placed round shape and a placed box.
