@@ -1,8 +1,10 @@
 //! One NGIK cost evaluation of the 41-DOF iCub (forward kinematics, collision placement, self and
 //! world counts, and the cost terms) for the Table III posture specs: the unit every map-building
-//! step multiplies.
+//! step multiplies. `eval` is one candidate at a time; `eval_batch_32` a population of 32 through
+//! the batched path (divide by 32 for the time per candidate; criterion's throughput line gives
+//! candidates per second).
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use trm_benches::random_configurations;
 use trm_tasks::Problem;
@@ -24,6 +26,19 @@ fn objective(c: &mut Criterion) {
                 black_box(problem.objective.eval(black_box(&samples[k]), &mut scratch))
             })
         });
+        let mut out = vec![0.0; 32];
+        group.throughput(Throughput::Elements(32));
+        group.bench_function(BenchmarkId::new("eval_batch_32", name), |b| {
+            b.iter(|| {
+                k = (k + 32) % (samples.len() - 32);
+                let population = &samples[k..k + 32];
+                problem
+                    .objective
+                    .eval_batch(black_box(population), &mut scratch, &mut out);
+                black_box(&out);
+            })
+        });
+        group.throughput(Throughput::Elements(1));
     }
     group.finish();
 }

@@ -167,3 +167,30 @@ fn optimiser_generations_never_allocate() {
         );
     }
 }
+
+#[test]
+fn batched_objective_evaluations_never_allocate() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../specs/table_iii/posture1.ron"
+    );
+    let mut problem = trm_tasks::Problem::load(path).unwrap();
+    let population = trm_benches::random_configurations(problem.objective.active(), 30, 5);
+    for noise in [false, true] {
+        if noise {
+            problem.objective.set_noise(4, 0.05, 1).unwrap();
+        }
+        let objective = &problem.objective;
+        let mut scratch = objective.scratch();
+        let mut out = vec![0.0; population.len()];
+        // the first call sizes the noise buffers
+        objective.eval_batch(&population, &mut scratch, &mut out);
+        let before = allocations();
+        for _ in 0..50 {
+            objective.eval_batch(&population, &mut scratch, &mut out);
+        }
+        let after = allocations();
+        assert!(out.iter().all(|v| v.is_finite()));
+        assert_eq!(after - before, 0, "eval_batch (noise {noise}) allocated");
+    }
+}

@@ -8,7 +8,7 @@
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
-use crate::fk::{FrameId, Plan, affine};
+use crate::fk::{FrameId, Plan, PoseBuffer, affine};
 
 /// Configurations per batch.
 pub const LANES: usize = 4;
@@ -54,13 +54,24 @@ impl PoseBatch {
     /// World pose of a link or named frame in configuration `lane` (< [`LANES`]).
     #[inline]
     pub fn pose(&self, lane: usize, frame: FrameId) -> Isometry3<f64> {
-        let p = &self.poses[frame.index()];
-        Isometry3::from_parts(
-            Translation3::new(p[4][lane], p[5][lane], p[6][lane]),
-            UnitQuaternion::new_unchecked(Quaternion::new(
-                p[0][lane], p[1][lane], p[2][lane], p[3][lane],
-            )),
-        )
+        lane_pose(&self.poses[frame.index()], lane)
+    }
+
+    /// Copies the poses of configuration `lane` (< [`LANES`]) into a one-configuration buffer
+    /// of the same model, so everything written for [`PoseBuffer`] (costs, collision placement)
+    /// runs on it. No allocation.
+    ///
+    /// # Panics
+    /// If the buffer belongs to another model (another number of links and frames).
+    pub fn lane_into(&self, lane: usize, out: &mut PoseBuffer) {
+        assert_eq!(
+            out.poses.len(),
+            self.poses.len(),
+            "pose buffer of another model"
+        );
+        for (p, o) in self.poses.iter().zip(out.poses.iter_mut()) {
+            *o = lane_pose(p, lane);
+        }
     }
 
     /// World position of a link or named frame in every lane: `[x, y, z]`, each one value per
@@ -70,6 +81,16 @@ impl PoseBatch {
         let p = &self.poses[frame.index()];
         [p[4], p[5], p[6]]
     }
+}
+
+#[inline]
+fn lane_pose(p: &PoseLanes, lane: usize) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p[4][lane], p[5][lane], p[6][lane]),
+        UnitQuaternion::new_unchecked(Quaternion::new(
+            p[0][lane], p[1][lane], p[2][lane], p[3][lane],
+        )),
+    )
 }
 
 const IDENTITY: PoseLanes = [

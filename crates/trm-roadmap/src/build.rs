@@ -13,6 +13,7 @@ use std::time::Instant;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
 use trm_tasks::Problem;
 use trm_tasks::spec::MapSpec;
@@ -225,25 +226,20 @@ pub fn build(
             .par_iter_mut()
             .map(|s| s.xnes.ask(&mut s.rng).to_vec())
             .collect();
-        let jobs: Vec<(usize, &Vec<f64>)> = asked
+        let jobs: Vec<(usize, &[f64])> = asked
             .iter()
             .enumerate()
-            .flat_map(|(i, xs)| xs.iter().map(move |x| (i, x)))
+            .flat_map(|(i, xs)| xs.iter().map(move |x| (i, x.as_slice())))
             .collect();
-        let h_star = |i: usize,
-                      q: &[f64],
-                      scratch: &mut trm_tasks::Scratch,
-                      t: &mut Vec<f64>,
-                      nn: &mut Vec<(f64, usize)>| {
-            t.resize(dim, 0.0);
-            let mut h = objective.eval_with_task(q, scratch, t);
+        // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
+        let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {
             // h_map: construction and smoothness over the m nearest map points
             map.index.nearest(t, m, nn);
             let mut h_map = 0.0;
             for &(dt, j) in nn.iter() {
                 h_map += (d - dt).abs() + settings.smoothness * distance(q, &map.points[j].q);
             }
-            h += settings.construct_weight * h_map;
+            let mut h = h + settings.construct_weight * h_map;
             // h_repel: keep away from the other searches' centres
             let mut h_rep = 0.0;
             for (j, c) in centres.iter().enumerate() {
@@ -251,44 +247,69 @@ pub fn build(
                     h_rep += (d - distance(t, c)).max(0.0);
                 }
             }
-            h + options.repel_weight * h_rep
+            h += options.repel_weight * h_rep;
+            h
         };
-        // every candidate of every search, in parallel
-        let fitness: Vec<f64> = jobs
-            .par_iter()
-            .map_init(
-                || (objective.scratch(), Vec::new(), Vec::new()),
-                |(scratch, t, nn), (i, q)| h_star(*i, q, scratch, t, nn),
-            )
-            .collect();
+        // h* of (search, candidate) jobs, in parallel batches: `fitness[k]`, and g in
+        // `tasks[k·dim..]`
+        let evaluate = |jobs: &[(usize, &[f64])], fitness: &mut [f64], tasks: &mut [f64]| {
+            fitness
+                .par_chunks_mut(LANES)
+                .zip(tasks.par_chunks_mut(LANES * dim))
+                .zip(jobs.par_chunks(LANES))
+                .for_each_init(
+                    || (objective.scratch(), Vec::new()),
+                    |(scratch, nn), ((fitness, tasks), jobs)| {
+                        let mut qs = [jobs[0].1; LANES];
+                        for (q, job) in qs.iter_mut().zip(jobs) {
+                            *q = job.1;
+                        }
+                        let qs = &qs[..jobs.len()];
+                        objective.eval_with_task_batch(qs, scratch, fitness, tasks);
+                        for (k, &(i, q)) in jobs.iter().enumerate() {
+                            let t = &tasks[k * dim..(k + 1) * dim];
+                            fitness[k] = h_star(i, q, fitness[k], t, nn);
+                        }
+                    },
+                );
+        };
+        // every candidate of every search
+        let mut fitness = vec![0.0; jobs.len()];
+        let mut tasks = vec![0.0; jobs.len() * dim];
+        evaluate(&jobs, &mut fitness, &mut tasks);
         evaluations += jobs.len() as u64;
-        // tells and centre evaluations in parallel, one task per search
+        // tells in parallel, one task per search; then every search's centre
         let mut offsets = Vec::with_capacity(searches.len());
         let mut offset = 0;
         for s in &searches {
             offsets.push(offset);
             offset += s.xnes.population();
         }
-        let told: Vec<trm_optim::Result<()>> = searches
+        let told: Vec<trm_optim::Result<Vec<f64>>> = searches
             .par_iter_mut()
             .enumerate()
-            .map_init(
-                || (objective.scratch(), Vec::new(), Vec::new()),
-                |(scratch, t, nn), (i, s)| {
-                    let n = s.xnes.population();
-                    s.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
-                    let mut q = s.xnes.mean().to_vec();
-                    bounds.clamp(&mut q);
-                    let f = h_star(i, &q, scratch, t, nn);
-                    s.xnes.record_center_fitness(&q, f);
-                    s.centre_f = f;
-                    s.centre_t.clone_from(t);
-                    Ok(())
-                },
-            )
+            .map(|(i, s)| {
+                let n = s.xnes.population();
+                s.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
+                let mut q = s.xnes.mean().to_vec();
+                bounds.clamp(&mut q);
+                Ok(q)
+            })
             .collect();
-        for r in told {
-            r?;
+        let centre_qs = told.into_iter().collect::<trm_optim::Result<Vec<_>>>()?;
+        let centre_jobs: Vec<(usize, &[f64])> = centre_qs
+            .iter()
+            .enumerate()
+            .map(|(i, q)| (i, q.as_slice()))
+            .collect();
+        let mut centre_f = vec![0.0; searches.len()];
+        let mut centre_t = vec![0.0; searches.len() * dim];
+        evaluate(&centre_jobs, &mut centre_f, &mut centre_t);
+        for (i, s) in searches.iter_mut().enumerate() {
+            s.xnes.record_center_fitness(&centre_qs[i], centre_f[i]);
+            s.centre_f = centre_f[i];
+            s.centre_t
+                .copy_from_slice(&centre_t[i * dim..(i + 1) * dim]);
         }
         evaluations += searches.len() as u64;
 
@@ -305,6 +326,8 @@ pub fn build(
             bounds.clamp(&mut q);
             let mut scratch = objective.scratch();
             let mut t = vec![0.0; dim];
+            // a point stores the one-configuration values (the reference the map is checked
+            // against later); the search used the batched ones, equal to ≤ 1e-12
             let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
             let mut nn = Vec::new();
             map.index.nearest(&t, 1, &mut nn);

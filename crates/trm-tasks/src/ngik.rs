@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Start, StopOptions, StopReason, by_name, minimize};
 
 use crate::error::Result;
@@ -107,12 +108,12 @@ pub fn solve_with(
         optimizer,
         rng,
         |xs, out| {
-            xs.par_iter().zip(out.par_iter_mut()).for_each_init(
-                || objective.scratch(),
-                |scratch, (x, o)| {
-                    *o = objective.eval(x, scratch);
-                },
-            );
+            xs.par_chunks(LANES)
+                .zip(out.par_chunks_mut(LANES))
+                .for_each_init(
+                    || objective.scratch(),
+                    |scratch, (xs, out)| objective.eval_batch(xs, scratch, out),
+                );
         },
         |_| true,
     );
@@ -123,7 +124,10 @@ pub fn solve_with(
     for ((x, lo), hi) in clamped.iter_mut().zip(&lower).zip(&upper) {
         *x = x.clamp(*lo, *hi);
     }
-    let start_cost = objective.eval(&clamped, &mut scratch);
+    // the same (batched) evaluation as the population's
+    let mut start_cost = [0.0];
+    objective.eval_batch(&[&clamped], &mut scratch, &mut start_cost);
+    let start_cost = start_cost[0];
     report.evaluations += 1;
     if start_cost < report.best_f || report.best_f.is_nan() {
         report.best_f = start_cost;

@@ -1,0 +1,123 @@
+//! Batched evaluation: `Objective::eval_batch` / `eval_with_task_batch` give what one-at-a-time
+//! evaluation gives (to rounding: batched and scalar kinematics differ in the last bits), for
+//! every batch split, with robustness noise, and NaN for invalid candidates.
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use trm_tasks::{Objective, Problem};
+
+fn spec(name: &str) -> Problem {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../specs")
+        .join(name);
+    Problem::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn candidates(objective: &Objective, n: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (lower, upper) = objective.active().bounds();
+    (0..n)
+        .map(|_| {
+            lower
+                .iter()
+                .zip(&upper)
+                .map(|(&l, &u)| if l < u { rng.random_range(l..=u) } else { l })
+                .collect()
+        })
+        .collect()
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()))
+}
+
+fn agrees_with_one_at_a_time(objective: &Objective, qs: &[Vec<f64>]) {
+    let mut scratch = objective.scratch();
+    let one: Vec<f64> = qs.iter().map(|q| objective.eval(q, &mut scratch)).collect();
+    let mut all = vec![0.0; qs.len()];
+    objective.eval_batch(qs, &mut scratch, &mut all);
+    for (k, (a, b)) in one.iter().zip(&all).enumerate() {
+        assert!(
+            close(*a, *b) || (a.is_nan() && b.is_nan()),
+            "candidate {k}: {a} vs {b}"
+        );
+    }
+    // any split into batches gives the same values, bit for bit
+    for split in [1, 3, 5, 7] {
+        let mut parts = vec![0.0; qs.len()];
+        for (q, out) in qs.chunks(split).zip(parts.chunks_mut(split)) {
+            objective.eval_batch(q, &mut scratch, out);
+        }
+        assert_eq!(
+            parts.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            all.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "split {split}"
+        );
+    }
+}
+
+#[test]
+fn a_table_iii_objective_batched_equals_one_at_a_time() {
+    let problem = spec("table_iii/posture1.ron");
+    let mut qs = candidates(&problem.objective, 37, 1);
+    qs[5][0] = f64::NAN;
+    qs[11].pop();
+    agrees_with_one_at_a_time(&problem.objective, &qs);
+    let mut out = vec![0.0; qs.len()];
+    problem
+        .objective
+        .eval_batch(&qs, &mut problem.objective.scratch(), &mut out);
+    assert!(out[5].is_nan() && out[11].is_nan());
+    assert!(out.iter().filter(|v| v.is_finite()).count() == 35);
+}
+
+#[test]
+fn noise_samples_are_extra_lanes_with_the_same_mean() {
+    let mut problem = spec("table_iii/posture1.ron");
+    problem.objective.set_noise(5, 0.05, 3).unwrap();
+    let qs = candidates(&problem.objective, 10, 2);
+    agrees_with_one_at_a_time(&problem.objective, &qs);
+}
+
+#[test]
+fn task_vectors_come_with_the_costs() {
+    let problem = spec("reach.ron");
+    let objective = &problem.objective;
+    let m = objective.task().expect("reach maps a task").dim();
+    let qs = candidates(objective, 9, 3);
+    let mut scratch = objective.scratch();
+    let mut out = vec![0.0; qs.len()];
+    let mut tasks = vec![0.0; qs.len() * m];
+    objective.eval_with_task_batch(&qs, &mut scratch, &mut out, &mut tasks);
+    for (k, q) in qs.iter().enumerate() {
+        let mut t = vec![0.0; m];
+        let h = objective.eval_with_task(q, &mut scratch, &mut t);
+        assert!(close(h, out[k]), "{h} vs {}", out[k]);
+        for (a, b) in t.iter().zip(&tasks[k * m..(k + 1) * m]) {
+            assert!(close(*a, *b), "{a} vs {b}");
+        }
+    }
+}
+
+#[test]
+fn a_planar_arm_with_a_masked_task_batched_equals_one_at_a_time() {
+    let text = "(model: \"planar_arm\",
+        costs: [(weight: 0.01, cost: Displacement)],
+        task: Some(Position(part: \"tool\", mask: (true, true, false))))";
+    let problem = Problem::from_ron(text, "arm.ron", Path::new(".")).unwrap();
+    let objective = &problem.objective;
+    let qs = candidates(objective, 11, 4);
+    agrees_with_one_at_a_time(objective, &qs);
+    let m = objective.task().unwrap().dim();
+    let mut scratch = objective.scratch();
+    let (mut out, mut tasks) = (vec![0.0; qs.len()], vec![0.0; qs.len() * m]);
+    objective.eval_with_task_batch(&qs, &mut scratch, &mut out, &mut tasks);
+    for (k, q) in qs.iter().enumerate() {
+        let t = objective.task_value(q, &mut scratch);
+        for (a, b) in t.iter().zip(&tasks[k * m..(k + 1) * m]) {
+            assert!(close(*a, *b), "candidate {k}: {a} vs {b}");
+        }
+    }
+}
