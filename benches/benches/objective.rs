@@ -28,10 +28,12 @@ fn objective(c: &mut Criterion) {
         });
         let mut out = vec![0.0; 32];
         group.throughput(Throughput::Elements(32));
+        let mut half = 0;
         group.bench_function(BenchmarkId::new("eval_batch_32", name), |b| {
             b.iter(|| {
-                k = (k + 32) % (samples.len() - 32);
-                let population = &samples[k..k + 32];
+                // the same 64 samples as `eval`, as two populations
+                half = 1 - half;
+                let population = &samples[32 * half..32 * (half + 1)];
                 problem
                     .objective
                     .eval_batch(black_box(population), &mut scratch, &mut out);

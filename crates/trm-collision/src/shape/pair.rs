@@ -113,8 +113,22 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
             let (iso, round) = Compiled::round_as_parry(p2, *radius);
             parry_intersects(&p1.iso, shape.as_ref(), &iso, round.shape())
         }
-        (Geometry::General { shape: s1, .. }, Geometry::General { shape: s2, .. }) => {
-            parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref())
+        (
+            Geometry::General {
+                shape: s1,
+                half_extents: h1,
+                ..
+            },
+            Geometry::General {
+                shape: s2,
+                half_extents: h2,
+                ..
+            },
+        ) => {
+            // boxes: each bounding sphere against the other's slabs before SAT/GJK
+            let apart = h2.is_some_and(|h| sphere_box_apart(&p1.center, p1.bound, p2, &h))
+                || h1.is_some_and(|h| sphere_box_apart(&p2.center, p2.bound, p1, &h));
+            !apart && parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref())
         }
     }
 }
