@@ -8,7 +8,7 @@ use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 use trm_collision::World;
 use trm_kinematics::ActiveSet;
-use trm_roadmap::{Roadmap, distance, segment_is_free};
+use trm_roadmap::{Roadmap, distance, segment_is_collision_free};
 use trm_tasks::Objective;
 
 use crate::trajectory::{Trajectory, time_parametrise};
@@ -216,6 +216,8 @@ pub struct Planner<'a> {
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
     scratch: trm_tasks::Scratch,
+    /// Samples of the segment being checked.
+    samples: Vec<f64>,
 }
 
 impl<'a> Planner<'a> {
@@ -276,6 +278,7 @@ impl<'a> Planner<'a> {
             edges,
             edge_state,
             scratch: objective.scratch(),
+            samples: Vec::new(),
         })
     }
 
@@ -309,8 +312,16 @@ impl<'a> Planner<'a> {
 
     /// Whether the straight segment a → b is free, checked every `resolution` of joint motion.
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let mut q = a.to_vec();
-        segment_is_free(a, b, resolution, &mut q, |x| self.is_free(x))
+        let (objective, world) = (&self.objective, &self.world);
+        segment_is_collision_free(
+            objective,
+            world,
+            a,
+            b,
+            resolution,
+            &mut self.samples,
+            &mut self.scratch,
+        )
     }
 
     fn task_of(&mut self, q: &[f64]) -> Vec<f64> {

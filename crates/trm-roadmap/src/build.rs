@@ -326,8 +326,6 @@ pub fn build(
             bounds.clamp(&mut q);
             let mut scratch = objective.scratch();
             let mut t = vec![0.0; dim];
-            // a point stores the one-configuration values (the reference the map is checked
-            // against later); the search used the batched ones, equal to ≤ 1e-12
             let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
             let mut nn = Vec::new();
             map.index.nearest(&t, 1, &mut nn);

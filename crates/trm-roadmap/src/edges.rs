@@ -4,7 +4,9 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use trm_tasks::Objective;
+use trm_collision::World;
+use trm_kinematics::LANES;
+use trm_tasks::{Objective, Scratch};
 
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
@@ -50,8 +52,8 @@ pub fn connect(
     let mut edges: Vec<(usize, usize, f64)> = (0..points.len())
         .into_par_iter()
         .map_init(
-            || (objective.scratch(), vec![0.0; objective.dim()]),
-            |(scratch, q), i| {
+            || (objective.scratch(), Vec::new()),
+            |(scratch, samples), i| {
                 let mut near: Vec<(f64, usize)> = (0..points.len())
                     .filter(|&j| j != i)
                     .map(|j| (distance(&points[i].q, &points[j].q), j))
@@ -60,9 +62,11 @@ pub fn connect(
                 near.truncate(neighbours);
                 near.into_iter()
                     .filter(|&(_, j)| {
-                        segment_is_free(&points[i].q, &points[j].q, resolution, q, |x| {
-                            objective.is_collision_free(x, scratch)
-                        })
+                        let (a, b) = (&points[i].q, &points[j].q);
+                        let world = objective.world();
+                        segment_is_collision_free(
+                            objective, world, a, b, resolution, samples, scratch,
+                        )
                     })
                     .map(|(l, j)| (i.min(j), i.max(j), l))
                     .collect::<Vec<_>>()
@@ -96,17 +100,56 @@ pub fn segment_is_free(
     q: &mut [f64],
     mut free: impl FnMut(&[f64]) -> bool,
 ) -> bool {
+    let steps = segment_steps(a, b, resolution);
+    (0..=steps).all(|s| {
+        segment_point(a, b, s, steps, q);
+        free(q)
+    })
+}
+
+/// Intervals of the segment a → b at `resolution`.
+fn segment_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
     let span = a
         .iter()
         .zip(b)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
-    let steps = (span / resolution).ceil().max(1.0) as usize;
-    (0..=steps).all(|s| {
-        let u = s as f64 / steps as f64;
-        for k in 0..q.len() {
-            q[k] = a[k] + u * (b[k] - a[k]);
+    (span / resolution).ceil().max(1.0) as usize
+}
+
+/// Sample `s` of `steps` on a → b, into `q`.
+fn segment_point(a: &[f64], b: &[f64], s: usize, steps: usize, q: &mut [f64]) {
+    let u = s as f64 / steps as f64;
+    for ((q, a), b) in q.iter_mut().zip(a).zip(b) {
+        *q = a + u * (b - a);
+    }
+}
+
+/// Whether the straight segment a → b is free of self-collisions and of collisions with
+/// `world`, at the samples of [`segment_is_free`], checked [`LANES`] samples at a time with
+/// [`Objective::all_collision_free_in`]. `samples` is scratch (grown to `LANES` × dim once).
+pub fn segment_is_collision_free(
+    objective: &Objective,
+    world: &World,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    samples: &mut Vec<f64>,
+    scratch: &mut Scratch,
+) -> bool {
+    let d = a.len();
+    let steps = segment_steps(a, b, resolution);
+    samples.resize(LANES * d, 0.0);
+    let mut s = 0;
+    while s <= steps {
+        let n = LANES.min(steps + 1 - s);
+        for (l, q) in samples.chunks_exact_mut(d).take(n).enumerate() {
+            segment_point(a, b, s + l, steps, q);
         }
-        free(q)
-    })
+        if !objective.all_collision_free_in(&samples[..n * d], world, scratch) {
+            return false;
+        }
+        s += n;
+    }
+    true
 }

@@ -18,7 +18,10 @@ mod index;
 mod map;
 
 pub use build::{BuildOptions, MAX_POINTS, MAX_SEARCHES, Progress, build};
-pub use edges::{MIN_RESOLUTION, check_edge_resolution, connect, distance, segment_is_free};
+pub use edges::{
+    MIN_RESOLUTION, check_edge_resolution, connect, distance, segment_is_collision_free,
+    segment_is_free,
+};
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Roadmap, VERSION};

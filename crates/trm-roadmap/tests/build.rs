@@ -196,3 +196,55 @@ fn zero_counts_and_a_zero_step_are_errors_not_hangs() {
         assert!(connect(&mut map, &problem.objective, neighbours, resolution).is_err());
     }
 }
+
+/// Batched segment checks give the one-configuration-at-a-time verdicts, in the map's world and
+/// in a cluttered one, on segments of every length (1 to 200 samples).
+#[test]
+fn batched_segment_checks_agree_with_one_sample_at_a_time() {
+    use rand::{RngExt, SeedableRng};
+    let problem = reach();
+    let objective = &problem.objective;
+    let mut world = objective.world().clone();
+    world
+        .add(
+            "box",
+            trm_collision::Shape::Box {
+                size: [0.3, 0.3, 0.3],
+            },
+            trm_kinematics::nalgebra::Isometry3::translation(-0.25, 0.15, 0.1),
+        )
+        .unwrap();
+    let (lower, upper) = objective.active().bounds();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    let mut random = || -> Vec<f64> {
+        lower
+            .iter()
+            .zip(&upper)
+            .map(|(&l, &u)| if l < u { rng.random_range(l..=u) } else { l })
+            .collect()
+    };
+    let mut scratch = objective.scratch();
+    let (mut samples, mut q) = (Vec::new(), vec![0.0; objective.dim()]);
+    let (mut free, mut blocked) = (0, 0);
+    for k in 0..300 {
+        let (a, b) = (random(), random());
+        let resolution = [0.005, 0.05, 0.5, 10.0][k % 4];
+        for w in [objective.world(), &world] {
+            let one = trm_roadmap::segment_is_free(&a, &b, resolution, &mut q, |x| {
+                objective.is_collision_free_in(x, w, &mut scratch)
+            });
+            let batched = trm_roadmap::segment_is_collision_free(
+                objective,
+                w,
+                &a,
+                &b,
+                resolution,
+                &mut samples,
+                &mut scratch,
+            );
+            assert_eq!(one, batched, "segment {k}");
+            if one { free += 1 } else { blocked += 1 }
+        }
+    }
+    assert!(free > 20 && blocked > 20, "{free} free, {blocked} blocked");
+}

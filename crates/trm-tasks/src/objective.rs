@@ -159,9 +159,18 @@ impl Objective {
         }
     }
 
-    /// Forward kinematics (and collision placement when needed) of `q` into `scratch`.
+    /// Forward kinematics (and collision placement when needed) of `q` into `scratch`, through
+    /// the batched kinematics like every other evaluation of the objective (in all lanes, so
+    /// the values are those of any batch holding `q`): a single check and a population's
+    /// evaluation never disagree, not even at exact contact. NaN in `q` gives NaN poses.
     fn pose(&self, q: &[f64], scratch: &mut Scratch, place: bool) {
-        self.active.forward_unchecked(q, &mut scratch.poses);
+        let d = self.dim();
+        for lane in 0..LANES {
+            scratch.lanes[lane * d..(lane + 1) * d].copy_from_slice(q);
+        }
+        self.active
+            .forward_batch_unchecked(&scratch.lanes, &mut scratch.batch);
+        scratch.batch.lane_into(0, &mut scratch.poses);
         if place {
             self.collision.place(&scratch.poses, &mut scratch.placed);
         }
@@ -199,15 +208,16 @@ impl Objective {
 
     /// Poses the `n` candidates `q(k)` with batched forward kinematics, [`LANES`] at a time (a
     /// partial batch is padded), and calls `f(k, q, scratch)` with candidate `k` posed (and its
-    /// bodies placed when `place`) in `scratch`, in order of `k`. Invalid candidates (wrong
-    /// length, NaN) are skipped. A candidate's poses do not depend on the others in its batch.
+    /// bodies placed when `place`) in `scratch`, in order of `k`, until `f` returns false.
+    /// Invalid candidates (wrong length, NaN) are skipped. A candidate's poses do not depend on
+    /// the others in its batch.
     fn pose_each<'q>(
         &self,
         n: usize,
         q: impl Fn(usize) -> &'q [f64],
         scratch: &mut Scratch,
         place: bool,
-        mut f: impl FnMut(usize, &'q [f64], &mut Scratch),
+        mut f: impl FnMut(usize, &'q [f64], &mut Scratch) -> bool,
     ) {
         let d = self.dim();
         let mut lanes = [0usize; LANES];
@@ -235,16 +245,45 @@ impl Objective {
                 if place {
                     self.collision.place(&scratch.poses, &mut scratch.placed);
                 }
-                f(k, q(k), scratch);
+                if !f(k, q(k), scratch) {
+                    return;
+                }
             }
         }
     }
 
+    /// Whether every configuration of `qs` (`n × dim` values, one configuration after the
+    /// other) is free of self-collisions and of collisions with `world`: batched as
+    /// [`Objective::eval_batch`], stopping at the first collision. A configuration of NaN
+    /// counts as colliding.
+    ///
+    /// # Panics
+    /// If `qs.len()` is not a multiple of [`Objective::dim`].
+    pub fn all_collision_free_in(&self, qs: &[f64], world: &World, scratch: &mut Scratch) -> bool {
+        let d = self.dim();
+        assert!(d > 0 && qs.len() % d == 0, "whole configurations");
+        let n = qs.len() / d;
+        if qs.iter().any(|v| v.is_nan()) {
+            return false;
+        }
+        let mut free = true;
+        self.pose_each(
+            n,
+            |k| &qs[k * d..(k + 1) * d],
+            scratch,
+            true,
+            |_, _, s| {
+                free = !self.collision.is_colliding(&s.placed, world);
+                free
+            },
+        );
+        free
+    }
+
     /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), with forward kinematics
     /// for [`LANES`] candidates at a time (and every noise sample of a candidate as one more
-    /// lane). Equal to `eval` to ≤ 1e-12 (batched and one-at-a-time kinematics differ in the last
-    /// bits); each value depends on its own candidate only, so splitting `qs` differently (over
-    /// threads, say) gives the same values. Allocation-free once `scratch` has grown to the
+    /// lane). Equal to `eval`, bit for bit: each value depends on its own candidate only, so
+    /// splitting `qs` differently (over threads, say) gives the same values. Allocation-free once `scratch` has grown to the
     /// largest batch with noise.
     ///
     /// # Panics
@@ -261,6 +300,7 @@ impl Objective {
                 place,
                 |k, q, s| {
                     out[k] = self.weighted_posed(q, s);
+                    true
                 },
             );
             return;
@@ -290,6 +330,7 @@ impl Objective {
             place,
             |j, q, s| {
                 out[owner[j]] += self.weighted_posed(q, s);
+                true
             },
         );
         let samples = self.noise.len() as f64;
@@ -338,6 +379,7 @@ impl Objective {
                     out[k] = self.weighted_posed(q, s);
                 }
                 task.eval(&self.context(q, s), &mut tasks[k * m..(k + 1) * m]);
+                true
             },
         );
     }

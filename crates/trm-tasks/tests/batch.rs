@@ -1,6 +1,6 @@
 //! Batched evaluation: `Objective::eval_batch` / `eval_with_task_batch` give what one-at-a-time
-//! evaluation gives (to rounding: batched and scalar kinematics differ in the last bits), for
-//! every batch split, with robustness noise, and NaN for invalid candidates.
+//! evaluation gives, bit for bit (both run the batched kinematics), for every batch split, with
+//! robustness noise, and NaN for invalid candidates.
 
 use std::path::Path;
 
@@ -29,8 +29,8 @@ fn candidates(objective: &Objective, n: usize, seed: u64) -> Vec<Vec<f64>> {
         .collect()
 }
 
-fn close(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs()))
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits()
 }
 
 fn agrees_with_one_at_a_time(objective: &Objective, qs: &[Vec<f64>]) {
@@ -40,7 +40,7 @@ fn agrees_with_one_at_a_time(objective: &Objective, qs: &[Vec<f64>]) {
     objective.eval_batch(qs, &mut scratch, &mut all);
     for (k, (a, b)) in one.iter().zip(&all).enumerate() {
         assert!(
-            close(*a, *b) || (a.is_nan() && b.is_nan()),
+            same(*a, *b) || (a.is_nan() && b.is_nan()),
             "candidate {k}: {a} vs {b}"
         );
     }
@@ -94,9 +94,9 @@ fn task_vectors_come_with_the_costs() {
     for (k, q) in qs.iter().enumerate() {
         let mut t = vec![0.0; m];
         let h = objective.eval_with_task(q, &mut scratch, &mut t);
-        assert!(close(h, out[k]), "{h} vs {}", out[k]);
+        assert!(same(h, out[k]), "{h} vs {}", out[k]);
         for (a, b) in t.iter().zip(&tasks[k * m..(k + 1) * m]) {
-            assert!(close(*a, *b), "{a} vs {b}");
+            assert!(same(*a, *b), "{a} vs {b}");
         }
     }
 }
@@ -117,7 +117,30 @@ fn a_planar_arm_with_a_masked_task_batched_equals_one_at_a_time() {
     for (k, q) in qs.iter().enumerate() {
         let t = objective.task_value(q, &mut scratch);
         for (a, b) in t.iter().zip(&tasks[k * m..(k + 1) * m]) {
-            assert!(close(*a, *b), "candidate {k}: {a} vs {b}");
+            assert!(same(*a, *b), "candidate {k}: {a} vs {b}");
         }
     }
+}
+
+#[test]
+fn batched_collision_checks_agree_and_nan_collides() {
+    let problem = spec("table_iii/posture1.ron");
+    let objective = &problem.objective;
+    let qs = candidates(objective, 40, 6);
+    let mut scratch = objective.scratch();
+    let world = objective.world();
+    for (k, window) in qs.windows(3).enumerate() {
+        let flat: Vec<f64> = window.concat();
+        let one = window
+            .iter()
+            .all(|q| objective.is_collision_free_in(q, world, &mut scratch));
+        assert_eq!(
+            objective.all_collision_free_in(&flat, world, &mut scratch),
+            one,
+            "window {k}"
+        );
+    }
+    let mut flat = qs[0].clone();
+    flat[3] = f64::NAN;
+    assert!(!objective.all_collision_free_in(&flat, world, &mut scratch));
 }
