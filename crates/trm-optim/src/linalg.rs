@@ -51,22 +51,61 @@ impl ExpmScratch {
 /// the Paterson–Stockmeyer scheme in 5 matrix products, and the result squared s times. No
 /// allocation, no linear solve.
 pub(crate) fn expm(a: &DMatrix<f64>, out: &mut DMatrix<f64>, s: &mut ExpmScratch) {
-    let n = a.nrows();
-    let norm = (0..n)
-        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let squarings = if norm > 0.25 {
-        (norm / 0.25).log2().ceil() as i32
-    } else {
-        0
-    };
     // c_k = 1/k!
     let mut c = [1.0f64; 13];
     for k in 1..13 {
         c[k] = c[k - 1] / k as f64;
     }
+    let squarings = scaled(a, s);
+    taylor(&c, out, s);
+    for _ in 0..squarings {
+        s.t.gemm(1.0, out, out, 0.0);
+        std::mem::swap(out, &mut s.t);
+    }
+}
+
+/// `out = φ(a) = (exp(a) − I) a⁻¹ = Σ aᵏ/(k+1)!` (defined for singular a too), as [`expm`]:
+/// scaled so that ‖a‖₁ ≤ 1/4, a degree-12 Taylor polynomial, then doubled back with
+/// φ(2x) = φ(x) (x φ(x) + 2) / 2. It gives exp of a low-rank update cheaply:
+/// exp(Z W Zᵀ) = I + Z φ(W ZᵀZ) W Zᵀ.
+pub(crate) fn phim(a: &DMatrix<f64>, out: &mut DMatrix<f64>, s: &mut ExpmScratch) {
+    // c_k = 1/(k+1)!
+    let mut c = [1.0f64; 13];
+    for k in 1..13 {
+        c[k] = c[k - 1] / (k + 1) as f64;
+    }
+    let doublings = scaled(a, s);
+    taylor(&c, out, s);
+    for _ in 0..doublings {
+        // s.a holds the current argument x; out = φ(x) → φ(2x), x → 2x
+        s.t.gemm(1.0, &s.a, out, 0.0);
+        for i in 0..s.t.nrows() {
+            s.t[(i, i)] += 2.0;
+        }
+        s.a2.gemm(0.5, out, &s.t, 0.0);
+        std::mem::swap(out, &mut s.a2);
+        s.a *= 2.0;
+    }
+}
+
+/// Copies `a` into `s.a`, scaled by 2^-k so that its 1-norm is at most 1/4; returns k.
+fn scaled(a: &DMatrix<f64>, s: &mut ExpmScratch) -> i32 {
+    let n = a.nrows();
+    let norm = (0..n)
+        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let k = if norm > 0.25 {
+        (norm / 0.25).log2().ceil() as i32
+    } else {
+        0
+    };
     s.a.copy_from(a);
-    s.a *= 0.5f64.powi(squarings);
+    s.a *= 0.5f64.powi(k);
+    k
+}
+
+/// `out = Σ_{k ≤ 12} c_k Aᵏ` for A = `s.a`, by Paterson–Stockmeyer in 5 matrix products.
+fn taylor(c: &[f64; 13], out: &mut DMatrix<f64>, s: &mut ExpmScratch) {
     s.a2.gemm(1.0, &s.a, &s.a, 0.0);
     s.a3.gemm(1.0, &s.a2, &s.a, 0.0);
     s.a4.gemm(1.0, &s.a2, &s.a2, 0.0);
@@ -90,15 +129,34 @@ pub(crate) fn expm(a: &DMatrix<f64>, out: &mut DMatrix<f64>, s: &mut ExpmScratch
     s.t.gemm(1.0, &s.a4, out, 0.0);
     block(&mut s.t, 0, &s.a, &s.a2, &s.a3);
     std::mem::swap(out, &mut s.t);
-    for _ in 0..squarings {
-        s.t.gemm(1.0, out, out, 0.0);
-        std::mem::swap(out, &mut s.t);
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn phim_times_a_is_expm_minus_identity() {
+        let n = 7;
+        let a = DMatrix::from_fn(n, n, |i, j| ((i * 5 + j * 3) % 7) as f64 * 0.1 - 0.3);
+        for factor in [0.0, 0.01, 0.2, 1.0, 6.0] {
+            let m = &a * factor;
+            let mut s = ExpmScratch::new(n);
+            let (mut e, mut p) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+            expm(&m, &mut e, &mut s);
+            phim(&m, &mut p, &mut s);
+            let want = e - DMatrix::identity(n, n);
+            let scale = want.abs().max().max(1e-300);
+            let got = &m * &p;
+            assert!(
+                (got - &want).abs().max() <= 1e-13 * scale.max(1.0),
+                "factor {factor}"
+            );
+            if factor == 0.0 {
+                assert_eq!(p, DMatrix::identity(n, n));
+            }
+        }
+    }
 
     #[test]
     fn expm_matches_the_eigen_decomposition() {

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
 use crate::error::{Result, invalid, positive};
-use crate::linalg::{ExpmScratch, expm, fill_normal, rank};
+use crate::linalg::{ExpmScratch, expm, fill_normal, phim, rank};
 
 /// xNES settings; `None` = the paper's default.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -65,6 +65,14 @@ pub struct Xnes {
     e: DMatrix<f64>,
     t1: DMatrix<f64>,
     expm_scratch: ExpmScratch,
+    /// λ < d: B's update through the low-rank identity exp(Z W Zᵀ) = I + Z φ(W ZᵀZ) W Zᵀ on
+    /// λ × λ matrices instead of a d × d exponential.
+    low_rank: bool,
+    /// Low-rank update: W ZᵀZ and φ of it (λ × λ), φ W Zᵀ (λ × d), scratch for φ.
+    k: DMatrix<f64>,
+    phi: DMatrix<f64>,
+    phi_wzt: DMatrix<f64>,
+    phi_scratch: ExpmScratch,
     mean_slice: Vec<f64>,
 }
 
@@ -109,6 +117,11 @@ impl Xnes {
             e: DMatrix::zeros(d, d),
             t1: DMatrix::zeros(d, d),
             expm_scratch: ExpmScratch::new(d),
+            low_rank: lambda < d,
+            k: DMatrix::zeros(lambda, lambda),
+            phi: DMatrix::zeros(lambda, lambda),
+            phi_wzt: DMatrix::zeros(lambda, d),
+            phi_scratch: ExpmScratch::new(lambda),
             mean_slice: start.mean.clone(),
         })
     }
@@ -158,30 +171,45 @@ impl Optimizer for Xnes {
                 self.uzt[(k, i)] = u * self.z[(i, k)];
             }
         }
-        self.g.gemm(1.0, &self.z, &self.uzt, 0.0);
-        for j in 0..d {
-            for i in 0..j {
-                let v = 0.5 * (self.g[(i, j)] + self.g[(j, i)]);
-                self.g[(i, j)] = v;
-                self.g[(j, i)] = v;
-            }
-        }
         for i in 0..d {
             self.grad_mean[i] = self.uzt.column(i).sum();
         }
-        let g_sigma = self.g.trace() / d as f64;
-        for i in 0..d {
-            self.g[(i, i)] -= g_sigma;
-        }
+        // G_σ = tr(G_M)/d = Σ u_k |z_k|² / d
+        let g_sigma = (0..self.lambda)
+            .map(|k| self.uzt.row(k).dot(&self.z.column(k).transpose()))
+            .sum::<f64>()
+            / d as f64;
         // μ ← μ + η_μ σ B G_δ
         self.step.gemv(1.0, &self.b, &self.grad_mean, 0.0);
         self.mean.axpy(self.eta_mean * self.sigma, &self.step, 1.0);
         self.sigma *= (0.5 * self.eta_sigma * g_sigma).exp();
-        // B ← B exp(η_B/2 G_B)
-        self.g *= 0.5 * self.eta_b;
-        expm(&self.g, &mut self.e, &mut self.expm_scratch);
-        self.t1.gemm(1.0, &self.b, &self.e, 0.0);
-        std::mem::swap(&mut self.b, &mut self.t1);
+        // B ← B exp(η_B/2 G_B), G_B = G_M − G_σ I
+        let half = 0.5 * self.eta_b;
+        if self.low_rank {
+            // B exp(η_B/2 G_M) = B + (B Z) φ(K) Ŵ Zᵀ, Ŵ = η_B/2 U, K = Ŵ ZᵀZ; and
+            // exp(−η_B/2 G_σ I) is a scalar
+            self.k.gemm(half, &self.uzt, &self.z, 0.0);
+            phim(&self.k, &mut self.phi, &mut self.phi_scratch);
+            self.phi_wzt.gemm(half, &self.phi, &self.uzt, 0.0);
+            self.b.gemm(1.0, &self.bz, &self.phi_wzt, 1.0);
+            self.b *= (-half * g_sigma).exp();
+        } else {
+            self.g.gemm(1.0, &self.z, &self.uzt, 0.0);
+            for j in 0..d {
+                for i in 0..j {
+                    let v = 0.5 * (self.g[(i, j)] + self.g[(j, i)]);
+                    self.g[(i, j)] = v;
+                    self.g[(j, i)] = v;
+                }
+            }
+            for i in 0..d {
+                self.g[(i, i)] -= g_sigma;
+            }
+            self.g *= half;
+            expm(&self.g, &mut self.e, &mut self.expm_scratch);
+            self.t1.gemm(1.0, &self.b, &self.e, 0.0);
+            std::mem::swap(&mut self.b, &mut self.t1);
+        }
         if !(self.sigma.is_finite() && self.sigma > 0.0) || self.b.iter().any(|v| !v.is_finite()) {
             self.state.set_degenerate();
         }
@@ -207,5 +235,49 @@ impl Optimizer for Xnes {
 
     fn state_mut(&mut self) -> &mut State {
         &mut self.state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    /// The low-rank update of B equals the d × d exponential's.
+    #[test]
+    fn low_rank_and_full_updates_agree() {
+        let d = 23;
+        let start = Start::new(vec![0.3; d], 0.5);
+        let options = XnesOptions {
+            population: Some(9),
+            ..Default::default()
+        };
+        let mut low = Xnes::new(&start, &options).unwrap();
+        assert!(low.low_rank);
+        let mut full = low.clone();
+        full.low_rank = false;
+        let (mut r1, mut r2) = (
+            rand_chacha::ChaCha8Rng::seed_from_u64(3),
+            rand_chacha::ChaCha8Rng::seed_from_u64(3),
+        );
+        for generation in 0..60 {
+            let fitness: Vec<f64> = low
+                .ask(&mut r1)
+                .iter()
+                .map(|x| {
+                    x.iter()
+                        .enumerate()
+                        .map(|(i, v)| (i + 1) as f64 * v * v)
+                        .sum()
+                })
+                .collect();
+            full.ask(&mut r2);
+            low.tell(&fitness).unwrap();
+            full.tell(&fitness).unwrap();
+            let scale = full.b.abs().max();
+            let diff = (&low.b - &full.b).abs().max();
+            assert!(diff <= 1e-12 * scale, "generation {generation}: {diff}");
+            assert!((low.sigma - full.sigma).abs() <= 1e-14 * full.sigma);
+        }
     }
 }
