@@ -1,21 +1,12 @@
 //! Shared inputs for trm's criterion benches (`cargo bench -p trm-benches`). The suites are in
 //! `benches/benches/`.
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use trm_kinematics::ActiveSet;
 
 /// `n` seeded uniform samples within the bounds of `active`.
 pub fn random_configurations(active: &ActiveSet, n: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (lower, upper) = active.bounds();
-    (0..n)
-        .map(|_| {
-            lower
-                .iter()
-                .zip(&upper)
-                .map(|(&l, &u)| if l < u { rng.random_range(l..=u) } else { l })
-                .collect()
-        })
-        .collect()
+    (0..n).map(|_| active.random(&mut rng)).collect()
 }

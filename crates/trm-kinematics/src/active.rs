@@ -147,6 +147,20 @@ impl ActiveSet {
         )
     }
 
+    /// A configuration drawn uniformly within the active motors' limits (a motor whose limits
+    /// coincide keeps that value). Seed `rng` for reproducible samples.
+    pub fn random(&self, rng: &mut impl rand::Rng) -> Vec<f64> {
+        use rand::RngExt;
+        let m = self.model.motors();
+        self.active
+            .iter()
+            .map(|&i| {
+                let (l, u) = (m[i].limits.lower, m[i].limits.upper);
+                if l < u { rng.random_range(l..=u) } else { l }
+            })
+            .collect()
+    }
+
     /// Active values taken from a full motor vector.
     pub fn from_motors(&self, motors: &[f64]) -> Vec<f64> {
         self.active.iter().map(|&m| motors[m]).collect()

@@ -122,3 +122,24 @@ fn wrong_lengths_non_finite_values_and_foreign_batches_are_errors() {
             .is_err()
     );
 }
+
+#[test]
+fn random_configurations_are_within_the_limits_and_seeded() {
+    let model = model("icub_upper_body.ron");
+    let active = model.all_active();
+    let (lower, upper) = active.bounds();
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let samples: Vec<Vec<f64>> = (0..200).map(|_| active.random(&mut rng)).collect();
+    for q in &samples {
+        assert_eq!(q.len(), lower.len());
+        assert!(
+            q.iter()
+                .zip(&lower)
+                .zip(&upper)
+                .all(|((v, l), u)| l <= v && v <= u)
+        );
+    }
+    let mut again = ChaCha8Rng::seed_from_u64(4);
+    assert_eq!(active.random(&mut again), samples[0]);
+    assert_ne!(samples[0], samples[1]);
+}

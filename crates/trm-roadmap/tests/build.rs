@@ -201,7 +201,7 @@ fn zero_counts_and_a_zero_step_are_errors_not_hangs() {
 /// in a cluttered one, on segments of every length (1 to 200 samples).
 #[test]
 fn batched_segment_checks_agree_with_one_sample_at_a_time() {
-    use rand::{RngExt, SeedableRng};
+    use rand::SeedableRng;
     let problem = reach();
     let objective = &problem.objective;
     let mut world = objective.world().clone();
@@ -214,15 +214,8 @@ fn batched_segment_checks_agree_with_one_sample_at_a_time() {
             trm_kinematics::nalgebra::Isometry3::translation(-0.25, 0.15, 0.1),
         )
         .unwrap();
-    let (lower, upper) = objective.active().bounds();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
-    let mut random = || -> Vec<f64> {
-        lower
-            .iter()
-            .zip(&upper)
-            .map(|(&l, &u)| if l < u { rng.random_range(l..=u) } else { l })
-            .collect()
-    };
+    let mut random = || objective.active().random(&mut rng);
     let mut scratch = objective.scratch();
     let (mut samples, mut q) = (Vec::new(), vec![0.0; objective.dim()]);
     let (mut free, mut blocked) = (0, 0);

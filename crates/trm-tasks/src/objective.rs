@@ -283,29 +283,78 @@ impl Objective {
     /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), with forward kinematics
     /// for [`LANES`] candidates at a time (and every noise sample of a candidate as one more
     /// lane). Equal to `eval`, bit for bit: each value depends on its own candidate only, so
-    /// splitting `qs` differently (over threads, say) gives the same values. Allocation-free once `scratch` has grown to the
-    /// largest batch with noise.
+    /// splitting `qs` differently (over threads, say) gives the same values. Allocation-free
+    /// once `scratch` has grown to the largest batch with noise.
     ///
     /// # Panics
     /// If `out` and `qs` differ in length.
     pub fn eval_batch<Q: AsRef<[f64]>>(&self, qs: &[Q], scratch: &mut Scratch, out: &mut [f64]) {
-        assert_eq!(qs.len(), out.len(), "one output per candidate");
-        out.fill(f64::NAN);
-        if self.noise.is_empty() {
-            let place = self.needs_collision;
-            self.pose_each(
-                qs.len(),
-                |k| qs[k].as_ref(),
-                scratch,
-                place,
-                |k, q, s| {
-                    out[k] = self.weighted_posed(q, s);
-                    true
-                },
+        self.eval_batch_with(qs, scratch, out, None);
+    }
+
+    /// [`Objective::eval_with_task`] of many candidates: `out[k]` = h(`qs[k]`) and
+    /// `tasks[k·m..(k+1)·m]` = g(`qs[k]`) (m = the task dimension; left untouched without a
+    /// task function and for invalid candidates). Batched as [`Objective::eval_batch`].
+    ///
+    /// # Panics
+    /// If `out` and `qs` differ in length or `tasks` is shorter than `qs.len()` × m.
+    pub fn eval_with_task_batch<Q: AsRef<[f64]>>(
+        &self,
+        qs: &[Q],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+        tasks: &mut [f64],
+    ) {
+        let task = self.task.as_deref().map(|task| {
+            assert!(
+                tasks.len() >= qs.len() * task.dim(),
+                "one task vector per candidate"
             );
-            return;
+            (task, tasks)
+        });
+        self.eval_batch_with(qs, scratch, out, task);
+    }
+
+    /// h of every candidate into `out` and, with a task function, g into its buffer.
+    fn eval_batch_with<Q: AsRef<[f64]>>(
+        &self,
+        qs: &[Q],
+        scratch: &mut Scratch,
+        out: &mut [f64],
+        mut task: Option<(&dyn TaskFunction, &mut [f64])>,
+    ) {
+        assert_eq!(qs.len(), out.len(), "one output per candidate");
+        let nominal = self.noise.is_empty();
+        if nominal {
+            out.fill(f64::NAN);
+        } else {
+            self.eval_noisy_batch(qs, scratch, out);
+            if task.is_none() {
+                return;
+            }
         }
-        // every valid candidate's noisy copies, one after the other
+        let place = nominal && self.needs_collision;
+        self.pose_each(
+            qs.len(),
+            |k| qs[k].as_ref(),
+            scratch,
+            place,
+            |k, q, s| {
+                if nominal {
+                    out[k] = self.weighted_posed(q, s);
+                }
+                if let Some((task, tasks)) = &mut task {
+                    let m = task.dim();
+                    task.eval(&self.context(q, s), &mut tasks[k * m..(k + 1) * m]);
+                }
+                true
+            },
+        );
+    }
+
+    /// The robust h: the mean over every valid candidate's noisy copies, all posed in batches.
+    fn eval_noisy_batch<Q: AsRef<[f64]>>(&self, qs: &[Q], scratch: &mut Scratch, out: &mut [f64]) {
+        out.fill(f64::NAN);
         let d = self.dim();
         let mut noisy = std::mem::take(&mut scratch.noisy_batch);
         let mut owner = std::mem::take(&mut scratch.noisy_owner);
@@ -341,47 +390,6 @@ impl Objective {
         }
         scratch.noisy_batch = noisy;
         scratch.noisy_owner = owner;
-    }
-
-    /// [`Objective::eval_with_task`] of many candidates: `out[k]` = h(`qs[k]`) and
-    /// `tasks[k·m..(k+1)·m]` = g(`qs[k]`) (m = the task dimension; left untouched without a
-    /// task function and for invalid candidates). Batched as [`Objective::eval_batch`].
-    ///
-    /// # Panics
-    /// If `out` and `qs` differ in length or `tasks` is shorter than `qs.len()` × m.
-    pub fn eval_with_task_batch<Q: AsRef<[f64]>>(
-        &self,
-        qs: &[Q],
-        scratch: &mut Scratch,
-        out: &mut [f64],
-        tasks: &mut [f64],
-    ) {
-        let Some(task) = &self.task else {
-            return self.eval_batch(qs, scratch, out);
-        };
-        let m = task.dim();
-        assert!(tasks.len() >= qs.len() * m, "one task vector per candidate");
-        let nominal = self.noise.is_empty();
-        if nominal {
-            assert_eq!(qs.len(), out.len(), "one output per candidate");
-            out.fill(f64::NAN);
-        } else {
-            self.eval_batch(qs, scratch, out);
-        }
-        let place = nominal && self.needs_collision;
-        self.pose_each(
-            qs.len(),
-            |k| qs[k].as_ref(),
-            scratch,
-            place,
-            |k, q, s| {
-                if nominal {
-                    out[k] = self.weighted_posed(q, s);
-                }
-                task.eval(&self.context(q, s), &mut tasks[k * m..(k + 1) * m]);
-                true
-            },
-        );
     }
 
     /// h(q) = Σ aᵢ hᵢ (the mean over the noise samples when noise is set). NaN for a q of the

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use trm_tasks::{Objective, Problem};
 
@@ -17,15 +17,8 @@ fn spec(name: &str) -> Problem {
 
 fn candidates(objective: &Objective, n: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (lower, upper) = objective.active().bounds();
     (0..n)
-        .map(|_| {
-            lower
-                .iter()
-                .zip(&upper)
-                .map(|(&l, &u)| if l < u { rng.random_range(l..=u) } else { l })
-                .collect()
-        })
+        .map(|_| objective.active().random(&mut rng))
         .collect()
 }
 
