@@ -127,9 +127,9 @@ fn optimiser_generations_never_allocate() {
     });
     // Our own buffers are reused everywhere. The exceptions are inside nalgebra: its matrix
     // products (through matrixmultiply) allocate packing buffers, one per product (xNES makes
-    // 8 per generation, CMA-ES 3), and CMA-ES's eigendecomposition allocates its result.
+    // 8–9 per generation, CMA-ES 3), and CMA-ES's eigendecomposition allocates its result.
     for (algo, products) in [
-        ("xnes", 10), // 8 products, plus squarings of larger exponentials
+        ("xnes", 10), // 8–9 products, plus squarings of larger exponentials
         ("snes", 0),
         ("oneplusone", 0),
         ("sir", 0),

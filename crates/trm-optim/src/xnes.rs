@@ -176,7 +176,11 @@ impl Optimizer for Xnes {
         }
         // G_σ = tr(G_M)/d = Σ u_k |z_k|² / d
         let g_sigma = (0..self.lambda)
-            .map(|k| self.uzt.row(k).dot(&self.z.column(k).transpose()))
+            .map(|k| {
+                (0..d)
+                    .map(|i| self.uzt[(k, i)] * self.z[(i, k)])
+                    .sum::<f64>()
+            })
             .sum::<f64>()
             / d as f64;
         // μ ← μ + η_μ σ B G_δ

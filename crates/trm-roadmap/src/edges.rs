@@ -128,6 +128,9 @@ fn segment_point(a: &[f64], b: &[f64], s: usize, steps: usize, q: &mut [f64]) {
 /// Whether the straight segment a → b is free of self-collisions and of collisions with
 /// `world`, at the samples of [`segment_is_free`], checked [`LANES`] samples at a time with
 /// [`Objective::all_collision_free_in`]. `samples` is scratch (grown to `LANES` × dim once).
+///
+/// # Panics
+/// If `a` or `b` does not have one value per active motor of `objective`.
 pub fn segment_is_collision_free(
     objective: &Objective,
     world: &World,
@@ -137,7 +140,8 @@ pub fn segment_is_collision_free(
     samples: &mut Vec<f64>,
     scratch: &mut Scratch,
 ) -> bool {
-    let d = a.len();
+    let d = objective.dim();
+    assert!(a.len() == d && b.len() == d, "one value per active motor");
     let steps = segment_steps(a, b, resolution);
     samples.resize(LANES * d, 0.0);
     let mut s = 0;
