@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_collision::World;
-use trm_plan::{Goal, PlanOptions, Planner};
+use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
 use trm_roadmap::Roadmap;
 use trm_tasks::Problem;
 
@@ -22,12 +22,20 @@ pub struct Args {
     /// (as `solve --out` writes) or "q": [active values].
     #[arg(long, default_value = "home")]
     from: String,
-    /// Goal: a task-space point "x,y,z" (any map node within --tolerance) or a JSON posture file.
+    /// Goal: a task-space point "x,y,z" (through a map node within --tolerance, then to the
+    /// point itself) or a JSON posture file.
     #[arg(long, allow_hyphen_values = true)]
     to: String,
-    /// Task-space tolerance for a point goal.
+    /// Task-space tolerance for the map node a point goal's path goes through.
     #[arg(long, default_value_t = 0.03)]
     tolerance: f64,
+    /// End a point goal's path at that map node: no exact finish (NGIK to the point and a
+    /// collision-checked last segment).
+    #[arg(long)]
+    no_exact: bool,
+    /// Task error the exact finish must reach (metres for positions).
+    #[arg(long, default_value_t = 1e-3, value_parser = crate::parse::positive)]
+    exact_tolerance: f64,
     /// Trajectory output (CSV; a .json with the task-space path is written beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -106,6 +114,8 @@ pub fn run(args: &Args) -> Result<()> {
     let options = PlanOptions {
         seed: args.seed,
         default_velocity: args.velocity,
+        exact_goal: !args.no_exact,
+        exact_tolerance: args.exact_tolerance,
         ..Default::default()
     };
     let plan = planner.plan(&start, &goal, &options)?;
@@ -134,6 +144,16 @@ pub fn run(args: &Args) -> Result<()> {
     );
     if let Some(last) = plan.trajectory.task_path.last() {
         println!("reached task point {last:?}");
+    }
+    match (&s.exact, s.goal_error) {
+        (ExactGoal::Reached { evaluations, .. }, Some(e)) => {
+            println!("exact goal: reached, task error {e:.2e} ({evaluations} NGIK evaluations)")
+        }
+        (ExactGoal::Fallback { reason }, Some(e)) => println!(
+            "exact goal: not used ({reason}); the path ends at the map node, task error {e:.3}"
+        ),
+        (_, Some(e)) => println!("task error at the end: {e:.3} (exact finish off)"),
+        _ => {}
     }
     if let Some(out) = &args.out {
         crate::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;

@@ -643,6 +643,11 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         "--velocity",
         &["0", "-1", "NaN", "inf"],
     ));
+    cases.extend(flag_cases(
+        &plan_to,
+        "--exact-tolerance",
+        &["0", "-1", "NaN", "inf", "x"],
+    ));
     cases.extend(flag_cases(&plan_to, "--seed", &["-5", "x"]));
     cases.extend(flag_cases(&plan_to, "--out", &["t.json"]));
     cases.extend(file_flag_cases(

@@ -16,5 +16,7 @@
 mod planner;
 mod trajectory;
 
-pub use planner::{Goal, PlanError, PlanOptions, PlanStats, Planned, Planner};
+pub use planner::{
+    EXACT_WEIGHT, ExactGoal, Goal, PlanError, PlanOptions, PlanStats, Planned, Planner,
+};
 pub use trajectory::{Trajectory, time_parametrise};

@@ -109,6 +109,41 @@ pub struct PlanOptions {
     pub default_velocity: f64,
     /// Optional joint acceleration limit, rad/s² (trapezoidal segments).
     pub acceleration: Option<f64>,
+    /// Finish a task-point goal at the point itself, not at the map node within the tolerance:
+    /// NGIK from the last node (the map's costs plus [`EXACT_WEIGHT`] · the task error, in the
+    /// current world) and a collision-checked straight final segment. When that fails, the
+    /// path ends at the node and [`PlanStats::exact`] says why.
+    pub exact_goal: bool,
+    /// Task error the exact finish must reach (task units: metres for positions).
+    pub exact_tolerance: f64,
+    /// Evaluation budget of the exact finish.
+    pub exact_evaluations: u64,
+}
+
+/// Weight of the task error in the exact finish of a task-point goal: large enough to dominate
+/// the map's costs near the target (an unsquared error has a constant gradient there, so the
+/// minimum sits on the target when its weight beats the other terms' slopes).
+pub const EXACT_WEIGHT: f64 = 100.0;
+
+/// How the exact finish of a task-point goal went.
+#[derive(Debug, Clone, Default, PartialEq)]
+#[non_exhaustive]
+pub enum ExactGoal {
+    /// Not attempted (not a task-point goal, or [`PlanOptions::exact_goal`] off).
+    #[default]
+    NotTried,
+    /// The path ends at the goal: final task error and NGIK evaluations spent.
+    Reached {
+        /// Task-space distance of the final posture to the goal point.
+        error: f64,
+        /// NGIK evaluations.
+        evaluations: u64,
+    },
+    /// The path ends at the map node; why the exact finish was not used.
+    Fallback {
+        /// What failed.
+        reason: String,
+    },
 }
 
 impl Default for PlanOptions {
@@ -120,6 +155,9 @@ impl Default for PlanOptions {
             seed: 0,
             default_velocity: 1.0,
             acceleration: None,
+            exact_goal: true,
+            exact_tolerance: 1e-3,
+            exact_evaluations: 30_000,
         }
     }
 }
@@ -164,6 +202,21 @@ impl PlanOptions {
                 );
             }
         }
+        if !(self.exact_tolerance.is_finite() && self.exact_tolerance > 0.0) {
+            return bad(
+                "exact_tolerance",
+                format!(
+                    "{}: give a finite positive task error",
+                    self.exact_tolerance
+                ),
+            );
+        }
+        if self.exact_goal && self.exact_evaluations == 0 {
+            return bad(
+                "exact_evaluations",
+                "0: give a budget of at least 1 evaluation, or turn exact_goal off".into(),
+            );
+        }
         Ok(())
     }
 }
@@ -185,6 +238,10 @@ pub struct PlanStats {
     pub length: f64,
     /// Wall time, seconds.
     pub seconds: f64,
+    /// Task-space distance of the path's end to a task-point goal (`None` for other goals).
+    pub goal_error: Option<f64>,
+    /// The exact finish of a task-point goal.
+    pub exact: ExactGoal,
 }
 
 /// A planned motion.
@@ -550,6 +607,13 @@ impl<'a> Planner<'a> {
                 path.iter().map(|v| config(v.index(), self)).collect();
             stats.path_nodes = node_ids.len();
             self.shortcut(&mut waypoints, options);
+            if let Goal::TaskPoint { t, .. } = goal {
+                if options.exact_goal {
+                    stats.exact = self.finish_exactly(&mut waypoints, t, options);
+                }
+                let end = waypoints.last().cloned().unwrap_or_default();
+                stats.goal_error = Some(distance(&self.task_of(&end), t));
+            }
             stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
             let trajectory = self.timed(&waypoints, options);
             stats.seconds = began.elapsed().as_secs_f64();
@@ -558,6 +622,56 @@ impl<'a> Planner<'a> {
                 nodes: node_ids,
                 stats,
             });
+        }
+    }
+
+    /// Appends a posture at the task point `t` reached by NGIK from the last waypoint, when it
+    /// is within the tolerance, collision-free, and joined by a free straight segment.
+    fn finish_exactly(
+        &mut self,
+        waypoints: &mut Vec<Vec<f64>>,
+        t: &[f64],
+        options: &PlanOptions,
+    ) -> ExactGoal {
+        let fallback = |reason: String| ExactGoal::Fallback { reason };
+        let Some(last) = waypoints.last().cloned() else {
+            return fallback("the path is empty".into());
+        };
+        let objective = match self.objective.with_task_target(t, EXACT_WEIGHT) {
+            Ok(o) => o.with_world(self.world.clone()),
+            Err(e) => return fallback(e.to_string()),
+        };
+        let solver = trm_tasks::spec::SolverSpec {
+            sigma: 0.02,
+            population: Some(30),
+            max_evaluations: options.exact_evaluations,
+            no_improvement: Some(5_000.min(options.exact_evaluations)),
+            seed: options.seed,
+            ..Default::default()
+        };
+        let solution = match trm_tasks::solve(&objective, &last, &solver) {
+            Ok(s) => s,
+            Err(e) => return fallback(format!("NGIK failed: {e}")),
+        };
+        let error = distance(&solution.task, t);
+        if error.is_nan() || error > options.exact_tolerance {
+            return fallback(format!(
+                "NGIK came within {error:.3e} of the goal, not {:.0e} (unreachable, or blocked in the current world)",
+                options.exact_tolerance
+            ));
+        }
+        if !self.is_free(&solution.q) {
+            return fallback("the posture at the goal collides in the current world".into());
+        }
+        if !self.segment_free(&last, &solution.q, options.resolution) {
+            return fallback(
+                "the straight segment from the last map node to the goal posture collides".into(),
+            );
+        }
+        waypoints.push(solution.q);
+        ExactGoal::Reached {
+            error,
+            evaluations: solution.evaluations,
         }
     }
 

@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
-use trm_plan::{Goal, PlanError, PlanOptions, Planner};
+use trm_plan::{ExactGoal, Goal, PlanError, PlanOptions, Planner};
 use trm_roadmap::{BuildOptions, Roadmap, build, connect};
 use trm_tasks::Problem;
 
@@ -301,8 +301,84 @@ fn out_of_range_options_are_refused_before_planning() {
             attach_neighbours: 0,
             ..Default::default()
         },
+        PlanOptions {
+            exact_tolerance: 0.0,
+            ..Default::default()
+        },
+        PlanOptions {
+            exact_tolerance: f64::NAN,
+            ..Default::default()
+        },
+        PlanOptions {
+            exact_evaluations: 0,
+            ..Default::default()
+        },
     ] {
         let e = planner.plan(&problem.start, &goal, &options).unwrap_err();
         assert!(matches!(e, PlanError::InvalidOptions { .. }), "{e}");
     }
+}
+
+/// A point goal off the map nodes: the path goes through a node within the tolerance and then
+/// to the point itself (NGIK, checked last segment); without the exact finish, or when it
+/// cannot reach the asked accuracy, the path ends at the node and says why.
+#[test]
+fn a_point_goal_is_finished_exactly_or_falls_back_clearly() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    let node = &map.points[map.points.len() / 3].t;
+    let goal_t: Vec<f64> = node
+        .iter()
+        .zip([0.012, -0.008, 0.006])
+        .map(|(a, b)| a + b)
+        .collect();
+    let goal = Goal::TaskPoint {
+        t: goal_t.clone(),
+        tolerance: 0.03,
+    };
+    let options = PlanOptions::default();
+    let plan = planner.plan(&p.start, &goal, &options).unwrap();
+    check(&mut planner, &p.start, &plan, &options);
+    assert!(
+        matches!(plan.stats.exact, ExactGoal::Reached { .. }),
+        "{:?}",
+        plan.stats.exact
+    );
+    let error = plan.stats.goal_error.unwrap();
+    assert!(error <= 1e-3, "ends {error} from the goal");
+    let end = plan.trajectory.task_path.last().unwrap();
+    let d = trm_roadmap::distance(end, &goal_t);
+    assert!((d - error).abs() < 1e-12, "{d} vs {error}");
+
+    let at_node = planner
+        .plan(
+            &p.start,
+            &goal,
+            &PlanOptions {
+                exact_goal: false,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    assert_eq!(at_node.stats.exact, ExactGoal::NotTried);
+    assert!(at_node.stats.goal_error.unwrap() > 1e-3);
+    assert_eq!(
+        at_node.trajectory.times.len() + 1,
+        plan.trajectory.times.len(),
+        "one more waypoint"
+    );
+
+    let strict = PlanOptions {
+        exact_tolerance: 1e-14,
+        exact_evaluations: 2_000,
+        ..Default::default()
+    };
+    let fallback = planner.plan(&p.start, &goal, &strict).unwrap();
+    check(&mut planner, &p.start, &fallback, &strict);
+    match &fallback.stats.exact {
+        ExactGoal::Fallback { reason } => assert!(reason.contains("came within"), "{reason}"),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(fallback.trajectory, at_node.trajectory);
 }

@@ -5,6 +5,8 @@ use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::Vector3;
 
 use crate::context::{Anchor, Context};
+use crate::error::{Result, TaskError};
+use crate::tasks::TaskFunction;
 
 /// A cost term. `eval` must return a value ≥ 0 (NaN marks an invalid candidate).
 pub trait Cost: Send + Sync + std::fmt::Debug {
@@ -299,5 +301,63 @@ impl Cost for TaskMapCost {
         let object = ctx.world.objects()[self.object].pose();
         let relative = object.inverse() * ctx.poses.pose(self.part);
         self.map.cost(&trm_taskmap::to_params(&relative)).0
+    }
+}
+
+/// ‖g(q) − t*‖ for the objective's task function g and a task-space point t* (Euclidean, in the
+/// task's units): the exact goal of a planned path. Task functions of up to
+/// [`TaskTarget::MAX_DIM`] outputs (evaluated on the stack, no allocation).
+#[derive(Debug, Clone)]
+pub struct TaskTarget {
+    task: std::sync::Arc<dyn TaskFunction>,
+    target: Vec<f64>,
+}
+
+impl TaskTarget {
+    /// The largest task dimension.
+    pub const MAX_DIM: usize = 16;
+
+    /// A target for `task`: one finite value per task output.
+    pub fn new(task: std::sync::Arc<dyn TaskFunction>, target: &[f64]) -> Result<Self> {
+        let m = task.dim();
+        let invalid = |problem: String| TaskError::Invalid {
+            what: format!("target of `{}`", task.label()),
+            problem,
+        };
+        if m > Self::MAX_DIM {
+            return Err(invalid(format!(
+                "the task has {m} outputs; at most {} are supported",
+                Self::MAX_DIM
+            )));
+        }
+        if target.len() != m {
+            return Err(invalid(format!(
+                "{} values for a task of {m} outputs",
+                target.len()
+            )));
+        }
+        if target.iter().any(|v| !v.is_finite()) {
+            return Err(invalid(format!("{target:?} is not finite")));
+        }
+        Ok(TaskTarget {
+            task,
+            target: target.to_vec(),
+        })
+    }
+}
+
+impl Cost for TaskTarget {
+    fn label(&self) -> String {
+        format!("target of {}", self.task.label())
+    }
+    fn eval(&self, ctx: &Context) -> f64 {
+        let mut g = [0.0; Self::MAX_DIM];
+        let g = &mut g[..self.target.len()];
+        self.task.eval(ctx, g);
+        g.iter()
+            .zip(&self.target)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
     }
 }

@@ -36,7 +36,7 @@ pub mod tasks;
 
 pub use comparison::{Comparison, ComparisonResult, ComparisonRun, ComparisonSummary};
 pub use context::{Anchor, Context};
-pub use costs::Cost;
+pub use costs::{Cost, TaskTarget};
 pub use error::{Result, TaskError};
 pub use ngik::{Solution, solve, solve_with, solver_start};
 pub use objective::{Objective, Scratch, TermValue};

@@ -1,6 +1,8 @@
 //! The weighted objective h = Σ aᵢ hᵢ, evaluated from one forward-kinematics pass per candidate,
 //! optionally averaged over Gaussian noise on q (robust postures).
 
+use std::sync::Arc;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -8,15 +10,15 @@ use trm_collision::{CollisionModel, PlacedBodies, World};
 use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
 use crate::context::Context;
-use crate::costs::Cost;
+use crate::costs::{Cost, TaskTarget};
 use crate::error::{Result, TaskError};
 use crate::tasks::TaskFunction;
 
-/// A weighted term.
-#[derive(Debug)]
+/// A weighted term (costs are shared between clones of an objective: they hold no state).
+#[derive(Debug, Clone)]
 struct Term {
     weight: f64,
-    cost: Box<dyn Cost>,
+    cost: Arc<dyn Cost>,
 }
 
 /// One term's share of a cost.
@@ -31,14 +33,15 @@ pub struct TermValue {
 }
 
 /// The objective of NGIK: robot (active motors), collision geometry, world, weighted costs and
-/// an optional task function. `Sync`: share it between threads, give each a [`Scratch`].
-#[derive(Debug)]
+/// an optional task function. `Sync`: share it between threads, give each a [`Scratch`]. Clones
+/// share the costs.
+#[derive(Debug, Clone)]
 pub struct Objective {
     active: ActiveSet,
     collision: CollisionModel,
     world: World,
     terms: Vec<Term>,
-    task: Option<Box<dyn TaskFunction>>,
+    task: Option<Arc<dyn TaskFunction>>,
     /// Noise offsets of the robust objective (common random numbers, drawn once).
     noise: Vec<Vec<f64>>,
     needs_collision: bool,
@@ -92,13 +95,32 @@ impl Objective {
             });
         }
         self.needs_collision |= cost.needs_collision();
-        self.terms.push(Term { weight, cost });
+        self.terms.push(Term {
+            weight,
+            cost: Arc::from(cost),
+        });
         Ok(())
     }
 
     /// Sets the task function.
     pub fn set_task(&mut self, task: Box<dyn TaskFunction>) {
-        self.task = Some(task);
+        self.task = Some(Arc::from(task));
+    }
+
+    /// A copy of this objective with one more term, `weight` · ‖g(q) − `target`‖ (g = the task
+    /// function): the same costs, pulled to an exact task-space point (for finishing a planned
+    /// path at its goal rather than at the nearest map node).
+    pub fn with_task_target(&self, target: &[f64], weight: f64) -> Result<Objective> {
+        let Some(task) = &self.task else {
+            return Err(TaskError::Invalid {
+                what: "task target".into(),
+                problem: "the objective has no task function".into(),
+            });
+        };
+        let cost = TaskTarget::new(task.clone(), target)?;
+        let mut out = self.clone();
+        out.add(weight, Box::new(cost))?;
+        Ok(out)
     }
 
     /// Makes the objective the mean over `samples` copies of q perturbed by N(0, σ²) noise
