@@ -36,7 +36,8 @@ pub struct Args {
     /// Task error the exact finish must reach (metres for positions).
     #[arg(long, default_value_t = 1e-3, value_parser = crate::parse::positive)]
     exact_tolerance: f64,
-    /// Trajectory output (CSV; a .json with the task-space path is written beside it).
+    /// Trajectory output (CSV; beside it a .json with the task-space path, a .ros.yaml ROS 2
+    /// JointTrajectory and an .svg of the path over the map).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Seed of the shortcutting.
@@ -159,15 +160,19 @@ pub fn run(args: &Args) -> Result<()> {
         crate::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
         let json = out.with_extension("json");
         crate::write_atomic(&json, plan.trajectory.to_json(&json)?.as_bytes())?;
+        let ros = out.with_extension("ros.yaml");
+        let yaml = plan.trajectory.to_ros_yaml(&problem.robot, &ros)?;
+        crate::write_atomic(&ros, yaml.as_bytes())?;
         let svg = out.with_extension("svg");
         crate::write_atomic(
             &svg,
             crate::build_map::scatter(first, Some(&plan.trajectory.task_path))?.as_bytes(),
         )?;
         println!(
-            "wrote {}, {} and {}",
+            "wrote {}, {}, {} (ROS 2 JointTrajectory) and {}",
             out.display(),
             json.display(),
+            ros.display(),
             svg.display()
         );
     }

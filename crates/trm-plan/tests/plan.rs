@@ -382,3 +382,79 @@ fn a_point_goal_is_finished_exactly_or_falls_back_clearly() {
     }
     assert_eq!(fallback.trajectory, at_node.trajectory);
 }
+
+/// The ROS 2 JointTrajectory YAML of a plan parses as YAML and carries the URDF joints (no
+/// mimics), their values through the couplings, zero waypoint velocities and the times.
+#[test]
+fn trajectories_export_as_ros_joint_trajectories() {
+    use yaml_rust2::YamlLoader;
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    let options = PlanOptions {
+        exact_goal: false,
+        ..Default::default()
+    };
+    let goal = Goal::TaskPoint {
+        t: map.points[7].t.clone(),
+        tolerance: 0.03,
+    };
+    let plan = planner.plan(&p.start, &goal, &options).unwrap();
+    let traj = &plan.trajectory;
+    let robot = &p.robot;
+    let path = Path::new("plan.ros.yaml");
+    let text = traj.to_ros_yaml(robot, path).unwrap();
+    let doc = &YamlLoader::load_from_str(&text).unwrap()[0];
+    let commanded: Vec<usize> = (0..robot.num_joints())
+        .filter(|&j| robot.joint(j).mimic.is_none())
+        .collect();
+    let names: Vec<&str> = doc["joint_names"]
+        .as_vec()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    let want: Vec<&str> = commanded
+        .iter()
+        .map(|&j| robot.joint(j).name.as_str())
+        .collect();
+    assert_eq!(names, want);
+    let points = doc["points"].as_vec().unwrap();
+    assert_eq!(points.len(), traj.times.len());
+    let mut joints = vec![0.0; robot.num_joints()];
+    for (k, point) in points.iter().enumerate() {
+        robot
+            .motors_to_joints(&traj.positions[k], &mut joints)
+            .unwrap();
+        let positions: Vec<f64> = point["positions"]
+            .as_vec()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let expected: Vec<f64> = commanded.iter().map(|&j| joints[j]).collect();
+        assert_eq!(positions, expected, "point {k}");
+        assert!(
+            point["velocities"]
+                .as_vec()
+                .unwrap()
+                .iter()
+                .all(|v| v.as_f64() == Some(0.0))
+        );
+        let t = &point["time_from_start"];
+        let time = t["sec"].as_i64().unwrap() as f64 + t["nanosec"].as_i64().unwrap() as f64 * 1e-9;
+        assert!(
+            (time - traj.times[k]).abs() <= 1e-9,
+            "{time} vs {}",
+            traj.times[k]
+        );
+    }
+    // a trajectory of another robot is refused with the file named
+    let mut other = traj.clone();
+    other.names[0] = "no_such_motor".into();
+    let e = other.to_ros_yaml(robot, path).unwrap_err().to_string();
+    assert!(
+        e.contains("plan.ros.yaml") && e.contains("no_such_motor"),
+        "{e}"
+    );
+}
