@@ -27,7 +27,7 @@ pub struct Args {
     /// RPROP iterations.
     #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
     iterations: usize,
-    /// Trajectory output (CSV; a .json beside it).
+    /// Trajectory output (CSV; a .json and a .ros.yaml ROS 2 JointTrajectory beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -92,7 +92,14 @@ pub fn run(args: &Args) -> Result<()> {
         crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;
         let json = out.with_extension("json");
         crate::write_atomic(&json, trajectory.to_json(&json)?.as_bytes())?;
-        println!("wrote {}", out.display());
+        let ros = out.with_extension("ros.yaml");
+        crate::write_atomic(&ros, trajectory.to_ros_yaml(&e.model, &ros)?.as_bytes())?;
+        println!(
+            "wrote {}, {} and {} (ROS 2 JointTrajectory)",
+            out.display(),
+            json.display(),
+            ros.display()
+        );
     }
     Ok(())
 }

@@ -396,9 +396,12 @@ fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
     crate::view::write_scene(&scene, path)
 }
 
-/// The optimised motion as CSV ([`trm_wholebody::Rollout::to_csv`]).
+/// The optimised motion as CSV ([`trm_wholebody::Rollout::to_csv`]) and, beside it, as a ROS 2
+/// JointTrajectory (`.ros.yaml`, [`trm_wholebody::Rollout::to_ros_yaml`]).
 fn write_trajectory(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
     crate::write_atomic(path, s.rollout.to_csv(problem.model())?.as_bytes())?;
-    eprintln!("wrote {}", path.display());
+    let ros = path.with_extension("ros.yaml");
+    crate::write_atomic(&ros, s.rollout.to_ros_yaml(problem.model())?.as_bytes())?;
+    eprintln!("wrote {} and {}", path.display(), ros.display());
     Ok(())
 }

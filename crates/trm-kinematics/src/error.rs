@@ -144,6 +144,14 @@ pub enum KinematicsError {
         /// The value.
         value: f64,
     },
+    /// A value outside its range.
+    #[error("{what}: {problem}")]
+    OutOfRange {
+        /// Which value.
+        what: String,
+        /// What is wrong and how to fix it.
+        problem: String,
+    },
 }
 
 fn suggest(suggestions: &[String]) -> String {

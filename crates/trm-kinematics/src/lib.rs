@@ -44,6 +44,7 @@ mod model;
 mod posture;
 mod resolve;
 mod ron_path;
+pub mod ros;
 mod tree;
 
 pub use active::ActiveSet;

@@ -377,60 +377,19 @@ impl Trajectory {
 }
 
 impl Trajectory {
-    /// The trajectory as a ROS 2 `trajectory_msgs/msg/JointTrajectory` in YAML (what
-    /// `ros2 topic pub` and the message tools read), for a controller of `robot`: the URDF's
-    /// movable joints without `<mimic>` (a controller commands those), their positions through
-    /// the model's couplings, zero velocities at every waypoint (the motion stops at each one, so
-    /// any interpolation through them with these velocities stays on the straight, collision-
-    /// checked segments), and `time_from_start` as `sec`/`nanosec`. Motors the trajectory does
-    /// not name keep their neutral values. Refuses what the readers refuse; `path` names the
-    /// file it is for.
+    /// The trajectory as a ROS 2 `trajectory_msgs/msg/JointTrajectory` in YAML for a controller
+    /// of `robot` ([`trm_kinematics::ros::joint_trajectory_yaml`]): the URDF joints a
+    /// controller commands, through the couplings, with zero velocity at every waypoint (the
+    /// motion stops at each one, so interpolating through them keeps to the straight, collision-
+    /// checked segments). Motors the trajectory does not name keep their neutral values.
+    /// Refuses what the readers refuse; `path` names the file it is for.
     pub fn to_ros_yaml(&self, robot: &RobotModel, path: &Path) -> Result<String, PlanError> {
         self.check(path)?;
         self.check_robot(robot, path, |_| 0)?;
         let frames = self.motor_frames(robot, &robot.neutral_motors())?;
-        let commanded: Vec<usize> = (0..robot.num_joints())
-            .filter(|&j| robot.joint(j).mimic.is_none())
-            .collect();
-        let quoted =
-            |name: &str| format!("\"{}\"", name.replace('\\', "\\\\").replace('"', "\\\""));
-        let list = |values: &mut dyn Iterator<Item = String>| {
-            format!("[{}]", values.collect::<Vec<_>>().join(", "))
-        };
-        let mut out = String::from(
-            "# trajectory_msgs/msg/JointTrajectory (ROS 2), written by trm\nheader:\n  stamp:\n    sec: 0\n    nanosec: 0\n  frame_id: \"\"\n",
-        );
-        out.push_str(&format!(
-            "joint_names: {}\npoints:\n",
-            list(&mut commanded.iter().map(|&j| quoted(&robot.joint(j).name)))
-        ));
-        let mut joints = vec![0.0; robot.num_joints()];
-        for (time, motors) in &frames {
-            robot
-                .motors_to_joints(motors, &mut joints)
-                .map_err(|e| invalid(path, 0, e.to_string(), "write a trajectory of this robot"))?;
-            // nanoseconds, rounded once, so that sec and nanosec never disagree
-            let total = (time * 1e9).round() as u64;
-            out.push_str(&format!(
-                "  - positions: {}\n    velocities: {}\n    accelerations: []\n    effort: []\n    time_from_start:\n      sec: {}\n      nanosec: {}\n",
-                list(&mut commanded.iter().map(|&j| yaml_float(joints[j]))),
-                list(&mut commanded.iter().map(|_| "0.0".to_string())),
-                total / 1_000_000_000,
-                total % 1_000_000_000
-            ));
-        }
-        Ok(out)
-    }
-}
-
-/// A float as YAML 1.1 (PyYAML, which ROS's tools use) reads it: plain decimal digits with a
-/// point, no exponent (Rust's `Display` of f64 never writes one and round-trips exactly).
-fn yaml_float(v: f64) -> String {
-    let text = format!("{v}");
-    if text.contains('.') {
-        text
-    } else {
-        text + ".0"
+        let motors: Vec<Vec<f64>> = frames.into_iter().map(|(_, q)| q).collect();
+        trm_kinematics::ros::joint_trajectory_yaml(robot, &self.times, &motors, None)
+            .map_err(|e| invalid(path, 0, e.to_string(), "write a trajectory of this robot"))
     }
 }
 

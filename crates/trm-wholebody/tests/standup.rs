@@ -220,3 +220,45 @@ fn the_same_machinery_reaches_towards_a_low_shelf() {
     let i = names.iter().position(|n| n == "world collision").unwrap();
     assert!(hand.violated_samples[i] > 0 && hand.violated_samples[names.len() - 1] == 1);
 }
+
+/// A rollout as a ROS 2 JointTrajectory: one point per control step, the URDF joints without
+/// mimics, joint velocities that match the positions' finite differences.
+#[test]
+fn a_rollout_exports_as_a_ros_joint_trajectory() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../specs/wholebody/low_shelf.ron"
+    );
+    let p = WholeBody::load(path).unwrap();
+    let r = p.rollout(&[0.0; 15], &p.ends()).unwrap();
+    let text = r.to_ros_yaml(p.model()).unwrap();
+    let points = text.matches("  - positions: [").count();
+    assert_eq!(points, r.times.len());
+    let numbers = |line: &str| -> Vec<f64> {
+        let inner = line.split('[').nth(1).unwrap().trim_end_matches(']');
+        inner.split(", ").map(|v| v.parse().unwrap()).collect()
+    };
+    let positions: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with("  - positions:"))
+        .map(numbers)
+        .collect();
+    let velocities: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with("    velocities:"))
+        .map(numbers)
+        .collect();
+    // the middle of the motion, where it moves: central differences against the velocities
+    let k = r.times.len() / 2;
+    let dt = r.times[k + 1] - r.times[k - 1];
+    let scale = velocities[k].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0, "the motion moves at step {k}");
+    for j in 0..positions[k].len() {
+        let fd = (positions[k + 1][j] - positions[k - 1][j]) / dt;
+        assert!(
+            (fd - velocities[k][j]).abs() <= 0.05 * scale,
+            "joint {j}: {fd} vs {}",
+            velocities[k][j]
+        );
+    }
+}
