@@ -1,7 +1,6 @@
 //! `cargo xtask build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]`
 //! and `cargo xtask map-info FILE`.
 
-use std::io::IsTerminal as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
@@ -56,32 +55,27 @@ pub fn run(args: &Args) -> Result<()> {
         seed: args.seed,
         ..Default::default()
     };
-    let tty = std::io::stderr().is_terminal();
-    let mut last_print = 0.0f64;
+    let mut progress = crate::progress::Progress::new("points", 0);
     let map = pool.install(|| -> Result<Roadmap> {
         let mut map = build(&problem, &options, |p| {
             let rate = p.evaluations as f64 / p.seconds.max(1e-9);
-            let eta = if p.points > 0 {
-                p.seconds / p.points as f64 * (p.target.saturating_sub(p.points)) as f64
-            } else {
-                f64::NAN
-            };
-            let line = format!(
-                "{:>5}/{} points, {} consecutive failures, {} evaluations ({:.0}/s), {:.1} s, ETA {:.0} s",
-                p.points, p.target, p.failures, p.evaluations, rate, p.seconds, eta
+            progress.set(
+                p.points as u64,
+                p.target as u64,
+                &format!(
+                    "{} consecutive failures, {} evaluations ({rate:.0}/s)",
+                    p.failures, p.evaluations
+                ),
             );
-            if tty {
-                eprint!("\r{line}   ");
-            } else if p.seconds - last_print >= 5.0 || p.points == p.target {
-                eprintln!("{line}");
-                last_print = p.seconds;
-            }
         })?;
-        if tty {
-            eprintln!();
-        }
+        progress.finish();
         let neighbours = map.settings.edge_neighbours;
-        connect(&mut map, &problem.objective, neighbours, args.edge_resolution)?;
+        connect(
+            &mut map,
+            &problem.objective,
+            neighbours,
+            args.edge_resolution,
+        )?;
         Ok(map)
     })?;
     crate::write_atomic(&out, map.to_json(&out)?.as_bytes())?;

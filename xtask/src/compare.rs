@@ -92,7 +92,15 @@ pub fn run(args: &Args) -> Result<()> {
         rayon::current_num_threads()
     );
     let pairs: Vec<(&str, &Problem)> = labels.iter().map(String::as_str).zip(&problems).collect();
-    let result = comparison.run(&pairs)?;
+    let progress = std::sync::Mutex::new(crate::progress::Progress::new("runs", 0));
+    let result = comparison.run_with_progress(&pairs, |done, total| {
+        if let Ok(mut p) = progress.lock() {
+            p.set(done as u64, total as u64, "");
+        }
+    })?;
+    if let Ok(p) = progress.lock() {
+        p.finish();
+    }
     let table = result.to_markdown();
     std::fs::create_dir_all(&args.out_dir)?;
     crate::write_atomic(&args.out_dir.join("runs.csv"), result.to_csv().as_bytes())?;

@@ -11,6 +11,7 @@ mod model_info;
 mod optimise;
 mod plan;
 mod plot;
+mod progress;
 mod reach_grasp;
 mod solve;
 mod speedup;

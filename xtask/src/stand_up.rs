@@ -76,11 +76,12 @@ pub fn run(args: &Args) -> Result<()> {
         trm_wholebody::constraint_names(&problem).len()
     );
     let started = Instant::now();
+    let budget = problem.spec().optimiser.rollouts;
+    let mut progress = crate::progress::Progress::new("rollouts", budget);
     let result = trm_wholebody::optimize(&problem, args.seed, |n, best| {
-        if n % 100 == 0 {
-            eprintln!("  rollout {n}: best φ_co {best:.4}");
-        }
+        progress.set(n.min(budget), budget, &format!("best φ_co {best:.4}"));
     })?;
+    progress.finish();
     let elapsed = started.elapsed().as_secs_f64();
     println!(
         "seed {}: {} rollouts ({} bootstrap) in {:.1} s ({:.1} ms per rollout); feasible: {}",

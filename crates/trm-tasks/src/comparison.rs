@@ -187,6 +187,16 @@ impl Comparison {
     /// Runs every algorithm `runs` times on every `(label, problem)`, from the problem's start
     /// posture, in parallel.
     pub fn run(&self, problems: &[(&str, &Problem)]) -> Result<ComparisonResult> {
+        self.run_with_progress(problems, |_, _| {})
+    }
+
+    /// [`Comparison::run`], calling `progress(done, total)` after each run (from the worker
+    /// threads, in completion order).
+    pub fn run_with_progress(
+        &self,
+        problems: &[(&str, &Problem)],
+        progress: impl Fn(usize, usize) + Sync,
+    ) -> Result<ComparisonResult> {
         self.check()?;
         if problems.is_empty() {
             return Err(TaskError::Invalid {
@@ -202,12 +212,15 @@ impl Comparison {
             })
             .collect();
         let started = Instant::now();
+        let done = std::sync::atomic::AtomicUsize::new(0);
         let runs = jobs
             .par_iter()
             .map(|&(p, algorithm, k)| -> Result<ComparisonRun> {
                 let problem = problems[p].1;
                 let solver = self.solver(algorithm, self.seed + k);
                 let s = crate::solve(&problem.objective, &problem.start, &solver)?;
+                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(finished, jobs.len());
                 Ok(ComparisonRun {
                     problem: p,
                     algorithm: algorithm.to_string(),
