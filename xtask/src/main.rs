@@ -80,19 +80,30 @@ impl Command {
     /// The files and directories the command writes to, checked before it starts work.
     fn outputs(&self) -> (Vec<PathBuf>, Vec<PathBuf>) {
         let file = |p: &Option<PathBuf>| p.iter().cloned().collect::<Vec<_>>();
+        // an output file and the files written beside it (same stem, these extensions)
+        let beside = |p: &Option<PathBuf>, extensions: &[&str]| {
+            p.iter()
+                .flat_map(|p| {
+                    std::iter::once(p.clone()).chain(extensions.iter().map(|e| p.with_extension(e)))
+                })
+                .collect::<Vec<_>>()
+        };
         match self {
             Command::BuildMap(a) => (vec![a.out_path()], vec![]),
             Command::ExploreTaskMap(a) => (vec![a.out_path()], vec![]),
             Command::Collide(a) => (file(&a.out), vec![]),
             Command::Fk(a) => (file(&a.out), vec![]),
             Command::GenAcm(a) => (file(&a.out), vec![]),
-            Command::Plan(a) => (file(&a.out), vec![]),
-            Command::ReachGrasp(a) => (file(&a.out), vec![]),
+            Command::Plan(a) => (beside(&a.out, &["json", "ros.yaml", "svg"]), vec![]),
+            Command::ReachGrasp(a) => (beside(&a.out, &["json", "ros.yaml"]), vec![]),
             Command::Solve(a) => (file(&a.out), vec![]),
             Command::View(a) => (vec![a.out.clone()], vec![]),
             Command::CompareOptimisers(a) => (vec![], vec![a.out_dir.clone()]),
             Command::Speedup(a) => (vec![], vec![a.out_dir.clone()]),
-            Command::StandUp(a) => (vec![], vec![a.out.clone()]),
+            Command::StandUp(a) => (
+                beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
+                vec![a.out.clone()],
+            ),
             Command::TaskMapStudies(a) => (vec![], vec![a.out_dir.clone()]),
             Command::GenIcub => (vec![], vec![models_dir()]),
             Command::ModelInfo(_) | Command::MapInfo(_) | Command::Optimise(_) => (vec![], vec![]),

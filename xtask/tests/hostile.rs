@@ -847,6 +847,51 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         });
     }
 
+    // files written beside --out (the ROS 2 trajectory) that are a directory or a symlink
+    std::fs::create_dir_all(dir.join("beside.ros.yaml")).unwrap();
+    std::os::unix::fs::symlink("/etc/hostname", dir.join("linked.ros.yaml")).unwrap();
+    std::fs::create_dir_all(dir.join("stand_up_out/trajectory.ros.yaml")).unwrap();
+    for (command, names) in [
+        (
+            vec![
+                "plan",
+                "--map",
+                "map.json",
+                "--to",
+                "0.1,0.2,0.3",
+                "--out",
+                "beside.csv",
+            ],
+            "beside.ros.yaml",
+        ),
+        (
+            vec![
+                "plan",
+                "--map",
+                "map.json",
+                "--to",
+                "0.1,0.2,0.3",
+                "--out",
+                "linked.csv",
+            ],
+            "linked.ros.yaml",
+        ),
+        (
+            vec!["reach-grasp", stick.as_str(), "--out", "beside.csv"],
+            "beside.ros.yaml",
+        ),
+        (
+            vec!["stand-up", "--rollouts", "1", "--out", "stand_up_out"],
+            "trajectory.ros.yaml",
+        ),
+    ] {
+        cases.push(Case {
+            what: format!("{} with {names} in the way", command[0]),
+            args: command.iter().map(|s| s.to_string()).collect(),
+            names: names.into(),
+        });
+    }
+
     // run them, two at a time
     let before: Vec<_> = listing(&dir);
     let next = AtomicUsize::new(0);
