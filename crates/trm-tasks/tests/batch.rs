@@ -137,3 +137,42 @@ fn batched_collision_checks_agree_and_nan_collides() {
     flat[3] = f64::NAN;
     assert!(!objective.all_collision_free_in(&flat, world, &mut scratch));
 }
+
+#[test]
+fn a_task_target_needs_a_task_function_and_a_finite_point_of_its_dimension() {
+    let problem = spec("reach.ron");
+    let objective = &problem.objective;
+    let e = objective
+        .with_task_target(&[0.1, 0.2], 100.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("2 values for a task of 3 outputs"), "{e}");
+    let e = objective
+        .with_task_target(&[0.1, f64::NAN, 0.0], 100.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not finite"), "{e}");
+    let e = objective
+        .with_task_target(&[0.1, 0.2, 0.0], -1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("-1"), "{e}");
+    let no_task = spec("table_iii/posture1.ron");
+    assert!(no_task.objective.task().is_none());
+    let e = no_task
+        .objective
+        .with_task_target(&[0.0; 3], 1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no task function"), "{e}");
+    // the target term is zero exactly at g(q), and the copy keeps every other term
+    let q = problem.start.clone();
+    let mut scratch = objective.scratch();
+    let at = objective.task_value(&q, &mut scratch);
+    let pulled = objective.with_task_target(&at, 100.0).unwrap();
+    assert_eq!(pulled.num_terms(), objective.num_terms() + 1);
+    assert_eq!(
+        pulled.eval(&q, &mut scratch),
+        objective.eval(&q, &mut scratch)
+    );
+}
