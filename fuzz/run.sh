@@ -14,7 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 root=..
 
-targets=(urdf model_description task_spec world motion_spec taskmap_spec map taskmap scene
+targets=(urdf model_description task_spec world motion_spec taskmap_spec map checkpoint taskmap scene
          configurations posture trajectory_csv trajectory_json)
 
 # The seed files of a target, one per line.

@@ -1,18 +1,22 @@
-//! `cargo xtask build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]`
-//! and `cargo xtask map-info FILE`.
+//! `cargo xtask build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]
+//! [--checkpoint-every N [--checkpoint FILE]]`, `cargo xtask build-map --resume FILE` and
+//! `cargo xtask map-info FILE`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_roadmap::{BuildOptions, Checkpoint, CheckpointOptions, Roadmap, build, connect, resume};
 use trm_tasks::Problem;
 
 /// Arguments of `build-map`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The task spec (with a task function and map settings).
-    spec: PathBuf,
-    /// Output map file (default: target/maps/<spec name>.map.json).
+    /// The task spec (with a task function and map settings); not with --resume, whose
+    /// checkpoint carries its spec.
+    #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+    spec: Option<PathBuf>,
+    /// Output map file (default: target/maps/<spec name>.map.json; with --resume, the
+    /// checkpoint's name with .json).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Number of points (default: the spec's map.max_points).
@@ -22,11 +26,22 @@ pub struct Args {
     #[arg(long, value_parser = crate::parse::count(1, 4096))]
     threads: Option<usize>,
     /// Concurrent searches P (an algorithm setting; default: the spec's map.searches).
-    #[arg(long, value_parser = crate::parse::count(1, trm_roadmap::MAX_SEARCHES))]
+    #[arg(long, value_parser = crate::parse::count(1, trm_roadmap::MAX_SEARCHES), conflicts_with = "resume")]
     searches: Option<usize>,
     /// Seed (default: the spec's solver.seed).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "resume")]
     seed: Option<u64>,
+    /// Write a checkpoint each time the map has grown by N points (and at the end), to resume
+    /// a killed build with --resume.
+    #[arg(long, value_name = "N", value_parser = crate::parse::count(1, trm_roadmap::MAX_POINTS))]
+    checkpoint_every: Option<usize>,
+    /// The checkpoint file (default: the map's name with .checkpoint).
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Finish a killed build from its checkpoint, with exactly the map the uninterrupted build
+    /// gives; it goes on checkpointing into the same file at the same interval.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
     /// Interpolation step (rad) for checking edges.
     #[arg(long, default_value_t = 0.05)]
     edge_resolution: f64,
@@ -36,9 +51,29 @@ pub struct Args {
 }
 
 impl Args {
-    /// Where the map goes: `--out`, or target/maps/<spec name>.map.json.
+    /// Where the map goes: `--out`, or target/maps/<spec name>.map.json (with `--resume`, the
+    /// checkpoint's path with .json).
     pub fn out_path(&self) -> PathBuf {
-        crate::default_out(&self.out, &self.spec, "target/maps", "map.json")
+        match (&self.out, &self.spec, &self.resume) {
+            (None, None, Some(checkpoint)) => checkpoint.with_extension("json"),
+            (_, spec, _) => crate::default_out(
+                &self.out,
+                spec.as_deref().unwrap_or(Path::new("map")),
+                "target/maps",
+                "map.json",
+            ),
+        }
+    }
+
+    /// Where checkpoints go, when the build writes them.
+    pub fn checkpoint_path(&self) -> Option<PathBuf> {
+        let path = self
+            .checkpoint
+            .clone()
+            .or_else(|| self.resume.clone())
+            .unwrap_or_else(|| self.out_path().with_extension("checkpoint"));
+        (self.checkpoint_every.is_some() || self.resume.is_some() || self.checkpoint.is_some())
+            .then_some(path)
     }
 }
 
@@ -46,18 +81,47 @@ impl Args {
 pub fn run(args: &Args) -> Result<()> {
     // checked before minutes of map building
     trm_roadmap::check_edge_resolution(args.edge_resolution).context("--edge-resolution")?;
-    let problem = Problem::load(&args.spec)?;
     let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
-    let options = BuildOptions {
+    let mut options = BuildOptions {
         points: args.points,
         searches: args.searches,
         seed: args.seed,
         ..Default::default()
     };
+    let (problem, resumed) = match (&args.spec, &args.resume) {
+        (Some(spec), _) => (Problem::load(spec)?, None),
+        (None, Some(file)) => {
+            let checkpoint = Checkpoint::load(file)?;
+            let problem = checkpoint
+                .problem()
+                .with_context(|| format!("the spec stored in checkpoint {}", file.display()))?;
+            println!(
+                "resuming {} from {} points (of {}), P = {}, seed {}",
+                checkpoint.spec_path(),
+                checkpoint.points(),
+                options.points.unwrap_or(checkpoint.target()),
+                checkpoint.seed_and_searches().1,
+                checkpoint.seed_and_searches().0
+            );
+            (problem, Some(checkpoint))
+        }
+        (None, None) => anyhow::bail!("give a spec, or --resume with a checkpoint"),
+    };
+    if let Some(path) = args.checkpoint_path() {
+        let every = match (args.checkpoint_every, &resumed) {
+            (Some(every), _) => every,
+            (None, Some(checkpoint)) => checkpoint.every(),
+            (None, None) => anyhow::bail!(
+                "--checkpoint {} without an interval\n  fix: add --checkpoint-every N (points)",
+                path.display()
+            ),
+        };
+        options.checkpoint = Some(CheckpointOptions { path, every });
+    }
     let mut progress = crate::progress::Progress::new("points", 0);
     let map = pool.install(|| -> Result<Roadmap> {
-        let mut map = build(&problem, &options, |p| {
+        let report = |p: &trm_roadmap::Progress| {
             let rate = p.evaluations as f64 / p.seconds.max(1e-9);
             progress.set(
                 p.points as u64,
@@ -67,7 +131,11 @@ pub fn run(args: &Args) -> Result<()> {
                     p.failures, p.evaluations
                 ),
             );
-        })?;
+        };
+        let mut map = match resumed {
+            Some(checkpoint) => resume(&problem, checkpoint, &options, report)?,
+            None => build(&problem, &options, report)?,
+        };
         progress.finish();
         let neighbours = map.settings.edge_neighbours;
         connect(
@@ -85,7 +153,7 @@ pub fn run(args: &Args) -> Result<()> {
     println!("wrote {} and {}", out.display(), svg.display());
     if args.view {
         let mut scene =
-            crate::view::problem_scene(&problem, &format!("map of {}", args.spec.display()))?;
+            crate::view::problem_scene(&problem, &format!("map of {}", problem.origin))?;
         crate::view::add_map(&mut scene, &map, problem.objective.active())?;
         crate::view::write_scene(&scene, &crate::view::scene_path(&out))?;
     }
@@ -207,7 +275,7 @@ mod tests {
     fn a_zero_or_nan_edge_resolution_is_refused_before_building() {
         for resolution in [0.0, f64::NAN, -0.05, 1e-9] {
             let e = run(&Args {
-                spec: crate::models_dir().join("../specs/reach.ron"),
+                spec: Some(crate::models_dir().join("../specs/reach.ron")),
                 out: Some(crate::test_dir("bm").join("never.map.json")),
                 points: Some(5),
                 threads: Some(1),
@@ -215,6 +283,9 @@ mod tests {
                 seed: None,
                 edge_resolution: resolution,
                 view: false,
+                checkpoint_every: None,
+                checkpoint: None,
+                resume: None,
             })
             .unwrap_err();
             assert!(format!("{e:#}").contains("--edge-resolution"), "{e:#}");

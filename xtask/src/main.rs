@@ -89,7 +89,12 @@ impl Command {
                 .collect::<Vec<_>>()
         };
         match self {
-            Command::BuildMap(a) => (vec![a.out_path()], vec![]),
+            Command::BuildMap(a) => (
+                std::iter::once(a.out_path())
+                    .chain(a.checkpoint_path())
+                    .collect(),
+                vec![],
+            ),
             Command::ExploreTaskMap(a) => (vec![a.out_path()], vec![]),
             Command::Collide(a) => (file(&a.out), vec![]),
             Command::Fk(a) => (file(&a.out), vec![]),
@@ -150,8 +155,22 @@ fn staged() -> std::sync::MutexGuard<'static, Option<Vec<trm_kinematics::StagedF
     STAGED.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// `cargo xtask map-info M | head` ends quietly when `head` closes the pipe, as command-line
+/// tools do, instead of panicking in `println!`: SIGPIPE back to its default disposition (Rust
+/// programs start with it ignored).
+#[allow(unsafe_code)]
+fn quiet_on_closed_pipes() {
+    #[cfg(unix)]
+    // SAFETY: `signal` with a valid signal number and the default handler, called before any
+    // other thread exists; nothing else in the program handles SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() {
     use clap::{CommandFactory, FromArgMatches};
+    quiet_on_closed_pipes();
     // `--seed -1` is a value clap checks (and names the flag), not an unknown option
     let command = Cli::command().mut_subcommands(|sub| {
         sub.mut_args(|arg| {

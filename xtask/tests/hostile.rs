@@ -281,6 +281,16 @@ fn valid_files(dir: &Path) {
     let spec = root.join("specs/reach.ron");
     let spec = spec.to_str().unwrap();
     make(&["build-map", spec, "--points", "4", "--out", "map.json"]);
+    make(&[
+        "build-map",
+        spec,
+        "--points",
+        "4",
+        "--out",
+        "ck.map.json",
+        "--checkpoint-every",
+        "2",
+    ]);
     make(&["solve", spec, "--out", "posture.json"]);
     let map: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("map.json")).unwrap()).unwrap();
@@ -619,6 +629,66 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         "--edge-resolution",
         &["0", "-0.1", "NaN", "inf", "1e-300", "x"],
     ));
+    // checkpoints: damaged, foreign, missing; flags that do not go with --resume
+    let checkpoint = std::fs::read(dir.join("ck.map.checkpoint")).unwrap();
+    let n = checkpoint.len();
+    let mut damaged: Vec<(String, Vec<u8>)> = vec![("empty".into(), vec![])];
+    for cut in [1, 10, n / 2, n - 1] {
+        damaged.push((format!("cut at byte {cut}"), checkpoint[..cut].to_vec()));
+    }
+    for at in [0, 20, n / 3, 2 * n / 3, n - 1] {
+        let mut bytes = checkpoint.clone();
+        bytes[at] ^= 0x40;
+        damaged.push((format!("byte {at} changed"), bytes));
+    }
+    damaged.push((
+        "a map file".into(),
+        std::fs::read(dir.join("map.json")).unwrap(),
+    ));
+    for (k, (what, bytes)) in damaged.into_iter().enumerate() {
+        let name = format!("bad_{k}.checkpoint");
+        std::fs::write(dir.join(&name), bytes).unwrap();
+        cases.push(Case {
+            what: format!("checkpoint: {what}"),
+            args: ["build-map", "--resume", &name, "--out", "o.json"]
+                .map(String::from)
+                .to_vec(),
+            names: name,
+        });
+    }
+    cases.extend(file_flag_cases(
+        &["build-map", "--out", "o.json"],
+        "--resume",
+        &["no_such.checkpoint", "."],
+    ));
+    cases.extend(flag_cases(
+        &["build-map", spec],
+        "--checkpoint-every",
+        &["0", "-1", "x", "100000000"],
+    ));
+    let resume = [
+        "build-map",
+        "--resume",
+        "ck.map.checkpoint",
+        "--out",
+        "o.json",
+    ];
+    cases.extend(flag_cases(&resume, "--seed", &["3"]));
+    cases.extend(flag_cases(&resume, "--searches", &["2"]));
+    cases.push(Case {
+        what: "build-map with a spec and --resume".into(),
+        args: ["build-map", spec, "--resume", "ck.map.checkpoint"]
+            .map(String::from)
+            .to_vec(),
+        names: "--resume".into(),
+    });
+    cases.push(Case {
+        what: "build-map --checkpoint without an interval".into(),
+        args: ["build-map", spec, "--checkpoint", "c.checkpoint"]
+            .map(String::from)
+            .to_vec(),
+        names: "--checkpoint-every".into(),
+    });
     let plan = ["plan", "--map", "map.json"];
     cases.extend(flag_cases(
         &plan,
@@ -805,6 +875,15 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         for command in [
             vec!["solve", spec, "--out"],
             vec!["build-map", spec, "--points", "2", "--out"],
+            vec![
+                "build-map",
+                spec,
+                "--points",
+                "2",
+                "--checkpoint-every",
+                "1",
+                "--checkpoint",
+            ],
             vec!["plan", "--map", "map.json", "--to", "0.1,0.2,0.3", "--out"],
             vec!["fk", "--configs", "configs.json", "--out"],
             vec!["collide", "--configs", "configs.json", "--out"],
@@ -1014,5 +1093,61 @@ fn a_killed_build_leaves_the_old_map_or_a_complete_new_one() {
         .filter(|n| n.ends_with(".tmp"))
         .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `kill -9` in the middle of a checkpointed build, then `--resume`: the same map file as an
+/// uninterrupted build, byte for byte apart from the timing statistics.
+#[test]
+fn a_killed_build_resumes_to_the_uninterrupted_map() {
+    let dir = std::env::temp_dir().join(format!("trm-resume-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = root().join("specs/reach.ron");
+    let xtask = |args: &[&str]| {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_xtask"));
+        command.args(args).current_dir(&dir).stderr(Stdio::null());
+        command
+    };
+    let build = |out: &str, more: &[&str]| {
+        let mut args = vec!["build-map", spec.to_str().unwrap(), "--points", "300"];
+        args.extend(["--out", out]);
+        args.extend(more);
+        xtask(&args)
+    };
+    let status = build("whole.map.json", &[]).stdout(Stdio::null()).status();
+    assert!(status.unwrap().success());
+    let mut child = build("killed.map.json", &["--checkpoint-every", "20"])
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let checkpoint = dir.join("killed.map.checkpoint");
+    let started = std::time::Instant::now();
+    while !checkpoint.exists() && started.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = child.kill(); // SIGKILL
+    let _ = child.wait();
+    assert!(
+        !dir.join("killed.map.json").exists(),
+        "the build ended before the kill"
+    );
+    let resumed = xtask(&["build-map", "--resume", "killed.map.checkpoint"])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&resumed.stdout);
+    assert!(resumed.status.success(), "{said}");
+    eprintln!("{}", said.lines().next().unwrap_or_default());
+    assert!(said.starts_with("resuming"), "{said}");
+    let read = |name: &str| {
+        let mut map: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap();
+        for timing in ["build_seconds", "edge_seconds", "threads"] {
+            map["stats"][timing] = serde_json::Value::Null;
+        }
+        serde_json::to_string(&map).unwrap()
+    };
+    assert!(read("whole.map.json") == read("killed.map.json"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -15,10 +15,17 @@ pub(crate) fn read_text(path: &Path) -> crate::Result<String> {
 /// memory.
 pub const MAX_INPUT_BYTES: u64 = 1 << 30;
 
-/// Reads a UTF-8 input file (a model, spec, map, trajectory…). Refuses what is not a regular
-/// file (a directory, a device such as `/dev/zero`, a pipe that may never end) and files over
-/// [`MAX_INPUT_BYTES`], with a message saying so; the one reader of every trm input.
+/// Reads a UTF-8 input file (a model, spec, map, trajectory…) with the checks of
+/// [`read_input_bytes`]; the one reader of every trm text input.
 pub fn read_input(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_input_bytes(path)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
+}
+
+/// Reads an input file's bytes. Refuses what is not a regular file (a directory, a device such
+/// as `/dev/zero`, a pipe that may never end) and files over [`MAX_INPUT_BYTES`], with a message
+/// saying so.
+pub fn read_input_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
     let meta = std::fs::metadata(path)?;
     if !meta.is_file() {
         let what = if meta.is_dir() {
@@ -40,7 +47,7 @@ pub fn read_input(path: &Path) -> std::io::Result<String> {
             ),
         ));
     }
-    std::fs::read_to_string(path)
+    std::fs::read(path)
 }
 
 /// Checks, before any work is done, that an output file can go to `path`: if something is there
@@ -348,6 +355,16 @@ pub enum FileError {
         /// The JSON error, with line and column.
         source: serde_json::Error,
     },
+    /// A binary file of the right format and version whose content does not decode.
+    #[error("{}: damaged {format} file ({problem})\n  fix: write the file again", path.display())]
+    Damaged {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The format.
+        format: &'static str,
+        /// What the decoder found.
+        problem: String,
+    },
     /// A value cannot be written (e.g. it does not serialise).
     #[error("{}: cannot write {format}: {source}", path.display())]
     Serialize {
@@ -443,6 +460,78 @@ pub fn json_text<T: serde::Serialize>(
     })
 }
 
+/// A value in trm's binary layout: the format name and version (postcard-encoded), the value
+/// (postcard: compact, every f64 kept bit for bit, infinities and NaN included), and a CRC-32
+/// of all that (little-endian), so a damaged or truncated file is found out. Read it back with
+/// [`parse_binary_versioned`].
+pub fn binary_bytes<T: serde::Serialize>(
+    path: &Path,
+    value: &T,
+    format: &'static str,
+    version: u32,
+) -> Result<Vec<u8>, FileError> {
+    let damaged = |e: postcard::Error| FileError::Damaged {
+        path: path.to_path_buf(),
+        format,
+        problem: format!("cannot encode: {e}"),
+    };
+    let mut bytes = postcard::to_stdvec(&(format, version)).map_err(damaged)?;
+    bytes.extend(postcard::to_stdvec(value).map_err(damaged)?);
+    let crc = crc32fast::hash(&bytes);
+    bytes.extend(crc.to_le_bytes());
+    Ok(bytes)
+}
+
+/// Reads what [`binary_bytes`] wrote: another format, another version, a file cut short or
+/// changed (checksum) and bytes that do not decode are each a clear error naming `path`.
+pub fn parse_binary_versioned<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    bytes: &[u8],
+    format: &'static str,
+    version: u32,
+) -> Result<T, FileError> {
+    let wrong = || FileError::WrongFormat {
+        path: path.to_path_buf(),
+        format,
+        detail: Some("its first bytes do not name the format".into()),
+    };
+    let (found, rest): ((String, u32), &[u8]) =
+        postcard::take_from_bytes(bytes).map_err(|_| wrong())?;
+    if found.0 != format {
+        return Err(wrong());
+    }
+    if found.1 != version {
+        return Err(FileError::WrongVersion {
+            path: path.to_path_buf(),
+            format,
+            found: found.1.to_string(),
+            expected: version,
+        });
+    }
+    let damaged = |problem: String| FileError::Damaged {
+        path: path.to_path_buf(),
+        format,
+        problem,
+    };
+    let Some((content, crc)) = bytes.split_last_chunk::<4>() else {
+        return Err(damaged("it ends early: truncated".into()));
+    };
+    if crc32fast::hash(content) != u32::from_le_bytes(*crc) {
+        return Err(damaged(
+            "its checksum does not match: truncated or changed".into(),
+        ));
+    }
+    let rest = &rest[..rest.len().saturating_sub(4)];
+    match postcard::take_from_bytes(rest) {
+        Ok((value, [])) => Ok(value),
+        Ok((_, extra)) => Err(damaged(format!("{} bytes after the end", extra.len()))),
+        Err(postcard::Error::DeserializeUnexpectedEnd) => {
+            Err(damaged("it ends early: truncated".into()))
+        }
+        Err(e) => Err(damaged(e.to_string())),
+    }
+}
+
 /// [`read_input`] with a [`FileError`] naming the file.
 pub fn read_file(path: &Path) -> Result<String, FileError> {
     read_input(path).map_err(|source| FileError::Io {
@@ -451,9 +540,22 @@ pub fn read_file(path: &Path) -> Result<String, FileError> {
     })
 }
 
+/// [`read_input_bytes`] with a [`FileError`] naming the file.
+pub fn read_file_bytes(path: &Path) -> Result<Vec<u8>, FileError> {
+    read_input_bytes(path).map_err(|source| FileError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// [`write_atomic`] with a [`FileError`] naming the file.
 pub fn write_file(path: &Path, text: &str) -> Result<(), FileError> {
-    write_atomic(path, text.as_bytes()).map_err(|source| FileError::Io {
+    write_file_bytes(path, text.as_bytes())
+}
+
+/// [`write_atomic`] of bytes with a [`FileError`] naming the file.
+pub fn write_file_bytes(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    write_atomic(path, bytes).map_err(|source| FileError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -466,4 +568,51 @@ pub fn save_json<T: serde::Serialize>(
     format: &'static str,
 ) -> Result<(), FileError> {
     write_file(path, &json_text(path, value, format)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every f64 (±∞ and NaN too) reads back bit for bit; any cut or changed byte, another
+    /// format and another version are errors that say which.
+    #[test]
+    fn binary_files_round_trip_and_damage_is_found() {
+        let path = Path::new("x.bin");
+        let value = (
+            vec![1.5, f64::INFINITY, f64::NEG_INFINITY, -0.0, 1e-310],
+            f64::NAN,
+        );
+        let bytes = binary_bytes(path, &value, "trm-test", 3).unwrap();
+        let back: (Vec<f64>, f64) = parse_binary_versioned(path, &bytes, "trm-test", 3).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back.0), bits(&value.0));
+        assert_eq!(back.1.to_bits(), value.1.to_bits());
+        let read = |b: &[u8]| parse_binary_versioned::<(Vec<f64>, f64)>(path, b, "trm-test", 3);
+        for cut in 0..bytes.len() {
+            let e = read(&bytes[..cut]).unwrap_err().to_string();
+            assert!(e.contains("x.bin") && e.contains("fix:"), "{cut}: {e}");
+        }
+        for i in 0..bytes.len() {
+            let mut changed = bytes.clone();
+            changed[i] ^= 0x10;
+            assert!(read(&changed).is_err(), "byte {i}");
+        }
+        let e = parse_binary_versioned::<(Vec<f64>, f64)>(path, &bytes, "trm-other", 3)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a trm-other file"), "{e}");
+        let e = parse_binary_versioned::<(Vec<f64>, f64)>(path, &bytes, "trm-test", 4)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("version 3") && e.contains("reads version 4"),
+            "{e}"
+        );
+        let mut longer = bytes[..bytes.len() - 4].to_vec();
+        longer.push(0);
+        longer.extend(crc32fast::hash(&longer).to_le_bytes());
+        let e = read(&longer).unwrap_err().to_string();
+        assert!(e.contains("1 bytes after the end"), "{e}");
+    }
 }

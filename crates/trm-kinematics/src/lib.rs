@@ -56,9 +56,10 @@ pub use description::{
 };
 pub use error::{KinematicsError, NameKind, Result, closest_names};
 pub use files::{
-    FileError, MAX_INPUT_BYTES, StagedFile, check_output, check_unique_keys, json_text,
-    load_versioned, parse_versioned, read_file, read_input, save_json, unique_names, write_atomic,
-    write_file,
+    FileError, MAX_INPUT_BYTES, StagedFile, binary_bytes, check_output, check_unique_keys,
+    json_text, load_versioned, parse_binary_versioned, parse_versioned, read_file, read_file_bytes,
+    read_input, read_input_bytes, save_json, unique_names, write_atomic, write_file,
+    write_file_bytes,
 };
 pub use fk::{FrameId, PoseBuffer};
 pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};

@@ -226,7 +226,7 @@ impl Start {
 
 /// Bookkeeping shared by all algorithms: counts, the best point, and the histories the stopping
 /// rules read. Allocated once.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct State {
     stop: StopOptions,
     bounds: Option<Bounds>,
@@ -277,6 +277,38 @@ impl State {
     pub fn clamp(&self, x: &mut [f64]) {
         if let Some(b) = &self.bounds {
             b.clamp(x);
+        }
+    }
+
+    /// Dimension of the search space.
+    pub fn dim(&self) -> usize {
+        self.best_x.len()
+    }
+
+    /// Whether candidates were handed out and not yet told.
+    pub fn pending(&self) -> bool {
+        self.pending > 0
+    }
+
+    /// Checks that bookkeeping read back from a file fits together (buffer sizes, bounds of
+    /// this dimension), so a damaged one is an error rather than a panic later.
+    pub fn check(&self) -> Result<()> {
+        let d = self.dim();
+        let window = self.stop.center_stagnation.map_or(0, |c| c.1);
+        self.stop.check()?;
+        let fits = !self.history.is_empty()
+            && self.history_len <= self.history.len()
+            && self.centre.len() == window
+            && self.bounds.as_ref().is_none_or(|b| {
+                b.lower.len() == d && Bounds::new(b.lower.clone(), b.upper.clone()).is_ok()
+            });
+        if fits {
+            Ok(())
+        } else {
+            Err(crate::error::invalid(
+                "state",
+                "the bookkeeping's buffers or bounds do not fit its dimension",
+            ))
         }
     }
 

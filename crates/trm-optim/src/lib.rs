@@ -66,4 +66,4 @@ pub use runner::{Generation, Report, minimize, minimize_fn};
 pub use simplex::{NelderMead, SimplexOptions};
 pub use sir::{Sir, SirOptions};
 pub use snes::{Snes, SnesOptions};
-pub use xnes::{Xnes, XnesOptions};
+pub use xnes::{Xnes, XnesOptions, XnesSnapshot};

@@ -41,6 +41,20 @@ pub(crate) fn default_population(d: usize) -> usize {
     4 + (3.0 * (d as f64).ln()).floor() as usize
 }
 
+/// The state of an xNES search between generations ([`Xnes::snapshot`], [`Xnes::resume`]),
+/// serialisable with serde. Store it in a format that keeps every f64 bit for bit (infinite
+/// values included: the bookkeeping starts at +∞), e.g. a binary one; JSON does not.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct XnesSnapshot {
+    population: usize,
+    learning_rates: [f64; 3],
+    mean: Vec<f64>,
+    sigma: f64,
+    /// B, column-major.
+    shape: Vec<f64>,
+    state: State,
+}
+
 /// The xNES optimiser.
 #[derive(Debug, Clone)]
 pub struct Xnes {
@@ -96,14 +110,36 @@ impl Xnes {
         ])?;
         let sigma = (steps.iter().map(|s| s.ln()).sum::<f64>() / d as f64).exp();
         let b = DMatrix::from_diagonal(&DVector::from_iterator(d, steps.iter().map(|s| s / sigma)));
-        Ok(Xnes {
-            state: State::new(start, lambda),
+        Ok(Self::with_distribution(
+            State::new(start, lambda),
+            [eta_mean, eta_sigma, eta_b],
+            DVector::from_column_slice(&start.mean),
+            sigma,
+            b,
+            lambda,
+        ))
+    }
+
+    /// An xNES search at N(mean, σ²BBᵀ) with the given bookkeeping, learning rates
+    /// (mean, σ, B) and population.
+    fn with_distribution(
+        state: State,
+        [eta_mean, eta_sigma, eta_b]: [f64; 3],
+        mean: DVector<f64>,
+        sigma: f64,
+        b: DMatrix<f64>,
+        lambda: usize,
+    ) -> Self {
+        let d = mean.len();
+        Xnes {
+            state,
             lambda,
             eta_mean,
             eta_sigma,
             eta_b,
             utilities: nes_utilities(lambda),
-            mean: DVector::from_column_slice(&start.mean),
+            mean_slice: mean.as_slice().to_vec(),
+            mean,
             sigma,
             b,
             z: DMatrix::zeros(d, lambda),
@@ -122,8 +158,63 @@ impl Xnes {
             phi: DMatrix::zeros(lambda, lambda),
             phi_wzt: DMatrix::zeros(lambda, d),
             phi_scratch: ExpmScratch::new(lambda),
-            mean_slice: start.mean.clone(),
+        }
+    }
+
+    /// Everything this search needs to go on exactly where it is (distribution, learning rates,
+    /// stopping bookkeeping), for checkpoints: [`Xnes::resume`] continues it, and with the same
+    /// random stream the continued search asks and tells exactly what this one would have.
+    /// Taken between generations; an `ask` still waiting for its `tell` is an error (its
+    /// candidates are not part of the snapshot).
+    pub fn snapshot(&self) -> Result<XnesSnapshot> {
+        if self.state.pending() {
+            return Err(invalid(
+                "snapshot",
+                "an ask is waiting for its tell; take snapshots between generations",
+            ));
+        }
+        Ok(XnesSnapshot {
+            population: self.lambda,
+            learning_rates: [self.eta_mean, self.eta_sigma, self.eta_b],
+            mean: self.mean.as_slice().to_vec(),
+            sigma: self.sigma,
+            shape: self.b.as_slice().to_vec(),
+            state: self.state.clone(),
         })
+    }
+
+    /// Continues a search from its [`Xnes::snapshot`]; a snapshot whose sizes do not fit
+    /// together (mean, d × d shape, bookkeeping of another dimension) is an error.
+    pub fn resume(snapshot: XnesSnapshot) -> Result<Self> {
+        let d = snapshot.mean.len();
+        if snapshot.population < 2 {
+            return Err(invalid("population", "xNES needs at least 2 candidates"));
+        }
+        if d == 0 || snapshot.shape.len() != d * d || snapshot.state.dim() != d {
+            return Err(invalid(
+                "snapshot",
+                format!(
+                    "a mean of {d} values needs a {d} × {d} shape matrix ({} values given) and bookkeeping of dimension {d} ({})",
+                    snapshot.shape.len(),
+                    snapshot.state.dim()
+                ),
+            ));
+        }
+        snapshot.state.check()?;
+        positive(&[
+            ("eta_mean", snapshot.learning_rates[0]),
+            ("eta_sigma", snapshot.learning_rates[1]),
+            ("eta_b", snapshot.learning_rates[2]),
+            ("sigma", snapshot.sigma),
+        ])?;
+        Ok(Self::with_distribution(
+            snapshot.state,
+            snapshot.learning_rates,
+            DVector::from_vec(snapshot.mean),
+            snapshot.sigma,
+            DMatrix::from_vec(d, d, snapshot.shape),
+            snapshot.population,
+        ))
     }
 
     /// Current global step size σ.
@@ -282,6 +373,63 @@ mod tests {
             let diff = (&low.b - &full.b).abs().max();
             assert!(diff <= 1e-12 * scale, "generation {generation}: {diff}");
             assert!((low.sigma - full.sigma).abs() <= 1e-14 * full.sigma);
+        }
+    }
+
+    /// A search resumed from a snapshot (through serde) asks and tells exactly what the
+    /// uninterrupted one does, and damaged snapshots are errors.
+    #[test]
+    fn a_resumed_search_continues_bit_for_bit() {
+        let d = 12;
+        let f = |x: &[f64]| {
+            x.iter()
+                .enumerate()
+                .map(|(i, v)| (i + 1) as f64 * v * v)
+                .sum::<f64>()
+        };
+        for population in [6, 20] {
+            let start = Start::new(vec![0.5; d], 0.3).with_stop(crate::StopOptions {
+                center_stagnation: Some((20, 40)),
+                ..Default::default()
+            });
+            let options = XnesOptions {
+                population: Some(population),
+                ..Default::default()
+            };
+            let mut whole = Xnes::new(&start, &options).unwrap();
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+            let step = |x: &mut Xnes, rng: &mut rand_chacha::ChaCha8Rng| {
+                let fitness: Vec<f64> = x.ask(rng).iter().map(|c| f(c)).collect();
+                x.tell(&fitness).unwrap();
+                let m = x.mean().to_vec();
+                x.record_center_fitness(&m, f(&m));
+            };
+            for _ in 0..25 {
+                step(&mut whole, &mut rng);
+            }
+            let mut resumed = Xnes::resume(whole.snapshot().unwrap()).unwrap();
+            let mut rng2 = rng.clone();
+            for _ in 0..40 {
+                step(&mut whole, &mut rng);
+                step(&mut resumed, &mut rng2);
+                assert_eq!(whole.snapshot().unwrap(), resumed.snapshot().unwrap());
+                assert_eq!(whole.stop(), resumed.stop());
+            }
+            // mid-generation and damaged snapshots
+            whole.ask(&mut rng);
+            assert!(whole.snapshot().is_err());
+            let mut bad = resumed.snapshot().unwrap();
+            bad.shape.pop();
+            assert!(Xnes::resume(bad).is_err());
+            let mut bad = resumed.snapshot().unwrap();
+            bad.state = State::new(&Start::new(vec![0.0; d + 1], 1.0), population);
+            assert!(Xnes::resume(bad).is_err());
+            let mut bad = resumed.snapshot().unwrap();
+            bad.state = State::new(&Start::new(vec![0.0; d], 1.0), population); // no stagnation rule
+            assert!(Xnes::resume(bad).is_ok());
+            let mut bad = resumed.snapshot().unwrap();
+            bad.sigma = f64::NAN;
+            assert!(Xnes::resume(bad).is_err());
         }
     }
 }

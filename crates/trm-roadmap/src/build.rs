@@ -8,6 +8,8 @@
 //! changes between generations, in search order: a seed and P give the same map on any number of
 //! threads.
 
+use std::collections::BTreeSet;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use rand::{RngExt, SeedableRng};
@@ -15,6 +17,8 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
+
+use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
 use trm_tasks::Problem;
 use trm_tasks::spec::MapSpec;
 
@@ -36,6 +40,17 @@ pub struct BuildOptions {
     pub max_generations: u64,
     /// Weight of the repulsion between concurrent searches.
     pub repel_weight: f64,
+    /// Write a [`Checkpoint`] while building (and once at the end), to resume a killed build.
+    pub checkpoint: Option<CheckpointOptions>,
+}
+
+/// Where and how often a build writes its [`Checkpoint`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckpointOptions {
+    /// The checkpoint file (replaced atomically each time).
+    pub path: PathBuf,
+    /// Write one each time the map has grown by this many points.
+    pub every: usize,
 }
 
 impl Default for BuildOptions {
@@ -46,6 +61,7 @@ impl Default for BuildOptions {
             seed: None,
             max_generations: 400,
             repel_weight: 1.0,
+            checkpoint: None,
         }
     }
 }
@@ -79,33 +95,58 @@ struct Growing {
     index: TaskIndex,
     neighbours: Vec<usize>,
     fails: Vec<usize>,
+    /// (neighbours + failures, index) of every point, for SELECTPROPORTIONAL.
+    scores: BTreeSet<(usize, usize)>,
 }
 
 impl Growing {
-    fn add(&mut self, point: MapPoint, radius: f64) {
+    fn new(dim: usize) -> Self {
+        Growing {
+            points: Vec::new(),
+            index: TaskIndex::new(dim),
+            neighbours: Vec::new(),
+            fails: Vec::new(),
+            scores: BTreeSet::new(),
+        }
+    }
+
+    /// Adds a point and counts it as a neighbour of the points within `radius` (and they of it).
+    fn add(&mut self, point: MapPoint, radius: f64, near: &mut Vec<usize>) {
         let i = self.points.len();
-        let mut near = 0;
-        for (j, p) in self.points.iter().enumerate() {
-            if distance(&p.t, &point.t) <= radius {
-                self.neighbours[j] += 1;
-                near += 1;
-            }
+        self.index.within(&point.t, radius, near);
+        for &j in near.iter() {
+            self.set_neighbours(j, self.neighbours[j] + 1);
         }
         self.index.add(&point.t);
         self.points.push(point);
-        self.neighbours.push(near);
+        self.neighbours.push(near.len());
         self.fails.push(0);
-        debug_assert_eq!(self.points.len(), i + 1);
+        self.scores.insert((near.len(), i));
     }
 
-    /// SELECTPROPORTIONAL: a point with the fewest neighbours + failures, uniformly among ties.
+    fn score(&self, i: usize) -> usize {
+        self.neighbours[i] + self.fails[i]
+    }
+
+    fn set_neighbours(&mut self, i: usize, n: usize) {
+        self.scores.remove(&(self.score(i), i));
+        self.neighbours[i] = n;
+        self.scores.insert((self.score(i), i));
+    }
+
+    fn set_fails(&mut self, i: usize, n: usize) {
+        self.scores.remove(&(self.score(i), i));
+        self.fails[i] = n;
+        self.scores.insert((self.score(i), i));
+    }
+
+    /// SELECTPROPORTIONAL: a point with the fewest neighbours + failures, uniformly among ties
+    /// (in index order, so a draw picks the same point whatever the bookkeeping).
     fn select(&self, rng: &mut ChaCha8Rng) -> Option<usize> {
-        let score = |i: usize| self.neighbours[i] + self.fails[i];
-        let best = (0..self.points.len()).map(score).min()?;
-        let ties: Vec<usize> = (0..self.points.len())
-            .filter(|&i| score(i) == best)
-            .collect();
-        Some(ties[rng.random_range(0..ties.len())])
+        let &(best, _) = self.scores.first()?;
+        let ties = self.scores.range((best, 0)..(best + 1, 0));
+        let k = rng.random_range(0..ties.clone().count());
+        ties.map(|&(_, i)| i).nth(k)
     }
 }
 
@@ -115,63 +156,304 @@ pub const MAX_POINTS: usize = 10_000_000;
 /// The most concurrent searches P.
 pub const MAX_SEARCHES: usize = 4096;
 
+/// The fixed settings of one build.
+struct Setup<'a> {
+    problem: &'a Problem,
+    settings: MapSpec,
+    target: usize,
+    searches: usize,
+    seed: u64,
+    max_generations: u64,
+    repel_weight: f64,
+    bounds: Bounds,
+    dim: usize,
+}
+
+impl<'a> Setup<'a> {
+    /// Checks the spec and the counts; the task's dimension comes from its task function.
+    fn new(
+        problem: &'a Problem,
+        target: Option<usize>,
+        searches: Option<usize>,
+        seed: Option<u64>,
+    ) -> Result<Self> {
+        let objective = &problem.objective;
+        let task = objective.task().ok_or_else(|| {
+            RoadmapError::Unsuitable(format!(
+                "{}: the spec has no task function; add `task: Some(Position(part: \"...\"))`",
+                problem.origin
+            ))
+        })?;
+        let settings: MapSpec = problem.spec.map.clone().unwrap_or_default();
+        let target = target.unwrap_or(settings.max_points);
+        if target == 0 || target > MAX_POINTS {
+            return Err(RoadmapError::Unsuitable(format!(
+                "{target} points: give 1 to {MAX_POINTS} (spec `map.max_points` or the points option)"
+            )));
+        }
+        let searches = searches.unwrap_or(settings.searches);
+        if searches == 0 || searches > MAX_SEARCHES {
+            return Err(RoadmapError::Unsuitable(format!(
+                "{searches} concurrent searches: give 1 to {MAX_SEARCHES} (spec `map.searches` or the searches option)"
+            )));
+        }
+        let (lower, upper) = objective.active().bounds();
+        Ok(Setup {
+            problem,
+            target,
+            searches,
+            seed: seed.unwrap_or(problem.spec.solver.seed),
+            max_generations: 0,
+            repel_weight: 0.0,
+            bounds: Bounds::new(lower, upper)?,
+            dim: task.dim(),
+            settings,
+        })
+    }
+}
+
+/// Everything a build holds between two generations.
+struct State {
+    master: ChaCha8Rng,
+    map: Growing,
+    searches: Vec<Search>,
+    started: u64,
+    failures: usize,
+    total_failures: u64,
+    evaluations: u64,
+    /// Seconds spent before a resume.
+    seconds_before: f64,
+}
+
+impl State {
+    fn fresh(setup: &Setup) -> Self {
+        State {
+            master: ChaCha8Rng::seed_from_u64(setup.seed),
+            map: Growing::new(setup.dim),
+            searches: Vec::new(),
+            started: 0,
+            failures: 0,
+            total_failures: 0,
+            evaluations: 0,
+            seconds_before: 0.0,
+        }
+    }
+
+    fn checkpoint(&self, setup: &Setup, every: usize, seconds: f64) -> Result<Checkpoint> {
+        let problem = setup.problem;
+        let running = self
+            .searches
+            .iter()
+            .map(|s| {
+                Ok(SearchState {
+                    xnes: s.xnes.snapshot()?,
+                    rng: StreamPosition::of(&s.rng),
+                    from: s.from,
+                    centre_t: s.centre_t.clone(),
+                    centre_f: s.centre_f,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Checkpoint {
+            software: software(),
+            spec_path: problem.origin.clone(),
+            spec: problem.text.clone(),
+            active: active_names(problem),
+            seed: setup.seed,
+            searches: setup.searches,
+            target: setup.target,
+            max_generations: setup.max_generations,
+            repel_weight: setup.repel_weight,
+            every,
+            master: StreamPosition::of(&self.master),
+            points: self.map.points.clone(),
+            fails: self.map.fails.clone(),
+            running,
+            started: self.started,
+            failures: self.failures,
+            total_failures: self.total_failures,
+            evaluations: self.evaluations,
+            seconds,
+        })
+    }
+
+    /// The state a checkpoint holds, for `setup` (which checked the checkpoint's settings).
+    fn restore(setup: &Setup, checkpoint: Checkpoint) -> Result<Self> {
+        let unfit = |what: String| {
+            RoadmapError::Unsuitable(format!(
+                "the checkpoint does not fit its own spec ({}): {what}; start the build again",
+                checkpoint.spec_path
+            ))
+        };
+        let n = setup.problem.objective.active().len();
+        let mut map = Growing::new(setup.dim);
+        let mut near = Vec::new();
+        for (i, (point, fails)) in checkpoint
+            .points
+            .into_iter()
+            .zip(checkpoint.fails)
+            .enumerate()
+        {
+            if point.q.len() != n || point.t.len() != setup.dim {
+                return Err(unfit(format!("points[{i}] has the wrong size")));
+            }
+            map.add(point, 1.5 * setup.settings.spacing, &mut near);
+            map.set_fails(i, fails);
+        }
+        let searches = checkpoint
+            .running
+            .into_iter()
+            .map(|s| {
+                let xnes = Xnes::resume(s.xnes)?;
+                if xnes.dim() != n || s.centre_t.len() != setup.dim {
+                    return Err(unfit("a running search has the wrong dimension".into()));
+                }
+                Ok(Search {
+                    xnes,
+                    rng: s.rng.rng(setup.seed),
+                    from: s.from,
+                    centre_t: s.centre_t,
+                    centre_f: s.centre_f,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(State {
+            master: checkpoint.master.rng(setup.seed),
+            map,
+            searches,
+            started: checkpoint.started,
+            failures: checkpoint.failures,
+            total_failures: checkpoint.total_failures,
+            evaluations: checkpoint.evaluations,
+            seconds_before: checkpoint.seconds,
+        })
+    }
+}
+
+fn software() -> String {
+    format!("trm {}", env!("CARGO_PKG_VERSION"))
+}
+
+fn active_names(problem: &Problem) -> Vec<String> {
+    problem
+        .objective
+        .active()
+        .names()
+        .map(str::to_string)
+        .collect()
+}
+
 /// Builds the map of a spec (it needs a task function and `map` settings, or their defaults).
 /// Zero or absurd point and search counts are errors.
 pub fn build(
     problem: &Problem,
     options: &BuildOptions,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    let mut setup = Setup::new(problem, options.points, options.searches, options.seed)?;
+    setup.max_generations = options.max_generations;
+    setup.repel_weight = options.repel_weight;
+    let state = State::fresh(&setup);
+    run(&setup, state, options.checkpoint.as_ref(), progress)
+}
+
+/// Finishes a build from its [`Checkpoint`] with exactly the map the uninterrupted build gives
+/// (timing statistics aside). `problem` is [`Checkpoint::problem`]. The seed, P and the search
+/// settings are the checkpoint's: a `seed` or `searches` option that differs is an error;
+/// `points` may set another target (the build goes on as if it had been started with it), and
+/// `checkpoint` keeps writing checkpoints.
+pub fn resume(
+    problem: &Problem,
+    checkpoint: Checkpoint,
+    options: &BuildOptions,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    for (what, given, stored) in [
+        ("seed", options.seed, checkpoint.seed),
+        (
+            "searches",
+            options.searches.map(|p| p as u64),
+            checkpoint.searches as u64,
+        ),
+    ] {
+        if given.is_some_and(|g| g != stored) {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the checkpoint's build has {what} {stored}; a resumed build keeps it (leave the {what} option out)"
+            )));
+        }
+    }
+    if problem.text != checkpoint.spec || active_names(problem) != checkpoint.active {
+        return Err(RoadmapError::Unsuitable(format!(
+            "the problem is not the checkpoint's ({}): resume with `Checkpoint::problem`",
+            checkpoint.spec_path
+        )));
+    }
+    let target = options.points.unwrap_or(checkpoint.target);
+    let mut setup = Setup::new(
+        problem,
+        Some(target),
+        Some(checkpoint.searches),
+        Some(checkpoint.seed),
+    )?;
+    setup.max_generations = checkpoint.max_generations;
+    setup.repel_weight = checkpoint.repel_weight;
+    let state = State::restore(&setup, checkpoint)?;
+    run(&setup, state, options.checkpoint.as_ref(), progress)
+}
+
+/// Algorithm 2 from `state` on; see the module documentation.
+fn run(
+    setup: &Setup,
+    mut state: State,
+    checkpoint: Option<&CheckpointOptions>,
     mut progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
+    let problem = setup.problem;
     let objective = &problem.objective;
-    let task = objective.task().ok_or_else(|| {
-        RoadmapError::Unsuitable(format!(
-            "{}: the spec has no task function; add `task: Some(Position(part: \"...\"))`",
-            problem.origin
-        ))
-    })?;
-    let dim = task.dim();
-    let settings: MapSpec = problem.spec.map.clone().unwrap_or_default();
-    let target = options.points.unwrap_or(settings.max_points);
-    if target == 0 || target > MAX_POINTS {
-        return Err(RoadmapError::Unsuitable(format!(
-            "{target} points: give 1 to {MAX_POINTS} (spec `map.max_points` or the points option)"
-        )));
-    }
-    let p_searches = options.searches.unwrap_or(settings.searches);
-    if p_searches == 0 || p_searches > MAX_SEARCHES {
-        return Err(RoadmapError::Unsuitable(format!(
-            "{p_searches} concurrent searches: give 1 to {MAX_SEARCHES} (spec `map.searches` or the searches option)"
-        )));
-    }
-    let seed = options.seed.unwrap_or(problem.spec.solver.seed);
+    let settings = &setup.settings;
+    let (target, p_searches, seed, dim) = (setup.target, setup.searches, setup.seed, setup.dim);
+    let bounds = &setup.bounds;
     let d = settings.spacing;
     let m = dim; // the number of neighbours is tied to the task-space dimension
-    let (lower, upper) = objective.active().bounds();
-    let bounds = Bounds::new(lower, upper)?;
-    let mut master = ChaCha8Rng::seed_from_u64(seed);
-    let mut map = Growing {
-        points: Vec::new(),
-        index: TaskIndex::new(dim),
-        neighbours: Vec::new(),
-        fails: Vec::new(),
-    };
-    let mut searches: Vec<Search> = Vec::new();
-    let mut started_count: u64 = 0;
-    let mut failures = 0usize;
-    let mut total_failures = 0u64;
-    let mut evaluations = 0u64;
+    if let Some(c) = checkpoint
+        && c.every == 0
+    {
+        return Err(RoadmapError::Unsuitable(
+            "a checkpoint every 0 points: give at least 1".into(),
+        ));
+    }
     let started = Instant::now();
+    let before = state.seconds_before;
+    let seconds = || before + started.elapsed().as_secs_f64();
+    let mut checkpointed = state.map.points.len();
+    let mut near = Vec::new();
     let stopped_because;
 
     loop {
+        if let Some(c) = checkpoint
+            && state.map.points.len() >= checkpointed + c.every
+        {
+            state.checkpoint(setup, c.every, seconds())?.save(&c.path)?;
+            checkpointed = state.map.points.len();
+        }
+        let State {
+            master,
+            map,
+            searches,
+            started: started_count,
+            failures,
+            total_failures,
+            evaluations,
+            ..
+        } = &mut state;
         if map.points.len() >= target {
             stopped_because = format!("reached {target} points");
             break;
         }
-        if failures >= settings.failure_limit {
+        if *failures >= settings.failure_limit {
             stopped_because = format!(
-                "{failures} consecutive failed searches (k = {})",
-                settings.failure_limit
+                "{} consecutive failed searches (k = {})",
+                *failures, settings.failure_limit
             );
             break;
         }
@@ -182,7 +464,7 @@ pub fn build(
             p_searches.min(map.points.len())
         };
         while searches.len() < wanted {
-            let from = map.select(&mut master);
+            let from = map.select(master);
             let (q0, (lambda, sigma)) = match from {
                 Some(i) => (map.points[i].q.clone(), settings.later_search),
                 None => (problem.start.clone(), settings.first_search),
@@ -191,7 +473,7 @@ pub fn build(
                 .with_bounds(bounds.clone())
                 .with_stop(StopOptions {
                     center_stagnation: Some((20, 40)),
-                    max_generations: Some(options.max_generations),
+                    max_generations: Some(setup.max_generations),
                     tol_x: None,
                     tol_fun: None,
                     ..Default::default()
@@ -204,8 +486,8 @@ pub fn build(
                 },
             )?;
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream(started_count + 1);
-            started_count += 1;
+            rng.set_stream(*started_count + 1);
+            *started_count += 1;
             searches.push(Search {
                 xnes,
                 rng,
@@ -214,7 +496,6 @@ pub fn build(
                 centre_f: f64::NAN,
             });
         }
-
         // one generation of every search: ask, evaluate all candidates in parallel, tell
         let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
         let have_centres = searches
@@ -247,7 +528,7 @@ pub fn build(
                     h_rep += (d - distance(t, c)).max(0.0);
                 }
             }
-            h += options.repel_weight * h_rep;
+            h += setup.repel_weight * h_rep;
             h
         };
         // h* of (search, candidate) jobs, in parallel batches: `fitness[k]`, and g in
@@ -277,11 +558,11 @@ pub fn build(
         let mut fitness = vec![0.0; jobs.len()];
         let mut tasks = vec![0.0; jobs.len() * dim];
         evaluate(&jobs, &mut fitness, &mut tasks);
-        evaluations += jobs.len() as u64;
+        *evaluations += jobs.len() as u64;
         // tells in parallel, one task per search; then every search's centre
         let mut offsets = Vec::with_capacity(searches.len());
         let mut offset = 0;
-        for s in &searches {
+        for s in searches.iter() {
             offsets.push(offset);
             offset += s.xnes.population();
         }
@@ -311,7 +592,7 @@ pub fn build(
             s.centre_t
                 .copy_from_slice(&centre_t[i * dim..(i + 1) * dim]);
         }
-        evaluations += searches.len() as u64;
+        *evaluations += searches.len() as u64;
 
         // converged searches: CHECK their mean, add it or count a failure (in search order)
         let mut changed = false;
@@ -332,14 +613,14 @@ pub fn build(
             let outside = nn.first().is_none_or(|(dt, _)| *dt >= d / 2.0);
             let ok = cost.is_finite() && outside && objective.is_collision_free(&q, &mut scratch);
             if ok {
-                map.add(MapPoint { q, t, cost }, 1.5 * d);
-                failures = 0;
+                map.add(MapPoint { q, t, cost }, 1.5 * d, &mut near);
+                *failures = 0;
                 changed = true;
             } else {
-                failures += 1;
-                total_failures += 1;
+                *failures += 1;
+                *total_failures += 1;
                 if let Some(from) = s.from {
-                    map.fails[from] += 1;
+                    map.set_fails(from, map.fails[from] + 1);
                 }
             }
         }
@@ -347,40 +628,43 @@ pub fn build(
             progress(&Progress {
                 points: map.points.len(),
                 target,
-                failures,
-                evaluations,
-                seconds: started.elapsed().as_secs_f64(),
+                failures: *failures,
+                evaluations: *evaluations,
+                seconds: seconds(),
             });
         }
     }
-    let build_seconds = started.elapsed().as_secs_f64();
+    if let Some(c) = checkpoint {
+        state.checkpoint(setup, c.every, seconds())?.save(&c.path)?;
+    }
+    let build_seconds = seconds();
     progress(&Progress {
-        points: map.points.len(),
+        points: state.map.points.len(),
         target,
-        failures,
-        evaluations,
+        failures: state.failures,
+        evaluations: state.evaluations,
         seconds: build_seconds,
     });
     Ok(Roadmap {
         format: FORMAT.into(),
         version: VERSION,
-        software: format!("trm {}", env!("CARGO_PKG_VERSION")),
+        software: software(),
         spec_path: problem.origin.clone(),
         spec: problem.text.clone(),
         seed,
         searches: p_searches,
-        settings,
-        active: objective.active().names().map(str::to_string).collect(),
-        task: task.label(),
-        points: map.points,
+        settings: settings.clone(),
+        active: active_names(problem),
+        task: objective.task().map(|t| t.label()).unwrap_or_default(),
+        points: state.map.points,
         edges: Vec::new(),
         edge_resolution: 0.0,
         stats: BuildStats {
             build_seconds,
             edge_seconds: 0.0,
-            evaluations,
-            searches_started: started_count,
-            failures: total_failures,
+            evaluations: state.evaluations,
+            searches_started: state.started,
+            failures: state.total_failures,
             stopped_because,
             threads: rayon::current_num_threads(),
         },

@@ -42,16 +42,43 @@ macro_rules! trees {
                         }
                     })*
                     Tree::Brute(points) => {
-                        out.extend(points.iter().enumerate().map(|(i, p)| {
-                            (p.iter().zip(t).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt(), i)
-                        }));
+                        out.extend(points.iter().enumerate().map(|(i, p)| (brute_distance(p, t), i)));
                         out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                         out.truncate(n);
                     }
                 }
             }
+
+            /// Items at most `radius` from `t` (in no particular order).
+            fn within(&self, t: &[f64], radius: f64, out: &mut Vec<usize>) {
+                out.clear();
+                match self {
+                    $(Tree::$variant(tree) => {
+                        let mut p = [0.0; $k];
+                        p.copy_from_slice(t);
+                        // a margin for rounding, then the exact test
+                        let bound = radius * radius * (1.0 + 1e-9);
+                        for nb in tree.within_unsorted::<SquaredEuclidean>(&p, bound) {
+                            if nb.distance.sqrt() <= radius {
+                                out.push(nb.item as usize);
+                            }
+                        }
+                    })*
+                    Tree::Brute(points) => out.extend(
+                        points.iter().enumerate().filter(|(_, p)| brute_distance(p, t) <= radius).map(|(i, _)| i),
+                    ),
+                }
+            }
         }
     };
+}
+
+fn brute_distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 trees!(D1 => 1, D2 => 2, D3 => 3, D4 => 4, D5 => 5, D6 => 6);
@@ -100,6 +127,11 @@ impl TaskIndex {
         self.tree.nearest(t, n.min(self.len), out);
         out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     }
+
+    /// The items within `radius` of `t` (distance ≤ radius), in no particular order.
+    pub fn within(&self, t: &[f64], radius: f64, out: &mut Vec<usize>) {
+        self.tree.within(t, radius, out);
+    }
 }
 
 #[cfg(test)]
@@ -140,6 +172,17 @@ mod tests {
                 for (a, b) in out.iter().zip(&brute[..4]) {
                     assert!((a.0 - b.0).abs() < 1e-12, "dim {dim}");
                 }
+                let radius = brute[7].0;
+                let mut within = Vec::new();
+                index.within(&q, radius, &mut within);
+                within.sort();
+                let mut expected: Vec<usize> = brute
+                    .iter()
+                    .filter(|b| b.0 <= radius)
+                    .map(|b| b.1)
+                    .collect();
+                expected.sort();
+                assert_eq!(within, expected, "dim {dim}");
             }
         }
     }

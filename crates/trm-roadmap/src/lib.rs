@@ -12,12 +12,16 @@
 //! ```
 
 mod build;
+mod checkpoint;
 mod edges;
 mod error;
 mod index;
 mod map;
 
-pub use build::{BuildOptions, MAX_POINTS, MAX_SEARCHES, Progress, build};
+pub use build::{
+    BuildOptions, CheckpointOptions, MAX_POINTS, MAX_SEARCHES, Progress, build, resume,
+};
+pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
     MIN_RESOLUTION, check_edge_resolution, connect, distance, segment_is_collision_free,
     segment_is_free,

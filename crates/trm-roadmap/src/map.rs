@@ -171,19 +171,7 @@ impl Roadmap {
     /// world files are found relative to the spec's original location, `spec_path`). Fails when
     /// the spec no longer loads or no longer has the map's active motors.
     pub fn problem(&self) -> Result<trm_tasks::Problem> {
-        let base = Path::new(&self.spec_path)
-            .parent()
-            .unwrap_or(Path::new("."));
-        let problem = trm_tasks::Problem::from_ron(&self.spec, &self.spec_path, base)?;
-        let names: Vec<&str> = problem.objective.active().names().collect();
-        if names != self.active.iter().map(String::as_str).collect::<Vec<_>>() {
-            return Err(RoadmapError::Unsuitable(format!(
-                "the spec stored in the map ({}) now selects {} active motors, the map has {}: rebuild the map",
-                self.spec_path,
-                names.len(),
-                self.active.len()
-            )));
-        }
+        let problem = problem_from_spec(&self.spec_path, &self.spec, &self.active)?;
         let dim = problem.objective.task().map_or(0, |t| t.dim());
         let robot = problem.objective.active().model();
         let motors = problem.objective.active().motor_indices();
@@ -299,6 +287,26 @@ impl Roadmap {
         }
         petgraph::algo::connected_components(&graph)
     }
+}
+
+/// The task of a spec stored in a map or checkpoint (its model and world files found relative
+/// to the spec's original location `spec_path`); it must still select the `active` motors.
+pub(crate) fn problem_from_spec(
+    spec_path: &str,
+    spec: &str,
+    active: &[String],
+) -> Result<trm_tasks::Problem> {
+    let base = Path::new(spec_path).parent().unwrap_or(Path::new("."));
+    let problem = trm_tasks::Problem::from_ron(spec, spec_path, base)?;
+    let names: Vec<&str> = problem.objective.active().names().collect();
+    if names != active.iter().map(String::as_str).collect::<Vec<_>>() {
+        return Err(RoadmapError::Unsuitable(format!(
+            "the spec stored in the file ({spec_path}) now selects {} active motors, the file has {}: build again",
+            names.len(),
+            active.len()
+        )));
+    }
+    Ok(problem)
 }
 
 /// What [`Roadmap::summary`] reports.

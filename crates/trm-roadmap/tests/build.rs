@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_roadmap::{BuildOptions, Checkpoint, CheckpointOptions, Roadmap, build, connect, resume};
 use trm_tasks::Problem;
 
 fn reach() -> Problem {
@@ -63,6 +63,110 @@ fn map_points_are_collision_free_spaced_and_the_same_on_any_thread_count() {
             .iter()
             .all(|&(a, b, _)| a < b && b < one.points.len())
     );
+}
+
+/// A build resumed from a checkpoint gives exactly the map of the uninterrupted build: from the
+/// last checkpoint of a shorter build (the state a longer one passes through) and from one
+/// written in the middle, on another thread count; damaged checkpoints and changed settings are
+/// errors.
+#[test]
+fn resumed_builds_give_the_uninterrupted_map() {
+    let problem = reach();
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    };
+    let whole = build(
+        &problem,
+        &BuildOptions {
+            points: Some(60),
+            ..Default::default()
+        },
+        |_| {},
+    )
+    .unwrap();
+    let path = tmp("resume.checkpoint");
+    let first = BuildOptions {
+        points: Some(35),
+        checkpoint: Some(CheckpointOptions {
+            path: path.clone(),
+            every: 10,
+        }),
+        ..Default::default()
+    };
+    // checkpoints in the middle: seen by the progress callback after they are written
+    let mut middle = None;
+    pool(1).install(|| {
+        build(&problem, &first, |p| {
+            if p.points >= 20 && middle.is_none() {
+                middle = Some(Checkpoint::load(&path).unwrap());
+            }
+        })
+        .unwrap()
+    });
+    let middle = middle.unwrap();
+    assert!((10..35).contains(&middle.points()), "{}", middle.points());
+    let last = Checkpoint::load(&path).unwrap();
+    assert_eq!(last.points(), 35);
+    for checkpoint in [middle, last] {
+        let problem = checkpoint.problem().unwrap();
+        let options = BuildOptions {
+            points: Some(60),
+            ..Default::default()
+        };
+        let resumed = pool(2)
+            .install(|| resume(&problem, checkpoint, &options, |_| {}))
+            .unwrap();
+        assert_eq!(resumed.points, whole.points);
+        assert_eq!(resumed.stats.evaluations, whole.stats.evaluations);
+        assert_eq!(resumed.stats.searches_started, whole.stats.searches_started);
+        assert_eq!(resumed.stats.failures, whole.stats.failures);
+    }
+    // changed settings, damaged files
+    let checkpoint = Checkpoint::load(&path).unwrap();
+    let e = resume(
+        &problem,
+        checkpoint.clone(),
+        &BuildOptions {
+            seed: Some(7),
+            ..Default::default()
+        },
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("seed 0") && e.contains("leave the seed option out"),
+        "{e}"
+    );
+    let specs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs");
+    let other = Problem::from_ron(&format!("{} ", problem.text), &problem.origin, &specs).unwrap();
+    let e = resume(&other, checkpoint, &BuildOptions::default(), |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Checkpoint::problem"), "{e}");
+    let bytes = std::fs::read(&path).unwrap();
+    let damaged = tmp("damaged.checkpoint");
+    for (what, content) in [
+        ("truncated", bytes[..bytes.len() / 2].to_vec()),
+        ("checksum", {
+            let mut b = bytes.clone();
+            b[bytes.len() / 3] ^= 1;
+            b
+        }),
+        (
+            "not a trm-checkpoint",
+            b"{\"format\": \"trm-roadmap\"}".to_vec(),
+        ),
+    ] {
+        std::fs::write(&damaged, content).unwrap();
+        let e = Checkpoint::load(&damaged).unwrap_err().to_string();
+        assert!(e.contains(what) && e.contains("damaged.checkpoint"), "{e}");
+    }
+    let _ = std::fs::remove_file(&path);
+    let _ = std::fs::remove_file(&damaged);
 }
 
 #[test]
