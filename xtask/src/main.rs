@@ -7,6 +7,7 @@ mod explore_task_map;
 mod fk;
 mod gen_acm;
 mod gen_icub;
+mod map_scaling;
 mod model_info;
 mod optimise;
 mod plan;
@@ -60,6 +61,8 @@ enum Command {
     Optimise(optimise::Args),
     /// Fig. 2 of the parallel paper: map-building time per thread count, and P's effect.
     Speedup(speedup::Args),
+    /// How building, memory, kd-tree queries and map files scale with the map's size (to 10 000 points).
+    MapScaling(map_scaling::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
@@ -105,6 +108,7 @@ impl Command {
             Command::View(a) => (vec![a.out.clone()], vec![]),
             Command::CompareOptimisers(a) => (vec![], vec![a.out_dir.clone()]),
             Command::Speedup(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::MapScaling(a) => (vec![], vec![a.out_dir.clone()]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
                 vec![a.out.clone()],
@@ -218,6 +222,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::ReachGrasp(args) => reach_grasp::run(&args),
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
+        Command::MapScaling(args) => map_scaling::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),

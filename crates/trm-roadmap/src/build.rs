@@ -77,6 +77,12 @@ pub struct Progress {
     pub failures: usize,
     /// Evaluations so far.
     pub evaluations: u64,
+    /// Generations run so far (in this run, when resumed).
+    pub generations: u64,
+    /// Wall seconds spent so far in the parallel part of the generations (asks, candidate and
+    /// centre evaluations, tells; in this run); the rest of `seconds` is the sequential part
+    /// (selecting, starting and checking searches, growing the map).
+    pub parallel_seconds: f64,
     /// Seconds since the start.
     pub seconds: f64,
 }
@@ -426,6 +432,7 @@ fn run(
     let before = state.seconds_before;
     let seconds = || before + started.elapsed().as_secs_f64();
     let mut checkpointed = state.map.points.len();
+    let (mut generations, mut parallel_seconds) = (0u64, 0.0f64);
     let mut near = Vec::new();
     let stopped_because;
 
@@ -497,6 +504,7 @@ fn run(
             });
         }
         // one generation of every search: ask, evaluate all candidates in parallel, tell
+        let parallel_start = Instant::now();
         let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
         let have_centres = searches
             .iter()
@@ -593,6 +601,8 @@ fn run(
                 .copy_from_slice(&centre_t[i * dim..(i + 1) * dim]);
         }
         *evaluations += searches.len() as u64;
+        parallel_seconds += parallel_start.elapsed().as_secs_f64();
+        generations += 1;
 
         // converged searches: CHECK their mean, add it or count a failure (in search order)
         let mut changed = false;
@@ -630,6 +640,8 @@ fn run(
                 target,
                 failures: *failures,
                 evaluations: *evaluations,
+                generations,
+                parallel_seconds,
                 seconds: seconds(),
             });
         }
@@ -643,6 +655,8 @@ fn run(
         target,
         failures: state.failures,
         evaluations: state.evaluations,
+        generations,
+        parallel_seconds,
         seconds: build_seconds,
     });
     Ok(Roadmap {

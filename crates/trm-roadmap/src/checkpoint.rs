@@ -109,7 +109,10 @@ impl Checkpoint {
     /// killed while writing leaves the previous checkpoint whole.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        Ok(trm_kinematics::write_file_bytes(path, &self.to_bytes(path)?)?)
+        Ok(trm_kinematics::write_file_bytes(
+            path,
+            &self.to_bytes(path)?,
+        )?)
     }
 
     /// The checkpoint file's bytes (`path` names it in errors).

@@ -214,19 +214,22 @@ impl Roadmap {
     pub fn summary(&self) -> MapSummary {
         let n = self.points.len();
         let extent = self.extent();
-        let distance = |a: &MapPoint, b: &MapPoint| {
-            a.t.iter()
-                .zip(&b.t)
-                .map(|(x, y)| (x - y).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        };
-        let nearest: Vec<f64> = (0..n)
-            .map(|i| {
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| distance(&self.points[i], &self.points[j]))
-                    .fold(f64::INFINITY, f64::min)
+        // each point's nearest other point, through the kd-tree (n log n, not n²)
+        let dim = self.points.first().map_or(0, |p| p.t.len());
+        let mut index = crate::TaskIndex::new(dim);
+        for p in &self.points {
+            index.add(&p.t);
+        }
+        let mut nn = Vec::new();
+        let nearest: Vec<f64> = self
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                index.nearest(&p.t, 2, &mut nn);
+                nn.iter()
+                    .find(|&&(_, j)| j != i)
+                    .map_or(f64::INFINITY, |&(dt, _)| dt)
             })
             .collect();
         let spacing = (n > 1).then(|| {

@@ -2,7 +2,7 @@
 //! the bimanual maps need). Implement [`TaskFunction`] to add your own.
 
 use trm_kinematics::FrameId;
-use trm_kinematics::nalgebra::Vector3;
+use trm_kinematics::nalgebra::{UnitQuaternion, Vector3};
 
 use crate::context::{Anchor, Context};
 
@@ -79,6 +79,35 @@ impl TaskFunction for RotationTask {
     }
     fn eval(&self, ctx: &Context, out: &mut [f64]) {
         write_masked(ctx.axis(self.part, &self.axis), self.mask, out);
+    }
+}
+
+/// A part's pose, 6-D: (position, scale · log(R_ref⁻¹ R_part)) — the rotation vector of the
+/// part's orientation relative to a reference, in the reference frame.
+#[derive(Debug, Clone)]
+pub struct PoseTask {
+    /// The frame.
+    pub part: FrameId,
+    /// Its name.
+    pub part_name: String,
+    /// Metres per radian.
+    pub scale: f64,
+    /// The reference orientation, inverted.
+    pub reference_inverse: UnitQuaternion<f64>,
+}
+
+impl TaskFunction for PoseTask {
+    fn dim(&self) -> usize {
+        6
+    }
+    fn label(&self) -> String {
+        format!("pose {}", self.part_name)
+    }
+    fn eval(&self, ctx: &Context, out: &mut [f64]) {
+        let pose = ctx.poses.pose(self.part);
+        let p = pose.translation.vector;
+        let r = (self.reference_inverse * pose.rotation).scaled_axis() * self.scale;
+        out[..6].copy_from_slice(&[p.x, p.y, p.z, r.x, r.y, r.z]);
     }
 }
 

@@ -145,6 +145,20 @@ fn task_functions_match_hand_computations() {
     assert!(((g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) - 1.0).abs() < 1e-12);
     let g = value("Rotation(part: \"tool\", axis: (1, 0, 0))");
     assert!((g[0] - (0.6f64).cos()).abs() < 1e-12 && (g[1] - (0.6f64).sin()).abs() < 1e-12);
+    // the planar arm turns the tool by 0.6 rad about z: 0.4 rad from a 0.2 rad reference
+    let g = value("Pose(part: \"tool\", scale: 0.5, reference: (0, 0, 0.2))");
+    assert_eq!(g.len(), 6);
+    assert!((g[0] - t[0]).abs() < 1e-12 && (g[1] - t[1]).abs() < 1e-12);
+    assert!(g[3].abs() < 1e-12 && g[4].abs() < 1e-12 && (g[5] - 0.5 * 0.4).abs() < 1e-12);
+    for bad in ["scale: 0", "scale: -1", "reference: (0, NaN, 0)"] {
+        let text = format!(
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], task: Some(Pose(part: \"tool\", {bad})))"
+        );
+        let e = Problem::from_ron(&text, "pose.ron", Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("pose.ron") && e.contains("task."), "{bad}: {e}");
+    }
 }
 
 #[test]

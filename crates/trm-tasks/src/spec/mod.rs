@@ -260,6 +260,21 @@ pub enum TaskSpec {
         #[serde(default = "all_axes")]
         mask: [bool; 3],
     },
+    /// A part's full pose, 6-D: its position (metres), then its orientation as the rotation
+    /// vector from `reference` (roll, pitch, yaw in the world frame) to the part's frame,
+    /// times `scale` (metres per radian), so that task-space distances weigh 1 rad of turn like
+    /// `scale` metres of travel. The rotation vector is continuous for turns below π from the
+    /// reference: pick a reference near the orientations the map will hold.
+    Pose {
+        /// The part.
+        part: String,
+        /// Metres per radian (default 0.1: 1 cm of spacing ≈ 5.7°).
+        #[serde(default = "default_pose_scale")]
+        scale: f64,
+        /// Reference orientation, roll-pitch-yaw (radians, world frame).
+        #[serde(default)]
+        reference: [f64; 3],
+    },
     /// Direction of the rod from a to b.
     RodDirection {
         /// First.
@@ -270,6 +285,10 @@ pub enum TaskSpec {
         #[serde(default = "all_axes")]
         mask: [bool; 3],
     },
+}
+
+fn default_pose_scale() -> f64 {
+    0.1
 }
 
 /// Robustness: the expected cost under N(0, σ²) noise on q.

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use trm_collision::World;
-use trm_kinematics::nalgebra::Vector3;
+use trm_kinematics::nalgebra::{UnitQuaternion, Vector3};
 use trm_kinematics::{ActiveSet, FrameId, RobotModel};
 
 use crate::context::Anchor;
@@ -14,7 +14,7 @@ use crate::costs::{
 };
 use crate::error::Result;
 use crate::tasks::{
-    AngleTask, DistanceTask, MidpointTask, PositionTask, RodDirectionTask, RotationTask,
+    AngleTask, DistanceTask, MidpointTask, PoseTask, PositionTask, RodDirectionTask, RotationTask,
     TaskFunction,
 };
 
@@ -318,6 +318,19 @@ impl Resolver<'_> {
                 names: format!("{} / {}", anchor_name(a), anchor_name(b)),
                 mask: self.mask(*mask, "task.mask")?,
             }),
+            TaskSpec::Pose {
+                part,
+                scale,
+                reference,
+            } => {
+                let [r, p, y] = self.finite(*reference, "task.reference")?;
+                Box::new(PoseTask {
+                    part: self.frame(part, "task.part")?,
+                    part_name: part.clone(),
+                    scale: self.positive(*scale, "task.scale")?,
+                    reference_inverse: UnitQuaternion::from_euler_angles(r, p, y).inverse(),
+                })
+            }
             TaskSpec::RodDirection { a, b, mask } => Box::new(RodDirectionTask {
                 a: self.anchor(a, "task.a")?,
                 b: self.anchor(b, "task.b")?,
