@@ -5,7 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use trm_roadmap::{BuildOptions, Checkpoint, CheckpointOptions, Roadmap, build, connect, resume};
+use trm_roadmap::{
+    BuildOptions, Checkpoint, CheckpointOptions, Evaluator, Roadmap, Threads, build_with, connect,
+    resume_with,
+};
 use trm_tasks::Problem;
 
 /// Arguments of `build-map`.
@@ -48,6 +51,11 @@ pub struct Args {
     /// Also write a 3-D view of the map (`<out stem>.scene.html` and `.scene.json`).
     #[arg(long)]
     view: bool,
+    /// Spread the evaluations over the processes of an MPI job (run under `mpirun`; needs an
+    /// xtask built with `--features mpi`). Rank 0 builds and writes the map; every rank uses
+    /// --threads threads. The map is the same on any number of ranks.
+    #[arg(long)]
+    mpi: bool,
 }
 
 impl Args {
@@ -82,7 +90,18 @@ pub fn run(args: &Args) -> Result<()> {
     // checked before minutes of map building
     trm_roadmap::check_edge_resolution(args.edge_resolution).context("--edge-resolution")?;
     let out = args.out_path();
-    let pool = crate::thread_pool(args.threads)?;
+    // the build runs on this thread, made a worker of the global pool (an MPI communicator
+    // stays on the thread that initialised MPI); under --mpi one thread per rank unless
+    // --threads says otherwise
+    let threads = match (args.mpi, args.threads) {
+        (true, None) => 1,
+        (_, threads) => crate::thread_count(threads)?,
+    };
+    // (only fails when the global pool already exists: a second run in one test process)
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .use_current_thread()
+        .build_global();
     let mut options = BuildOptions {
         points: args.points,
         searches: args.searches,
@@ -119,45 +138,80 @@ pub fn run(args: &Args) -> Result<()> {
         };
         options.checkpoint = Some(CheckpointOptions { path, every });
     }
-    let mut progress = crate::progress::Progress::new("points", 0);
-    let map = pool.install(|| -> Result<Roadmap> {
-        let report = |p: &trm_roadmap::Progress| {
-            let rate = p.evaluations as f64 / p.seconds.max(1e-9);
-            progress.set(
-                p.points as u64,
-                p.target as u64,
-                &format!(
-                    "{} consecutive failures, {} evaluations ({rate:.0}/s)",
-                    p.failures, p.evaluations
-                ),
-            );
-        };
-        let mut map = match resumed {
-            Some(checkpoint) => resume(&problem, checkpoint, &options, report)?,
-            None => build(&problem, &options, report)?,
-        };
-        progress.finish();
-        let neighbours = map.settings.edge_neighbours;
-        connect(
-            &mut map,
-            &problem.objective,
-            neighbours,
-            args.edge_resolution,
-        )?;
-        Ok(map)
-    })?;
-    crate::write_atomic(&out, map.to_json(&out)?.as_bytes())?;
-    print_summary(&map);
-    let svg = out.with_extension("svg");
-    crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;
-    println!("wrote {} and {}", out.display(), svg.display());
-    if args.view {
-        let mut scene =
-            crate::view::problem_scene(&problem, &format!("map of {}", problem.origin))?;
-        crate::view::add_map(&mut scene, &map, problem.objective.active())?;
-        crate::view::write_scene(&scene, &crate::view::scene_path(&out))?;
+    let job = Job {
+        args,
+        problem: &problem,
+        options: &options,
+        out: &out,
+    };
+    if args.mpi {
+        return crate::distributed::build_map(job, resumed);
     }
-    Ok(())
+    job.run(resumed, &mut Threads)
+}
+
+/// A build-map run, ready to go: its evaluations on this process's threads or spread over the
+/// ranks of an MPI job.
+pub struct Job<'a> {
+    /// The arguments.
+    pub args: &'a Args,
+    /// The task.
+    pub problem: &'a Problem,
+    /// The build options.
+    pub options: &'a BuildOptions,
+    /// Where the map goes.
+    pub out: &'a Path,
+}
+
+impl Job<'_> {
+    /// Builds (or resumes), connects and writes the map, evaluating with `evaluator`.
+    pub fn run(self, resumed: Option<Checkpoint>, evaluator: &mut dyn Evaluator) -> Result<()> {
+        let Job {
+            args,
+            problem,
+            options,
+            out,
+        } = self;
+        let mut progress = crate::progress::Progress::new("points", 0);
+        let map = (|| -> Result<Roadmap> {
+            let report = |p: &trm_roadmap::Progress| {
+                let rate = p.evaluations as f64 / p.seconds.max(1e-9);
+                progress.set(
+                    p.points as u64,
+                    p.target as u64,
+                    &format!(
+                        "{} consecutive failures, {} evaluations ({rate:.0}/s)",
+                        p.failures, p.evaluations
+                    ),
+                );
+            };
+            let mut map = match resumed {
+                Some(checkpoint) => resume_with(problem, checkpoint, options, evaluator, report)?,
+                None => build_with(problem, options, evaluator, report)?,
+            };
+            progress.finish();
+            let neighbours = map.settings.edge_neighbours;
+            connect(
+                &mut map,
+                &problem.objective,
+                neighbours,
+                args.edge_resolution,
+            )?;
+            Ok(map)
+        })()?;
+        crate::write_atomic(out, map.to_json(out)?.as_bytes())?;
+        print_summary(&map);
+        let svg = out.with_extension("svg");
+        crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;
+        println!("wrote {} and {}", out.display(), svg.display());
+        if args.view {
+            let mut scene =
+                crate::view::problem_scene(problem, &format!("map of {}", problem.origin))?;
+            crate::view::add_map(&mut scene, &map, problem.objective.active())?;
+            crate::view::write_scene(&scene, &crate::view::scene_path(out))?;
+        }
+        Ok(())
+    }
 }
 
 /// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
@@ -286,6 +340,7 @@ mod tests {
                 checkpoint_every: None,
                 checkpoint: None,
                 resume: None,
+                mpi: false,
             })
             .unwrap_err();
             assert!(format!("{e:#}").contains("--edge-resolution"), "{e:#}");

@@ -3,6 +3,7 @@
 mod build_map;
 mod collide;
 mod compare;
+mod distributed;
 mod explore_task_map;
 mod fk;
 mod gen_acm;
@@ -344,8 +345,15 @@ fn numbers(flag: &str, text: &str, expected: &str) -> Result<Vec<f64>> {
 /// A thread pool for `--threads`: all cores when absent; 0 is an error; more threads than
 /// cores are capped to the cores (more only slow the build down) with a note.
 fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(thread_count(threads)?)
+        .build()?)
+}
+
+/// The thread count of a `--threads` flag: all cores when absent, capped to the cores.
+fn thread_count(threads: Option<usize>) -> Result<usize> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads = match threads {
+    Ok(match threads {
         None => cores,
         Some(0) => {
             anyhow::bail!("--threads 0: give at least 1 (or leave it out for all {cores} cores)")
@@ -357,10 +365,7 @@ fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
             cores
         }
         Some(t) => t,
-    };
-    Ok(rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()?)
+    })
 }
 
 /// A fresh scratch directory for a test, named after it and this process.

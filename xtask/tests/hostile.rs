@@ -683,6 +683,13 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         names: "--resume".into(),
     });
     cases.push(Case {
+        what: "build-map --mpi from an xtask built without MPI".into(),
+        args: ["build-map", spec, "--points", "2", "--mpi"]
+            .map(String::from)
+            .to_vec(),
+        names: "--features mpi".into(),
+    });
+    cases.push(Case {
         what: "build-map --checkpoint without an interval".into(),
         args: ["build-map", spec, "--checkpoint", "c.checkpoint"]
             .map(String::from)

@@ -19,8 +19,8 @@ use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
 
 use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
-use trm_tasks::Problem;
 use trm_tasks::spec::MapSpec;
+use trm_tasks::{Objective, Problem};
 
 use crate::edges::distance;
 use crate::error::{Result, RoadmapError};
@@ -161,6 +161,58 @@ impl Growing {
 pub const MAX_POINTS: usize = 10_000_000;
 /// The most concurrent searches P.
 pub const MAX_SEARCHES: usize = 4096;
+
+/// Where a build's candidates are evaluated: h(q) and g(q) for a batch, on this process's
+/// threads ([`Threads`]) or spread over processes (the `mpi` feature's `trm_roadmap::mpi`).
+/// Every evaluation of an [`Objective`] gives the same bits however candidates are split, so a
+/// seed and P give the same map whatever evaluates them.
+pub trait Evaluator {
+    /// h(qs\[k\]) into `fitness[k]` and g(qs\[k\]) into `tasks[k·dim..(k + 1)·dim]`.
+    fn evaluate(
+        &mut self,
+        objective: &Objective,
+        qs: &[&[f64]],
+        fitness: &mut [f64],
+        tasks: &mut [f64],
+    ) -> Result<()>;
+}
+
+/// Evaluates on the threads of the current rayon pool, [`LANES`] candidates at a time.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Threads;
+
+impl Evaluator for Threads {
+    fn evaluate(
+        &mut self,
+        objective: &Objective,
+        qs: &[&[f64]],
+        fitness: &mut [f64],
+        tasks: &mut [f64],
+    ) -> Result<()> {
+        evaluate_on_threads(objective, qs, fitness, tasks);
+        Ok(())
+    }
+}
+
+/// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time ([`Threads`]).
+pub fn evaluate_on_threads(
+    objective: &Objective,
+    qs: &[&[f64]],
+    fitness: &mut [f64],
+    tasks: &mut [f64],
+) {
+    let dim = objective.task().map_or(0, |t| t.dim());
+    fitness
+        .par_chunks_mut(LANES)
+        .zip(tasks.par_chunks_mut((LANES * dim).max(1)))
+        .zip(qs.par_chunks(LANES))
+        .for_each_init(
+            || objective.scratch(),
+            |scratch, ((fitness, tasks), qs)| {
+                objective.eval_with_task_batch(qs, scratch, fitness, tasks);
+            },
+        );
+}
 
 /// The fixed settings of one build.
 struct Setup<'a> {
@@ -356,11 +408,28 @@ pub fn build(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
+    build_with(problem, options, &mut Threads, progress)
+}
+
+/// [`build`] with the candidates evaluated by `evaluator` (e.g. across MPI processes): the
+/// same map as [`build`].
+pub fn build_with(
+    problem: &Problem,
+    options: &BuildOptions,
+    evaluator: &mut dyn Evaluator,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
     let mut setup = Setup::new(problem, options.points, options.searches, options.seed)?;
     setup.max_generations = options.max_generations;
     setup.repel_weight = options.repel_weight;
     let state = State::fresh(&setup);
-    run(&setup, state, options.checkpoint.as_ref(), progress)
+    run(
+        &setup,
+        state,
+        options.checkpoint.as_ref(),
+        evaluator,
+        progress,
+    )
 }
 
 /// Finishes a build from its [`Checkpoint`] with exactly the map the uninterrupted build gives
@@ -372,6 +441,17 @@ pub fn resume(
     problem: &Problem,
     checkpoint: Checkpoint,
     options: &BuildOptions,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    resume_with(problem, checkpoint, options, &mut Threads, progress)
+}
+
+/// [`resume`] with the candidates evaluated by `evaluator`, as [`build_with`].
+pub fn resume_with(
+    problem: &Problem,
+    checkpoint: Checkpoint,
+    options: &BuildOptions,
+    evaluator: &mut dyn Evaluator,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     for (what, given, stored) in [
@@ -404,7 +484,13 @@ pub fn resume(
     setup.max_generations = checkpoint.max_generations;
     setup.repel_weight = checkpoint.repel_weight;
     let state = State::restore(&setup, checkpoint)?;
-    run(&setup, state, options.checkpoint.as_ref(), progress)
+    run(
+        &setup,
+        state,
+        options.checkpoint.as_ref(),
+        evaluator,
+        progress,
+    )
 }
 
 /// Algorithm 2 from `state` on; see the module documentation.
@@ -412,6 +498,7 @@ fn run(
     setup: &Setup,
     mut state: State,
     checkpoint: Option<&CheckpointOptions>,
+    evaluator: &mut dyn Evaluator,
     mut progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     let problem = setup.problem;
@@ -539,33 +626,31 @@ fn run(
             h += setup.repel_weight * h_rep;
             h
         };
-        // h* of (search, candidate) jobs, in parallel batches: `fitness[k]`, and g in
-        // `tasks[k·dim..]`
-        let evaluate = |jobs: &[(usize, &[f64])], fitness: &mut [f64], tasks: &mut [f64]| {
+        // h* of (search, candidate) jobs: h and g by the evaluator, then h_map and h_repel in
+        // parallel batches: `fitness[k]`, and g in `tasks[k·dim..]`
+        let evaluate = |evaluator: &mut dyn Evaluator,
+                        jobs: &[(usize, &[f64])],
+                        fitness: &mut [f64],
+                        tasks: &mut [f64]|
+         -> Result<()> {
+            let qs: Vec<&[f64]> = jobs.iter().map(|job| job.1).collect();
+            evaluator.evaluate(objective, &qs, fitness, tasks)?;
             fitness
                 .par_chunks_mut(LANES)
-                .zip(tasks.par_chunks_mut(LANES * dim))
+                .zip(tasks.par_chunks(LANES * dim))
                 .zip(jobs.par_chunks(LANES))
-                .for_each_init(
-                    || (objective.scratch(), Vec::new()),
-                    |(scratch, nn), ((fitness, tasks), jobs)| {
-                        let mut qs = [jobs[0].1; LANES];
-                        for (q, job) in qs.iter_mut().zip(jobs) {
-                            *q = job.1;
-                        }
-                        let qs = &qs[..jobs.len()];
-                        objective.eval_with_task_batch(qs, scratch, fitness, tasks);
-                        for (k, &(i, q)) in jobs.iter().enumerate() {
-                            let t = &tasks[k * dim..(k + 1) * dim];
-                            fitness[k] = h_star(i, q, fitness[k], t, nn);
-                        }
-                    },
-                );
+                .for_each_init(Vec::new, |nn, ((fitness, tasks), jobs)| {
+                    for (k, &(i, q)) in jobs.iter().enumerate() {
+                        let t = &tasks[k * dim..(k + 1) * dim];
+                        fitness[k] = h_star(i, q, fitness[k], t, nn);
+                    }
+                });
+            Ok(())
         };
         // every candidate of every search
         let mut fitness = vec![0.0; jobs.len()];
         let mut tasks = vec![0.0; jobs.len() * dim];
-        evaluate(&jobs, &mut fitness, &mut tasks);
+        evaluate(evaluator, &jobs, &mut fitness, &mut tasks)?;
         *evaluations += jobs.len() as u64;
         // tells in parallel, one task per search; then every search's centre
         let mut offsets = Vec::with_capacity(searches.len());
@@ -593,7 +678,7 @@ fn run(
             .collect();
         let mut centre_f = vec![0.0; searches.len()];
         let mut centre_t = vec![0.0; searches.len() * dim];
-        evaluate(&centre_jobs, &mut centre_f, &mut centre_t);
+        evaluate(evaluator, &centre_jobs, &mut centre_f, &mut centre_t)?;
         for (i, s) in searches.iter_mut().enumerate() {
             s.xnes.record_center_fitness(&centre_qs[i], centre_f[i]);
             s.centre_f = centre_f[i];

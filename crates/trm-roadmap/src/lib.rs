@@ -17,9 +17,12 @@ mod edges;
 mod error;
 mod index;
 mod map;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 
 pub use build::{
-    BuildOptions, CheckpointOptions, MAX_POINTS, MAX_SEARCHES, Progress, build, resume,
+    BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, Threads, build,
+    build_with, evaluate_on_threads, resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
