@@ -8,6 +8,8 @@
 //! non-finite or out-of-range value, truncations, duplicated and unknown keys, wrong types,
 //! numeric arrays one element short.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::Mutex;
@@ -1147,14 +1149,7 @@ fn a_killed_build_resumes_to_the_uninterrupted_map() {
     assert!(resumed.status.success(), "{said}");
     eprintln!("{}", said.lines().next().unwrap_or_default());
     assert!(said.starts_with("resuming"), "{said}");
-    let read = |name: &str| {
-        let mut map: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap();
-        for timing in ["build_seconds", "edge_seconds", "threads"] {
-            map["stats"][timing] = serde_json::Value::Null;
-        }
-        serde_json::to_string(&map).unwrap()
-    };
+    let read = |name: &str| common::map_without_timings(&dir.join(name));
     assert!(read("whole.map.json") == read("killed.map.json"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -4,6 +4,8 @@
 //! `cargo test -p xtask --features mpi --test mpi` (what `.ci/run` runs).
 #![cfg(feature = "mpi")]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -45,12 +47,7 @@ fn xtask(dir: &Path, ranks: Option<usize>, args: &[&str]) -> String {
 
 /// A map file without its timing statistics.
 fn map(dir: &Path, name: &str) -> String {
-    let mut map: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap();
-    for timing in ["build_seconds", "edge_seconds", "threads"] {
-        map["stats"][timing] = serde_json::Value::Null;
-    }
-    serde_json::to_string(&map).unwrap()
+    common::map_without_timings(&dir.join(name))
 }
 
 #[test]

@@ -1,6 +1,8 @@
 //! Task-relevant roadmaps: maps of postures that evenly cover a task space while satisfying a
 //! task's costs (Stollenga et al., IROS 2013; parallel E-TRM of Stollenga, Schmidhuber and
-//! Gomez). [`build`] grows a map with P concurrent xNES searches, [`connect`] adds
+//! Gomez). [`build`] grows a map with P concurrent xNES searches (writing [`Checkpoint`]s that
+//! [`resume`] finishes exactly; [`build_with`] evaluates the candidates elsewhere, e.g. across
+//! MPI processes with the `mpi` feature's `trm_roadmap::mpi`), [`connect`] adds
 //! configuration-space edges, and [`Roadmap`] saves and loads map files.
 //!
 //! ```no_run
