@@ -698,6 +698,11 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .to_vec(),
         names: "--checkpoint-every".into(),
     });
+    cases.extend(file_flag_cases(
+        &["map-info", "map.json"],
+        "--world",
+        &["no_such.ron", ".", "map.json", "posture.json"],
+    ));
     let plan = ["plan", "--map", "map.json"];
     cases.extend(flag_cases(
         &plan,

@@ -43,6 +43,9 @@ pub use acm::AllowedCollisionMatrix;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};
 pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
+/// Axis-aligned boxes (parry's), as [`PlacedBodies::bounding_box`] and
+/// [`WorldObject::bounding_box`] return them.
+pub use parry3d_f64::bounding_volume::Aabb;
 pub use query::{CollidingPair, CollisionCount, Other, PairDistance};
 pub use shape::{Shape, ShapeProblem};
 pub use trm_kinematics::DisableReason;

@@ -1,6 +1,7 @@
 //! The collision model of a robot: one body per URDF `<collision>` element, the allowed-collision
 //! matrix, and the flat list of body pairs the queries walk.
 
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -95,6 +96,15 @@ impl PlacedBodies {
     /// True for a robot without collision geometry.
     pub fn is_empty(&self) -> bool {
         self.placed.is_empty()
+    }
+
+    /// An axis-aligned box enclosing every placed body (through their bounding spheres);
+    /// `None` without bodies.
+    pub fn bounding_box(&self) -> Option<Aabb> {
+        self.placed
+            .iter()
+            .map(Placed::bounding_box)
+            .reduce(|a, b| a.merged(&b))
     }
 }
 

@@ -35,6 +35,11 @@ impl WorldObject {
     pub fn pose(&self) -> &Isometry3<f64> {
         &self.pose
     }
+
+    /// An axis-aligned box enclosing the object (through its bounding sphere).
+    pub fn bounding_box(&self) -> parry3d_f64::bounding_volume::Aabb {
+        self.placed.bounding_box()
+    }
 }
 
 /// Named objects around the robot, in the world frame (the robot's root link).

@@ -108,7 +108,7 @@ pub fn segment_is_free(
 }
 
 /// Intervals of the segment a → b at `resolution`.
-fn segment_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
+pub(crate) fn segment_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
     let span = a
         .iter()
         .zip(b)
@@ -118,7 +118,7 @@ fn segment_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
 }
 
 /// Sample `s` of `steps` on a → b, into `q`.
-fn segment_point(a: &[f64], b: &[f64], s: usize, steps: usize, q: &mut [f64]) {
+pub(crate) fn segment_point(a: &[f64], b: &[f64], s: usize, steps: usize, q: &mut [f64]) {
     let u = s as f64 / steps as f64;
     for ((q, a), b) in q.iter_mut().zip(a).zip(b) {
         *q = a + u * (b - a);
@@ -140,6 +140,27 @@ pub fn segment_is_collision_free(
     samples: &mut Vec<f64>,
     scratch: &mut Scratch,
 ) -> bool {
+    segment_all(
+        objective,
+        a,
+        b,
+        resolution,
+        samples,
+        scratch,
+        |qs, scratch| objective.all_collision_free_in(qs, world, scratch),
+    )
+}
+
+/// Whether `check` holds for every batch of [`LANES`] samples of a → b.
+fn segment_all(
+    objective: &Objective,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    samples: &mut Vec<f64>,
+    scratch: &mut Scratch,
+    mut check: impl FnMut(&[f64], &mut Scratch) -> bool,
+) -> bool {
     let d = objective.dim();
     assert!(a.len() == d && b.len() == d, "one value per active motor");
     let steps = segment_steps(a, b, resolution);
@@ -150,7 +171,7 @@ pub fn segment_is_collision_free(
         for (l, q) in samples.chunks_exact_mut(d).take(n).enumerate() {
             segment_point(a, b, s + l, steps, q);
         }
-        if !objective.all_collision_free_in(&samples[..n * d], world, scratch) {
+        if !check(&samples[..n * d], scratch) {
             return false;
         }
         s += n;

@@ -13,6 +13,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod blocked;
 mod build;
 mod checkpoint;
 mod edges;
@@ -22,6 +23,7 @@ mod map;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 
+pub use blocked::{BlockIndex, Blocked, blocked_exhaustive};
 pub use build::{
     BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, Threads, build,
     build_with, evaluate_on_threads, resume, resume_with,

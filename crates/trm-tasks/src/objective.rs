@@ -282,24 +282,49 @@ impl Objective {
     /// # Panics
     /// If `qs.len()` is not a multiple of [`Objective::dim`].
     pub fn all_collision_free_in(&self, qs: &[f64], world: &World, scratch: &mut Scratch) -> bool {
+        self.all_placed(qs, scratch, |placed| {
+            !self.collision.is_colliding(placed, world)
+        })
+    }
+
+    /// Whether no configuration of `qs` (as in [`Objective::all_collision_free_in`]) touches an
+    /// object of `world`; self-collisions are not checked (for postures known to be free of
+    /// them, against objects that changed).
+    ///
+    /// # Panics
+    /// If `qs.len()` is not a multiple of [`Objective::dim`].
+    pub fn all_clear_of(&self, qs: &[f64], world: &World, scratch: &mut Scratch) -> bool {
+        self.all_placed(qs, scratch, |placed| {
+            !self.collision.any_world_collision(placed, world)
+        })
+    }
+
+    /// Whether `free` holds for the placed bodies of every configuration of `qs`, batched,
+    /// stopping at the first that fails; NaN fails.
+    fn all_placed(
+        &self,
+        qs: &[f64],
+        scratch: &mut Scratch,
+        mut free: impl FnMut(&PlacedBodies) -> bool,
+    ) -> bool {
         let d = self.dim();
         assert!(d > 0 && qs.len() % d == 0, "whole configurations");
         let n = qs.len() / d;
         if qs.iter().any(|v| v.is_nan()) {
             return false;
         }
-        let mut free = true;
+        let mut all = true;
         self.pose_each(
             n,
             |k| &qs[k * d..(k + 1) * d],
             scratch,
             true,
             |_, _, s| {
-                free = !self.collision.is_colliding(&s.placed, world);
-                free
+                all = free(&s.placed);
+                all
             },
         );
-        free
+        all
     }
 
     /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), with forward kinematics
@@ -475,6 +500,13 @@ impl Objective {
     /// Whether `q` is free of self- and world collisions.
     pub fn is_collision_free(&self, q: &[f64], scratch: &mut Scratch) -> bool {
         self.is_collision_free_in(q, &self.world, scratch)
+    }
+
+    /// The robot's collision bodies placed at `q` (e.g. for their
+    /// [`PlacedBodies::bounding_box`]).
+    pub fn placed<'s>(&self, q: &[f64], scratch: &'s mut Scratch) -> &'s PlacedBodies {
+        self.pose(q, scratch, true);
+        &scratch.placed
     }
 
     /// Whether `q` is free of self-collisions and of collisions with `world` (another world

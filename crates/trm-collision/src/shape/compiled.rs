@@ -55,6 +55,14 @@ pub(crate) struct Placed {
     pub iso: Isometry3<f64>,
 }
 
+impl Placed {
+    /// The axis-aligned box of the bounding sphere.
+    pub fn bounding_box(&self) -> parry3d_f64::bounding_volume::Aabb {
+        let r = nalgebra::Vector3::repeat(self.bound);
+        parry3d_f64::bounding_volume::Aabb::new(self.center - r, self.center + r)
+    }
+}
+
 impl Default for Placed {
     fn default() -> Self {
         Placed {

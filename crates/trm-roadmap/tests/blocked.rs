@@ -1,0 +1,94 @@
+//! What a world change blocks: the indexed search finds exactly what checking every node and
+//! edge finds, over many random changes (objects added near the map, the table moved, removed).
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+use trm_collision::{Shape, World};
+use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use trm_roadmap::{BlockIndex, BuildOptions, blocked_exhaustive, build, connect};
+use trm_tasks::Problem;
+
+#[test]
+fn indexed_blocking_equals_the_exhaustive_check_on_random_world_changes() {
+    let problem =
+        Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap();
+    let objective = &problem.objective;
+    let mut map = build(
+        &problem,
+        &BuildOptions {
+            points: Some(60),
+            ..Default::default()
+        },
+        |_| {},
+    )
+    .unwrap();
+    connect(&mut map, objective, 6, 0.05).unwrap();
+    let index = BlockIndex::new(&map, objective).unwrap();
+    // the map's own world blocks nothing
+    let own = index.blocked(&map, objective, objective.world()).unwrap();
+    assert!(own.nodes.is_empty() && own.edges.is_empty() && own.changed.is_empty());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let (mut worlds_blocking, mut nodes, mut edges) = (0, 0, 0);
+    for case in 0..80 {
+        let mut world: World = objective.world().clone();
+        match case % 4 {
+            // the table moved up or sideways
+            0 => {
+                let table = *world.object("table").unwrap().pose();
+                let shift = Translation3::new(
+                    rng.random_range(-0.1..0.1),
+                    rng.random_range(-0.1..0.1),
+                    rng.random_range(0.0..0.2),
+                );
+                world.set_pose("table", shift * table).unwrap();
+            }
+            // the table gone, and maybe an object instead
+            1 => {
+                world.remove("table").unwrap();
+            }
+            _ => {}
+        }
+        for k in 0..rng.random_range(case % 4 / 2..3) {
+            let near = &map.points[rng.random_range(0..map.points.len())].t;
+            let centre = Translation3::new(
+                near[0] + rng.random_range(-0.12..0.12),
+                near[1] + rng.random_range(-0.12..0.12),
+                near[2] + rng.random_range(-0.12..0.12),
+            );
+            let turn = UnitQuaternion::from_euler_angles(
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+            );
+            let size = rng.random_range(0.01..0.1);
+            let shape = match k % 3 {
+                0 => Shape::Box {
+                    size: [size, 2.0 * size, size],
+                },
+                1 => Shape::Sphere { radius: size },
+                _ => Shape::Capsule {
+                    radius: size / 2.0,
+                    length: size,
+                },
+            };
+            world
+                .add(
+                    &format!("thing{k}"),
+                    shape,
+                    Isometry3::from_parts(centre, turn),
+                )
+                .unwrap();
+        }
+        let indexed = index.blocked(&map, objective, &world).unwrap();
+        let exhaustive = blocked_exhaustive(&map, objective, &world).unwrap();
+        assert_eq!(indexed, exhaustive, "world change {case}");
+        if !indexed.nodes.is_empty() || !indexed.edges.is_empty() {
+            worlds_blocking += 1;
+        }
+        nodes += indexed.nodes.len();
+        edges += indexed.edges.len();
+    }
+    eprintln!("{worlds_blocking} of 80 changes blocked something: {nodes} nodes, {edges} edges");
+    assert!(worlds_blocking >= 20 && nodes > 0 && edges > 0);
+}
