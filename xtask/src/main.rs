@@ -116,7 +116,8 @@ impl Command {
             ),
             Command::TaskMapStudies(a) => (vec![], vec![a.out_dir.clone()]),
             Command::GenIcub => (vec![], vec![models_dir()]),
-            Command::ModelInfo(_) | Command::MapInfo(_) | Command::Optimise(_) => (vec![], vec![]),
+            Command::ModelInfo(a) => (file(&a.ros_postures), vec![]),
+            Command::MapInfo(_) | Command::Optimise(_) => (vec![], vec![]),
         }
     }
 }

@@ -17,6 +17,13 @@ pub struct Args {
     /// Also list every disabled collision pair.
     #[arg(long)]
     collisions: bool,
+    /// Write every named posture as a one-point ROS 2 JointTrajectory (YAML, one document per
+    /// posture) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub ros_postures: Option<PathBuf>,
+    /// Seconds a controller gets to reach each posture of --ros-postures.
+    #[arg(long, default_value_t = 2.0, value_parser = crate::parse::positive)]
+    posture_seconds: f64,
     #[command(flatten)]
     meshes: crate::MeshArgs,
 }
@@ -64,6 +71,15 @@ fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
 /// Prints the report.
 pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(args.model.as_deref())?;
+    if let Some(out) = &args.ros_postures {
+        let yaml = trm_kinematics::ros::named_postures_yaml(&model, args.posture_seconds)?;
+        crate::write_atomic(out, yaml.as_bytes())?;
+        println!(
+            "wrote {} ({} named postures)",
+            out.display(),
+            model.posture_names().count()
+        );
+    }
     let tree = model.tree();
     let fixed = tree.joints.len() - model.num_joints();
     println!("model `{}` from {}", model.name(), model.origin());

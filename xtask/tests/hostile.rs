@@ -698,6 +698,11 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .to_vec(),
         names: "--checkpoint-every".into(),
     });
+    cases.extend(flag_cases(
+        &["model-info", "--ros-postures", "p.ros.yaml"],
+        "--posture-seconds",
+        &["0", "-1", "NaN", "inf", "x"],
+    ));
     cases.extend(file_flag_cases(
         &["map-info", "map.json"],
         "--world",
@@ -904,6 +909,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             vec!["gen-acm", "--samples", "10", "--out"],
             vec!["view", "--out"],
             vec!["explore-task-map", stick.as_str(), "--out"],
+            vec!["model-info", "--ros-postures"],
         ] {
             cases.push(Case {
                 what: format!("{} --out {out}", command[0]),

@@ -102,6 +102,25 @@ fn yaml_float(v: f64) -> String {
     }
 }
 
+/// Every named posture of `robot` as a one-point `trajectory_msgs/msg/JointTrajectory` (the
+/// posture reached `seconds` after the start, at rest), one YAML document per posture, each
+/// headed by a comment naming it: what a controller needs to go to "home".
+pub fn named_postures_yaml(robot: &RobotModel, seconds: f64) -> Result<String> {
+    if !(seconds.is_finite() && seconds > 0.0) {
+        return Err(KinematicsError::OutOfRange {
+            what: "posture time".into(),
+            problem: format!("{seconds} s: give a positive time to reach each posture"),
+        });
+    }
+    let mut text = String::new();
+    for name in robot.posture_names() {
+        let q = robot.posture(name)?.to_vec();
+        text.push_str(&format!("---\n# posture `{name}` of `{}`\n", robot.name()));
+        text.push_str(&joint_trajectory_yaml(robot, &[seconds], &[q], None)?);
+    }
+    Ok(text)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,6 +142,30 @@ mod tests {
             .unwrap();
         let inner = line.split('[').nth(1).unwrap().trim_end_matches(']');
         inner.split(", ").map(|v| v.parse().unwrap()).collect()
+    }
+
+    #[test]
+    fn named_postures_are_one_point_trajectories() {
+        let robot = icub();
+        let text = named_postures_yaml(&robot, 2.5).unwrap();
+        let names: Vec<&str> = robot.posture_names().collect();
+        assert!(!names.is_empty());
+        assert_eq!(text.matches("---\n").count(), names.len());
+        for (k, name) in names.iter().enumerate() {
+            assert!(text.contains(&format!("# posture `{name}`")));
+            let single = joint_trajectory_yaml(
+                &robot,
+                &[2.5],
+                &[robot.posture(name).unwrap().to_vec()],
+                None,
+            )
+            .unwrap();
+            assert_eq!(list(&text, "positions", k), list(&single, "positions", 0));
+        }
+        assert!(text.contains("sec: 2") && text.contains("nanosec: 500000000"));
+        for bad in [0.0, -1.0, f64::NAN] {
+            assert!(named_postures_yaml(&robot, bad).is_err());
+        }
     }
 
     #[test]
