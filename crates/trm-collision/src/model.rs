@@ -98,6 +98,12 @@ impl PlacedBodies {
         self.placed.is_empty()
     }
 
+    /// Axis-aligned boxes enclosing each placed body (through its bounding sphere), in body
+    /// order.
+    pub fn body_boxes(&self) -> impl Iterator<Item = Aabb> + '_ {
+        self.placed.iter().map(Placed::bounding_box)
+    }
+
     /// An axis-aligned box enclosing every placed body (through their bounding spheres);
     /// `None` without bodies.
     pub fn bounding_box(&self) -> Option<Aabb> {

@@ -29,12 +29,16 @@ pub struct Blocked {
     pub changed: Vec<String>,
 }
 
-/// Boxes around a map's nodes and edges, for [`BlockIndex::blocked`]: a BVH over the nodes'
-/// boxes, one over the edges' (each the union of its samples' boxes), and every edge sample's
-/// own box, so that only the samples near a changed object are checked.
+/// Boxes around a map's nodes and edges, for [`BlockIndex::blocked`]: the robot's bodies are
+/// grouped by kinematic branch (torso, head, each arm…), and a BVH holds one box per node and
+/// group, another one per edge and group (the union over the edge's samples); every edge
+/// sample's box around the whole robot is kept too, so that only the samples near a changed
+/// object are checked.
 pub struct BlockIndex {
     nodes: Bvh,
     edges: Bvh,
+    /// The number of body groups (leaves per node and per edge).
+    groups: usize,
     /// The boxes of the samples of edge k: `samples[sample_start[k]..sample_start[k + 1]]`.
     samples: Vec<Aabb>,
     sample_start: Vec<usize>,
@@ -67,48 +71,68 @@ impl BlockIndex {
     /// map's (its `Roadmap::problem`).
     pub fn new(map: &Roadmap, objective: &Objective) -> Result<Self> {
         check_fit(map, objective)?;
+        let (group_of, groups) = branch_groups(objective);
+        let grouped = |placed: &trm_collision::PlacedBodies, out: &mut Vec<Aabb>| {
+            let start = out.len();
+            out.resize(start + groups, Aabb::new_invalid());
+            for (body, aabb) in placed.body_boxes().enumerate() {
+                let g = &mut out[start + group_of[body]];
+                *g = g.merged(&aabb);
+            }
+        };
         let node_boxes: Vec<Aabb> = map
             .points
             .par_iter()
             .map_init(
                 || objective.scratch(),
-                |scratch, p| bodies_box(objective, &p.q, scratch),
+                |scratch, p| {
+                    let mut boxes = Vec::with_capacity(groups);
+                    grouped(objective.placed(&p.q, scratch), &mut boxes);
+                    boxes
+                },
             )
+            .flatten_iter()
             .collect();
-        let edge_samples: Vec<Vec<Aabb>> = map
+        // per edge: its groups' boxes over all samples, and each sample's whole-robot box
+        let per_edge: Vec<(Vec<Aabb>, Vec<Aabb>)> = map
             .edges
             .par_iter()
             .map_init(
-                || (objective.scratch(), vec![0.0; objective.dim()]),
-                |(scratch, q), &(a, b, _)| {
+                || (objective.scratch(), vec![0.0; objective.dim()], Vec::new()),
+                |(scratch, q, boxes), &(a, b, _)| {
                     let (qa, qb) = (&map.points[a].q, &map.points[b].q);
                     let steps = segment_steps(qa, qb, map.edge_resolution);
-                    (0..=steps)
+                    let mut union = vec![Aabb::new_invalid(); groups];
+                    let samples = (0..=steps)
                         .map(|s| {
                             segment_point(qa, qb, s, steps, q);
-                            bodies_box(objective, q, scratch)
+                            let placed = objective.placed(q, scratch);
+                            boxes.clear();
+                            grouped(placed, boxes);
+                            for (u, g) in union.iter_mut().zip(boxes.iter()) {
+                                *u = u.merged(g);
+                            }
+                            placed.bounding_box().unwrap_or_else(Aabb::new_invalid)
                         })
-                        .collect()
+                        .collect();
+                    (union, samples)
                 },
             )
             .collect();
-        let edge_boxes: Vec<Aabb> = edge_samples
-            .iter()
-            .map(|boxes| {
-                boxes
-                    .iter()
-                    .fold(Aabb::new_invalid(), |union, b| union.merged(b))
-            })
-            .collect();
-        let mut sample_start = Vec::with_capacity(edge_samples.len() + 1);
+        let mut sample_start = Vec::with_capacity(per_edge.len() + 1);
         sample_start.push(0);
-        for boxes in &edge_samples {
-            sample_start.push(sample_start.last().copied().unwrap_or(0) + boxes.len());
+        for (_, samples) in &per_edge {
+            sample_start.push(sample_start.last().copied().unwrap_or(0) + samples.len());
         }
+        let edge_boxes: Vec<Aabb> = per_edge
+            .iter()
+            .flat_map(|(u, _)| u.iter().copied())
+            .collect();
         Ok(BlockIndex {
             nodes: Bvh::from_leaves(BvhBuildStrategy::Binned, &node_boxes),
             edges: Bvh::from_leaves(BvhBuildStrategy::Binned, &edge_boxes),
-            samples: edge_samples.into_iter().flatten().collect(),
+            groups,
+            samples: per_edge.into_iter().flat_map(|(_, s)| s).collect(),
             sample_start,
         })
     }
@@ -129,7 +153,10 @@ impl BlockIndex {
         let near = |bvh: &Bvh| {
             let mut found: Vec<usize> = boxes
                 .iter()
-                .flat_map(|aabb| bvh.intersect_aabb(aabb).map(|i| i as usize))
+                .flat_map(|aabb| {
+                    bvh.intersect_aabb(aabb)
+                        .map(|leaf| leaf as usize / self.groups)
+                })
                 .collect();
             found.sort_unstable();
             found.dedup();
@@ -179,12 +206,46 @@ impl BlockIndex {
     }
 }
 
-/// The box around the robot's bodies at `q` (an empty box for a robot without bodies).
-fn bodies_box(objective: &Objective, q: &[f64], scratch: &mut trm_tasks::Scratch) -> Aabb {
-    objective
-        .placed(q, scratch)
-        .bounding_box()
-        .unwrap_or_else(Aabb::new_invalid)
+/// Groups the robot's collision bodies by kinematic branch: a body belongs to the topmost link
+/// of the unbranched chain above its link (a branch point is a link with two or more children
+/// that carry bodies): torso, head, each arm, …. Returns body → group and the group count (at
+/// least 1).
+fn branch_groups(objective: &Objective) -> (Vec<usize>, usize) {
+    let links = &objective.active().model().tree().links;
+    let bodies = objective.collision().bodies();
+    // which links have bodies at or below them, and how many such children each link has
+    let mut carries = vec![false; links.len()];
+    for b in bodies {
+        let mut l = Some(b.link);
+        while let Some(i) = l.filter(|&i| !carries[i]) {
+            carries[i] = true;
+            l = links[i].parent;
+        }
+    }
+    let mut children = vec![0usize; links.len()];
+    for (i, link) in links.iter().enumerate() {
+        if let (Some(p), true) = (link.parent, carries[i]) {
+            children[p] += 1;
+        }
+    }
+    let top = |mut l: usize| {
+        while let Some(p) = links[l].parent.filter(|&p| children[p] < 2) {
+            l = p;
+        }
+        l
+    };
+    let mut tops: Vec<usize> = Vec::new();
+    let group_of = bodies
+        .iter()
+        .map(|b| {
+            let t = top(b.link);
+            tops.iter().position(|&x| x == t).unwrap_or_else(|| {
+                tops.push(t);
+                tops.len() - 1
+            })
+        })
+        .collect();
+    (group_of, tops.len().max(1))
 }
 
 /// The objects of `world` the objective's (the map's) world does not have at that pose and

@@ -58,8 +58,14 @@ pub fn connect(
                     .filter(|&j| j != i)
                     .map(|j| (distance(&points[i].q, &points[j].q), j))
                     .collect();
-                near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                near.truncate(neighbours);
+                // the `neighbours` nearest (ties by index), without sorting all of them
+                let order =
+                    |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+                if near.len() > neighbours {
+                    near.select_nth_unstable_by(neighbours, order);
+                    near.truncate(neighbours);
+                }
+                near.sort_by(order);
                 near.into_iter()
                     .filter(|&(_, j)| {
                         let (a, b) = (&points[i].q, &points[j].q);
