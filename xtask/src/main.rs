@@ -15,6 +15,7 @@ mod plan;
 mod plot;
 mod progress;
 mod reach_grasp;
+mod repair_map;
 mod solve;
 mod speedup;
 mod stand_up;
@@ -64,6 +65,8 @@ enum Command {
     Speedup(speedup::Args),
     /// How building, memory, kd-tree queries and map files scale with the map's size (to 10 000 points).
     MapScaling(map_scaling::Args),
+    /// Repair a map for a world that changed: remove what it blocks, re-grow, reconnect.
+    RepairMap(repair_map::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
@@ -110,6 +113,7 @@ impl Command {
             Command::CompareOptimisers(a) => (vec![], vec![a.out_dir.clone()]),
             Command::Speedup(a) => (vec![], vec![a.out_dir.clone()]),
             Command::MapScaling(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::RepairMap(a) => (vec![a.out_path()], vec![]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
                 vec![a.out.clone()],
@@ -225,6 +229,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Solve(args) => solve::run(&args),
         Command::Speedup(args) => speedup::run(&args),
         Command::MapScaling(args) => map_scaling::run(&args),
+        Command::RepairMap(args) => repair_map::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),

@@ -698,6 +698,32 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .to_vec(),
         names: "--checkpoint-every".into(),
     });
+    cases.extend(file_flag_cases(
+        &["repair-map", "map.json", "--out", "r.json"],
+        "--world",
+        &["no_such.ron", ".", "map.json", "posture.json"],
+    ));
+    for bad in ["no_such.json", ".", "posture.json", "world.ron"] {
+        cases.push(Case {
+            what: format!("repair-map {bad}"),
+            args: ["repair-map", bad, "--world", "world.ron", "--out", "r.json"]
+                .map(String::from)
+                .to_vec(),
+            names: bad.into(),
+        });
+    }
+    cases.extend(flag_cases(
+        &[
+            "repair-map",
+            "map.json",
+            "--world",
+            "world.ron",
+            "--out",
+            "r.json",
+        ],
+        "--threads",
+        &["0", "-1", "x"],
+    ));
     cases.extend(flag_cases(
         &["model-info", "--ros-postures", "p.ros.yaml"],
         "--posture-seconds",
@@ -910,6 +936,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             vec!["view", "--out"],
             vec!["explore-task-map", stick.as_str(), "--out"],
             vec!["model-info", "--ros-postures"],
+            vec!["repair-map", "map.json", "--world", "world.ron", "--out"],
         ] {
             cases.push(Case {
                 what: format!("{} --out {out}", command[0]),

@@ -101,8 +101,12 @@ struct Growing {
     index: TaskIndex,
     neighbours: Vec<usize>,
     fails: Vec<usize>,
-    /// (neighbours + failures, index) of every point, for SELECTPROPORTIONAL.
+    /// (neighbours + failures, index) of every point searches may start from, for
+    /// SELECTPROPORTIONAL.
     scores: BTreeSet<(usize, usize)>,
+    /// Whether searches may start from a point (all in a build; near the lost region in a
+    /// repair).
+    selectable: Vec<bool>,
 }
 
 impl Growing {
@@ -113,11 +117,13 @@ impl Growing {
             neighbours: Vec::new(),
             fails: Vec::new(),
             scores: BTreeSet::new(),
+            selectable: Vec::new(),
         }
     }
 
-    /// Adds a point and counts it as a neighbour of the points within `radius` (and they of it).
-    fn add(&mut self, point: MapPoint, radius: f64, near: &mut Vec<usize>) {
+    /// Adds a point and counts it as a neighbour of the points within `radius` (and they of it);
+    /// searches may start from it when `selectable`.
+    fn add(&mut self, point: MapPoint, radius: f64, near: &mut Vec<usize>, selectable: bool) {
         let i = self.points.len();
         self.index.within(&point.t, radius, near);
         for &j in near.iter() {
@@ -127,7 +133,10 @@ impl Growing {
         self.points.push(point);
         self.neighbours.push(near.len());
         self.fails.push(0);
-        self.scores.insert((near.len(), i));
+        self.selectable.push(selectable);
+        if selectable {
+            self.scores.insert((near.len(), i));
+        }
     }
 
     fn score(&self, i: usize) -> usize {
@@ -135,15 +144,21 @@ impl Growing {
     }
 
     fn set_neighbours(&mut self, i: usize, n: usize) {
-        self.scores.remove(&(self.score(i), i));
-        self.neighbours[i] = n;
-        self.scores.insert((self.score(i), i));
+        self.rescore(i, |g| g.neighbours[i] = n);
     }
 
     fn set_fails(&mut self, i: usize, n: usize) {
-        self.scores.remove(&(self.score(i), i));
-        self.fails[i] = n;
-        self.scores.insert((self.score(i), i));
+        self.rescore(i, |g| g.fails[i] = n);
+    }
+
+    /// Changes point `i`'s bookkeeping with `change`, keeping its score in the set.
+    fn rescore(&mut self, i: usize, change: impl FnOnce(&mut Self)) {
+        let was = (self.score(i), i);
+        change(self);
+        if self.selectable[i] {
+            self.scores.remove(&was);
+            self.scores.insert((self.score(i), i));
+        }
     }
 
     /// SELECTPROPORTIONAL: a point with the fewest neighbours + failures, uniformly among ties
@@ -214,22 +229,39 @@ pub fn evaluate_on_threads(
         );
 }
 
+/// Where new points may go: within `radius` of one of the `lost` task points (a repair).
+pub(crate) struct Region {
+    pub(crate) lost: TaskIndex,
+    pub(crate) radius: f64,
+}
+
+impl Region {
+    fn contains(&self, t: &[f64], nn: &mut Vec<(f64, usize)>) -> bool {
+        self.lost.nearest(t, 1, nn);
+        nn.first().is_some_and(|&(dt, _)| dt <= self.radius)
+    }
+}
+
 /// The fixed settings of one build.
-struct Setup<'a> {
+pub(crate) struct Setup<'a> {
     problem: &'a Problem,
-    settings: MapSpec,
+    /// The objective the build minimises (the problem's, or the same in another world).
+    pub(crate) objective: &'a Objective,
+    /// A repair grows only here; selection starts searches only from points near it.
+    pub(crate) region: Option<Region>,
+    pub(crate) settings: MapSpec,
     target: usize,
     searches: usize,
     seed: u64,
-    max_generations: u64,
-    repel_weight: f64,
+    pub(crate) max_generations: u64,
+    pub(crate) repel_weight: f64,
     bounds: Bounds,
     dim: usize,
 }
 
 impl<'a> Setup<'a> {
     /// Checks the spec and the counts; the task's dimension comes from its task function.
-    fn new(
+    pub(crate) fn new(
         problem: &'a Problem,
         target: Option<usize>,
         searches: Option<usize>,
@@ -258,6 +290,8 @@ impl<'a> Setup<'a> {
         let (lower, upper) = objective.active().bounds();
         Ok(Setup {
             problem,
+            objective,
+            region: None,
             target,
             searches,
             seed: seed.unwrap_or(problem.spec.solver.seed),
@@ -271,7 +305,7 @@ impl<'a> Setup<'a> {
 }
 
 /// Everything a build holds between two generations.
-struct State {
+pub(crate) struct State {
     master: ChaCha8Rng,
     map: Growing,
     searches: Vec<Search>,
@@ -335,6 +369,23 @@ impl State {
         })
     }
 
+    /// A build continuing from `points` (a repair): searches start only from the points
+    /// within twice the region's radius of a lost point.
+    pub(crate) fn from_points(setup: &Setup, points: Vec<MapPoint>) -> Self {
+        let mut state = State::fresh(setup);
+        let (mut near, mut nn) = (Vec::new(), Vec::new());
+        for point in points {
+            let selectable = setup.region.as_ref().is_none_or(|r| {
+                r.lost.nearest(&point.t, 1, &mut nn);
+                nn.first().is_some_and(|&(dt, _)| dt <= 2.0 * r.radius)
+            });
+            state
+                .map
+                .add(point, 1.5 * setup.settings.spacing, &mut near, selectable);
+        }
+        state
+    }
+
     /// The state a checkpoint holds, for `setup` (which checked the checkpoint's settings).
     fn restore(setup: &Setup, checkpoint: Checkpoint) -> Result<Self> {
         let unfit = |what: String| {
@@ -355,7 +406,7 @@ impl State {
             if point.q.len() != n || point.t.len() != setup.dim {
                 return Err(unfit(format!("points[{i}] has the wrong size")));
             }
-            map.add(point, 1.5 * setup.settings.spacing, &mut near);
+            map.add(point, 1.5 * setup.settings.spacing, &mut near, true);
             map.set_fails(i, fails);
         }
         let searches = checkpoint
@@ -494,7 +545,7 @@ pub fn resume_with(
 }
 
 /// Algorithm 2 from `state` on; see the module documentation.
-fn run(
+pub(crate) fn run(
     setup: &Setup,
     mut state: State,
     checkpoint: Option<&CheckpointOptions>,
@@ -502,7 +553,7 @@ fn run(
     mut progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     let problem = setup.problem;
-    let objective = &problem.objective;
+    let objective = setup.objective;
     let settings = &setup.settings;
     let (target, p_searches, seed, dim) = (setup.target, setup.searches, setup.seed, setup.dim);
     let bounds = &setup.bounds;
@@ -706,9 +757,16 @@ fn run(
             let mut nn = Vec::new();
             map.index.nearest(&t, 1, &mut nn);
             let outside = nn.first().is_none_or(|(dt, _)| *dt >= d / 2.0);
-            let ok = cost.is_finite() && outside && objective.is_collision_free(&q, &mut scratch);
+            let inside = setup
+                .region
+                .as_ref()
+                .is_none_or(|r| r.contains(&t, &mut nn));
+            let ok = cost.is_finite()
+                && outside
+                && inside
+                && objective.is_collision_free(&q, &mut scratch);
             if ok {
-                map.add(MapPoint { q, t, cost }, 1.5 * d, &mut near);
+                map.add(MapPoint { q, t, cost }, 1.5 * d, &mut near, true);
                 *failures = 0;
                 changed = true;
             } else {
@@ -758,6 +816,7 @@ fn run(
         points: state.map.points,
         edges: Vec::new(),
         edge_resolution: 0.0,
+        world: None,
         stats: BuildStats {
             build_seconds,
             edge_seconds: 0.0,

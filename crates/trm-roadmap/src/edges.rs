@@ -48,8 +48,42 @@ pub fn connect(
         )));
     }
     let started = Instant::now();
+    map.edges = edges_from(map, objective, neighbours, resolution, 0);
+    map.edge_resolution = resolution;
+    map.stats.edge_seconds = started.elapsed().as_secs_f64();
+    Ok(())
+}
+
+/// Adds to `map`'s edges those of points `from..` to their `neighbours` nearest points (as
+/// [`connect`] makes them), e.g. for points added by a repair; the others' edges stay.
+pub(crate) fn connect_from(
+    map: &mut Roadmap,
+    objective: &Objective,
+    neighbours: usize,
+    resolution: f64,
+    from: usize,
+) -> Result<()> {
+    check_edge_resolution(resolution)?;
+    let mut edges = edges_from(map, objective, neighbours, resolution, from);
+    edges.extend_from_slice(&map.edges);
+    edges.sort_by_key(|e| (e.0, e.1));
+    edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    map.edges = edges;
+    map.edge_resolution = resolution;
+    Ok(())
+}
+
+/// The collision-free edges of points `from..` to their `neighbours` nearest points, sorted
+/// and without duplicates.
+fn edges_from(
+    map: &Roadmap,
+    objective: &Objective,
+    neighbours: usize,
+    resolution: f64,
+    from: usize,
+) -> Vec<(usize, usize, f64)> {
     let points = &map.points;
-    let mut edges: Vec<(usize, usize, f64)> = (0..points.len())
+    let mut edges: Vec<(usize, usize, f64)> = (from..points.len())
         .into_par_iter()
         .map_init(
             || (objective.scratch(), Vec::new()),
@@ -82,10 +116,7 @@ pub fn connect(
         .collect();
     edges.sort_by_key(|e| (e.0, e.1));
     edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
-    map.edges = edges;
-    map.edge_resolution = resolution;
-    map.stats.edge_seconds = started.elapsed().as_secs_f64();
-    Ok(())
+    edges
 }
 
 /// Euclidean distance between two vectors (joint or task space).

@@ -22,6 +22,7 @@ mod index;
 mod map;
 #[cfg(feature = "mpi")]
 pub mod mpi;
+mod repair;
 
 pub use blocked::{BlockIndex, Blocked, blocked_exhaustive};
 pub use build::{
@@ -36,3 +37,4 @@ pub use edges::{
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Roadmap, VERSION};
+pub use repair::{RepairReport, repair};

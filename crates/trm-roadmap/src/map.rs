@@ -12,6 +12,7 @@
 //!   "points": [ { "q": [ … ], "t": [x, y, z], "cost": 0.03 }, … ],
 //!   "edges": [ [i, j, length], … ],           // i < j, checked collision-free
 //!   "edge_resolution": 0.05,
+//!   "world": { "objects": [ … ] },           // only in a repaired map: the world it is valid in
 //!   "stats": { "build_seconds": 2.7, "evaluations": 123456, … } }
 //! ```
 //!
@@ -93,6 +94,10 @@ pub struct Roadmap {
     pub edges: Vec<(usize, usize, f64)>,
     /// Interpolation step (rad) at which edges were checked.
     pub edge_resolution: f64,
+    /// The world the map is valid for when it is not its spec's (a repaired map's); absent
+    /// otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<trm_collision::WorldSpec>,
     /// Statistics.
     pub stats: BuildStats,
 }
@@ -171,7 +176,15 @@ impl Roadmap {
     /// world files are found relative to the spec's original location, `spec_path`). Fails when
     /// the spec no longer loads or no longer has the map's active motors.
     pub fn problem(&self) -> Result<trm_tasks::Problem> {
-        let problem = problem_from_spec(&self.spec_path, &self.spec, &self.active)?;
+        let mut problem = problem_from_spec(&self.spec_path, &self.spec, &self.active)?;
+        if let Some(world) = &self.world {
+            let world = trm_collision::World::from_spec(world, &self.spec_path).map_err(|e| {
+                RoadmapError::Unsuitable(format!(
+                    "the map's recorded world: {e}; repair the map again"
+                ))
+            })?;
+            problem.objective.set_world(world);
+        }
         let dim = problem.objective.task().map_or(0, |t| t.dim());
         let robot = problem.objective.active().model();
         let motors = problem.objective.active().motor_indices();

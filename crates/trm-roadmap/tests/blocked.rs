@@ -92,3 +92,69 @@ fn indexed_blocking_equals_the_exhaustive_check_on_random_world_changes() {
     eprintln!("{worlds_blocking} of 80 changes blocked something: {nodes} nodes, {edges} edges");
     assert!(worlds_blocking >= 20 && nodes > 0 && edges > 0);
 }
+
+/// Occupied task-space cells of side `d`.
+fn cells(map: &trm_roadmap::Roadmap, d: f64) -> std::collections::BTreeSet<Vec<i64>> {
+    map.points
+        .iter()
+        .map(|p| p.t.iter().map(|v| (v / d).floor() as i64).collect())
+        .collect()
+}
+
+/// A repaired map is collision-free in the new world under the exhaustive check, records that
+/// world, and covers about what a rebuild in the new world covers; repairing it again for the
+/// same world changes nothing.
+#[test]
+fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let problem = Problem::load(root.join("specs/reach.ron")).unwrap();
+    let points = 150;
+    let options = BuildOptions {
+        points: Some(points),
+        ..Default::default()
+    };
+    let mut map = build(&problem, &options, |_| {}).unwrap();
+    connect(&mut map, &problem.objective, 8, 0.05).unwrap();
+    let world = World::load(root.join("specs/worlds/reach_with_box.ron")).unwrap();
+    let (repaired, report) = trm_roadmap::repair(&map, &problem, &world).unwrap();
+    eprintln!("{report:?}");
+    assert!(report.blocked_nodes > 0 && report.added_nodes > 0);
+    assert_eq!(
+        repaired.points.len(),
+        points - report.blocked_nodes + report.added_nodes
+    );
+    // valid in the new world: nothing blocked under the exhaustive check
+    let again = repaired.problem().unwrap();
+    assert!(again.objective.world().object("new_box").is_ok());
+    let check = blocked_exhaustive(&repaired, &again.objective, &world).unwrap();
+    assert!(
+        check.nodes.is_empty() && check.edges.is_empty(),
+        "{check:?}"
+    );
+    assert!(
+        repaired
+            .edges
+            .iter()
+            .all(|&(a, b, _)| a < b && b < repaired.points.len())
+    );
+    // a rebuild in the new world, to the same number of points
+    let text = problem.text.replace(
+        "world: (objects: [",
+        "world: (objects: [\n        (name: \"new_box\", shape: Box(size: (0.08, 0.06, 0.16)), xyz: (-0.3, 0.08, -0.04)),",
+    );
+    let rebuilt_problem = Problem::from_ron(&text, &problem.origin, &root.join("specs")).unwrap();
+    let started = std::time::Instant::now();
+    let rebuilt = build(&rebuilt_problem, &options, |_| {}).unwrap();
+    eprintln!("rebuild {:.2} s", started.elapsed().as_secs_f64());
+    let d = map.settings.spacing;
+    let (ours, theirs) = (cells(&repaired, d).len(), cells(&rebuilt, d).len());
+    eprintln!(
+        "occupied cells: repaired {ours}, rebuilt {theirs}, before {}",
+        cells(&map, d).len()
+    );
+    assert!(ours as f64 >= 0.95 * theirs as f64, "{ours} vs {theirs}");
+    // the same world again: nothing to do
+    let (twice, report) = trm_roadmap::repair(&repaired, &again, &world).unwrap();
+    assert_eq!(report.blocked_nodes, 0);
+    assert_eq!(twice.points, repaired.points);
+}

@@ -1,0 +1,119 @@
+//! `cargo xtask repair-map MAP --world W.ron [--out FILE] [--compare-rebuild]`: a map repaired
+//! for a world that changed (`trm_roadmap::repair`).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use trm_collision::World;
+use trm_roadmap::{BuildOptions, Roadmap, build};
+
+/// Arguments of `repair-map`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The map (built by build-map, or repaired before).
+    map: PathBuf,
+    /// The world the map must be valid in (RON).
+    #[arg(long, value_name = "WORLD.ron")]
+    world: PathBuf,
+    /// Output map (default: the map's name with .repaired.map.json).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Also build the map from scratch in the new world (same size, seed and settings) and
+    /// compare coverage and time.
+    #[arg(long)]
+    compare_rebuild: bool,
+    /// Worker threads (the map does not depend on it).
+    #[arg(long, value_parser = crate::parse::count(1, 4096))]
+    threads: Option<usize>,
+}
+
+impl Args {
+    /// Where the repaired map goes.
+    pub fn out_path(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| {
+            let name = self.map.file_name().map_or("map".into(), |n| {
+                n.to_string_lossy()
+                    .trim_end_matches(".json")
+                    .trim_end_matches(".map")
+                    .to_string()
+            });
+            self.map.with_file_name(format!("{name}.repaired.map.json"))
+        })
+    }
+}
+
+/// Occupied task-space cells of side `d`.
+fn cells(map: &Roadmap, d: f64) -> usize {
+    map.points
+        .iter()
+        .map(|p| {
+            p.t.iter()
+                .map(|v| (v / d).floor() as i64)
+                .collect::<Vec<_>>()
+        })
+        .collect::<std::collections::BTreeSet<_>>()
+        .len()
+}
+
+/// Repairs the map, prints the report, writes the repaired map.
+pub fn run(args: &Args) -> Result<()> {
+    let map = Roadmap::load(&args.map)?;
+    let problem = map
+        .problem()
+        .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
+    let world = World::load(&args.world)?;
+    let out = args.out_path();
+    let pool = crate::thread_pool(args.threads)?;
+    let started = Instant::now();
+    let (repaired, report) = pool.install(|| trm_roadmap::repair(&map, &problem, &world))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let d = map.settings.spacing;
+    println!(
+        "blocked: {} nodes, {} edges removed; grown: {} nodes, {} edges; lost cells of side d: {}, {} hold a point again",
+        report.blocked_nodes,
+        report.removed_edges,
+        report.added_nodes,
+        report.added_edges,
+        report.lost_cells,
+        report.restored_cells
+    );
+    println!(
+        "repaired in {seconds:.2} s (finding what is blocked {:.3} s, growing {:.2} s, connecting {:.2} s); {} points, {} edges, {} occupied cells (before: {})",
+        report.seconds[0],
+        report.seconds[1],
+        report.seconds[2],
+        repaired.points.len(),
+        repaired.edges.len(),
+        cells(&repaired, d),
+        cells(&map, d)
+    );
+    if args.compare_rebuild {
+        let mut fresh = map.problem()?;
+        fresh.objective.set_world(world.clone());
+        let started = Instant::now();
+        let rebuilt = pool.install(|| {
+            build(
+                &fresh,
+                &BuildOptions {
+                    points: Some(map.points.len()),
+                    searches: Some(map.searches),
+                    seed: Some(map.seed),
+                    ..Default::default()
+                },
+                |_| {},
+            )
+        })?;
+        let rebuild_seconds = started.elapsed().as_secs_f64();
+        println!(
+            "rebuild in the new world: {} points, {} occupied cells in {rebuild_seconds:.2} s (edges not built); repair: {:.0} % of its coverage in {:.0} % of its time",
+            rebuilt.points.len(),
+            cells(&rebuilt, d),
+            100.0 * cells(&repaired, d) as f64 / cells(&rebuilt, d).max(1) as f64,
+            100.0 * seconds / rebuild_seconds
+        );
+    }
+    crate::write_atomic(&out, repaired.to_json(&out)?.as_bytes())?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
