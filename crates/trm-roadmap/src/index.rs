@@ -1,5 +1,7 @@
 //! Task-space nearest neighbours with kiddo kd-trees (dimension 1–6; brute force above).
 
+use std::collections::HashMap;
+
 use kiddo::{KdTree, SquaredEuclidean};
 
 macro_rules! trees {
@@ -89,6 +91,11 @@ pub struct TaskIndex {
     dim: usize,
     tree: Tree,
     len: usize,
+    /// The first item at each exact task vector, and the later items at the same vector:
+    /// kiddo's buckets cannot hold more identical points than their size, so only the first
+    /// goes into the tree and the others are added to every answer that holds it.
+    first: HashMap<Vec<u64>, usize>,
+    copies: HashMap<usize, Vec<usize>>,
 }
 
 impl TaskIndex {
@@ -98,13 +105,24 @@ impl TaskIndex {
             dim,
             tree: Tree::new(dim),
             len: 0,
+            first: HashMap::new(),
+            copies: HashMap::new(),
         }
     }
 
-    /// Adds a point; its item is its insertion order.
+    /// Adds a point; its item is its insertion order. Any number of points may share a task
+    /// vector.
     pub fn add(&mut self, t: &[f64]) {
         debug_assert_eq!(t.len(), self.dim);
-        self.tree.add(t, self.len);
+        // −0.0 and 0.0 are one place
+        let key: Vec<u64> = t.iter().map(|v| (v + 0.0).to_bits()).collect();
+        match self.first.get(&key) {
+            Some(&first) => self.copies.entry(first).or_default().push(self.len),
+            None => {
+                self.tree.add(t, self.len);
+                self.first.insert(key, self.len);
+            }
+        }
         self.len += 1;
     }
 
@@ -118,19 +136,35 @@ impl TaskIndex {
         self.len == 0
     }
 
-    /// The `n` nearest points to `t` as (distance, item), nearest first.
+    /// The `n` nearest points to `t` as (distance, item), nearest first (ties by item).
     pub fn nearest(&self, t: &[f64], n: usize, out: &mut Vec<(f64, usize)>) {
         if self.len == 0 || n == 0 {
             out.clear();
             return;
         }
-        self.tree.nearest(t, n.min(self.len), out);
+        self.tree.nearest(t, n.min(self.first.len()), out);
+        if !self.copies.is_empty() {
+            for k in 0..out.len() {
+                let (dt, item) = out[k];
+                if let Some(copies) = self.copies.get(&item) {
+                    out.extend(copies.iter().map(|&c| (dt, c)));
+                }
+            }
+        }
         out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        out.truncate(n);
     }
 
     /// The items within `radius` of `t` (distance ≤ radius), in no particular order.
     pub fn within(&self, t: &[f64], radius: f64, out: &mut Vec<usize>) {
         self.tree.within(t, radius, out);
+        if !self.copies.is_empty() {
+            for k in 0..out.len() {
+                if let Some(copies) = self.copies.get(&out[k]) {
+                    out.extend_from_slice(copies);
+                }
+            }
+        }
     }
 }
 
@@ -138,6 +172,31 @@ impl TaskIndex {
 mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
+
+    /// Any number of identical task vectors (more than a kd-tree bucket holds) are found,
+    /// every one of them.
+    #[test]
+    fn identical_points_are_all_found() {
+        let mut index = TaskIndex::new(3);
+        for k in 0..100 {
+            index.add(&[0.1, if k % 2 == 0 { 0.0 } else { -0.0 }, 0.3]);
+        }
+        index.add(&[0.2, 0.0, 0.3]);
+        let mut out = Vec::new();
+        index.nearest(&[0.1, 0.0, 0.3], 100, &mut out);
+        assert_eq!(out.len(), 100);
+        assert!(
+            out.iter()
+                .enumerate()
+                .all(|(k, &(d, i))| d == 0.0 && i == k)
+        );
+        index.nearest(&[0.25, 0.0, 0.3], 2, &mut out);
+        assert_eq!(out.iter().map(|p| p.1).collect::<Vec<_>>(), [100, 0]);
+        let mut near = Vec::new();
+        index.within(&[0.1, 0.0, 0.3], 0.05, &mut near);
+        near.sort();
+        assert_eq!(near, (0..100).collect::<Vec<_>>());
+    }
 
     #[test]
     fn nearest_neighbours_equal_brute_force() {

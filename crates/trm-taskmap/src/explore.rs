@@ -84,6 +84,12 @@ pub fn explore(
         evaluate(g)
     };
     for (k, g0) in starts.iter().enumerate() {
+        if let Some(j) = starts[..k].iter().position(|s| s == g0) {
+            return Err(TaskMapError::Invalid {
+                what: format!("starts[{k}]"),
+                problem: format!("repeats starts[{j}]; give each start once"),
+            });
+        }
         let value = eval(g0, &mut evaluations);
         if value.is_nan() || value <= settings.threshold {
             return Err(TaskMapError::InfeasibleStart {

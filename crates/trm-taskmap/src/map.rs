@@ -217,8 +217,14 @@ impl TaskMap {
 
     fn reindex(&mut self) {
         let mut index = KdTree::new();
+        // one entry per place: the kd-tree's buckets cannot hold more identical points than
+        // their size, and the nearest of identical points is the first anyway
+        let mut seen = std::collections::HashSet::new();
         for (i, p) in self.points.iter().enumerate() {
-            index.add(&self.metric.scale(&p.g), i as u64);
+            let scaled = self.metric.scale(&p.g);
+            if seen.insert(scaled.map(|v| (v + 0.0).to_bits())) {
+                index.add(&scaled, i as u64);
+            }
         }
         self.index = Some(TaskIndexCell(index));
     }
@@ -334,5 +340,30 @@ impl TaskMap {
         })?;
         map.reindex();
         Ok(map)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A map (from a file, say) holding more identical points than a kd-tree bucket: indexed
+    /// without a panic, and the nearest is the first of them.
+    #[test]
+    fn identical_points_index_and_the_first_is_nearest() {
+        let point = |x: f64| TaskPoint {
+            g: [x, 0.0, 0.0, 0.0, 0.0, 0.0],
+            value: 1.0,
+            parent: None,
+            cluster: 0,
+        };
+        let mut points: Vec<TaskPoint> = (0..100).map(|_| point(0.1)).collect();
+        points.push(point(0.3));
+        let map = TaskMap::new(Metric::default(), 0.0, points, 0);
+        assert_eq!(map.nearest(&[0.12, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap().0, 0);
+        assert_eq!(
+            map.nearest(&[0.29, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap().0,
+            100
+        );
     }
 }
