@@ -43,19 +43,6 @@ impl Args {
     }
 }
 
-/// Occupied task-space cells of side `d`.
-fn cells(map: &Roadmap, d: f64) -> usize {
-    map.points
-        .iter()
-        .map(|p| {
-            p.t.iter()
-                .map(|v| (v / d).floor() as i64)
-                .collect::<Vec<_>>()
-        })
-        .collect::<std::collections::BTreeSet<_>>()
-        .len()
-}
-
 /// Repairs the map, prints the report, writes the repaired map.
 pub fn run(args: &Args) -> Result<()> {
     let map = Roadmap::load(&args.map)?;
@@ -68,7 +55,6 @@ pub fn run(args: &Args) -> Result<()> {
     let started = Instant::now();
     let (repaired, report) = pool.install(|| trm_roadmap::repair(&map, &problem, &world))?;
     let seconds = started.elapsed().as_secs_f64();
-    let d = map.settings.spacing;
     println!(
         "blocked: {} nodes, {} edges removed; grown: {} nodes, {} edges; lost cells of side d: {}, {} hold a point again",
         report.blocked_nodes,
@@ -85,8 +71,8 @@ pub fn run(args: &Args) -> Result<()> {
         report.seconds[2],
         repaired.points.len(),
         repaired.edges.len(),
-        cells(&repaired, d),
-        cells(&map, d)
+        repaired.occupied_cells(),
+        map.occupied_cells()
     );
     if args.compare_rebuild {
         let mut fresh = map.problem()?;
@@ -108,8 +94,8 @@ pub fn run(args: &Args) -> Result<()> {
         println!(
             "rebuild in the new world: {} points, {} occupied cells in {rebuild_seconds:.2} s (edges not built); repair: {:.0} % of its coverage in {:.0} % of its time",
             rebuilt.points.len(),
-            cells(&rebuilt, d),
-            100.0 * cells(&repaired, d) as f64 / cells(&rebuilt, d).max(1) as f64,
+            rebuilt.occupied_cells(),
+            100.0 * repaired.occupied_cells() as f64 / rebuilt.occupied_cells().max(1) as f64,
             100.0 * seconds / rebuild_seconds
         );
     }

@@ -698,6 +698,72 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .to_vec(),
         names: "--checkpoint-every".into(),
     });
+    // maps whose edge step or recorded world does not hold
+    let map: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("map.json")).unwrap()).unwrap();
+    let bad_maps = [
+        ("edge_resolution", serde_json::json!(0.0)),
+        ("edge_resolution", serde_json::json!(1e-300)),
+        ("edge_resolution", serde_json::json!(-0.05)),
+        (
+            "world",
+            serde_json::json!({"objects": [{"name": "ball", "shape": {"Sphere": {"radius": -1.0}}}]}),
+        ),
+        (
+            "world",
+            serde_json::json!({"objects": [
+                {"name": "ball", "shape": {"Sphere": {"radius": 0.1}}},
+                {"name": "ball", "shape": {"Sphere": {"radius": 0.1}}}]}),
+        ),
+        ("world", serde_json::json!("table")),
+    ];
+    for (k, (key, value)) in bad_maps.into_iter().enumerate() {
+        let mut bad = map.clone();
+        bad[key] = value.clone();
+        let name = format!("bad_map_{k}.map.json");
+        std::fs::write(dir.join(&name), serde_json::to_string(&bad).unwrap()).unwrap();
+        for command in [
+            vec!["map-info", name.as_str()],
+            vec![
+                "repair-map",
+                name.as_str(),
+                "--world",
+                "world.ron",
+                "--out",
+                "r.json",
+            ],
+        ] {
+            cases.push(Case {
+                what: format!("{} with {key} = {value}", command[0]),
+                args: command.iter().map(|a| a.to_string()).collect(),
+                names: name.clone(),
+            });
+        }
+    }
+    let scaling = ["map-scaling", spec, "--out-dir", "ms"];
+    cases.extend(flag_cases(
+        &scaling,
+        "--points",
+        &["0", "-1", "x", "100000000"],
+    ));
+    cases.extend(flag_cases(&scaling, "--threads", &["0", "-1", "x"]));
+    cases.extend(file_flag_cases(
+        &["map-scaling", spec],
+        "--out-dir",
+        &["posture.json"],
+    ));
+    cases.push(Case {
+        what: "model-info --ros-postures of a model without named postures".into(),
+        args: [
+            "model-info",
+            "icub_upper_body.urdf",
+            "--ros-postures",
+            "p.ros.yaml",
+        ]
+        .map(String::from)
+        .to_vec(),
+        names: "named postures".into(),
+    });
     cases.extend(file_flag_cases(
         &["repair-map", "map.json", "--out", "r.json"],
         "--world",

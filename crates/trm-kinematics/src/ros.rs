@@ -112,6 +112,15 @@ pub fn named_postures_yaml(robot: &RobotModel, seconds: f64) -> Result<String> {
             problem: format!("{seconds} s: give a positive time to reach each posture"),
         });
     }
+    if robot.posture_names().next().is_none() {
+        return Err(KinematicsError::OutOfRange {
+            what: "named postures".into(),
+            problem: format!(
+                "model `{}` has none; name postures in its description (`postures`)",
+                robot.name()
+            ),
+        });
+    }
     let mut text = String::new();
     for name in robot.posture_names() {
         let q = robot.posture(name)?.to_vec();

@@ -17,6 +17,9 @@ use crate::edges::{segment_is_collision_free, segment_point, segment_steps};
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
 
+/// The most edge samples a [`BlockIndex`] boxes (a box is 48 bytes per body group).
+pub const MAX_SAMPLES: usize = 20_000_000;
+
 /// What a world blocks in a map: node and edge indices (ascending), and the objects that
 /// differ from the map's own world.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -71,6 +74,19 @@ impl BlockIndex {
     /// map's (its `Roadmap::problem`).
     pub fn new(map: &Roadmap, objective: &Objective) -> Result<Self> {
         check_fit(map, objective)?;
+        let samples: usize = map
+            .edges
+            .iter()
+            .map(|&(a, b, _)| {
+                segment_steps(&map.points[a].q, &map.points[b].q, map.edge_resolution) + 1
+            })
+            .sum();
+        if samples > MAX_SAMPLES {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the map's edges hold {samples} checked postures (edge resolution {} rad), over the {MAX_SAMPLES} the index boxes: connect the map at a coarser resolution",
+                map.edge_resolution
+            )));
+        }
         let (group_of, groups) = branch_groups(objective);
         let grouped = |placed: &trm_collision::PlacedBodies, out: &mut Vec<Aabb>| {
             let start = out.len();

@@ -179,6 +179,19 @@ impl Checkpoint {
                 return Err(format!("points[{i}] holds a non-finite value"));
             }
         }
+        // counters far below their types' ends, so the build can go on counting
+        const COUNT_LIMIT: u64 = 1 << 60;
+        let counts = [
+            self.started,
+            self.evaluations,
+            self.total_failures,
+            self.failures as u64,
+        ];
+        if counts.iter().any(|&c| c >= COUNT_LIMIT)
+            || self.fails.iter().any(|&f| f as u64 >= COUNT_LIMIT)
+        {
+            return Err("a counter of 2^60 or more".into());
+        }
         if self.fails.len() != self.points.len() {
             return Err("failure counts and points differ in number".into());
         }
@@ -199,5 +212,50 @@ impl Checkpoint {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Counters at the end of their types (which the build would overflow going on) and parts
+    /// that do not fit together are refused on reading.
+    #[test]
+    fn checkpoints_with_absurd_counters_are_refused() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach_point.ron");
+        let problem = Problem::load(root).unwrap();
+        let path = std::env::temp_dir().join(format!("trm-ck-{}.checkpoint", std::process::id()));
+        let options = crate::BuildOptions {
+            points: Some(2),
+            checkpoint: Some(crate::CheckpointOptions {
+                path: path.clone(),
+                every: 1,
+            }),
+            ..Default::default()
+        };
+        crate::build(&problem, &options, |_| {}).unwrap();
+        let good = Checkpoint::load(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        let reread = |c: &Checkpoint| {
+            Checkpoint::from_bytes(&c.to_bytes(&path).unwrap(), &path).map_err(|e| e.to_string())
+        };
+        assert!(reread(&good).is_ok());
+        let mut bad = Vec::new();
+        for change in 0..5 {
+            let mut c = good.clone();
+            match change {
+                0 => c.started = u64::MAX,
+                1 => c.evaluations = u64::MAX - 1,
+                2 => c.failures = usize::MAX,
+                3 => c.fails[0] = usize::MAX,
+                _ => c.fails.pop().map_or((), drop),
+            }
+            bad.push(reread(&c).unwrap_err());
+        }
+        assert!(
+            bad.iter().all(|e| e.contains("start the build again")),
+            "{bad:?}"
+        );
     }
 }

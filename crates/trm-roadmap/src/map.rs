@@ -161,6 +161,14 @@ impl Roadmap {
                 return Err(format!("points[{i}] holds a non-finite value"));
             }
         }
+        if !self.edges.is_empty() && crate::check_edge_resolution(self.edge_resolution).is_err() {
+            return Err(format!(
+                "edge_resolution {} for {} edges: edges are checked at a finite step of at least {} rad",
+                self.edge_resolution,
+                self.edges.len(),
+                crate::MIN_RESOLUTION
+            ));
+        }
         for (k, &(a, b, w)) in self.edges.iter().enumerate() {
             if a >= self.points.len() || b >= self.points.len() || a == b || !w.is_finite() {
                 return Err(format!(
@@ -323,6 +331,24 @@ pub(crate) fn problem_from_spec(
         )));
     }
     Ok(problem)
+}
+
+/// The task-space cell of side `d` holding `t` (cells anchored at the origin).
+pub(crate) fn cell(t: &[f64], d: f64) -> Vec<i64> {
+    t.iter().map(|v| (v / d).floor() as i64).collect()
+}
+
+impl Roadmap {
+    /// Task-space cells of side d (the map's spacing, anchored at the origin) that hold a point:
+    /// the coverage a repair and a rebuild are compared by.
+    pub fn occupied_cells(&self) -> usize {
+        let d = self.settings.spacing;
+        self.points
+            .iter()
+            .map(|p| cell(&p.t, d))
+            .collect::<std::collections::BTreeSet<_>>()
+            .len()
+    }
 }
 
 /// What [`Roadmap::summary`] reports.

@@ -14,7 +14,7 @@ use crate::build::{Region, Setup, State, Threads, run};
 use crate::edges::connect_from;
 use crate::error::Result;
 use crate::index::TaskIndex;
-use crate::map::Roadmap;
+use crate::map::{Roadmap, cell};
 
 /// Consecutive failed searches after which a repair stops growing (at most the map's own
 /// `failure_limit`).
@@ -38,11 +38,6 @@ pub struct RepairReport {
     pub restored_cells: usize,
     /// Seconds: finding what is blocked, growing, connecting.
     pub seconds: [f64; 3],
-}
-
-/// The cell of side `d` holding `t`.
-fn cell(t: &[f64], d: f64) -> Vec<i64> {
-    t.iter().map(|v| (v / d).floor() as i64).collect()
 }
 
 /// Repairs `map` (built for `problem`, its [`Roadmap::problem`]) for `world`: removes what the

@@ -93,14 +93,6 @@ fn indexed_blocking_equals_the_exhaustive_check_on_random_world_changes() {
     assert!(worlds_blocking >= 20 && nodes > 0 && edges > 0);
 }
 
-/// Occupied task-space cells of side `d`.
-fn cells(map: &trm_roadmap::Roadmap, d: f64) -> std::collections::BTreeSet<Vec<i64>> {
-    map.points
-        .iter()
-        .map(|p| p.t.iter().map(|v| (v / d).floor() as i64).collect())
-        .collect()
-}
-
 /// A repaired map is collision-free in the new world under the exhaustive check, records that
 /// world, and covers about what a rebuild in the new world covers; repairing it again for the
 /// same world changes nothing.
@@ -146,11 +138,10 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
     let started = std::time::Instant::now();
     let rebuilt = build(&rebuilt_problem, &options, |_| {}).unwrap();
     eprintln!("rebuild {:.2} s", started.elapsed().as_secs_f64());
-    let d = map.settings.spacing;
-    let (ours, theirs) = (cells(&repaired, d).len(), cells(&rebuilt, d).len());
+    let (ours, theirs) = (repaired.occupied_cells(), rebuilt.occupied_cells());
     eprintln!(
         "occupied cells: repaired {ours}, rebuilt {theirs}, before {}",
-        cells(&map, d).len()
+        map.occupied_cells()
     );
     assert!(ours as f64 >= 0.95 * theirs as f64, "{ours} vs {theirs}");
     // the same world again: nothing to do
