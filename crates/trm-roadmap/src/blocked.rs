@@ -11,6 +11,7 @@ use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 use trm_collision::{Aabb, World, WorldObject};
+use trm_kinematics::LANES;
 use trm_tasks::Objective;
 
 use crate::edges::{segment_is_collision_free, segment_point, segment_steps};
@@ -96,14 +97,22 @@ impl BlockIndex {
                 *g = g.merged(&aabb);
             }
         };
+        let d = objective.dim();
         let node_boxes: Vec<Aabb> = map
             .points
-            .par_iter()
+            .par_chunks(LANES)
             .map_init(
-                || objective.scratch(),
-                |scratch, p| {
-                    let mut boxes = Vec::with_capacity(groups);
-                    grouped(objective.placed(&p.q, scratch), &mut boxes);
+                || (objective.scratch(), Vec::new()),
+                |(scratch, qs), chunk| {
+                    qs.clear();
+                    for p in chunk {
+                        qs.extend_from_slice(&p.q);
+                    }
+                    let mut boxes = Vec::with_capacity(chunk.len() * groups);
+                    objective.all_placed(qs, scratch, |placed| {
+                        grouped(placed, &mut boxes);
+                        true
+                    });
                     boxes
                 },
             )
@@ -114,23 +123,26 @@ impl BlockIndex {
             .edges
             .par_iter()
             .map_init(
-                || (objective.scratch(), vec![0.0; objective.dim()], Vec::new()),
-                |(scratch, q, boxes), &(a, b, _)| {
+                || (objective.scratch(), Vec::new(), Vec::new()),
+                |(scratch, qs, boxes), &(a, b, _)| {
                     let (qa, qb) = (&map.points[a].q, &map.points[b].q);
                     let steps = segment_steps(qa, qb, map.edge_resolution);
+                    qs.clear();
+                    qs.resize((steps + 1) * d, 0.0);
+                    for (s, q) in qs.chunks_exact_mut(d).enumerate() {
+                        segment_point(qa, qb, s, steps, q);
+                    }
                     let mut union = vec![Aabb::new_invalid(); groups];
-                    let samples = (0..=steps)
-                        .map(|s| {
-                            segment_point(qa, qb, s, steps, q);
-                            let placed = objective.placed(q, scratch);
-                            boxes.clear();
-                            grouped(placed, boxes);
-                            for (u, g) in union.iter_mut().zip(boxes.iter()) {
-                                *u = u.merged(g);
-                            }
-                            placed.bounding_box().unwrap_or_else(Aabb::new_invalid)
-                        })
-                        .collect();
+                    let mut samples = Vec::with_capacity(steps + 1);
+                    objective.all_placed(qs, scratch, |placed| {
+                        boxes.clear();
+                        grouped(placed, boxes);
+                        for (u, g) in union.iter_mut().zip(boxes.iter()) {
+                            *u = u.merged(g);
+                        }
+                        samples.push(placed.bounding_box().unwrap_or_else(Aabb::new_invalid));
+                        true
+                    });
                     (union, samples)
                 },
             )

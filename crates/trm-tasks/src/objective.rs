@@ -299,9 +299,14 @@ impl Objective {
         })
     }
 
-    /// Whether `free` holds for the placed bodies of every configuration of `qs`, batched,
-    /// stopping at the first that fails; NaN fails.
-    fn all_placed(
+    /// Calls `f` with the robot's bodies placed at each configuration of `qs` (`n × dim`
+    /// values), in order, with forward kinematics [`LANES`] configurations at a time, until `f`
+    /// returns false; returns whether it held for all. A configuration holding NaN makes it
+    /// false without a call.
+    ///
+    /// # Panics
+    /// If `qs.len()` is not a multiple of [`Objective::dim`].
+    pub fn all_placed(
         &self,
         qs: &[f64],
         scratch: &mut Scratch,
@@ -500,13 +505,6 @@ impl Objective {
     /// Whether `q` is free of self- and world collisions.
     pub fn is_collision_free(&self, q: &[f64], scratch: &mut Scratch) -> bool {
         self.is_collision_free_in(q, &self.world, scratch)
-    }
-
-    /// The robot's collision bodies placed at `q` (e.g. for their
-    /// [`PlacedBodies::bounding_box`]).
-    pub fn placed<'s>(&self, q: &[f64], scratch: &'s mut Scratch) -> &'s PlacedBodies {
-        self.pose(q, scratch, true);
-        &scratch.placed
     }
 
     /// Whether `q` is free of self-collisions and of collisions with `world` (another world
