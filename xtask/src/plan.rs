@@ -1,12 +1,12 @@
 //! `cargo xtask plan --map FILE [--map FILE2 …] [--world WORLD.ron] --from home|q.json
-//! --to "x,y,z"|q.json [--out traj.csv]`.
+//! [--repair] --to "x,y,z"|q.json [--out traj.csv]`.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_collision::World;
 use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
-use trm_roadmap::Roadmap;
+use trm_roadmap::{RepairOptions, Roadmap};
 use trm_tasks::Problem;
 
 /// Arguments of `plan`.
@@ -18,6 +18,10 @@ pub struct Args {
     /// The current world (RON), replacing the one the maps were built in.
     #[arg(long)]
     world: Option<PathBuf>,
+    /// Repair the maps for --world before planning: park what it blocks, bring back parked
+    /// nodes it frees, grow points where coverage was lost (`repair-map` without its refill).
+    #[arg(long, requires = "world")]
+    repair: bool,
     /// Start: `home` (the spec's start posture) or a JSON file with "motors": {name: value}
     /// (as `solve --out` writes) or "q": [active values].
     #[arg(long, default_value = "home")]
@@ -76,19 +80,40 @@ pub fn run(args: &Args) -> Result<()> {
         "--tolerance {}: give a finite positive task-space distance",
         args.tolerance
     );
-    let maps: Vec<Roadmap> = args
+    let mut maps: Vec<Roadmap> = args
         .maps
         .iter()
         .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
         .collect::<Result<_>>()?;
+    let world = args.world.as_ref().map(World::load).transpose()?;
+    if let (true, Some(world)) = (args.repair, &world) {
+        for (map, path) in maps.iter_mut().zip(&args.maps) {
+            let problem = map
+                .problem()
+                .with_context(|| format!("the spec stored in {}", path.display()))?;
+            let options = RepairOptions {
+                refill: false,
+                ..Default::default()
+            };
+            let started = std::time::Instant::now();
+            let (repaired, report) = trm_roadmap::repair(map, &problem, world, &options)?;
+            print!(
+                "{}: repaired in {:.2} s; ",
+                path.display(),
+                started.elapsed().as_secs_f64()
+            );
+            crate::repair_map::print_report(&report);
+            *map = repaired;
+        }
+    }
     let first = &maps[0];
     let problem = first
         .problem()
         .with_context(|| format!("the spec stored in {}", args.maps[0].display()))?;
     let refs: Vec<&Roadmap> = maps.iter().collect();
     let mut planner = Planner::new(&problem.objective, &refs)?;
-    if let Some(w) = &args.world {
-        planner.set_world(World::load(w)?);
+    if let Some(world) = world {
+        planner.set_world(world);
     }
     let start = if args.from == "home" {
         problem.start.clone()

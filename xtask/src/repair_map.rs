@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use trm_collision::World;
-use trm_roadmap::{BuildOptions, Roadmap, build};
+use trm_roadmap::{BuildOptions, RepairOptions, RepairReport, Roadmap, build};
 
 /// Arguments of `repair-map`.
 #[derive(clap::Args)]
@@ -53,17 +53,10 @@ pub fn run(args: &Args) -> Result<()> {
     let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
     let started = Instant::now();
-    let (repaired, report) = pool.install(|| trm_roadmap::repair(&map, &problem, &world))?;
+    let (repaired, report) =
+        pool.install(|| trm_roadmap::repair(&map, &problem, &world, &RepairOptions::default()))?;
     let seconds = started.elapsed().as_secs_f64();
-    println!(
-        "blocked: {} nodes, {} edges removed; grown: {} nodes, {} edges; lost cells of side d: {}, {} hold a point again",
-        report.blocked_nodes,
-        report.removed_edges,
-        report.added_nodes,
-        report.added_edges,
-        report.lost_cells,
-        report.restored_cells
-    );
+    print_report(&report);
     println!(
         "repaired in {seconds:.2} s (finding what is blocked {:.3} s, growing {:.2} s, connecting {:.2} s); {} points, {} edges, {} occupied cells (before: {})",
         report.seconds[0],
@@ -74,6 +67,13 @@ pub fn run(args: &Args) -> Result<()> {
         repaired.occupied_cells(),
         map.occupied_cells()
     );
+    if let Some(parked) = &repaired.parked {
+        println!(
+            "kept aside (parked, back without a search when the world frees them): {} nodes, {} edges",
+            parked.points.len(),
+            parked.edges.len()
+        );
+    }
     if args.compare_rebuild {
         let mut fresh = map.problem()?;
         fresh.objective.set_world(world.clone());
@@ -102,4 +102,20 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&out, repaired.to_json(&out)?.as_bytes())?;
     println!("wrote {}", out.display());
     Ok(())
+}
+
+/// Prints what a repair did (also for `plan --repair`).
+pub fn print_report(report: &RepairReport) {
+    println!(
+        "blocked: {} nodes, {} edges parked; restored from the parked ones: {} nodes, {} edges; grown: {} nodes, {} edges ({}); lost cells of side d: {}, {} hold a point again",
+        report.blocked_nodes,
+        report.blocked_edges,
+        report.restored_nodes,
+        report.restored_edges,
+        report.added_nodes,
+        report.added_edges,
+        report.stopped_because,
+        report.lost_cells,
+        report.restored_cells
+    );
 }

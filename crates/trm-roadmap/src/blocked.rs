@@ -33,16 +33,20 @@ pub struct Blocked {
     pub changed: Vec<String>,
 }
 
-/// Boxes around a map's nodes and edges, for [`BlockIndex::blocked`]: the robot's bodies are
-/// grouped by kinematic branch (torso, head, each arm…), and a BVH holds one box per node and
-/// group, another one per edge and group (the union over the edge's samples); every edge
-/// sample's box around the whole robot is kept too, so that only the samples near a changed
-/// object are checked.
+/// Boxes around a map's nodes and edges, for [`BlockIndex::blocked`] and
+/// [`BlockIndex::changes`]: the robot's bodies are grouped by kinematic branch (torso, head,
+/// each arm…), and a BVH holds one box per node and group, another one per edge and group (the
+/// union over the edge's samples); every edge sample's box around the whole robot is kept too,
+/// so that only the samples near a changed object are checked. Nodes and edges added to the map
+/// later are boxed by [`BlockIndex::extend`].
 pub struct BlockIndex {
     nodes: Bvh,
     edges: Bvh,
-    /// The number of body groups (leaves per node and per edge).
+    /// Body → group, and the number of groups (leaves per node and per edge).
+    group_of: Vec<usize>,
     groups: usize,
+    /// The nodes and edges boxed so far.
+    node_count: usize,
     /// The boxes of the samples of edge k: `samples[sample_start[k]..sample_start[k + 1]]`.
     samples: Vec<Aabb>,
     sample_start: Vec<usize>,
@@ -51,10 +55,27 @@ pub struct BlockIndex {
 impl std::fmt::Debug for BlockIndex {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("BlockIndex")
-            .field("nodes", &self.nodes.leaf_count())
-            .field("edges", &self.edges.leaf_count())
+            .field("nodes", &self.node_count)
+            .field("edges", &(self.sample_start.len() - 1))
             .finish()
     }
+}
+
+/// How the nodes and edges of a map change status from one world to another
+/// ([`BlockIndex::changes`]): indices ascending.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Changes {
+    /// Nodes clear before and blocked now.
+    pub blocked_nodes: Vec<usize>,
+    /// Edges clear before and blocked now.
+    pub blocked_edges: Vec<usize>,
+    /// Nodes blocked before and clear now.
+    pub freed_nodes: Vec<usize>,
+    /// Edges blocked before and clear now.
+    pub freed_edges: Vec<usize>,
+    /// Names of the objects that differ between the two worlds (added, moved, reshaped or
+    /// removed).
+    pub changed: Vec<String>,
 }
 
 /// Checks that `objective` poses the map's postures.
@@ -75,20 +96,65 @@ impl BlockIndex {
     /// map's (its `Roadmap::problem`).
     pub fn new(map: &Roadmap, objective: &Objective) -> Result<Self> {
         check_fit(map, objective)?;
-        let samples: usize = map
-            .edges
-            .iter()
-            .map(|&(a, b, _)| {
-                segment_steps(&map.points[a].q, &map.points[b].q, map.edge_resolution) + 1
-            })
-            .sum();
+        let (group_of, groups) = branch_groups(objective);
+        let mut index = BlockIndex {
+            nodes: Bvh::new(),
+            edges: Bvh::new(),
+            group_of,
+            groups,
+            node_count: 0,
+            samples: Vec::new(),
+            sample_start: vec![0],
+        };
+        let (node_boxes, edge_boxes) = index.boxes(map, objective)?;
+        index.nodes = Bvh::from_leaves(BvhBuildStrategy::Binned, &node_boxes);
+        index.edges = Bvh::from_leaves(BvhBuildStrategy::Binned, &edge_boxes);
+        Ok(index)
+    }
+
+    /// Boxes the nodes and edges `map` has beyond those indexed (a map only ever grows at its
+    /// end: nodes and edges appended, none removed or renumbered).
+    pub fn extend(&mut self, map: &Roadmap, objective: &Objective) -> Result<()> {
+        check_fit(map, objective)?;
+        let (first_node, first_edge) = (self.node_count, self.sample_start.len() - 1);
+        if map.points.len() < first_node || map.edges.len() < first_edge {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the index holds {first_node} nodes and {first_edge} edges, the map {} and {}: index the map anew",
+                map.points.len(),
+                map.edges.len()
+            )));
+        }
+        let (node_boxes, edge_boxes) = self.boxes(map, objective)?;
+        let leaf = |first: usize, k: usize| (first * self.groups + k) as u32;
+        for (k, aabb) in node_boxes.into_iter().enumerate() {
+            self.nodes.insert(aabb, leaf(first_node, k));
+        }
+        for (k, aabb) in edge_boxes.into_iter().enumerate() {
+            self.edges.insert(aabb, leaf(first_edge, k));
+        }
+        Ok(())
+    }
+
+    /// The group boxes of the nodes and edges not yet indexed (leaves in order); records the
+    /// edges' sample boxes and the new counts.
+    fn boxes(&mut self, map: &Roadmap, objective: &Objective) -> Result<(Vec<Aabb>, Vec<Aabb>)> {
+        let (first_node, first_edge) = (self.node_count, self.sample_start.len() - 1);
+        let new_edges = &map.edges[first_edge..];
+        let samples: usize = self.samples.len()
+            + new_edges
+                .iter()
+                .map(|&(a, b, _)| {
+                    segment_steps(&map.points[a].q, &map.points[b].q, map.edge_resolution) + 1
+                })
+                .sum::<usize>();
         if samples > MAX_SAMPLES {
             return Err(RoadmapError::Unsuitable(format!(
                 "the map's edges hold {samples} checked postures (edge resolution {} rad), over the {MAX_SAMPLES} the index boxes: connect the map at a coarser resolution",
                 map.edge_resolution
             )));
         }
-        let (group_of, groups) = branch_groups(objective);
+        let groups = self.groups;
+        let group_of = &self.group_of;
         let grouped = |placed: &trm_collision::PlacedBodies, out: &mut Vec<Aabb>| {
             let start = out.len();
             out.resize(start + groups, Aabb::new_invalid());
@@ -98,8 +164,7 @@ impl BlockIndex {
             }
         };
         let d = objective.dim();
-        let node_boxes: Vec<Aabb> = map
-            .points
+        let node_boxes: Vec<Aabb> = map.points[first_node..]
             .par_chunks(LANES)
             .map_init(
                 || (objective.scratch(), Vec::new()),
@@ -119,8 +184,7 @@ impl BlockIndex {
             .flatten_iter()
             .collect();
         // per edge: its groups' boxes over all samples, and each sample's whole-robot box
-        let per_edge: Vec<(Vec<Aabb>, Vec<Aabb>)> = map
-            .edges
+        let per_edge: Vec<(Vec<Aabb>, Vec<Aabb>)> = new_edges
             .par_iter()
             .map_init(
                 || (objective.scratch(), Vec::new(), Vec::new()),
@@ -147,39 +211,99 @@ impl BlockIndex {
                 },
             )
             .collect();
-        let mut sample_start = Vec::with_capacity(per_edge.len() + 1);
-        sample_start.push(0);
-        for (_, samples) in &per_edge {
-            sample_start.push(sample_start.last().copied().unwrap_or(0) + samples.len());
+        let mut edge_boxes = Vec::with_capacity(per_edge.len() * groups);
+        for (union, samples) in per_edge {
+            edge_boxes.extend(union);
+            self.samples.extend(samples);
+            self.sample_start.push(self.samples.len());
         }
-        let edge_boxes: Vec<Aabb> = per_edge
-            .iter()
-            .flat_map(|(u, _)| u.iter().copied())
-            .collect();
-        Ok(BlockIndex {
-            nodes: Bvh::from_leaves(BvhBuildStrategy::Binned, &node_boxes),
-            edges: Bvh::from_leaves(BvhBuildStrategy::Binned, &edge_boxes),
-            groups,
-            samples: per_edge.into_iter().flat_map(|(_, s)| s).collect(),
-            sample_start,
-        })
+        self.node_count = map.points.len();
+        debug_assert_eq!(self.sample_start.len() - 1, map.edges.len());
+        Ok((node_boxes, edge_boxes))
+    }
+
+    /// Checks that the index boxes exactly `map`'s nodes and edges.
+    fn check_indexed(&self, map: &Roadmap) -> Result<()> {
+        if map.points.len() != self.node_count || map.edges.len() != self.sample_start.len() - 1 {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the index holds {} nodes and {} edges, the map {} and {}: extend the index first",
+                self.node_count,
+                self.sample_start.len() - 1,
+                map.points.len(),
+                map.edges.len()
+            )));
+        }
+        Ok(())
     }
 
     /// The nodes and edges of `map` that `world` blocks (exactly those
     /// [`blocked_exhaustive`] finds), looking only at the objects that differ from the map's
     /// world and at the nodes and edges near them.
     pub fn blocked(&self, map: &Roadmap, objective: &Objective, world: &World) -> Result<Blocked> {
+        let clear_nodes = vec![false; map.points.len()];
+        let clear_edges = vec![false; map.edges.len()];
+        let c = self.changes(
+            map,
+            objective,
+            objective.world(),
+            world,
+            &clear_nodes,
+            &clear_edges,
+        )?;
+        Ok(Blocked {
+            nodes: c.blocked_nodes,
+            edges: c.blocked_edges,
+            changed: changed_objects(objective.world(), world)
+                .iter()
+                .map(|o| o.name().to_string())
+                .collect(),
+        })
+    }
+
+    /// How the map's nodes and edges change status when the world goes from `before` to
+    /// `after`, given which were blocked in `before` (`node_blocked`, `edge_blocked`; the map's
+    /// own nodes and edges are clear in the world it was built in). Only nodes and edges whose
+    /// boxes touch an object that differs between the two worlds (at its old or new pose) are
+    /// looked at: one clear before is checked against the objects new in `after` (only the
+    /// edge samples near them), one blocked before against all of `after`. Everything else
+    /// keeps its status, so the result is exactly what checking everything in both worlds
+    /// would give.
+    pub fn changes(
+        &self,
+        map: &Roadmap,
+        objective: &Objective,
+        before: &World,
+        after: &World,
+        node_blocked: &[bool],
+        edge_blocked: &[bool],
+    ) -> Result<Changes> {
         check_fit(map, objective)?;
-        let changed = changed_objects(objective, world);
-        let mut only_changed = World::new();
-        for o in &changed {
-            only_changed
+        self.check_indexed(map)?;
+        if node_blocked.len() != map.points.len() || edge_blocked.len() != map.edges.len() {
+            return Err(RoadmapError::Unsuitable(format!(
+                "{} node and {} edge flags for a map of {} nodes and {} edges",
+                node_blocked.len(),
+                edge_blocked.len(),
+                map.points.len(),
+                map.edges.len()
+            )));
+        }
+        let added = changed_objects(before, after);
+        let gone = changed_objects(after, before);
+        let mut new_objects = World::new();
+        for o in &added {
+            new_objects
                 .add(o.name(), o.shape().clone(), *o.pose())
                 .map_err(|e| RoadmapError::Unsuitable(e.to_string()))?;
         }
-        let boxes: Vec<Aabb> = changed.iter().map(|o| o.bounding_box()).collect();
+        let new_boxes: Vec<Aabb> = added.iter().map(|o| o.bounding_box()).collect();
+        let all_boxes: Vec<Aabb> = added
+            .iter()
+            .chain(&gone)
+            .map(|o| o.bounding_box())
+            .collect();
         let near = |bvh: &Bvh| {
-            let mut found: Vec<usize> = boxes
+            let mut found: Vec<usize> = all_boxes
                 .iter()
                 .flat_map(|aabb| {
                     bvh.intersect_aabb(aabb)
@@ -190,46 +314,81 @@ impl BlockIndex {
             found.dedup();
             found
         };
-        let nodes = near(&self.nodes)
+        // (index, was blocked, is blocked) of every node near a change
+        let nodes: Vec<(usize, bool, bool)> = near(&self.nodes)
             .into_par_iter()
             .map_init(
                 || objective.scratch(),
                 |scratch, i| {
-                    (!objective.all_clear_of(&map.points[i].q, &only_changed, scratch)).then_some(i)
+                    let q = &map.points[i].q;
+                    let was = node_blocked[i];
+                    let is = if was {
+                        !objective.is_collision_free_in(q, after, scratch)
+                    } else {
+                        !objective.all_clear_of(q, &new_objects, scratch)
+                    };
+                    (i, was, is)
                 },
             )
-            .flatten()
             .collect();
-        // an edge is blocked when one of its samples is; only samples whose box meets a
-        // changed object's can be
+        // an edge clear before is blocked when one of its samples near a new object is; one
+        // blocked before is checked whole
         let d = objective.dim();
-        let edges = near(&self.edges)
+        let edges: Vec<(usize, bool, bool)> = near(&self.edges)
             .into_par_iter()
             .map_init(
                 || (objective.scratch(), Vec::new()),
                 |(scratch, qs), k| {
                     let (a, b, _) = map.edges[k];
                     let (qa, qb) = (&map.points[a].q, &map.points[b].q);
+                    let was = edge_blocked[k];
+                    if was {
+                        let free = segment_is_collision_free(
+                            objective,
+                            after,
+                            qa,
+                            qb,
+                            map.edge_resolution,
+                            qs,
+                            scratch,
+                        );
+                        return (k, was, !free);
+                    }
                     let own = &self.samples[self.sample_start[k]..self.sample_start[k + 1]];
                     let steps = own.len() - 1;
                     qs.clear();
                     for (s, sample) in own.iter().enumerate() {
-                        if boxes.iter().any(|b| b.intersects(sample)) {
+                        if new_boxes.iter().any(|b| b.intersects(sample)) {
                             qs.resize(qs.len() + d, 0.0);
                             let at = qs.len() - d;
                             segment_point(qa, qb, s, steps, &mut qs[at..]);
                         }
                     }
-                    (!qs.is_empty() && !objective.all_clear_of(qs, &only_changed, scratch))
-                        .then_some(k)
+                    let is = !qs.is_empty() && !objective.all_clear_of(qs, &new_objects, scratch);
+                    (k, was, is)
                 },
             )
-            .flatten()
             .collect();
-        Ok(Blocked {
-            nodes,
-            edges,
-            changed: changed.iter().map(|o| o.name().to_string()).collect(),
+        let pick = |items: &[(usize, bool, bool)], was: bool| -> Vec<usize> {
+            items
+                .iter()
+                .filter(|&&(_, w, i)| w == was && i != was)
+                .map(|&(k, _, _)| k)
+                .collect()
+        };
+        let mut changed: Vec<String> = added
+            .iter()
+            .chain(&gone)
+            .map(|o| o.name().to_string())
+            .collect();
+        changed.sort();
+        changed.dedup();
+        Ok(Changes {
+            blocked_nodes: pick(&nodes, false),
+            blocked_edges: pick(&edges, false),
+            freed_nodes: pick(&nodes, true),
+            freed_edges: pick(&edges, true),
+            changed,
         })
     }
 }
@@ -276,13 +435,12 @@ fn branch_groups(objective: &Objective) -> (Vec<usize>, usize) {
     (group_of, tops.len().max(1))
 }
 
-/// The objects of `world` the objective's (the map's) world does not have at that pose and
-/// shape.
-fn changed_objects<'w>(objective: &Objective, world: &'w World) -> Vec<&'w WorldObject> {
+/// The objects of `world` that `reference` does not have at that pose and shape.
+fn changed_objects<'w>(reference: &World, world: &'w World) -> Vec<&'w WorldObject> {
     world
         .objects()
         .iter()
-        .filter(|o| !objective.world().objects().iter().any(|m| same(m, o)))
+        .filter(|o| !reference.objects().iter().any(|m| same(m, o)))
         .collect()
 }
 
@@ -335,7 +493,7 @@ pub fn blocked_exhaustive(map: &Roadmap, objective: &Objective, world: &World) -
         )
         .flatten()
         .collect();
-    let changed = changed_objects(objective, world)
+    let changed = changed_objects(objective.world(), world)
         .iter()
         .map(|o| o.name().to_string())
         .collect();

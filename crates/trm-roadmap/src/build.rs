@@ -250,11 +250,14 @@ pub(crate) struct Setup<'a> {
     /// A repair grows only here; selection starts searches only from points near it.
     pub(crate) region: Option<Region>,
     pub(crate) settings: MapSpec,
-    target: usize,
+    pub(crate) target: usize,
     searches: usize,
     seed: u64,
     pub(crate) max_generations: u64,
     pub(crate) repel_weight: f64,
+    /// A repair's budget: stop at this instant, or after this many evaluations.
+    pub(crate) deadline: Option<Instant>,
+    pub(crate) max_evaluations: Option<u64>,
     bounds: Bounds,
     dim: usize,
 }
@@ -297,6 +300,8 @@ impl<'a> Setup<'a> {
             seed: seed.unwrap_or(problem.spec.solver.seed),
             max_generations: 0,
             repel_weight: 0.0,
+            deadline: None,
+            max_evaluations: None,
             bounds: Bounds::new(lower, upper)?,
             dim: task.dim(),
             settings,
@@ -602,6 +607,14 @@ pub(crate) fn run(
             );
             break;
         }
+        if setup.deadline.is_some_and(|d| Instant::now() >= d) {
+            stopped_because = "time budget spent".to_string();
+            break;
+        }
+        if setup.max_evaluations.is_some_and(|m| *evaluations >= m) {
+            stopped_because = format!("evaluation budget spent ({} evaluations)", *evaluations);
+            break;
+        }
         // start searches: one from home while the map is empty, then up to P
         let wanted = if map.points.is_empty() {
             1
@@ -817,6 +830,7 @@ pub(crate) fn run(
         edges: Vec::new(),
         edge_resolution: 0.0,
         world: None,
+        parked: None,
         stats: BuildStats {
             build_seconds,
             edge_seconds: 0.0,

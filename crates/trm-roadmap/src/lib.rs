@@ -24,7 +24,7 @@ mod map;
 pub mod mpi;
 mod repair;
 
-pub use blocked::{BlockIndex, Blocked, blocked_exhaustive};
+pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
     BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, Threads, build,
     build_with, evaluate_on_threads, resume, resume_with,
@@ -36,5 +36,5 @@ pub use edges::{
 };
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
-pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Roadmap, VERSION};
-pub use repair::{RepairReport, repair};
+pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Parked, Roadmap, VERSION};
+pub use repair::{LiveMap, REPAIR_FAILURE_LIMIT, RepairOptions, RepairReport, repair};

@@ -44,6 +44,18 @@ pub struct MapPoint {
     pub cost: f64,
 }
 
+/// The nodes and edges of a repaired map that its world blocks ([`Roadmap::parked`]).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Parked {
+    /// Blocked points.
+    pub points: Vec<MapPoint>,
+    /// Blocked edges and the edges of blocked points, `(i, j, length)`, i < j, over the map's
+    /// points followed by the parked ones: node i ≥ `points.len()` of the map is parked point
+    /// i − `points.len()`.
+    pub edges: Vec<(usize, usize, f64)>,
+}
+
 /// How a map was built.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -98,6 +110,10 @@ pub struct Roadmap {
     /// otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub world: Option<trm_collision::WorldSpec>,
+    /// Nodes and edges that `world` blocks, kept aside (a repaired map's): they come back,
+    /// without a search, when a later repair finds them clear again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parked: Option<Parked>,
     /// Statistics.
     pub stats: BuildStats,
 }
@@ -142,42 +158,29 @@ impl Roadmap {
     /// Checks that points and edges fit together: one value per active motor in every posture,
     /// one task dimension for all, finite numbers, edges between existing points.
     fn check(&self) -> std::result::Result<(), String> {
-        let dim = self.points.first().map_or(0, |p| p.t.len());
-        for (i, p) in self.points.iter().enumerate() {
-            if p.q.len() != self.active.len() {
-                return Err(format!(
-                    "points[{i}].q has {} values for {} active motors",
-                    p.q.len(),
-                    self.active.len()
-                ));
-            }
-            if p.t.len() != dim {
-                return Err(format!(
-                    "points[{i}].t has {} dimensions, points[0].t {dim}",
-                    p.t.len()
-                ));
-            }
-            if !(p.q.iter().chain(&p.t).all(|v| v.is_finite()) && p.cost.is_finite()) {
-                return Err(format!("points[{i}] holds a non-finite value"));
-            }
-        }
-        if !self.edges.is_empty() && crate::check_edge_resolution(self.edge_resolution).is_err() {
+        let parked = self.parked.clone().unwrap_or_default();
+        let dim = self
+            .points
+            .iter()
+            .chain(&parked.points)
+            .next()
+            .map_or(0, |p| p.t.len());
+        check_points("points", &self.points, self.active.len(), dim)?;
+        check_points("parked.points", &parked.points, self.active.len(), dim)?;
+        let edges = self.edges.len() + parked.edges.len();
+        if edges > 0 && crate::check_edge_resolution(self.edge_resolution).is_err() {
             return Err(format!(
-                "edge_resolution {} for {} edges: edges are checked at a finite step of at least {} rad",
+                "edge_resolution {} for {edges} edges: edges are checked at a finite step of at least {} rad",
                 self.edge_resolution,
-                self.edges.len(),
                 crate::MIN_RESOLUTION
             ));
         }
-        for (k, &(a, b, w)) in self.edges.iter().enumerate() {
-            if a >= self.points.len() || b >= self.points.len() || a == b || !w.is_finite() {
-                return Err(format!(
-                    "edges[{k}] = ({a}, {b}, {w}) does not join two of the {} points",
-                    self.points.len()
-                ));
-            }
-        }
-        Ok(())
+        check_edges("edges", &self.edges, self.points.len())?;
+        check_edges(
+            "parked.edges",
+            &parked.edges,
+            self.points.len() + parked.points.len(),
+        )
     }
 
     /// The task this map was built for, rebuilt from the spec the map carries (its model and
@@ -197,10 +200,15 @@ impl Roadmap {
         let robot = problem.objective.active().model();
         let motors = problem.objective.active().motor_indices();
         let mut scratch = problem.objective.scratch();
-        for (i, p) in self.points.iter().enumerate() {
+        let parked = self.parked.as_ref().map_or(&[][..], |p| &p.points[..]);
+        let lists = [("points", &self.points[..]), ("parked.points", parked)];
+        for (i, (what, p)) in lists
+            .iter()
+            .flat_map(|&(what, list)| list.iter().enumerate().map(move |(i, p)| (i, (what, p))))
+        {
             if p.t.len() != dim {
                 return Err(RoadmapError::Unsuitable(format!(
-                    "points[{i}].t has {} dimensions, the task of the spec stored in the map ({}) {dim}: rebuild the map",
+                    "{what}[{i}].t has {} dimensions, the task of the spec stored in the map ({}) {dim}: rebuild the map",
                     p.t.len(),
                     self.spec_path
                 )));
@@ -209,7 +217,7 @@ impl Roadmap {
                 let motor = &robot.motors()[m];
                 motor.limits.check(v).map_err(|problem| {
                     RoadmapError::Unsuitable(format!(
-                        "points[{i}]: `{}` {problem}: rebuild the map",
+                        "{what}[{i}]: `{}` {problem}: rebuild the map",
                         motor.name
                     ))
                 })?;
@@ -223,7 +231,7 @@ impl Roadmap {
                 .fold(0.0, f64::max);
             if gap > 1e-6 {
                 return Err(RoadmapError::Unsuitable(format!(
-                    "points[{i}].t is {gap:.3e} away from the task value of points[{i}].q: the map does not fit the spec stored in it ({}); rebuild the map",
+                    "{what}[{i}].t is {gap:.3e} away from the task value of {what}[{i}].q: the map does not fit the spec stored in it ({}); rebuild the map",
                     self.spec_path
                 )));
             }
@@ -331,6 +339,49 @@ pub(crate) fn problem_from_spec(
         )));
     }
     Ok(problem)
+}
+
+/// Checks a list of points: one value per active motor, `dim` task dimensions, finite values.
+fn check_points(
+    what: &str,
+    points: &[MapPoint],
+    active: usize,
+    dim: usize,
+) -> std::result::Result<(), String> {
+    for (i, p) in points.iter().enumerate() {
+        if p.q.len() != active {
+            return Err(format!(
+                "{what}[{i}].q has {} values for {active} active motors",
+                p.q.len()
+            ));
+        }
+        if p.t.len() != dim {
+            return Err(format!(
+                "{what}[{i}].t has {} dimensions, points[0].t {dim}",
+                p.t.len()
+            ));
+        }
+        if !(p.q.iter().chain(&p.t).all(|v| v.is_finite()) && p.cost.is_finite()) {
+            return Err(format!("{what}[{i}] holds a non-finite value"));
+        }
+    }
+    Ok(())
+}
+
+/// Checks a list of edges: two different nodes of `nodes`, a finite length.
+fn check_edges(
+    what: &str,
+    edges: &[(usize, usize, f64)],
+    nodes: usize,
+) -> std::result::Result<(), String> {
+    for (k, &(a, b, w)) in edges.iter().enumerate() {
+        if a >= nodes || b >= nodes || a == b || !w.is_finite() {
+            return Err(format!(
+                "{what}[{k}] = ({a}, {b}, {w}) does not join two of the {nodes} points"
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The task-space cell of side `d` holding `t` (cells anchored at the origin).

@@ -6,7 +6,9 @@ use std::path::Path;
 use rand::{RngExt, SeedableRng};
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use trm_roadmap::{BlockIndex, BuildOptions, blocked_exhaustive, build, connect};
+use trm_roadmap::{
+    BlockIndex, BuildOptions, LiveMap, RepairOptions, blocked_exhaustive, build, connect,
+};
 use trm_tasks::Problem;
 
 #[test]
@@ -108,13 +110,16 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
     let mut map = build(&problem, &options, |_| {}).unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let world = World::load(root.join("specs/worlds/reach_with_box.ron")).unwrap();
-    let (repaired, report) = trm_roadmap::repair(&map, &problem, &world).unwrap();
+    let (repaired, report) =
+        trm_roadmap::repair(&map, &problem, &world, &RepairOptions::default()).unwrap();
     eprintln!("{report:?}");
     assert!(report.blocked_nodes > 0 && report.added_nodes > 0);
     assert_eq!(
         repaired.points.len(),
         points - report.blocked_nodes + report.added_nodes
     );
+    let parked = repaired.parked.as_ref().expect("blocked nodes are parked");
+    assert_eq!(parked.points.len(), report.blocked_nodes);
     // valid in the new world: nothing blocked under the exhaustive check
     let again = repaired.problem().unwrap();
     assert!(again.objective.world().object("new_box").is_ok());
@@ -145,7 +150,109 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
     );
     assert!(ours as f64 >= 0.95 * theirs as f64, "{ours} vs {theirs}");
     // the same world again: nothing to do
-    let (twice, report) = trm_roadmap::repair(&repaired, &again, &world).unwrap();
+    let (twice, report) =
+        trm_roadmap::repair(&repaired, &again, &world, &RepairOptions::default()).unwrap();
     assert_eq!(report.blocked_nodes, 0);
     assert_eq!(twice.points, repaired.points);
+    // the box gone: every parked node and edge comes back without a search
+    let (back, report) = trm_roadmap::repair(
+        &repaired,
+        &again,
+        problem.objective.world(),
+        &RepairOptions::default(),
+    )
+    .unwrap();
+    eprintln!("{report:?}");
+    assert_eq!(report.restored_nodes, parked.points.len());
+    assert_eq!((report.blocked_nodes, report.added_nodes), (0, 0));
+    assert!(back.parked.is_none());
+    for p in &map.points {
+        assert!(back.points.contains(p), "an original node came back");
+    }
+    let position = |p: &trm_roadmap::MapPoint| back.points.iter().position(|b| b == p).unwrap();
+    let edges: std::collections::BTreeSet<(usize, usize)> =
+        back.edges.iter().map(|&(a, b, _)| (a, b)).collect();
+    for &(a, b, _) in &map.edges {
+        let (a, b) = (position(&map.points[a]), position(&map.points[b]));
+        assert!(
+            edges.contains(&(a.min(b), a.max(b))),
+            "an original edge came back"
+        );
+    }
+}
+
+/// A live map's blocked flags stay exactly those of the exhaustive check over a sequence of
+/// worlds: a box sliding through the map, a ball appearing and going, the table moving; and a
+/// repair under an evaluation budget adds only clear nodes and edges.
+#[test]
+fn a_live_map_tracks_a_moving_world_exactly() {
+    let problem =
+        Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap();
+    let objective = &problem.objective;
+    let mut map = build(
+        &problem,
+        &BuildOptions {
+            points: Some(80),
+            ..Default::default()
+        },
+        |_| {},
+    )
+    .unwrap();
+    connect(&mut map, objective, 6, 0.05).unwrap();
+    let mut live = LiveMap::new(&map, &problem).unwrap();
+    let (mut parked_max, mut freed) = (0, 0);
+    for step in 0..24 {
+        let mut world = objective.world().clone();
+        let x = -0.45 + 0.02 * step as f64;
+        world
+            .add(
+                "box",
+                Shape::Box {
+                    size: [0.08, 0.06, 0.16],
+                },
+                Isometry3::translation(x, 0.1, -0.04),
+            )
+            .unwrap();
+        if (6..14).contains(&step) {
+            world
+                .add(
+                    "ball",
+                    Shape::Sphere { radius: 0.05 },
+                    Isometry3::translation(-0.25, 0.2, 0.05),
+                )
+                .unwrap();
+        }
+        if step >= 18 {
+            world
+                .set_pose("table", Isometry3::translation(-0.4, 0.0, -0.1))
+                .unwrap();
+        }
+        let changes = live.set_world(world.clone()).unwrap();
+        freed += changes.freed_nodes.len();
+        if step % 6 == 5 {
+            let report = live
+                .repair(&RepairOptions {
+                    evaluations: Some(20_000),
+                    refill: false,
+                    ..Default::default()
+                })
+                .unwrap();
+            eprintln!("step {step}: {report:?}");
+        }
+        let all = live.all();
+        let exhaustive = blocked_exhaustive(all, objective, &world).unwrap();
+        let flagged: Vec<usize> = (0..all.points.len())
+            .filter(|&i| live.is_blocked(i))
+            .collect();
+        assert_eq!(flagged, exhaustive.nodes, "nodes at step {step}");
+        let current = live.map();
+        let check = blocked_exhaustive(&current, objective, &world).unwrap();
+        assert!(
+            check.nodes.is_empty() && check.edges.is_empty(),
+            "step {step}: {check:?}"
+        );
+        parked_max = parked_max.max(live.parked_nodes());
+    }
+    eprintln!("at most {parked_max} parked, {freed} freed");
+    assert!(parked_max > 0 && freed > 0);
 }
