@@ -1,6 +1,7 @@
 // The trm viewer: renders a `trm-scene` document (crates/trm-view) embedded in the page as
 // <script id="trm-scene" type="application/json">. Robot collision shapes per link, link poses
-// per frame (play, pause, scrub), world objects, roadmap points and edges coloured by cost
+// per frame (play, pause, scrub), world objects (moving ones posed per frame), roadmap points and
+// edges coloured by cost (or red where a frame says they are blocked)
 // (click a point to see its posture), a task-space path. After the first render it writes what
 // it drew into <pre id="trm-report"> so that a headless browser test can check it.
 // URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing; ?pick=I shows map
@@ -162,6 +163,7 @@ data.world.forEach((o) => {
   mesh.name = o.name;
   world.add(mesh);
 });
+const worldMeshes = world.children.slice();
 
 // ---- map ---------------------------------------------------------------------------------
 const map = data.map;
@@ -201,6 +203,30 @@ if (map && map.points.length > 0) {
   mapEdges = new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 }));
   scene3.add(mapEdges);
 }
+// a map in a moving world (a scenario's frames): points and edges that exist yet, blocked ones red
+const blockedColor = new THREE.Color(0xd01010);
+function showMapState(state) {
+  if (!mapPoints || !state) return;
+  const pc = mapPoints.geometry.getAttribute('color');
+  const ec = mapEdges.geometry.getAttribute('color');
+  map.points.forEach((_, i) => {
+    const c = costColor(map.cost[i]);
+    pc.setXYZ(i, c.r, c.g, c.b);
+  });
+  state.blocked.forEach((i) => pc.setXYZ(i, blockedColor.r, blockedColor.g, blockedColor.b));
+  map.edges.forEach(([a, b], i) => {
+    ec.setXYZ(2 * i, pc.getX(a), pc.getY(a), pc.getZ(a));
+    ec.setXYZ(2 * i + 1, pc.getX(b), pc.getY(b), pc.getZ(b));
+  });
+  state.blocked_edges.forEach((i) => {
+    ec.setXYZ(2 * i, blockedColor.r, blockedColor.g, blockedColor.b);
+    ec.setXYZ(2 * i + 1, blockedColor.r, blockedColor.g, blockedColor.b);
+  });
+  pc.needsUpdate = true;
+  ec.needsUpdate = true;
+  mapPoints.geometry.setDrawRange(0, state.nodes);
+  mapEdges.geometry.setDrawRange(0, 2 * state.edges);
+}
 
 // ---- path --------------------------------------------------------------------------------
 let path = null;
@@ -236,6 +262,13 @@ function showFrame(i) {
   const f = frames[current];
   if (!f) return;
   f.poses.forEach((p, slot) => setPose(linkGroups[slot], p));
+  if (f.world) {
+    f.world.forEach((p, k) => {
+      worldMeshes[k].visible = p !== null;
+      if (p !== null) setPose(worldMeshes[k], p);
+    });
+  }
+  showMapState(f.map);
   slider.value = String(current);
   timeLabel.textContent = `frame ${current + 1}/${frames.length}, t = ${f.t.toFixed(2)} s`;
 }

@@ -16,6 +16,7 @@ mod plot;
 mod progress;
 mod reach_grasp;
 mod repair_map;
+mod scenario;
 mod solve;
 mod speedup;
 mod stand_up;
@@ -67,6 +68,9 @@ enum Command {
     MapScaling(map_scaling::Args),
     /// Repair a map for a world that changed: remove what it blocks, re-grow, reconnect.
     RepairMap(repair_map::Args),
+    /// A map in a moving world: objects move, appear and vanish, goals change; each step
+    /// invalidates, repairs within a budget and replans (specs/scenarios/).
+    Scenario(scenario::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
@@ -114,6 +118,7 @@ impl Command {
             Command::Speedup(a) => (vec![], vec![a.out_dir.clone()]),
             Command::MapScaling(a) => (vec![], vec![a.out_dir.clone()]),
             Command::RepairMap(a) => (vec![a.out_path()], vec![]),
+            Command::Scenario(a) => (vec![], vec![a.out_dir.clone()]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
                 vec![a.out.clone()],
@@ -230,6 +235,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::Speedup(args) => speedup::run(&args),
         Command::MapScaling(args) => map_scaling::run(&args),
         Command::RepairMap(args) => repair_map::run(&args),
+        Command::Scenario(args) => scenario::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),

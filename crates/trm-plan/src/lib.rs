@@ -14,9 +14,13 @@
 //! ```
 
 mod planner;
+pub mod scenario;
 mod trajectory;
 
 pub use planner::{
     EXACT_WEIGHT, ExactGoal, Goal, PlanError, PlanOptions, PlanStats, Planned, Planner,
+};
+pub use scenario::{
+    Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,
 };
 pub use trajectory::{Trajectory, time_parametrise};

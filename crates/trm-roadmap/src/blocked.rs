@@ -264,10 +264,11 @@ impl BlockIndex {
     /// `after`, given which were blocked in `before` (`node_blocked`, `edge_blocked`; the map's
     /// own nodes and edges are clear in the world it was built in). Only nodes and edges whose
     /// boxes touch an object that differs between the two worlds (at its old or new pose) are
-    /// looked at: one clear before is checked against the objects new in `after` (only the
-    /// edge samples near them), one blocked before against all of `after`. Everything else
-    /// keeps its status, so the result is exactly what checking everything in both worlds
-    /// would give.
+    /// looked at: one clear before is checked against the objects new in `after`, one blocked
+    /// before against all of `after` — of an edge, only the samples whose box touches such an
+    /// object. Map nodes and edges are free of self-collisions (they were checked when made),
+    /// so only objects can block them. Everything else keeps its status, so the result is
+    /// exactly what checking everything in both worlds would give.
     pub fn changes(
         &self,
         map: &Roadmap,
@@ -314,6 +315,9 @@ impl BlockIndex {
             found.dedup();
             found
         };
+        // every object of `after`: a node or edge sample away from all their boxes is clear
+        // (the map's nodes and edges are free of self-collisions: only objects can block them)
+        let after_boxes: Vec<Aabb> = after.objects().iter().map(|o| o.bounding_box()).collect();
         // (index, was blocked, is blocked) of every node near a change
         let nodes: Vec<(usize, bool, bool)> = near(&self.nodes)
             .into_par_iter()
@@ -322,17 +326,14 @@ impl BlockIndex {
                 |scratch, i| {
                     let q = &map.points[i].q;
                     let was = node_blocked[i];
-                    let is = if was {
-                        !objective.is_collision_free_in(q, after, scratch)
-                    } else {
-                        !objective.all_clear_of(q, &new_objects, scratch)
-                    };
+                    let is =
+                        !objective.all_clear_of(q, if was { after } else { &new_objects }, scratch);
                     (i, was, is)
                 },
             )
             .collect();
-        // an edge clear before is blocked when one of its samples near a new object is; one
-        // blocked before is checked whole
+        // an edge is blocked when one of its samples near an object that could block it is:
+        // one clear before, near a new object; one blocked before, near any object
         let d = objective.dim();
         let edges: Vec<(usize, bool, bool)> = near(&self.edges)
             .into_par_iter()
@@ -342,29 +343,22 @@ impl BlockIndex {
                     let (a, b, _) = map.edges[k];
                     let (qa, qb) = (&map.points[a].q, &map.points[b].q);
                     let was = edge_blocked[k];
-                    if was {
-                        let free = segment_is_collision_free(
-                            objective,
-                            after,
-                            qa,
-                            qb,
-                            map.edge_resolution,
-                            qs,
-                            scratch,
-                        );
-                        return (k, was, !free);
-                    }
+                    let (boxes, objects) = if was {
+                        (&after_boxes, after)
+                    } else {
+                        (&new_boxes, &new_objects)
+                    };
                     let own = &self.samples[self.sample_start[k]..self.sample_start[k + 1]];
                     let steps = own.len() - 1;
                     qs.clear();
                     for (s, sample) in own.iter().enumerate() {
-                        if new_boxes.iter().any(|b| b.intersects(sample)) {
+                        if boxes.iter().any(|b| b.intersects(sample)) {
                             qs.resize(qs.len() + d, 0.0);
                             let at = qs.len() - d;
                             segment_point(qa, qb, s, steps, &mut qs[at..]);
                         }
                     }
-                    let is = !qs.is_empty() && !objective.all_clear_of(qs, &new_objects, scratch);
+                    let is = !qs.is_empty() && !objective.all_clear_of(qs, objects, scratch);
                     (k, was, is)
                 },
             )

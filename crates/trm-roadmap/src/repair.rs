@@ -183,8 +183,9 @@ impl<'p> LiveMap<'p> {
         Ok(changes)
     }
 
-    /// Whether edge k of [`LiveMap::all`] is usable: clear, between clear nodes.
-    fn edge_usable(&self, k: usize) -> bool {
+    /// Whether edge k of [`LiveMap::all`] is usable in the current world: clear, between
+    /// clear nodes.
+    pub fn is_usable(&self, k: usize) -> bool {
         let (a, b, _) = self.all.edges[k];
         !self.edge_blocked[k] && !self.node_blocked[a] && !self.node_blocked[b]
     }
@@ -213,7 +214,7 @@ impl<'p> LiveMap<'p> {
         for (k, &(a, b, l)) in self.all.edges.iter().enumerate() {
             let (a, b) = (renumber[a], renumber[b]);
             let e = (a.min(b), a.max(b), l);
-            if self.edge_usable(k) {
+            if self.is_usable(k) {
                 edges.push(e);
             } else {
                 parked.edges.push(e);

@@ -103,6 +103,28 @@ pub struct SceneFrame {
     pub joints: Vec<f64>,
     /// World poses of [`Scene::links`].
     pub poses: Vec<Pose>,
+    /// Where [`Scene::world`]'s objects are in this frame (`None`: absent), when they move;
+    /// absent when they stand still.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<Vec<Option<Pose>>>,
+    /// The state of [`Scene::map`] in this frame, when it changes (a map in a moving world).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map: Option<FrameMap>,
+}
+
+/// The state of a changing map in one frame: how many of the scene map's points and edges
+/// exist yet (they only grow), and which are blocked (drawn red).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameMap {
+    /// The first `nodes` points of [`SceneMap::points`] exist.
+    pub nodes: usize,
+    /// The first `edges` edges exist.
+    pub edges: usize,
+    /// Blocked points (indices below `nodes`).
+    pub blocked: Vec<usize>,
+    /// Blocked edges (indices below `edges`).
+    pub blocked_edges: Vec<usize>,
 }
 
 /// A world object.
@@ -189,7 +211,8 @@ pub struct Scene {
     model: Option<RobotModel>,
 }
 
-fn pose(p: &Isometry3<f64>) -> Pose {
+/// A pose as the scene stores it (position, then quaternion x, y, z, w).
+pub fn pose(p: &Isometry3<f64>) -> Pose {
     let t = p.translation.vector;
     let q = p.rotation.coords; // (i, j, k, w)
     let r = |v: f64| (v * 1e7).round() / 1e7;
@@ -301,6 +324,8 @@ impl Scene {
             base: pose(base),
             joints,
             poses,
+            world: None,
+            map: None,
         });
         Ok(())
     }
@@ -457,6 +482,25 @@ impl Scene {
                 return bad(
                     format!("frames[{i}]"),
                     "needs one finite pose per link and one finite value per movable joint",
+                );
+            }
+        }
+        let points = self.map.as_ref().map_or(0, |m| m.points.len());
+        let edges = self.map.as_ref().map_or(0, |m| m.edges.len());
+        for (i, f) in self.frames.iter().enumerate() {
+            let world_ok = f.world.as_ref().is_none_or(|w| {
+                w.len() == self.world.len() && w.iter().flatten().all(|p| finite(p))
+            });
+            let map_ok = f.map.as_ref().is_none_or(|m| {
+                m.nodes <= points
+                    && m.edges <= edges
+                    && m.blocked.iter().all(|&b| b < m.nodes)
+                    && m.blocked_edges.iter().all(|&b| b < m.edges)
+            });
+            if !(world_ok && map_ok) {
+                return bad(
+                    format!("frames[{i}]"),
+                    "needs one finite pose or null per world object, and map counts and blocked indices within the scene's map",
                 );
             }
         }

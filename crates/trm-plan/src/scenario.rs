@@ -1,0 +1,597 @@
+//! Scenarios: a map's world with objects that move, appear and vanish, and a sequence of task
+//! goals; [`run_scenario`] steps one at a fixed rate — the world changes, the map is kept valid
+//! ([`LiveMap`]: invalidation, parking and restoring), repaired within a budget, and the robot
+//! replans whenever its goal changes or the rest of its motion is blocked, then moves on.
+//!
+//! Spec (RON; times in seconds, positions in metres, angles as URDF roll-pitch-yaw):
+//!
+//! ```ron
+//! (
+//!     description: "a box slides across the table",
+//!     duration: 4.0,
+//!     rate: 10.0,                       // steps per second (default 10)
+//!     objects: [
+//!         (name: "box", shape: Box(size: (0.08, 0.06, 0.16)),
+//!          path: [(t: 0.0, xyz: (-0.3, -0.3, -0.04)), (t: 4.0, xyz: (-0.3, 0.5, -0.04))]),
+//!         (name: "can", shape: Cylinder(radius: 0.03, length: 0.12),
+//!          path: [(t: 0.0, xyz: (-0.25, 0.1, 0.0))], appear: 2.0),
+//!     ],
+//!     goals: [(t: 0.0, to: [-0.3, 0.1, 0.0]), (t: 2.0, to: [-0.25, 0.2, 0.05])],
+//! )
+//! ```
+//!
+//! An object follows its keyframes piecewise linearly (held before the first and after the
+//! last), is present from `appear` (default 0) until `vanish` (default never), and joins the
+//! map's own world; the goal at time t is the last one whose `t` has come.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Deserialize;
+use trm_collision::{Shape, World};
+use trm_kinematics::SpecError;
+use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError, segment_is_collision_free};
+use trm_tasks::Problem;
+
+use crate::planner::{Goal, PlanError, PlanOptions, Planner};
+use crate::trajectory::Trajectory;
+
+/// What can go wrong with a scenario.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ScenarioError {
+    /// The spec is malformed or does not fit the map.
+    #[error(transparent)]
+    Spec(Box<SpecError>),
+    /// The spec file could not be read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// From keeping the map valid.
+    #[error(transparent)]
+    Roadmap(#[from] RoadmapError),
+    /// From planning (not an unreachable goal: that is a step's outcome).
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
+
+/// A keyframe of a moving object.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    /// Time, s.
+    pub t: f64,
+    /// Position, m.
+    pub xyz: [f64; 3],
+    /// Orientation, roll-pitch-yaw, rad.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+/// An object of a scenario.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MovingObject {
+    /// Unique name (not one of the map's world).
+    pub name: String,
+    /// Shape, as in world files.
+    pub shape: Shape,
+    /// Keyframes, times ascending (one keyframe: it stands still).
+    pub path: Vec<Keyframe>,
+    /// When it appears, s.
+    #[serde(default)]
+    pub appear: f64,
+    /// When it vanishes, s (never when absent).
+    #[serde(default)]
+    pub vanish: Option<f64>,
+}
+
+/// A task goal from time `t` on.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimedGoal {
+    /// From when, s.
+    pub t: f64,
+    /// The task point.
+    pub to: Vec<f64>,
+}
+
+fn ten() -> f64 {
+    10.0
+}
+
+/// A scenario; see the module documentation.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// What happens, in words.
+    #[serde(default)]
+    pub description: String,
+    /// Length, s.
+    pub duration: f64,
+    /// Steps per second.
+    #[serde(default = "ten")]
+    pub rate: f64,
+    /// Objects added to the map's world.
+    #[serde(default)]
+    pub objects: Vec<MovingObject>,
+    /// Task goals, times ascending.
+    pub goals: Vec<TimedGoal>,
+}
+
+/// The most steps a scenario may have.
+pub const MAX_STEPS: usize = 100_000;
+
+impl Scenario {
+    /// Parses and checks a scenario; `origin` names it in errors.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, ScenarioError> {
+        let scenario: Scenario = ron::from_str(text)
+            .map_err(|e| ScenarioError::Spec(Box::new(SpecError::from_ron(&e, origin))))?;
+        let bad = |field: String, problem: String, fix: &str| {
+            Err(ScenarioError::Spec(Box::new(SpecError::at(
+                text, origin, &field, problem, fix,
+            ))))
+        };
+        let d = scenario.duration;
+        if !(d.is_finite() && d > 0.0) {
+            return bad(
+                "duration".into(),
+                format!("{d} s"),
+                "give a finite positive length in seconds",
+            );
+        }
+        let r = scenario.rate;
+        if !(r.is_finite() && r > 0.0 && (d * r).floor() < MAX_STEPS as f64) {
+            return bad(
+                "rate".into(),
+                format!("{r} steps per second over {d} s"),
+                &format!("give a finite positive rate with at most {MAX_STEPS} steps in all"),
+            );
+        }
+        let ascending = |times: &mut dyn Iterator<Item = f64>| {
+            let mut last = f64::NEG_INFINITY;
+            for (k, t) in times.enumerate() {
+                if !(t.is_finite() && t >= last) {
+                    return Some(k);
+                }
+                last = t;
+            }
+            None
+        };
+        for (i, o) in scenario.objects.iter().enumerate() {
+            if o.path.is_empty() {
+                return bad(
+                    format!("objects[{i}].path"),
+                    "no keyframe".into(),
+                    "give at least one (t: 0.0, xyz: (x, y, z))",
+                );
+            }
+            if let Some(k) = ascending(&mut o.path.iter().map(|f| f.t)) {
+                return bad(
+                    format!("objects[{i}].path[{k}].t"),
+                    format!("{} s", o.path[k].t),
+                    "give finite keyframe times in ascending order",
+                );
+            }
+            for (k, f) in o.path.iter().enumerate() {
+                if !f.xyz.iter().chain(&f.rpy).all(|v| v.is_finite()) {
+                    return bad(
+                        format!("objects[{i}].path[{k}]"),
+                        "a non-finite position or angle".into(),
+                        "give finite numbers",
+                    );
+                }
+            }
+            let vanish = o.vanish.unwrap_or(f64::INFINITY);
+            if !(o.appear.is_finite() && vanish > o.appear) {
+                return bad(
+                    format!("objects[{i}].appear"),
+                    format!("appears at {} s, vanishes at {vanish} s", o.appear),
+                    "give a finite appear time before vanish",
+                );
+            }
+            if let Some(j) = scenario.objects[..i].iter().position(|p| p.name == o.name) {
+                return bad(
+                    format!("objects[{i}].name"),
+                    format!("`{}` is also objects[{j}]", o.name),
+                    "give every object its own name",
+                );
+            }
+        }
+        if scenario.goals.is_empty() {
+            return bad(
+                "goals".into(),
+                "no goal".into(),
+                "give at least one (t: 0.0, to: (x, y, z))",
+            );
+        }
+        if let Some(k) = ascending(&mut scenario.goals.iter().map(|g| g.t)) {
+            return bad(
+                format!("goals[{k}].t"),
+                format!("{} s", scenario.goals[k].t),
+                "give finite goal times in ascending order",
+            );
+        }
+        if let Some(k) = scenario
+            .goals
+            .iter()
+            .position(|g| g.to.is_empty() || !g.to.iter().all(|v| v.is_finite()))
+        {
+            return bad(
+                format!("goals[{k}].to"),
+                "an empty or non-finite task point".into(),
+                "give the task point's finite coordinates",
+            );
+        }
+        // every object must be a valid world object (shape, pose)
+        scenario.world_at(&World::new(), 0.0).map_err(|e| {
+            ScenarioError::Spec(Box::new(SpecError::at(
+                text,
+                origin,
+                "objects",
+                e.to_string(),
+                "give valid shapes and unique names",
+            )))
+        })?;
+        Ok(scenario)
+    }
+
+    /// Reads and checks a scenario file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, ScenarioError> {
+        let path = path.as_ref();
+        let text = trm_kinematics::read_input(path).map_err(|source| ScenarioError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_ron(&text, &path.display().to_string())
+    }
+
+    /// The number of steps (times 0, 1/rate, … up to the duration).
+    pub fn steps(&self) -> usize {
+        (self.duration * self.rate + 1e-9).floor() as usize + 1
+    }
+
+    /// `base` with the scenario's objects present at time `t`, at their poses then.
+    pub fn world_at(&self, base: &World, t: f64) -> Result<World, trm_collision::CollisionError> {
+        let mut world = base.clone();
+        for o in &self.objects {
+            if t < o.appear || o.vanish.is_some_and(|v| t >= v) {
+                continue;
+            }
+            world.add(&o.name, o.shape.clone(), pose_at(&o.path, t))?;
+        }
+        Ok(world)
+    }
+
+    /// The goal at time `t` (the last whose time has come), if any.
+    pub fn goal_at(&self, t: f64) -> Option<&[f64]> {
+        self.goals
+            .iter()
+            .rev()
+            .find(|g| g.t <= t + 1e-9)
+            .map(|g| g.to.as_slice())
+    }
+}
+
+/// The pose along keyframes at `t`: piecewise linear position, orientation interpolated on
+/// the sphere; held outside.
+fn pose_at(path: &[Keyframe], t: f64) -> Isometry3<f64> {
+    let pose = |f: &Keyframe| {
+        Isometry3::from_parts(
+            Translation3::new(f.xyz[0], f.xyz[1], f.xyz[2]),
+            UnitQuaternion::from_euler_angles(f.rpy[0], f.rpy[1], f.rpy[2]),
+        )
+    };
+    let next = path.iter().position(|f| f.t > t);
+    match next {
+        None => pose(&path[path.len() - 1]),
+        Some(0) => pose(&path[0]),
+        Some(k) => {
+            let (a, b) = (&path[k - 1], &path[k]);
+            let u = (t - a.t) / (b.t - a.t);
+            pose(a).lerp_slerp(&pose(b), u)
+        }
+    }
+}
+
+/// Settings of a scenario run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioOptions {
+    /// Repair budget per step, s (`None`: only the evaluation budget).
+    pub repair_seconds: Option<f64>,
+    /// Repair budget per step in evaluations (reproducible; `None`: only the time budget).
+    pub repair_evaluations: Option<u64>,
+    /// Task-space tolerance of the map node a goal's path goes through.
+    pub tolerance: f64,
+    /// Task error at which a goal counts as reached (metres for positions).
+    pub reached: f64,
+    /// Planning settings (the exact finish included).
+    pub plan: PlanOptions,
+}
+
+impl Default for ScenarioOptions {
+    fn default() -> Self {
+        ScenarioOptions {
+            repair_seconds: Some(0.04),
+            repair_evaluations: None,
+            tolerance: 0.03,
+            reached: 2e-3,
+            plan: PlanOptions {
+                exact_evaluations: 6_000,
+                exact_tolerance: 1e-3,
+                ..Default::default()
+            },
+        }
+    }
+}
+
+/// What the robot did in a step.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Went on with its motion (the goal unchanged, the rest of the motion clear).
+    Kept,
+    /// Planned anew: why.
+    Replanned(String),
+    /// Found no path: why (it stays where it is).
+    Failed(String),
+}
+
+/// One step of a scenario run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport {
+    /// Time, s.
+    pub t: f64,
+    /// Nodes the step's world change blocked, and parked nodes it freed.
+    pub blocked: usize,
+    /// Parked nodes freed.
+    pub restored: usize,
+    /// Nodes grown by the step's repair.
+    pub added: usize,
+    /// Seconds: invalidation, repair, planning.
+    pub seconds: [f64; 3],
+    /// What the robot did.
+    pub action: Action,
+    /// Task distance of the robot to the goal at the end of the step.
+    pub goal_error: Option<f64>,
+    /// Whether the robot's posture at the start of the step collides (an object ran into it).
+    pub hit: bool,
+    /// Nodes of the live map at the end of the step ([`LiveMap::all`]'s first `nodes`), and
+    /// the parked ones among them.
+    pub nodes: usize,
+    /// Edges of the live map at the end of the step.
+    pub edges: usize,
+    /// Parked nodes at the end of the step.
+    pub parked_nodes: Vec<usize>,
+    /// Parked edges (blocked, or with a parked end) at the end of the step.
+    pub parked_edges: Vec<usize>,
+}
+
+/// A scenario run.
+#[derive(Debug, Clone)]
+pub struct ScenarioRun {
+    /// One report per step.
+    pub steps: Vec<StepReport>,
+    /// The robot's motion: its posture at every step.
+    pub motion: Trajectory,
+    /// The world at every step.
+    pub worlds: Vec<World>,
+    /// Every node and edge the map had during the run (indices of the steps' reports).
+    pub map: Roadmap,
+}
+
+/// Runs `scenario` on `map` (built for `problem`, its `Roadmap::problem`), from the problem's
+/// start posture; see the module documentation. Deterministic for a given map and options
+/// unless a time budget cuts a repair short.
+pub fn run_scenario(
+    map: &Roadmap,
+    problem: &Problem,
+    scenario: &Scenario,
+    options: &ScenarioOptions,
+) -> Result<ScenarioRun, ScenarioError> {
+    options.plan.check()?;
+    let dim = map.points.first().map_or(0, |p| p.t.len());
+    if let Some(k) = scenario.goals.iter().position(|g| g.to.len() != dim) {
+        return Err(ScenarioError::Spec(Box::new(SpecError {
+            origin: "scenario".into(),
+            position: None,
+            field: format!("goals[{k}].to"),
+            problem: format!(
+                "{} values for the map's {dim}-dimensional task space",
+                scenario.goals[k].to.len()
+            ),
+            fix: format!("give {dim} coordinates"),
+        })));
+    }
+    let objective = &problem.objective;
+    let active = objective.active();
+    let base = objective.world().clone();
+    if let Some(o) = scenario
+        .objects
+        .iter()
+        .find(|o| base.object(&o.name).is_ok())
+    {
+        return Err(ScenarioError::Spec(Box::new(SpecError {
+            origin: "scenario".into(),
+            position: None,
+            field: "objects".into(),
+            problem: format!("`{}` is already an object of the map's world", o.name),
+            fix: "give the scenario's objects other names".into(),
+        })));
+    }
+    let mut live = LiveMap::new(map, problem)?;
+    let dt = 1.0 / scenario.rate;
+    let repair = RepairOptions {
+        seconds: options.repair_seconds,
+        evaluations: options.repair_evaluations,
+        refill: false,
+    };
+    let mut q = problem.start.clone();
+    let mut scratch = objective.scratch();
+    let mut samples = Vec::new();
+    // the motion being executed: waypoints (active values) with times, its goal, its clock
+    let mut motion: Option<(Vec<Vec<f64>>, Vec<f64>, Vec<f64>, f64)> = None;
+    let (mut steps, mut worlds, mut times, mut postures) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for k in 0..scenario.steps() {
+        let t = k as f64 * dt;
+        let world = scenario.world_at(&base, t).map_err(|e| {
+            ScenarioError::Roadmap(RoadmapError::Unsuitable(format!("world at {t} s: {e}")))
+        })?;
+        let started = Instant::now();
+        let changes = live.set_world(world.clone())?;
+        let invalidate = started.elapsed().as_secs_f64();
+        let started = Instant::now();
+        let repaired = live.repair(&repair)?;
+        let repair_seconds = started.elapsed().as_secs_f64();
+        let hit = !objective.is_collision_free_in(&q, &world, &mut scratch);
+        let goal = scenario.goal_at(t).map(<[f64]>::to_vec);
+        // replan when the goal changed or the rest of the motion is blocked
+        let started = Instant::now();
+        let why = match (&motion, &goal) {
+            (_, None) => None,
+            (None, Some(_)) => Some("a new goal".to_string()),
+            (Some((_, _, g, _)), Some(goal)) if g != goal => Some("a new goal".to_string()),
+            (Some((waypoints, times, _, clock)), Some(_)) => {
+                let next = times
+                    .iter()
+                    .position(|&s| s > *clock)
+                    .unwrap_or(times.len());
+                let mut from = q.clone();
+                let blocked = waypoints[next..].iter().any(|w| {
+                    let free = segment_is_collision_free(
+                        objective,
+                        &world,
+                        &from,
+                        w,
+                        options.plan.resolution,
+                        &mut samples,
+                        &mut scratch,
+                    );
+                    from.clone_from(w);
+                    !free
+                });
+                let ended = next == times.len();
+                let off = |goal: &[f64]| {
+                    let task = objective.task_value(&q, &mut scratch);
+                    trm_roadmap::distance(&task, goal) > options.reached
+                };
+                if blocked {
+                    Some("the rest of the motion is blocked".to_string())
+                } else if ended && goal.as_deref().is_some_and(off) {
+                    Some("the motion ended short of the goal".to_string())
+                } else {
+                    None
+                }
+            }
+        };
+        let action = match (why, &goal) {
+            (Some(why), Some(goal)) => {
+                let current = live.map();
+                let mut planner = Planner::new(objective, &[&current])?;
+                planner.set_world(world.clone());
+                let planned = planner.plan(
+                    &q,
+                    &Goal::TaskPoint {
+                        t: goal.clone(),
+                        tolerance: options.tolerance,
+                    },
+                    &options.plan,
+                );
+                match planned {
+                    Ok(p) => {
+                        let waypoints = p
+                            .trajectory
+                            .positions
+                            .iter()
+                            .map(|m| active.from_motors(m))
+                            .collect();
+                        motion = Some((waypoints, p.trajectory.times, goal.clone(), 0.0));
+                        Action::Replanned(why)
+                    }
+                    Err(e @ (PlanError::Unreachable { .. } | PlanError::InvalidStart(_))) => {
+                        motion = None;
+                        Action::Failed(e.to_string())
+                    }
+                    Err(e) => return Err(e.into()),
+                }
+            }
+            _ if goal.is_none() => Action::Kept,
+            _ if motion.is_none() => Action::Failed("no motion".into()),
+            _ => Action::Kept,
+        };
+        let plan_seconds = started.elapsed().as_secs_f64();
+        // record the posture at t, then move on by one step
+        times.push(t);
+        postures.push(active.to_motors(&q));
+        if let Some((waypoints, wtimes, _, clock)) = &mut motion {
+            *clock += dt;
+            q = sample(waypoints, wtimes, *clock);
+        }
+        let goal_error = goal.as_ref().map(|g| {
+            let task = objective.task_value(&q, &mut scratch);
+            trm_roadmap::distance(&task, g)
+        });
+        let all = live.all();
+        steps.push(StepReport {
+            t,
+            blocked: changes.blocked_nodes.len(),
+            restored: changes.freed_nodes.len(),
+            added: repaired.added_nodes,
+            seconds: [invalidate, repair_seconds, plan_seconds],
+            action,
+            goal_error,
+            hit,
+            nodes: all.points.len(),
+            edges: all.edges.len(),
+            parked_nodes: (0..all.points.len())
+                .filter(|&i| live.is_blocked(i))
+                .collect(),
+            parked_edges: (0..all.edges.len())
+                .filter(|&k| !live.is_usable(k))
+                .collect(),
+        });
+        worlds.push(world);
+    }
+    let motion = Trajectory {
+        names: active
+            .model()
+            .motors()
+            .iter()
+            .map(|m| m.name.clone())
+            .collect(),
+        task_path: postures
+            .iter()
+            .map(|m| objective.task_value(&active.from_motors(m), &mut scratch))
+            .collect(),
+        times,
+        positions: postures,
+    };
+    Ok(ScenarioRun {
+        steps,
+        motion,
+        worlds,
+        map: live.all().clone(),
+    })
+}
+
+/// The posture at time `clock` along waypoints reached at `times` (linear in between, held
+/// after the end).
+fn sample(waypoints: &[Vec<f64>], times: &[f64], clock: f64) -> Vec<f64> {
+    match times.iter().position(|&s| s > clock) {
+        None => waypoints[waypoints.len() - 1].clone(),
+        Some(0) => waypoints[0].clone(),
+        Some(k) => {
+            let u = (clock - times[k - 1]) / (times[k] - times[k - 1]);
+            waypoints[k - 1]
+                .iter()
+                .zip(&waypoints[k])
+                .map(|(a, b)| a + u * (b - a))
+                .collect()
+        }
+    }
+}
