@@ -1,7 +1,7 @@
 // The trm viewer: renders a `trm-scene` document (crates/trm-view) embedded in the page as
 // <script id="trm-scene" type="application/json">. Robot collision shapes per link, link poses
 // per frame (play, pause, scrub), world objects (moving ones posed per frame), roadmap points and
-// edges coloured by cost (or red where a frame says they are blocked)
+// edges coloured by cost (black where a frame says they are blocked)
 // (click a point to see its posture), a task-space path. After the first render it writes what
 // it drew into <pre id="trm-report"> so that a headless browser test can check it.
 // URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing; ?pick=I shows map
@@ -203,8 +203,18 @@ if (map && map.points.length > 0) {
   mapEdges = new THREE.LineSegments(eg, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 }));
   scene3.add(mapEdges);
 }
-// a map in a moving world (a scenario's frames): points and edges that exist yet, blocked ones red
-const blockedColor = new THREE.Color(0xd01010);
+// a map in a moving world (a scenario's frames): points and edges that exist yet, blocked ones black
+const blockedColor = new THREE.Color(0x202020); // black: the cost colours run blue to red
+// points drawn in the blocked colour (for the report)
+function countBlocked() {
+  const pc = mapPoints.geometry.getAttribute('color');
+  let n = 0;
+  for (let i = 0; i < Math.min(pc.count, mapPoints.geometry.drawRange.count); i += 1) {
+    const near = (a, b) => Math.abs(a - b) < 1e-6; // the attribute holds 32-bit floats
+    if (near(pc.getX(i), blockedColor.r) && near(pc.getY(i), blockedColor.g) && near(pc.getZ(i), blockedColor.b)) n += 1;
+  }
+  return n;
+}
 function showMapState(state) {
   if (!mapPoints || !state) return;
   const pc = mapPoints.geometry.getAttribute('color');
@@ -311,7 +321,9 @@ if (mapPoints) {
     '<div>point cost</div><div style="height:10px;width:180px;background:linear-gradient(to right,' +
     'hsl(240,85%,50%),hsl(120,85%,50%),hsl(0,85%,50%))"></div>' +
     `<div style="width:180px;display:flex;justify-content:space-between"><span>${costRange[0].toPrecision(3)}</span>` +
-    `<span>${costRange[1].toPrecision(3)}</span></div><div>click a point to see its posture</div>`;
+    `<span>${costRange[1].toPrecision(3)}</span></div>` +
+    (frames.some((f) => f.map) ? '<div>black: blocked in this frame</div>' : '') +
+    '<div>click a point to see its posture</div>';
   panel.appendChild(legend);
 }
 if (path) toggle(`path (${data.path.length} points)`, true, (v) => { path.visible = v; });
@@ -399,6 +411,9 @@ report.textContent = JSON.stringify({
   frames: frames.length,
   frame: current,
   fk_error: fkError(),
+  objects_shown: worldMeshes.filter((m) => m.visible).length,
+  points_shown: mapPoints ? Math.min(mapPoints.geometry.drawRange.count, map.points.length) : 0,
+  points_blocked: mapPoints ? countBlocked() : 0,
   pixels: drawn.n,
   width: drawn.w,
   height: drawn.h,

@@ -310,6 +310,25 @@ mod tests {
             .set_map(points.clone(), cost, &postures, edges)
             .unwrap();
         scene.set_path(points[..50].to_vec());
+        // a map in a moving world: from frame 1 on, the first object moves and the last is
+        // gone; the map grows and some of it is blocked
+        for (i, frame) in scene.frames.iter_mut().enumerate().skip(1) {
+            let mut poses: Vec<Option<trm_view::Pose>> =
+                scene.world.iter().map(|o| Some(o.pose)).collect();
+            if let Some(Some(p)) = poses.first_mut() {
+                p[2] += 0.01 * i as f64;
+            }
+            if let Some(last) = poses.last_mut() {
+                *last = None;
+            }
+            frame.world = Some(poses);
+            frame.map = Some(trm_view::FrameMap {
+                nodes: 150 + 10 * i,
+                edges: 140 + 10 * i,
+                blocked: (0..5 * i).collect(),
+                blocked_edges: (0..3 * i).collect(),
+            });
+        }
         scene
     }
 
@@ -398,6 +417,11 @@ mod tests {
         assert_eq!(report["frames"], scene.frames.len());
         assert_eq!(report["frame"], 3);
         assert!(report["fk_error"].as_f64().unwrap() < 1e-5, "{report}");
+        // frame 3's moving world and map: one object hidden, 180 points drawn, 15 red
+        let state = scene.frames[3].map.as_ref().unwrap();
+        assert_eq!(report["objects_shown"], scene.world.len() - 1);
+        assert_eq!(report["points_shown"], state.nodes);
+        assert_eq!(report["points_blocked"], state.blocked.len());
         // ?pick=7 shows map point 7's posture, computed by the page: its last link is where
         // trm's kinematics puts it
         assert_eq!(report["picked"], 7);

@@ -353,6 +353,10 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             at("specs/taskmaps/stick.ron"),
             vec!["explore-task-map", "{}", "--out", "o.taskmap.json"],
         ),
+        (
+            at("specs/scenarios/sliding_box.ron"),
+            vec!["scenario", "{}", "--map", "map.json", "--out-dir", "sc"],
+        ),
     ] {
         let text = read(&source);
         cases.extend(file_cases(
@@ -368,6 +372,8 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     let stand = ["stand-up", "{}", "--out", "su"];
     let collide = ["collide", "--configs", "configs.json", "--world", "{}"];
     let explore = ["explore-task-map", "{}"];
+    let scenario = ["scenario", "{}", "--map", "map.json", "--out-dir", "sc"];
+    let sliding = "specs/scenarios/sliding_box.ron";
     for (source, from, to, args) in [
         (
             "specs/reach.ron",
@@ -475,6 +481,34 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             "samples: 0",
             &explore[..],
         ),
+        (sliding, "duration: 6.0", "duration: 0.0", &scenario[..]),
+        (sliding, "rate: 10.0", "rate: 1e9", &scenario[..]),
+        (sliding, "rate: 10.0", "rate: -10.0", &scenario[..]),
+        (
+            sliding,
+            "to: [-0.3, 0.15, 0.1]",
+            "to: [-0.3, 0.15]",
+            &scenario[..],
+        ),
+        (sliding, "to: [-0.3, 0.15, 0.1]", "to: []", &scenario[..]),
+        (sliding, "(t: 1.5, to:", "(t: -1.5, to:", &scenario[..]),
+        (sliding, "(t: 2.5, xyz:", "(t: 7.5, xyz:", &scenario[..]),
+        (sliding, "name: \"can\"", "name: \"table\"", &scenario[..]),
+        (
+            sliding,
+            "name: \"can\"",
+            "name: \"sliding_box\"",
+            &scenario[..],
+        ),
+        (
+            sliding,
+            "appear: 2.0",
+            "appear: 2.0, vanish: Some(1.0)",
+            &scenario[..],
+        ),
+        (sliding, "radius: 0.03", "radius: 0.0", &scenario[..]),
+        (sliding, "goals: [", "goals: [], goal: [", &scenario[..]),
+        (sliding, "duration: 6.0,", "", &scenario[..]),
     ] {
         let text = read(&at(source));
         assert!(text.contains(from), "{source} has no `{from}`");
@@ -716,6 +750,25 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
                 {"name": "ball", "shape": {"Sphere": {"radius": 0.1}}}]}),
         ),
         ("world", serde_json::json!("table")),
+        (
+            "parked",
+            serde_json::json!({"points": [{"q": [0.0], "t": [0.0, 0.0, 0.0], "cost": 0.0}], "edges": []}),
+        ),
+        (
+            "parked",
+            serde_json::json!({"points": [], "edges": [[0, 99, 1.0]]}),
+        ),
+        (
+            "parked",
+            serde_json::json!({"points": [map["points"][0]], "edges": [[4, 4, 1.0]]}),
+        ),
+        ("parked", {
+            // a parked point whose task vector is not its posture's
+            let mut p = map["points"][0].clone();
+            p["t"][0] = serde_json::json!(5.0);
+            serde_json::json!({"points": [p], "edges": []})
+        }),
+        ("parked", serde_json::json!({"points": []})),
     ];
     for (k, (key, value)) in bad_maps.into_iter().enumerate() {
         let mut bad = map.clone();
@@ -740,6 +793,53 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             });
         }
     }
+    let sliding = at("specs/scenarios/sliding_box.ron");
+    let sliding = sliding.to_str().unwrap();
+    let run_scenario = ["scenario", sliding, "--map", "map.json", "--out-dir", "sc"];
+    cases.extend(flag_cases(
+        &run_scenario,
+        "--repair-ms",
+        &["0", "-1", "NaN", "inf", "x"],
+    ));
+    cases.extend(flag_cases(
+        &run_scenario,
+        "--repair-evaluations",
+        &["0", "-1", "x"],
+    ));
+    cases.extend(flag_cases(&run_scenario, "--threads", &["0", "x"]));
+    cases.extend(file_flag_cases(
+        &["scenario", sliding, "--out-dir", "sc"],
+        "--map",
+        &["no_such.json", ".", "posture.json", "world.ron"],
+    ));
+    cases.extend(file_flag_cases(
+        &["scenario", sliding, "--map", "map.json"],
+        "--out-dir",
+        &["posture.json"],
+    ));
+    for bad in ["no_such.ron", ".", "map.json", "world.ron"] {
+        cases.push(Case {
+            what: format!("scenario {bad}"),
+            args: ["scenario", bad, "--map", "map.json", "--out-dir", "sc"]
+                .map(String::from)
+                .to_vec(),
+            names: bad.into(),
+        });
+    }
+    cases.push(Case {
+        what: "plan --repair without --world".into(),
+        args: [
+            "plan",
+            "--map",
+            "map.json",
+            "--to",
+            "0.1,0.2,0.3",
+            "--repair",
+        ]
+        .map(String::from)
+        .to_vec(),
+        names: "--world".into(),
+    });
     let scaling = ["map-scaling", spec, "--out-dir", "ms"];
     cases.extend(flag_cases(
         &scaling,

@@ -122,6 +122,9 @@ pub struct Scenario {
     pub objects: Vec<MovingObject>,
     /// Task goals, times ascending.
     pub goals: Vec<TimedGoal>,
+    /// Where the spec came from, and its text (for located errors found later).
+    #[serde(skip)]
+    source: (String, String),
 }
 
 /// The most steps a scenario may have.
@@ -130,8 +133,9 @@ pub const MAX_STEPS: usize = 100_000;
 impl Scenario {
     /// Parses and checks a scenario; `origin` names it in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, ScenarioError> {
-        let scenario: Scenario = ron::from_str(text)
+        let mut scenario: Scenario = ron::from_str(text)
             .map_err(|e| ScenarioError::Spec(Box::new(SpecError::from_ron(&e, origin))))?;
+        scenario.source = (origin.to_string(), text.to_string());
         let bad = |field: String, problem: String, fix: &str| {
             Err(ScenarioError::Spec(Box::new(SpecError::at(
                 text, origin, &field, problem, fix,
@@ -228,16 +232,12 @@ impl Scenario {
                 "give the task point's finite coordinates",
             );
         }
-        // every object must be a valid world object (shape, pose)
-        scenario.world_at(&World::new(), 0.0).map_err(|e| {
-            ScenarioError::Spec(Box::new(SpecError::at(
-                text,
-                origin,
-                "objects",
-                e.to_string(),
-                "give valid shapes and unique names",
-            )))
-        })?;
+        // every object must be a valid world object
+        for (i, o) in scenario.objects.iter().enumerate() {
+            if let Err(e) = World::new().add(&o.name, o.shape.clone(), pose_at(&o.path, 0.0)) {
+                return bad(format!("objects[{i}].shape"), e.to_string(), "");
+            }
+        }
         Ok(scenario)
     }
 
@@ -249,6 +249,17 @@ impl Scenario {
             source,
         })?;
         Self::from_ron(&text, &path.display().to_string())
+    }
+
+    /// An error about `field` of this scenario's spec, located in its text.
+    fn error(&self, field: &str, problem: String, fix: String) -> ScenarioError {
+        let (origin, text) = &self.source;
+        let origin = if origin.is_empty() {
+            "scenario"
+        } else {
+            origin
+        };
+        ScenarioError::Spec(Box::new(SpecError::at(text, origin, field, problem, fix)))
     }
 
     /// The number of steps (times 0, 1/rate, … up to the duration).
@@ -396,32 +407,31 @@ pub fn run_scenario(
     options.plan.check()?;
     let dim = map.points.first().map_or(0, |p| p.t.len());
     if let Some(k) = scenario.goals.iter().position(|g| g.to.len() != dim) {
-        return Err(ScenarioError::Spec(Box::new(SpecError {
-            origin: "scenario".into(),
-            position: None,
-            field: format!("goals[{k}].to"),
-            problem: format!(
+        return Err(scenario.error(
+            &format!("goals[{k}].to"),
+            format!(
                 "{} values for the map's {dim}-dimensional task space",
                 scenario.goals[k].to.len()
             ),
-            fix: format!("give {dim} coordinates"),
-        })));
+            format!("give {dim} coordinates"),
+        ));
     }
     let objective = &problem.objective;
     let active = objective.active();
     let base = objective.world().clone();
-    if let Some(o) = scenario
+    if let Some(i) = scenario
         .objects
         .iter()
-        .find(|o| base.object(&o.name).is_ok())
+        .position(|o| base.object(&o.name).is_ok())
     {
-        return Err(ScenarioError::Spec(Box::new(SpecError {
-            origin: "scenario".into(),
-            position: None,
-            field: "objects".into(),
-            problem: format!("`{}` is already an object of the map's world", o.name),
-            fix: "give the scenario's objects other names".into(),
-        })));
+        return Err(scenario.error(
+            &format!("objects[{i}].name"),
+            format!(
+                "`{}` is already an object of the map's world",
+                scenario.objects[i].name
+            ),
+            "give the scenario's objects other names".into(),
+        ));
     }
     let mut live = LiveMap::new(map, problem)?;
     let dt = 1.0 / scenario.rate;
@@ -433,8 +443,7 @@ pub fn run_scenario(
     let mut q = problem.start.clone();
     let mut scratch = objective.scratch();
     let mut samples = Vec::new();
-    // the motion being executed: waypoints (active values) with times, its goal, its clock
-    let mut motion: Option<(Vec<Vec<f64>>, Vec<f64>, Vec<f64>, f64)> = None;
+    let mut motion: Option<Motion> = None;
     let (mut steps, mut worlds, mut times, mut postures) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for k in 0..scenario.steps() {
@@ -450,19 +459,20 @@ pub fn run_scenario(
         let repair_seconds = started.elapsed().as_secs_f64();
         let hit = !objective.is_collision_free_in(&q, &world, &mut scratch);
         let goal = scenario.goal_at(t).map(<[f64]>::to_vec);
-        // replan when the goal changed or the rest of the motion is blocked
+        // replan when the goal changed, the rest of the motion is blocked, or it ended short
         let started = Instant::now();
         let why = match (&motion, &goal) {
             (_, None) => None,
             (None, Some(_)) => Some("a new goal".to_string()),
-            (Some((_, _, g, _)), Some(goal)) if g != goal => Some("a new goal".to_string()),
-            (Some((waypoints, times, _, clock)), Some(_)) => {
-                let next = times
+            (Some(m), Some(goal)) if &m.goal != goal => Some("a new goal".to_string()),
+            (Some(m), Some(_)) => {
+                let next = m
+                    .times
                     .iter()
-                    .position(|&s| s > *clock)
-                    .unwrap_or(times.len());
+                    .position(|&s| s > m.clock)
+                    .unwrap_or(m.times.len());
                 let mut from = q.clone();
-                let blocked = waypoints[next..].iter().any(|w| {
+                let blocked = m.waypoints[next..].iter().any(|w| {
                     let free = segment_is_collision_free(
                         objective,
                         &world,
@@ -475,7 +485,7 @@ pub fn run_scenario(
                     from.clone_from(w);
                     !free
                 });
-                let ended = next == times.len();
+                let ended = next == m.times.len();
                 let off = |goal: &[f64]| {
                     let task = objective.task_value(&q, &mut scratch);
                     trm_roadmap::distance(&task, goal) > options.reached
@@ -510,7 +520,12 @@ pub fn run_scenario(
                             .iter()
                             .map(|m| active.from_motors(m))
                             .collect();
-                        motion = Some((waypoints, p.trajectory.times, goal.clone(), 0.0));
+                        motion = Some(Motion {
+                            waypoints,
+                            times: p.trajectory.times,
+                            goal: goal.clone(),
+                            clock: 0.0,
+                        });
                         Action::Replanned(why)
                     }
                     Err(e @ (PlanError::Unreachable { .. } | PlanError::InvalidStart(_))) => {
@@ -528,9 +543,9 @@ pub fn run_scenario(
         // record the posture at t, then move on by one step
         times.push(t);
         postures.push(active.to_motors(&q));
-        if let Some((waypoints, wtimes, _, clock)) = &mut motion {
-            *clock += dt;
-            q = sample(waypoints, wtimes, *clock);
+        if let Some(m) = &mut motion {
+            m.clock += dt;
+            q = sample(&m.waypoints, &m.times, m.clock);
         }
         let goal_error = goal.as_ref().map(|g| {
             let task = objective.task_value(&q, &mut scratch);
@@ -577,6 +592,15 @@ pub fn run_scenario(
         worlds,
         map: live.all().clone(),
     })
+}
+
+/// The motion being executed: waypoints (active values) reached at `times`, for `goal`, and
+/// how far along it the robot is.
+struct Motion {
+    waypoints: Vec<Vec<f64>>,
+    times: Vec<f64>,
+    goal: Vec<f64>,
+    clock: f64,
 }
 
 /// The posture at time `clock` along waypoints reached at `times` (linear in between, held
