@@ -122,6 +122,16 @@ fn link_dir(origin: &str) -> Option<PathBuf> {
 }
 
 impl CollisionModel {
+    /// The smallest axis-aligned boxes enclosing each body of `placed` (placed by this model),
+    /// in body order: tighter than [`PlacedBodies::body_boxes`], a little dearer.
+    pub fn tight_boxes<'a>(&'a self, placed: &'a PlacedBodies) -> impl Iterator<Item = Aabb> + 'a {
+        self.inner
+            .compiled
+            .iter()
+            .zip(&placed.placed)
+            .map(|(c, p)| c.tight_box(p))
+    }
+
     /// Bodies from the URDF's `<collision>` elements (meshes found relative to the URDF) and
     /// the allowed-collision matrix of the model description
     /// ([`AllowedCollisionMatrix::from_model`]).

@@ -36,6 +36,11 @@ impl WorldObject {
         &self.pose
     }
 
+    /// The smallest axis-aligned box enclosing the object.
+    pub fn tight_box(&self) -> parry3d_f64::bounding_volume::Aabb {
+        self.compiled.tight_box(&self.placed)
+    }
+
     /// An axis-aligned box enclosing the object (through its bounding sphere).
     pub fn bounding_box(&self) -> parry3d_f64::bounding_volume::Aabb {
         self.placed.bounding_box()

@@ -367,6 +367,8 @@ pub struct StepReport {
     pub seconds: [f64; 3],
     /// What the robot did.
     pub action: Action,
+    /// The step's goal.
+    pub goal: Option<Vec<f64>>,
     /// Task distance of the robot to the goal at the end of the step.
     pub goal_error: Option<f64>,
     /// Whether the robot's posture at the start of the step collides (an object ran into it).
@@ -444,6 +446,8 @@ pub fn run_scenario(
     let mut scratch = objective.scratch();
     let mut samples = Vec::new();
     let mut motion: Option<Motion> = None;
+    // the goal of the last planning attempt, successful or not
+    let mut tried: Option<Vec<f64>> = None;
     let (mut steps, mut worlds, mut times, mut postures) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for k in 0..scenario.steps() {
@@ -463,6 +467,7 @@ pub fn run_scenario(
         let started = Instant::now();
         let why = match (&motion, &goal) {
             (_, None) => None,
+            (None, Some(goal)) if tried.as_ref() == Some(goal) => Some("trying again".to_string()),
             (None, Some(_)) => Some("a new goal".to_string()),
             (Some(m), Some(goal)) if &m.goal != goal => Some("a new goal".to_string()),
             (Some(m), Some(_)) => {
@@ -501,6 +506,7 @@ pub fn run_scenario(
         };
         let action = match (why, &goal) {
             (Some(why), Some(goal)) => {
+                tried = Some(goal.clone());
                 let current = live.map();
                 let mut planner = Planner::new(objective, &[&current])?;
                 planner.set_world(world.clone());
@@ -559,6 +565,7 @@ pub fn run_scenario(
             added: repaired.added_nodes,
             seconds: [invalidate, repair_seconds, plan_seconds],
             action,
+            goal,
             goal_error,
             hit,
             nodes: all.points.len(),

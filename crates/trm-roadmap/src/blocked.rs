@@ -18,8 +18,9 @@ use crate::edges::{segment_is_collision_free, segment_point, segment_steps};
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
 
-/// The most edge samples a [`BlockIndex`] boxes (a box is 48 bytes per body group).
-pub const MAX_SAMPLES: usize = 20_000_000;
+/// The most edge samples a [`BlockIndex`] boxes (24 bytes per body group and sample: about
+/// 0.7 GB at the most for the iCub's 6 groups).
+pub const MAX_SAMPLES: usize = 5_000_000;
 
 /// What a world blocks in a map: node and edge indices (ascending), and the objects that
 /// differ from the map's own world.
@@ -47,9 +48,43 @@ pub struct BlockIndex {
     groups: usize,
     /// The nodes and edges boxed so far.
     node_count: usize,
-    /// The boxes of the samples of edge k: `samples[sample_start[k]..sample_start[k + 1]]`.
-    samples: Vec<Aabb>,
+    /// The group boxes of the samples of edge k: sample s of edge k has boxes
+    /// `samples[(sample_start[k] + s) · groups..][..groups]` (single precision, rounded
+    /// outwards).
+    samples: Vec<SmallBox>,
     sample_start: Vec<usize>,
+}
+
+/// An axis-aligned box in single precision, enclosing the double-precision box it was made
+/// from.
+#[derive(Debug, Clone, Copy)]
+struct SmallBox {
+    mins: [f32; 3],
+    maxs: [f32; 3],
+}
+
+impl SmallBox {
+    fn new(aabb: &Aabb) -> Self {
+        let down = |v: f64| {
+            let f = v as f32;
+            if f64::from(f) > v { f.next_down() } else { f }
+        };
+        let up = |v: f64| {
+            let f = v as f32;
+            if f64::from(f) < v { f.next_up() } else { f }
+        };
+        SmallBox {
+            mins: [down(aabb.mins.x), down(aabb.mins.y), down(aabb.mins.z)],
+            maxs: [up(aabb.maxs.x), up(aabb.maxs.y), up(aabb.maxs.z)],
+        }
+    }
+
+    /// Whether it meets `aabb` (touching counts).
+    fn intersects(&self, aabb: &Aabb) -> bool {
+        (0..3).all(|k| {
+            f64::from(self.mins[k]) <= aabb.maxs[k] && f64::from(self.maxs[k]) >= aabb.mins[k]
+        })
+    }
 }
 
 impl std::fmt::Debug for BlockIndex {
@@ -140,7 +175,7 @@ impl BlockIndex {
     fn boxes(&mut self, map: &Roadmap, objective: &Objective) -> Result<(Vec<Aabb>, Vec<Aabb>)> {
         let (first_node, first_edge) = (self.node_count, self.sample_start.len() - 1);
         let new_edges = &map.edges[first_edge..];
-        let samples: usize = self.samples.len()
+        let samples: usize = self.sample_start.last().copied().unwrap_or(0)
             + new_edges
                 .iter()
                 .map(|&(a, b, _)| {
@@ -158,7 +193,7 @@ impl BlockIndex {
         let grouped = |placed: &trm_collision::PlacedBodies, out: &mut Vec<Aabb>| {
             let start = out.len();
             out.resize(start + groups, Aabb::new_invalid());
-            for (body, aabb) in placed.body_boxes().enumerate() {
+            for (body, aabb) in objective.collision().tight_boxes(placed).enumerate() {
                 let g = &mut out[start + group_of[body]];
                 *g = g.merged(&aabb);
             }
@@ -184,7 +219,7 @@ impl BlockIndex {
             .flatten_iter()
             .collect();
         // per edge: its groups' boxes over all samples, and each sample's whole-robot box
-        let per_edge: Vec<(Vec<Aabb>, Vec<Aabb>)> = new_edges
+        let per_edge: Vec<(Vec<Aabb>, Vec<SmallBox>)> = new_edges
             .par_iter()
             .map_init(
                 || (objective.scratch(), Vec::new(), Vec::new()),
@@ -197,14 +232,14 @@ impl BlockIndex {
                         segment_point(qa, qb, s, steps, q);
                     }
                     let mut union = vec![Aabb::new_invalid(); groups];
-                    let mut samples = Vec::with_capacity(steps + 1);
+                    let mut samples = Vec::with_capacity((steps + 1) * groups);
                     objective.all_placed(qs, scratch, |placed| {
                         boxes.clear();
                         grouped(placed, boxes);
                         for (u, g) in union.iter_mut().zip(boxes.iter()) {
                             *u = u.merged(g);
                         }
-                        samples.push(placed.bounding_box().unwrap_or_else(Aabb::new_invalid));
+                        samples.extend(boxes.iter().map(SmallBox::new));
                         true
                     });
                     (union, samples)
@@ -215,7 +250,7 @@ impl BlockIndex {
         for (union, samples) in per_edge {
             edge_boxes.extend(union);
             self.samples.extend(samples);
-            self.sample_start.push(self.samples.len());
+            self.sample_start.push(self.samples.len() / groups);
         }
         self.node_count = map.points.len();
         debug_assert_eq!(self.sample_start.len() - 1, map.edges.len());
@@ -297,12 +332,8 @@ impl BlockIndex {
                 .add(o.name(), o.shape().clone(), *o.pose())
                 .map_err(|e| RoadmapError::Unsuitable(e.to_string()))?;
         }
-        let new_boxes: Vec<Aabb> = added.iter().map(|o| o.bounding_box()).collect();
-        let all_boxes: Vec<Aabb> = added
-            .iter()
-            .chain(&gone)
-            .map(|o| o.bounding_box())
-            .collect();
+        let new_boxes: Vec<Aabb> = added.iter().map(|o| o.tight_box()).collect();
+        let all_boxes: Vec<Aabb> = added.iter().chain(&gone).map(|o| o.tight_box()).collect();
         let near = |bvh: &Bvh| {
             let mut found: Vec<usize> = all_boxes
                 .iter()
@@ -317,7 +348,7 @@ impl BlockIndex {
         };
         // every object of `after`: a node or edge sample away from all their boxes is clear
         // (the map's nodes and edges are free of self-collisions: only objects can block them)
-        let after_boxes: Vec<Aabb> = after.objects().iter().map(|o| o.bounding_box()).collect();
+        let after_boxes: Vec<Aabb> = after.objects().iter().map(|o| o.tight_box()).collect();
         // (index, was blocked, is blocked) of every node near a change
         let nodes: Vec<(usize, bool, bool)> = near(&self.nodes)
             .into_par_iter()
@@ -348,11 +379,12 @@ impl BlockIndex {
                     } else {
                         (&new_boxes, &new_objects)
                     };
-                    let own = &self.samples[self.sample_start[k]..self.sample_start[k + 1]];
-                    let steps = own.len() - 1;
+                    let g = self.groups;
+                    let own = &self.samples[self.sample_start[k] * g..self.sample_start[k + 1] * g];
+                    let steps = own.len() / g - 1;
                     qs.clear();
-                    for (s, sample) in own.iter().enumerate() {
-                        if boxes.iter().any(|b| b.intersects(sample)) {
+                    for (s, sample) in own.chunks_exact(g).enumerate() {
+                        if sample.iter().any(|a| boxes.iter().any(|b| a.intersects(b))) {
                             qs.resize(qs.len() + d, 0.0);
                             let at = qs.len() - d;
                             segment_point(qa, qb, s, steps, &mut qs[at..]);

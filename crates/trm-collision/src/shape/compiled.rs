@@ -93,6 +93,18 @@ impl Compiled {
         out.bound = self.bound;
     }
 
+    /// The smallest axis-aligned box enclosing the shape placed at `p` (exact for segments
+    /// swept by balls and for boxes; parry's for other shapes).
+    pub fn tight_box(&self, p: &Placed) -> parry3d_f64::bounding_volume::Aabb {
+        match &self.geometry {
+            Geometry::Round { radius, .. } => {
+                let r = Vector3::repeat(*radius);
+                parry3d_f64::bounding_volume::Aabb::new(p.a.inf(&p.b) - r, p.a.sup(&p.b) + r)
+            }
+            Geometry::General { shape, .. } => shape.compute_aabb(&p.iso),
+        }
+    }
+
     /// A parry shape and pose for a round shape placed at `p` (ball when degenerate).
     pub(crate) fn round_as_parry(p: &Placed, radius: f64) -> (Isometry3<f64>, RoundShape) {
         if p.a == p.b {
