@@ -172,8 +172,24 @@ pub fn run(args: &Args) -> Result<()> {
         println!("reached task point {last:?}");
     }
     match (&s.exact, s.goal_error) {
-        (ExactGoal::Reached { evaluations, .. }, Some(e)) => {
-            println!("exact goal: reached, task error {e:.2e} ({evaluations} NGIK evaluations)")
+        (
+            ExactGoal::Reached {
+                evaluations,
+                detour,
+                ..
+            },
+            Some(e),
+        ) => {
+            let how = if *detour > 0 {
+                format!(
+                    "; the straight last segment was blocked: {detour} waypoints through the map instead"
+                )
+            } else {
+                String::new()
+            };
+            println!(
+                "exact goal: reached, task error {e:.2e} ({evaluations} NGIK evaluations){how}"
+            )
         }
         (ExactGoal::Fallback { reason }, Some(e)) => println!(
             "exact goal: not used ({reason}); the path ends at the map node, task error {e:.3}"

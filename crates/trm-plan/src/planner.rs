@@ -138,6 +138,9 @@ pub enum ExactGoal {
         error: f64,
         /// NGIK evaluations.
         evaluations: u64,
+        /// Waypoints of the short plan through the map that replaced a blocked straight last
+        /// segment (0: the straight segment was free).
+        detour: usize,
     },
     /// The path ends at the map node; why the exact finish was not used.
     Fallback {
@@ -385,8 +388,46 @@ impl<'a> Planner<'a> {
         self.objective.task_value(q, &mut self.scratch)
     }
 
-    /// Plans from `start` (active values, need not be a map node) to `goal`.
+    /// Plans from `start` (active values, need not be a map node) to `goal`. A task-point goal
+    /// with the exact finish on and no reachable node within its tolerance, but one within
+    /// twice it, goes through that node and lets NGIK cover the rest; it is unreachable only
+    /// when that fails too.
     pub fn plan(
+        &mut self,
+        start: &[f64],
+        goal: &Goal,
+        options: &PlanOptions,
+    ) -> Result<Planned, PlanError> {
+        let planned = self.plan_once(start, goal, options);
+        // a task point with no reachable node within the tolerance but one within twice it:
+        // through that node, and NGIK the rest of the way
+        if let (
+            Err(PlanError::Unreachable {
+                closest_node: Some(_),
+                closest_distance,
+                ..
+            }),
+            Goal::TaskPoint { t, tolerance },
+            true,
+        ) = (&planned, goal, options.exact_goal)
+            && *closest_distance > *tolerance
+            && *closest_distance <= 2.0 * tolerance
+        {
+            let wider = Goal::TaskPoint {
+                t: t.clone(),
+                tolerance: closest_distance * (1.0 + 1e-9) + 1e-12,
+            };
+            if let Ok(p) = self.plan_once(start, &wider, options)
+                && matches!(p.stats.exact, ExactGoal::Reached { .. })
+            {
+                return Ok(p);
+            }
+        }
+        planned
+    }
+
+    /// [`Planner::plan`] with the goal as given.
+    fn plan_once(
         &mut self,
         start: &[f64],
         goal: &Goal,
@@ -626,7 +667,8 @@ impl<'a> Planner<'a> {
     }
 
     /// Appends a posture at the task point `t` reached by NGIK from the last waypoint, when it
-    /// is within the tolerance, collision-free, and joined by a free straight segment.
+    /// is within the tolerance and collision-free, joined by a free straight segment or, when
+    /// that is blocked, by a short plan through the map to it.
     fn finish_exactly(
         &mut self,
         waypoints: &mut Vec<Vec<f64>>,
@@ -663,15 +705,39 @@ impl<'a> Planner<'a> {
         if !self.is_free(&solution.q) {
             return fallback("the posture at the goal collides in the current world".into());
         }
+        let mut detour = Vec::new();
         if !self.segment_free(&last, &solution.q, options.resolution) {
-            return fallback(
-                "the straight segment from the last map node to the goal posture collides".into(),
-            );
+            // a short plan through the map to the goal posture (attached like a configuration
+            // goal), instead of the blocked straight segment
+            let local = PlanOptions {
+                exact_goal: false,
+                ..options.clone()
+            };
+            match self.plan(&last, &Goal::Configuration(solution.q.clone()), &local) {
+                Ok(p) => {
+                    detour = p
+                        .trajectory
+                        .positions
+                        .iter()
+                        .skip(1)
+                        .map(|m| self.active.from_motors(m))
+                        .collect();
+                    detour.pop(); // the goal posture itself, pushed below
+                }
+                Err(_) => {
+                    return fallback(
+                        "the straight segment from the last map node to the goal posture collides, and no path through the map reaches that posture".into(),
+                    );
+                }
+            }
         }
+        let detour_len = detour.len();
+        waypoints.extend(detour);
         waypoints.push(solution.q);
         ExactGoal::Reached {
             error,
             evaluations: solution.evaluations,
+            detour: detour_len,
         }
     }
 

@@ -383,6 +383,54 @@ fn a_point_goal_is_finished_exactly_or_falls_back_clearly() {
     assert_eq!(fallback.trajectory, at_node.trajectory);
 }
 
+/// A point goal beyond the map's edge — its nearest node farther than the tolerance but within
+/// twice it — is reached through that node and NGIK; farther than twice the tolerance, or
+/// without the exact finish, it stays unreachable.
+#[test]
+fn a_point_goal_just_off_the_map_is_reached_through_its_nearest_node() {
+    let p = problem();
+    let map = map();
+    let mut planner = Planner::new(&p.objective, &[map]).unwrap();
+    // the node farthest out along +y, and a goal 4 cm beyond it
+    let edge = map
+        .points
+        .iter()
+        .max_by(|a, b| a.t[1].total_cmp(&b.t[1]))
+        .unwrap();
+    let goal_t = vec![edge.t[0], edge.t[1] + 0.04, edge.t[2]];
+    let nearest = map
+        .points
+        .iter()
+        .map(|m| trm_roadmap::distance(&m.t, &goal_t))
+        .fold(f64::INFINITY, f64::min);
+    assert!(nearest > 0.03 && nearest <= 0.06, "{nearest}");
+    let goal = Goal::TaskPoint {
+        t: goal_t.clone(),
+        tolerance: 0.03,
+    };
+    let options = PlanOptions::default();
+    let plan = planner.plan(&p.start, &goal, &options).unwrap();
+    check(&mut planner, &p.start, &plan, &options);
+    assert!(matches!(plan.stats.exact, ExactGoal::Reached { .. }));
+    assert!(plan.stats.goal_error.unwrap() <= 1e-3);
+    let no_exact = PlanOptions {
+        exact_goal: false,
+        ..Default::default()
+    };
+    assert!(matches!(
+        planner.plan(&p.start, &goal, &no_exact),
+        Err(PlanError::Unreachable { .. })
+    ));
+    let narrow = Goal::TaskPoint {
+        t: goal_t,
+        tolerance: nearest / 2.5,
+    };
+    assert!(matches!(
+        planner.plan(&p.start, &narrow, &options),
+        Err(PlanError::Unreachable { .. })
+    ));
+}
+
 /// The ROS 2 JointTrajectory YAML of a plan parses as YAML and carries the URDF joints (no
 /// mimics), their values through the couplings, zero waypoint velocities and the times.
 #[test]
