@@ -56,7 +56,7 @@ pub struct BlockIndex {
 }
 
 /// An axis-aligned box in single precision, enclosing the double-precision box it was made
-/// from.
+/// from (widened by a millionth).
 #[derive(Debug, Clone, Copy)]
 struct SmallBox {
     mins: [f32; 3],
@@ -65,14 +65,11 @@ struct SmallBox {
 
 impl SmallBox {
     fn new(aabb: &Aabb) -> Self {
-        let down = |v: f64| {
-            let f = v as f32;
-            if f64::from(f) > v { f.next_down() } else { f }
-        };
-        let up = |v: f64| {
-            let f = v as f32;
-            if f64::from(f) < v { f.next_up() } else { f }
-        };
+        // a margin of a millionth (relative, at least a micrometre) is more than the half
+        // unit in the last place f32 rounding can move a value by
+        let margin = |v: f64| 1e-6 * v.abs().max(1.0);
+        let down = |v: f64| (v - margin(v)) as f32;
+        let up = |v: f64| (v + margin(v)) as f32;
         SmallBox {
             mins: [down(aabb.mins.x), down(aabb.mins.y), down(aabb.mins.z)],
             maxs: [up(aabb.maxs.x), up(aabb.maxs.y), up(aabb.maxs.z)],
