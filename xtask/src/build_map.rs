@@ -180,8 +180,8 @@ impl Job<'_> {
                     p.points as u64,
                     p.target as u64,
                     &format!(
-                        "{} consecutive failures, {} evaluations ({rate:.0}/s)",
-                        p.failures, p.evaluations
+                        "{} failed searches ({} in a row), {} evaluations ({rate:.0}/s)",
+                        p.total_failures, p.failures, p.evaluations
                     ),
                 );
             };

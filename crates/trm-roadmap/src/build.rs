@@ -19,7 +19,7 @@ use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
 
 use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
-use trm_tasks::spec::MapSpec;
+use trm_tasks::spec::{FailureCount, MapSpec};
 use trm_tasks::{Objective, Problem};
 
 use crate::edges::distance;
@@ -75,6 +75,8 @@ pub struct Progress {
     pub target: usize,
     /// Consecutive failed searches.
     pub failures: usize,
+    /// All failed searches.
+    pub total_failures: u64,
     /// Evaluations so far.
     pub evaluations: u64,
     /// Generations run so far (in this run, when resumed).
@@ -600,11 +602,12 @@ pub(crate) fn run(
             stopped_because = format!("reached {target} points");
             break;
         }
-        if *failures >= settings.failure_limit {
-            stopped_because = format!(
-                "{} consecutive failed searches (k = {})",
-                *failures, settings.failure_limit
-            );
+        let (counted, which) = match settings.failures {
+            FailureCount::Total => (*total_failures, "failed searches"),
+            FailureCount::Consecutive => (*failures as u64, "consecutive failed searches"),
+        };
+        if counted >= settings.failure_limit as u64 {
+            stopped_because = format!("{counted} {which} (k = {})", settings.failure_limit);
             break;
         }
         if setup.deadline.is_some_and(|d| Instant::now() >= d) {
@@ -795,6 +798,7 @@ pub(crate) fn run(
                 points: map.points.len(),
                 target,
                 failures: *failures,
+                total_failures: *total_failures,
                 evaluations: *evaluations,
                 generations,
                 parallel_seconds,
@@ -810,6 +814,7 @@ pub(crate) fn run(
         points: state.map.points.len(),
         target,
         failures: state.failures,
+        total_failures: state.total_failures,
         evaluations: state.evaluations,
         generations,
         parallel_seconds,

@@ -287,6 +287,7 @@ impl<'p> LiveMap<'p> {
         setup.max_generations = 400;
         setup.repel_weight = 1.0;
         setup.settings.failure_limit = setup.settings.failure_limit.min(REPAIR_FAILURE_LIMIT);
+        setup.settings.failures = trm_tasks::spec::FailureCount::Consecutive;
         setup.deadline = options
             .seconds
             .map(|s| started + Duration::from_secs_f64(s.clamp(0.0, 1e9)));
@@ -307,6 +308,7 @@ impl<'p> LiveMap<'p> {
         if refill && budget_left && points.len() < self.size {
             setup.region = None;
             setup.settings.failure_limit = self.all.settings.failure_limit;
+            setup.settings.failures = self.all.settings.failures;
             setup.target = self.size;
             setup.max_evaluations = options
                 .evaluations

@@ -345,3 +345,51 @@ fn batched_segment_checks_agree_with_one_sample_at_a_time() {
     }
     assert!(free > 20 && blocked > 20, "{free} free, {blocked} blocked");
 }
+
+/// `failure_limit` counts every failed search by default (Algorithm 1), or only those since
+/// the last accepted point with `failures: Consecutive`.
+#[test]
+fn the_failure_limit_counts_all_failures_or_consecutive_ones() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("specs/reach.ron")).unwrap();
+    assert!(text.contains("failure_limit: 60,"));
+    let with = |setting: &str| {
+        let spec = text
+            .replace("failure_limit: 60,", setting)
+            .replace("spacing: 0.025,", "spacing: 0.08,");
+        let problem = Problem::from_ron(&spec, "reach.ron", &root.join("specs")).unwrap();
+        build(
+            &problem,
+            &BuildOptions {
+                // a wide spacing: the workspace fills up and searches fail
+                points: Some(400),
+                ..Default::default()
+            },
+            |_| {},
+        )
+        .unwrap()
+    };
+    let total = with("failure_limit: 3,");
+    // searches that end in the same generation are checked together: the count may pass k
+    let stop = &total.stats.stopped_because;
+    assert!(
+        stop.ends_with(" failed searches (k = 3)") && !stop.contains("consecutive"),
+        "{stop}"
+    );
+    assert!(
+        total.stats.failures >= 3 && total.stats.failures <= 6,
+        "{:?}",
+        total.stats
+    );
+    let consecutive = with("failure_limit: 3, failures: Consecutive,");
+    assert!(
+        consecutive
+            .stats
+            .stopped_because
+            .ends_with(" consecutive failed searches (k = 3)"),
+        "{}",
+        consecutive.stats.stopped_because
+    );
+    assert!(consecutive.stats.failures >= 3);
+    assert!(consecutive.points.len() >= total.points.len());
+}

@@ -338,6 +338,16 @@ impl Default for SolverSpec {
     }
 }
 
+/// Which failed searches stop a map build ([`MapSpec::failure_limit`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FailureCount {
+    /// All of them, as Algorithm 1 of the E-TRM paper counts (the default).
+    #[default]
+    Total,
+    /// Only those since the last accepted point (every accepted point resets the count).
+    Consecutive,
+}
+
 /// Roadmap settings (E-TRM and parallel E-TRM; defaults from the papers).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -348,8 +358,10 @@ pub struct MapSpec {
     pub construct_weight: f64,
     /// Smoothness weight c on ‖q − q′‖.
     pub smoothness: f64,
-    /// Consecutive failures after which construction stops (k).
+    /// Failed searches after which construction stops (k), counted as `failures` says.
     pub failure_limit: usize,
+    /// Which failed searches count towards `failure_limit`.
+    pub failures: FailureCount,
     /// Largest number of points.
     pub max_points: usize,
     /// (λ, σ) of the first point's search.
@@ -369,6 +381,7 @@ impl Default for MapSpec {
             construct_weight: 1.0,
             smoothness: 0.01,
             failure_limit: 100,
+            failures: FailureCount::Total,
             max_points: 1000,
             first_search: (150, 0.15),
             later_search: (30, 0.03),
