@@ -125,7 +125,13 @@ impl Command {
             ),
             Command::TaskMapStudies(a) => (vec![], vec![a.out_dir.clone()]),
             Command::GenIcub => (vec![], vec![models_dir()]),
-            Command::ModelInfo(a) => (file(&a.ros_postures), vec![]),
+            Command::ModelInfo(a) => (
+                file(&a.ros_postures)
+                    .into_iter()
+                    .chain(file(&a.write_srdf))
+                    .collect(),
+                vec![],
+            ),
             Command::MapInfo(_) | Command::Optimise(_) => (vec![], vec![]),
         }
     }

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use trm_collision::{CollisionModel, Shape};
-use trm_kinematics::{JointKind, RobotModel};
+use trm_kinematics::srdf::Srdf;
+use trm_kinematics::{JointKind, ModelDescription, RobotModel};
 
 /// Arguments of `model-info`.
 #[derive(clap::Args)]
@@ -21,6 +22,14 @@ pub struct Args {
     /// posture) to this file.
     #[arg(long, value_name = "FILE")]
     pub ros_postures: Option<PathBuf>,
+    /// Read an SRDF (MoveIt's semantic description) into the model first: its groups, group
+    /// states, end effectors and disabled collision pairs join the model description's.
+    #[arg(long, value_name = "FILE.srdf")]
+    srdf: Option<PathBuf>,
+    /// Write the model's groups, named postures and allowed-collision matrix as an SRDF that
+    /// MoveIt loads.
+    #[arg(long, value_name = "FILE.srdf")]
+    pub write_srdf: Option<PathBuf>,
     /// Seconds a controller gets to reach each posture of --ros-postures.
     #[arg(long, default_value_t = 2.0, value_parser = crate::parse::positive)]
     posture_seconds: f64,
@@ -68,9 +77,47 @@ fn coupling_formula(model: &RobotModel, coordinate: usize) -> String {
     }
 }
 
+/// The model description `model` was loaded with: the embedded one, the .ron file's, or none
+/// (a plain URDF).
+fn own_description(model: Option<&std::path::Path>) -> Result<ModelDescription> {
+    let text = match model {
+        None => trm_models::ICUB_UPPER_BODY_RON.to_string(),
+        Some(p) if p.to_string_lossy() == "icub_upper_body" => {
+            trm_models::ICUB_UPPER_BODY_RON.to_string()
+        }
+        Some(p) if p.to_string_lossy() == "icub_sagittal" => {
+            trm_models::ICUB_SAGITTAL_RON.to_string()
+        }
+        Some(p) if p.extension().is_some_and(|e| e == "ron") => std::fs::read_to_string(p)?,
+        Some(_) => return Ok(ModelDescription::default()),
+    };
+    let origin = model.map_or("icub_upper_body".into(), |p| p.display().to_string());
+    Ok(ModelDescription::from_ron(&text, &origin)?)
+}
+
 /// Prints the report.
 pub fn run(args: &Args) -> Result<()> {
-    let model = crate::load_model(args.model.as_deref())?;
+    let mut model = crate::load_model(args.model.as_deref())?;
+    if let Some(path) = &args.srdf {
+        let srdf = Srdf::load(path)?;
+        let (description, report) =
+            srdf.to_description(&model, &own_description(args.model.as_deref())?)?;
+        model = model.with_description(&description, None)?;
+        println!("from {}: {report}", path.display());
+    }
+    if let Some(out) = &args.write_srdf {
+        let collision = args.meshes.collision_model(&model)?;
+        let disabled = collision.acm().to_spec(&model, |_| true);
+        let srdf = Srdf::from_model(&model, &disabled);
+        crate::write_atomic(out, srdf.to_xml().as_bytes())?;
+        println!(
+            "wrote {} ({} groups, {} group states, {} disabled link pairs)",
+            out.display(),
+            srdf.groups.len(),
+            srdf.group_states.len(),
+            srdf.disabled.len()
+        );
+    }
     if let Some(out) = &args.ros_postures {
         let yaml = trm_kinematics::ros::named_postures_yaml(&model, args.posture_seconds)?;
         crate::write_atomic(out, yaml.as_bytes())?;

@@ -45,6 +45,7 @@ mod posture;
 mod resolve;
 mod ron_path;
 pub mod ros;
+pub mod srdf;
 mod tree;
 
 pub use active::ActiveSet;

@@ -20,6 +20,10 @@ pub struct OnePlusOneOptions {
     pub target_success: Option<f64>,
     /// Number of constraints for [`OnePlusOne::tell_constrained`] (default 0).
     pub constraints: usize,
+    /// The active covariance update of Arnold and Hansen (GECCO 2010, part of their
+    /// constrained algorithm of 2012): an offspring worse than the fifth-order ancestor of its
+    /// parent shrinks the covariance along its step, with c⁻ = 0.4/(n^1.6 + 1) (default on).
+    pub active: Option<bool>,
 }
 
 /// The (1+1)-CMA-ES. The first `ask` hands out the start point itself (the parent must have a
@@ -32,6 +36,11 @@ pub struct OnePlusOne {
     c_p: f64,
     c_c: f64,
     c_cov: f64,
+    /// c⁻ of the active update, 0 when it is off.
+    c_minus: f64,
+    /// The values of the last five parents (the current one last): the first is the fifth-
+    /// order ancestor of the next offspring.
+    ancestors: std::collections::VecDeque<f64>,
     threshold: f64,
     cc_constraint: f64,
     beta: f64,
@@ -72,6 +81,12 @@ impl OnePlusOne {
             c_p: 1.0 / 12.0,
             c_c: 2.0 / (nf + 2.0),
             c_cov: 2.0 / (nf * nf + 6.0),
+            c_minus: if options.active.unwrap_or(true) {
+                0.4 / (nf.powf(1.6) + 1.0)
+            } else {
+                0.0
+            },
+            ancestors: std::collections::VecDeque::with_capacity(5),
             threshold: 0.44,
             cc_constraint: 1.0 / (nf + 2.0),
             beta: 0.1 / (nf + 2.0),
@@ -105,8 +120,16 @@ impl OnePlusOne {
 
     /// Rank-one update of C = AAᵀ to α C + β v vᵀ with v = `self.path`, keeping A⁻¹ in step.
     fn rank_one(&mut self, alpha: f64, beta: f64) {
+        let v = std::mem::take(&mut self.path);
+        self.rank_one_along(&v, alpha, beta);
+        self.path = v;
+    }
+
+    /// Rank-one update of C = AAᵀ to α C + β v vᵀ, keeping A⁻¹ in step (β may be negative
+    /// as long as α + β ‖A⁻¹v‖² > 0).
+    fn rank_one_along(&mut self, v: &DVector<f64>, alpha: f64, beta: f64) {
         // w = A⁻¹ v
-        self.t1.gemv(1.0, &self.a_inv, &self.path, 0.0);
+        self.t1.gemv(1.0, &self.a_inv, v, 0.0);
         let w2 = self.t1.norm_squared();
         if w2 <= 0.0 || !w2.is_finite() {
             return;
@@ -115,13 +138,34 @@ impl OnePlusOne {
         let root = (1.0 + beta / alpha * w2).sqrt();
         // A ← √α A + √α/‖w‖² (root − 1) v wᵀ
         self.a *= sa;
-        self.a
-            .ger(sa / w2 * (root - 1.0), &self.path, &self.t1, 1.0);
+        self.a.ger(sa / w2 * (root - 1.0), v, &self.t1, 1.0);
         // A⁻¹ ← A⁻¹/√α − 1/(√α ‖w‖²) (1 − 1/root) w (wᵀ A⁻¹)
         self.t2.gemv_tr(1.0, &self.a_inv, &self.t1, 0.0);
         self.a_inv *= 1.0 / sa;
         self.a_inv
             .ger(-(1.0 - 1.0 / root) / (sa * w2), &self.t1, &self.t2, 1.0);
+    }
+
+    /// The active update for an offspring worse than the parent's fifth-order ancestor:
+    /// C ← (1 + c⁻) C − c⁻ (Az)(Az)ᵀ, with c⁻ reduced to 1/(2‖z‖² − 1) where it would
+    /// exceed it (so that C stays positive definite).
+    fn shrink_along_last_step(&mut self) {
+        let z2 = self.z.norm_squared();
+        let mut c = self.c_minus;
+        if c * (2.0 * z2 - 1.0) > 1.0 {
+            c = 1.0 / (2.0 * z2 - 1.0);
+        }
+        let v = std::mem::take(&mut self.az);
+        self.rank_one_along(&v, 1.0 + c, -c);
+        self.az = v;
+    }
+
+    /// Records a new parent's value.
+    fn remember(&mut self, f: f64) {
+        if self.ancestors.len() == 5 {
+            self.ancestors.pop_front();
+        }
+        self.ancestors.push_back(f);
     }
 
     fn update_step(&mut self, succeeded: bool) {
@@ -133,6 +177,7 @@ impl OnePlusOne {
     fn accept(&mut self, f: f64) {
         self.parent.copy_from_slice(&self.candidate[0]);
         self.parent_f = Some(f);
+        self.remember(f);
         let cc = self.c_c;
         if self.success < self.threshold {
             self.path.axpy((cc * (2.0 - cc)).sqrt(), &self.az, 1.0 - cc);
@@ -235,12 +280,18 @@ impl Optimizer for OnePlusOne {
                 self.state.clamp(&mut self.candidate[0]);
                 self.parent.copy_from_slice(&self.candidate[0]);
                 self.parent_f = Some(f);
+                self.remember(f);
             }
             Some(pf) => {
                 let succeeded = f <= pf;
                 self.update_step(succeeded);
                 if succeeded {
                     self.accept(f);
+                } else if self.c_minus > 0.0
+                    && self.ancestors.len() == 5
+                    && self.ancestors.front().is_some_and(|&a| f > a)
+                {
+                    self.shrink_along_last_step();
                 }
             }
         }
