@@ -826,6 +826,40 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             names: bad.into(),
         });
     }
+    // SRDF files: malformed, unknown names, missing attributes, wrong values
+    for (k, (what, text, names)) in [
+        ("truncated XML", "<robot name=\"r\">\n  <group name=\"a\">", "srdf_0.srdf"),
+        ("an unknown joint", "<robot>\n<group name=\"a\"><joint name=\"r_elbw\"/></group>\n</robot>", "r_elbow"),
+        ("an unknown link", "<robot>\n<disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/>\n</robot>", "r_hand"),
+        ("a missing attribute", "<robot>\n<end_effector name=\"e\" group=\"a\"/>\n</robot>", "parent_link"),
+        ("a non-number", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"x\"/></group_state></robot>", "srdf_4.srdf"),
+        ("another root", "<urdf/>", "srdf_5.srdf"),
+        ("a reversed chain", "<robot><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"chest\"/></group></robot>", "srdf_6.srdf"),
+        ("binary", "\u{0}\u{1}\u{2}", "srdf_7.srdf"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let name = format!("srdf_{k}.srdf");
+        std::fs::write(dir.join(&name), text).unwrap();
+        cases.push(Case {
+            what: format!("model-info --srdf with {what}"),
+            args: ["model-info", "icub_upper_body.urdf", "--srdf", name.as_str()]
+                .map(String::from)
+                .to_vec(),
+            names: names.into(),
+        });
+    }
+    cases.extend(file_flag_cases(
+        &["model-info"],
+        "--srdf",
+        &["no_such.srdf", ".", "map.json"],
+    ));
+    cases.extend(file_flag_cases(
+        &["model-info"],
+        "--write-srdf",
+        &[".", "map.json/x.srdf"],
+    ));
     cases.push(Case {
         what: "plan --repair without --world".into(),
         args: [
