@@ -227,13 +227,7 @@ pub fn run(args: &Args) -> Result<()> {
             plan.trajectory
                 .task_path
                 .iter()
-                .map(|p| {
-                    [
-                        p[0],
-                        p.get(1).copied().unwrap_or(0.0),
-                        p.get(2).copied().unwrap_or(0.0),
-                    ]
-                })
+                .map(|p| crate::view::point3(p))
                 .collect(),
         );
         scene.set_world(planner.world());

@@ -126,13 +126,7 @@ pub fn run(args: &Args) -> Result<()> {
         run.motion
             .task_path
             .iter()
-            .map(|p| {
-                [
-                    p[0],
-                    p.get(1).copied().unwrap_or(0.0),
-                    p.get(2).copied().unwrap_or(0.0),
-                ]
-            })
+            .map(|p| crate::view::point3(p))
             .collect(),
     );
     crate::view::write_scene(&scene, &dir.join("scenario.scene.html"))?;

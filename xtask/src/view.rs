@@ -150,7 +150,8 @@ fn trajectory(path: &Path, robot: &RobotModel, start: &[f64]) -> Result<(Frames,
     Ok((frames, t.task_path.iter().map(|p| point3(p)).collect()))
 }
 
-fn point3(v: &[f64]) -> [f64; 3] {
+/// The first three components of a task vector (zeros where it has fewer), for drawing.
+pub fn point3(v: &[f64]) -> [f64; 3] {
     [
         v.first().copied().unwrap_or(0.0),
         v.get(1).copied().unwrap_or(0.0),

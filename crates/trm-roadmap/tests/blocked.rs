@@ -11,21 +11,27 @@ use trm_roadmap::{
 };
 use trm_tasks::Problem;
 
-#[test]
-fn indexed_blocking_equals_the_exhaustive_check_on_random_world_changes() {
+/// The reach problem and a map of `points` points, connected to 6 neighbours.
+fn reach_map(points: usize) -> (Problem, trm_roadmap::Roadmap) {
     let problem =
         Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap();
-    let objective = &problem.objective;
     let mut map = build(
         &problem,
         &BuildOptions {
-            points: Some(60),
+            points: Some(points),
             ..Default::default()
         },
         |_| {},
     )
     .unwrap();
-    connect(&mut map, objective, 6, 0.05).unwrap();
+    connect(&mut map, &problem.objective, 6, 0.05).unwrap();
+    (problem, map)
+}
+
+#[test]
+fn indexed_blocking_equals_the_exhaustive_check_on_random_world_changes() {
+    let (problem, map) = reach_map(60);
+    let objective = &problem.objective;
     let index = BlockIndex::new(&map, objective).unwrap();
     // the map's own world blocks nothing
     let own = index.blocked(&map, objective, objective.world()).unwrap();
@@ -186,19 +192,8 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
 /// repair under an evaluation budget adds only clear nodes and edges.
 #[test]
 fn a_live_map_tracks_a_moving_world_exactly() {
-    let problem =
-        Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap();
+    let (problem, map) = reach_map(80);
     let objective = &problem.objective;
-    let mut map = build(
-        &problem,
-        &BuildOptions {
-            points: Some(80),
-            ..Default::default()
-        },
-        |_| {},
-    )
-    .unwrap();
-    connect(&mut map, objective, 6, 0.05).unwrap();
     let mut live = LiveMap::new(&map, &problem).unwrap();
     let (mut parked_max, mut freed) = (0, 0);
     for step in 0..24 {
