@@ -407,6 +407,18 @@ pub fn run_scenario(
     options: &ScenarioOptions,
 ) -> Result<ScenarioRun, ScenarioError> {
     options.plan.check()?;
+    for (what, v) in [
+        ("tolerance", options.tolerance),
+        ("reached", options.reached),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(PlanError::InvalidOptions {
+                what: format!("scenario {what}"),
+                problem: format!("{v}: give a finite positive task-space distance"),
+            }
+            .into());
+        }
+    }
     let dim = map.points.first().map_or(0, |p| p.t.len());
     if let Some(k) = scenario.goals.iter().position(|g| g.to.len() != dim) {
         return Err(scenario.error(

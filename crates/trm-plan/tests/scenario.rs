@@ -118,6 +118,22 @@ fn a_scenario_run_keeps_the_map_valid_reaches_goals_and_is_reproducible() {
         repair_evaluations: Some(3_000),
         ..Default::default()
     };
+    for bad in [
+        ScenarioOptions {
+            tolerance: f64::NAN,
+            ..options.clone()
+        },
+        ScenarioOptions {
+            reached: -1.0,
+            ..options.clone()
+        },
+        ScenarioOptions {
+            repair_seconds: Some(f64::NAN),
+            ..options.clone()
+        },
+    ] {
+        assert!(run_scenario(&map, &problem, &scenario, &bad).is_err());
+    }
     let run = run_scenario(&map, &problem, &scenario, &options).unwrap();
     assert_eq!(run.steps.len(), scenario.steps());
     assert_eq!(run.motion.positions.len(), run.steps.len());

@@ -235,6 +235,11 @@ impl<'p> LiveMap<'p> {
     /// repeated for the same world. The report's blocked/restored counts are left at zero
     /// (they belong to [`LiveMap::set_world`]).
     pub fn repair(&mut self, options: &RepairOptions) -> Result<RepairReport> {
+        if let Some(s) = options.seconds.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+            return Err(RoadmapError::Unsuitable(format!(
+                "a repair budget of {s} s: give a finite number of seconds, at least 0"
+            )));
+        }
         let started = Instant::now();
         let d = self.all.settings.spacing;
         let dim = self.all.points.first().map_or(0, |p| p.t.len());
@@ -290,7 +295,7 @@ impl<'p> LiveMap<'p> {
         setup.settings.failures = trm_tasks::spec::FailureCount::Consecutive;
         setup.deadline = options
             .seconds
-            .map(|s| started + Duration::from_secs_f64(s.clamp(0.0, 1e9)));
+            .map(|s| started + Duration::from_secs_f64(s.min(1e9)));
         setup.max_evaluations = options.evaluations;
         let grown = run(
             &setup,
