@@ -57,7 +57,8 @@ impl TaskFunction for PositionTask {
     }
 }
 
-/// The direction of a part's axis (masked): g = R_part u.
+/// The direction of a part's axis (masked): g = R_part u, or R_ref⁻¹ R_part u in the frame of
+/// a reference part.
 #[derive(Debug, Clone)]
 pub struct RotationTask {
     /// The frame.
@@ -68,6 +69,8 @@ pub struct RotationTask {
     pub axis: Vector3<f64>,
     /// Components kept.
     pub mask: [bool; 3],
+    /// The reference frame and its name; the world when `None`.
+    pub relative_to: Option<(FrameId, String)>,
 }
 
 impl TaskFunction for RotationTask {
@@ -75,10 +78,18 @@ impl TaskFunction for RotationTask {
         mask_dim(self.mask)
     }
     fn label(&self) -> String {
-        format!("rotation {}", self.part_name)
+        match &self.relative_to {
+            Some((_, r)) => format!("rotation {} relative to {r}", self.part_name),
+            None => format!("rotation {}", self.part_name),
+        }
     }
     fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        write_masked(ctx.axis(self.part, &self.axis), self.mask, out);
+        let axis = ctx.axis(self.part, &self.axis);
+        let axis = match &self.relative_to {
+            Some((r, _)) => ctx.poses.pose(*r).rotation.inverse_transform_vector(&axis),
+            None => axis,
+        };
+        write_masked(axis, self.mask, out);
     }
 }
 

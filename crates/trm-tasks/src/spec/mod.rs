@@ -231,6 +231,10 @@ pub enum TaskSpec {
         /// Components kept.
         #[serde(default = "all_axes")]
         mask: [bool; 3],
+        /// The part (or frame) whose frame the direction is expressed in: the hand's angles
+        /// relative to the head, say. The world when absent.
+        #[serde(default)]
+        relative_to: Option<String>,
     },
     /// Distance between two anchors.
     Distance {

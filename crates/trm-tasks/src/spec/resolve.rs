@@ -294,11 +294,20 @@ impl Resolver<'_> {
                 part_name: part.clone(),
                 mask: self.mask(*mask, "task.mask")?,
             }),
-            TaskSpec::Rotation { part, axis, mask } => Box::new(RotationTask {
+            TaskSpec::Rotation {
+                part,
+                axis,
+                mask,
+                relative_to,
+            } => Box::new(RotationTask {
                 part: self.frame(part, "task.part")?,
                 part_name: part.clone(),
                 axis: self.unit(*axis, "task.axis")?,
                 mask: self.mask(*mask, "task.mask")?,
+                relative_to: match relative_to {
+                    Some(r) => Some((self.frame(r, "task.relative_to")?, r.clone())),
+                    None => None,
+                },
             }),
             TaskSpec::Distance { a, b } => Box::new(DistanceTask {
                 a: self.anchor(a, "task.a")?,
