@@ -218,3 +218,42 @@ fn errors_point_at_their_own_field_not_the_first_matching_word() {
         "{e}"
     );
 }
+
+/// `Rotation(…, relative_to)` is the part's axis in the reference's frame: R_ref⁻¹ R_part u,
+/// checked against the frames' world poses at a few postures.
+#[test]
+fn a_rotation_relative_to_another_part_is_the_axis_in_its_frame() {
+    let spec = "(model: \"icub_upper_body\", start: Some(\"home\"), costs: [(weight: 1.0, cost: Collision())],
+        task: Some(Rotation(part: \"r_hand\", axis: (0, -1, 0), relative_to: Some(\"head\"))))";
+    let problem = Problem::from_ron(spec, "relative.ron", &specs_dir()).unwrap();
+    let objective = &problem.objective;
+    let robot = &problem.robot;
+    let (hand, head) = (
+        robot.frame_names().position(|n| n == "r_hand").unwrap(),
+        robot.frame_names().position(|n| n == "head").unwrap(),
+    );
+    let mut scratch = objective.scratch();
+    for k in 0..4 {
+        let q: Vec<f64> = problem
+            .start
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + 0.1 * ((i * 7 + k * 3) % 5) as f64 - 0.2)
+            .collect();
+        let mut q = q;
+        let (lower, upper) = objective.active().bounds();
+        for i in 0..q.len() {
+            q[i] = q[i].clamp(lower[i], upper[i]);
+        }
+        let got = objective.task_value(&q, &mut scratch);
+        let poses = objective.poses(&q, &mut scratch);
+        let world =
+            poses.poses()[hand].rotation * trm_kinematics::nalgebra::Vector3::new(0.0, -1.0, 0.0);
+        let want = poses.poses()[head].rotation.inverse() * world;
+        for i in 0..3 {
+            assert!((got[i] - want[i]).abs() < 1e-12, "{got:?} vs {want:?}");
+        }
+    }
+    let label = objective.task().unwrap().label();
+    assert_eq!(label, "rotation r_hand relative to head");
+}
