@@ -119,7 +119,7 @@ fn the_hand_tuned_trajectory_violates_what_the_independent_check_finds() {
 #[test]
 fn bootstrap_then_cca_finds_a_feasible_better_trajectory_reproducibly() {
     let mut spec = problem().spec().clone();
-    spec.optimiser.bootstrap_rollouts = 400;
+    spec.optimiser.bootstrap_rollouts = 700;
     spec.optimiser.rollouts = 60;
     let text = std::fs::read_to_string(SPEC).unwrap();
     let p = WholeBody::new(spec, trm_models::icub_sagittal(), SPEC, &text).unwrap();
