@@ -5,6 +5,7 @@ mod collide;
 mod compare;
 mod distributed;
 mod explore_task_map;
+mod fit_proxies;
 mod fk;
 mod gen_acm;
 mod gen_icub;
@@ -71,6 +72,8 @@ enum Command {
     /// A map in a moving world: objects move, appear and vanish, goals change; each step
     /// invalidates, repairs within a budget and replans (specs/scenarios/).
     Scenario(scenario::Args),
+    /// Fit a sphere, capsule or box around each link's collision meshes; optionally write the URDF with them.
+    FitProxies(fit_proxies::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
@@ -119,6 +122,7 @@ impl Command {
             Command::MapScaling(a) => (vec![], vec![a.out_dir.clone()]),
             Command::RepairMap(a) => (vec![a.out_path()], vec![]),
             Command::Scenario(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::FitProxies(a) => (file(&a.out), vec![]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
                 vec![a.out.clone()],
@@ -242,6 +246,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::MapScaling(args) => map_scaling::run(&args),
         Command::RepairMap(args) => repair_map::run(&args),
         Command::Scenario(args) => scenario::run(&args),
+        Command::FitProxies(args) => fit_proxies::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),
         Command::TaskMapStudies(args) => task_map_studies::run(&args),

@@ -861,6 +861,20 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &[".", "map.json/x.srdf"],
     ));
     cases.push(Case {
+        what: "fit-proxies of a model without meshes".into(),
+        args: ["fit-proxies", "icub_upper_body.urdf"]
+            .map(String::from)
+            .to_vec(),
+        names: "icub_upper_body.urdf".into(),
+    });
+    for bad in ["no_such.urdf", ".", "map.json", "world.ron"] {
+        cases.push(Case {
+            what: format!("fit-proxies {bad}"),
+            args: ["fit-proxies", bad].map(String::from).to_vec(),
+            names: bad.into(),
+        });
+    }
+    cases.push(Case {
         what: "plan --repair without --world".into(),
         args: [
             "plan",

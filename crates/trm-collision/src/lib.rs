@@ -32,6 +32,7 @@
 mod acm;
 mod cull;
 mod error;
+pub mod fit;
 mod generate;
 pub mod mesh;
 mod model;

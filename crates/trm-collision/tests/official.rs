@@ -84,3 +84,49 @@ fn the_official_urdfs_with_their_meshes_can_be_collision_checked() {
         "{pairs:?}"
     );
 }
+
+/// Proxies fitted to the official meshes (`trm_collision::fit`) enclose every vertex of every
+/// link's meshes' convex hulls.
+#[test]
+fn proxies_fitted_to_the_official_meshes_enclose_every_vertex() {
+    let Some(dir) = meshes() else {
+        eprintln!("TRM_ICUB_MESHES is not set: skipping the fitting check (see .ci/run)");
+        return;
+    };
+    let options = CollisionOptions {
+        package_paths: vec![dir],
+        ..Default::default()
+    };
+    let robot = trm_models::icub_genova04();
+    let collision = CollisionModel::with_options(&robot, &options).unwrap();
+    let (mut links, mut fitted, mut hulls) = (0, 0.0, 0.0);
+    for l in 0..robot.tree().links.len() {
+        let points: Vec<trm_kinematics::nalgebra::Point3<f64>> = collision
+            .bodies()
+            .iter()
+            .filter(|b| b.link == l)
+            .flat_map(|b| match &b.shape {
+                trm_collision::Shape::Convex { points } => points
+                    .iter()
+                    .map(|v| b.local * trm_kinematics::nalgebra::Point3::new(v[0], v[1], v[2]))
+                    .collect(),
+                _ => Vec::new(),
+            })
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        let fits = trm_collision::fit::fit(&points).unwrap();
+        for f in [&fits.sphere, &fits.capsule, &fits.cuboid] {
+            assert!(trm_collision::fit::worst_outside(f, &points) <= 1e-9);
+        }
+        links += 1;
+        fitted += fits.best().volume;
+        hulls += fits.hull_volume;
+    }
+    eprintln!(
+        "{links} links: fitted {:.2}× the hulls' volume",
+        fitted / hulls
+    );
+    assert!(links >= 39 && fitted / hulls < 2.0);
+}

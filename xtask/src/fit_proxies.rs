@@ -1,0 +1,313 @@
+//! `cargo xtask fit-proxies MODEL.urdf [--package-path DIR] [--out FILE.urdf] [--compare MODEL]`:
+//! a sphere, capsule or box fitted around each link's collision meshes (`trm_collision::fit`),
+//! with the volume against the meshes' convex hulls; optionally the URDF with the meshes
+//! replaced by the fitted primitives, and a comparison with another model's primitives.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use trm_collision::fit::{Fitted, fit, worst_outside};
+use trm_collision::{CollisionModel, Shape};
+use trm_kinematics::nalgebra::Point3;
+
+/// Arguments of `fit-proxies`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The URDF whose `<collision>` meshes are fitted.
+    model: PathBuf,
+    #[command(flatten)]
+    meshes: crate::MeshArgs,
+    /// Write the URDF with each meshed link's collisions replaced by its fitted primitive.
+    #[arg(long, value_name = "FILE.urdf")]
+    pub out: Option<PathBuf>,
+    /// Another model of the same robot (e.g. hand-made proxies) whose primitives' volumes are
+    /// compared link by link.
+    #[arg(long, value_name = "MODEL")]
+    compare: Option<PathBuf>,
+}
+
+/// Volume of a primitive (`None` for meshes).
+fn volume(shape: &Shape) -> Option<f64> {
+    use std::f64::consts::PI;
+    match shape {
+        Shape::Sphere { radius } => Some(4.0 / 3.0 * PI * radius.powi(3)),
+        Shape::Box { size } => Some(size[0] * size[1] * size[2]),
+        Shape::Cylinder { radius, length } => Some(PI * radius * radius * length),
+        Shape::Capsule { radius, length } => {
+            Some(PI * radius * radius * (length + 4.0 * radius / 3.0))
+        }
+        Shape::Convex { .. } => None,
+    }
+}
+
+/// One link's fit.
+struct LinkFit {
+    link: String,
+    fitted: Fitted,
+    hull: f64,
+    worst: f64,
+}
+
+/// Fits every link that has meshes, prints the table, writes what was asked.
+pub fn run(args: &Args) -> Result<()> {
+    let model = crate::load_model(Some(&args.model))?;
+    let collision = args.meshes.collision_model(&model)?;
+    let links = &model.tree().links;
+    let mut fits = Vec::new();
+    for (l, link) in links.iter().enumerate() {
+        let mut points: Vec<Point3<f64>> = Vec::new();
+        for b in collision.bodies().iter().filter(|b| b.link == l) {
+            if let Shape::Convex { points: p } = &b.shape {
+                points.extend(p.iter().map(|v| b.local * Point3::new(v[0], v[1], v[2])));
+            }
+        }
+        if points.is_empty() {
+            continue;
+        }
+        let all =
+            fit(&points).with_context(|| format!("link `{}`: no finite vertices", link.name))?;
+        let fitted = all.best().clone();
+        let worst = worst_outside(&fitted, &points);
+        fits.push(LinkFit {
+            link: link.name.clone(),
+            fitted,
+            hull: all.hull_volume,
+            worst,
+        });
+    }
+    if fits.is_empty() {
+        bail!(
+            "{}: no link has mesh collisions to fit\n  fix: give a URDF whose <collision> elements are meshes (found through --package-path)",
+            args.model.display()
+        );
+    }
+    let other = match &args.compare {
+        Some(p) => Some(CollisionModel::new(&crate::load_model(Some(p))?)?),
+        None => None,
+    };
+    let other_volume = |name: &str| -> Option<f64> {
+        let other = other.as_ref()?;
+        let l = other
+            .robot()
+            .tree()
+            .links
+            .iter()
+            .position(|k| k.name == name)?;
+        let v: Option<f64> = other
+            .bodies()
+            .iter()
+            .filter(|b| b.link == l)
+            .map(|b| volume(&b.shape))
+            .sum();
+        v.filter(|v| *v > 0.0)
+    };
+    println!(
+        "{:<24} {:>9} {:>9} {:>8} {:>9}{}",
+        "link",
+        "hull cm³",
+        "fit cm³",
+        "fit/hull",
+        "primitive",
+        if other.is_some() {
+            "  compared cm³  compared/hull"
+        } else {
+            ""
+        }
+    );
+    let (mut hull_sum, mut fit_sum, mut cmp_fit, mut cmp_other, mut tighter) =
+        (0.0, 0.0, 0.0, 0.0, 0);
+    for f in &fits {
+        hull_sum += f.hull;
+        fit_sum += f.fitted.volume;
+        let mut line = format!(
+            "{:<24} {:>9.1} {:>9.1} {:>8.2} {:>9}",
+            f.link,
+            f.hull * 1e6,
+            f.fitted.volume * 1e6,
+            f.fitted.volume / f.hull.max(1e-12),
+            f.fitted.shape.kind()
+        );
+        if let Some(v) = other_volume(&f.link) {
+            cmp_fit += f.fitted.volume;
+            cmp_other += v;
+            tighter += usize::from(f.fitted.volume < v);
+            let _ = write!(line, "  {:>12.1}  {:>13.2}", v * 1e6, v / f.hull.max(1e-12));
+        }
+        println!("{line}");
+    }
+    let worst = fits
+        .iter()
+        .map(|f| f.worst)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!(
+        "{} links: fitted {:.1} cm³ against hulls {:.1} cm³ ({:.2}×); every vertex enclosed: {} (largest distance outside {:.1e} m)",
+        fits.len(),
+        fit_sum * 1e6,
+        hull_sum * 1e6,
+        fit_sum / hull_sum.max(1e-12),
+        if worst <= 1e-9 { "yes" } else { "NO" },
+        worst.max(0.0)
+    );
+    if let Some(p) = &args.compare {
+        println!(
+            "against {} on the {} links both have: fitted {:.1} cm³, compared {:.1} cm³ ({:.2}×); the fit is tighter on {tighter}",
+            p.display(),
+            fits.iter()
+                .filter(|f| other_volume(&f.link).is_some())
+                .count(),
+            cmp_fit * 1e6,
+            cmp_other * 1e6,
+            cmp_fit / cmp_other.max(1e-12)
+        );
+    }
+    if let Some(out) = &args.out {
+        let text = std::fs::read_to_string(&args.model)
+            .with_context(|| format!("reading {}", args.model.display()))?;
+        let urdf = with_proxies(&text, &fits)
+            .with_context(|| format!("rewriting {}", args.model.display()))?;
+        crate::write_atomic(out, urdf.as_bytes())?;
+        println!(
+            "wrote {} ({} links with fitted proxies)",
+            out.display(),
+            fits.len()
+        );
+    }
+    Ok(())
+}
+
+/// The URDF text with each fitted link's `<collision>` elements replaced by one element with
+/// its fitted primitive.
+fn with_proxies(text: &str, fits: &[LinkFit]) -> Result<String> {
+    let doc = roxmltree::Document::parse(text)?;
+    // (start, end, replacement) of every collision element of a fitted link
+    let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    for link in doc
+        .root_element()
+        .children()
+        .filter(|n| n.has_tag_name("link"))
+    {
+        let Some(f) = fits
+            .iter()
+            .find(|f| Some(f.link.as_str()) == link.attribute("name"))
+        else {
+            continue;
+        };
+        let collisions: Vec<_> = link
+            .children()
+            .filter(|n| n.has_tag_name("collision"))
+            .collect();
+        for (k, c) in collisions.iter().enumerate() {
+            let replacement = if k == 0 {
+                collision_xml(&f.fitted)
+            } else {
+                String::new()
+            };
+            edits.push((c.range().start, c.range().end, replacement));
+        }
+    }
+    edits.sort_by_key(|e| e.0);
+    let mut out = String::with_capacity(text.len());
+    let mut at = 0;
+    for (start, end, replacement) in edits {
+        out.push_str(&text[at..start]);
+        out.push_str(&replacement);
+        at = end;
+    }
+    out.push_str(&text[at..]);
+    Ok(out)
+}
+
+/// Added to radii and half sizes written with six decimals, so that the rounded primitive
+/// still encloses every vertex (rounding moves the origin by at most 5e-7 m).
+const MARGIN: f64 = 2e-6;
+
+/// A `<collision>` element for a fitted primitive.
+fn collision_xml(f: &Fitted) -> String {
+    let t = f.pose.translation.vector;
+    let (r, p, y) = f.pose.rotation.euler_angles();
+    let geometry = match &f.shape {
+        Shape::Sphere { radius } => format!("<sphere radius=\"{:.6}\"/>", radius + MARGIN),
+        Shape::Capsule { radius, length } => format!(
+            "<capsule radius=\"{:.6}\" length=\"{length:.6}\"/>",
+            radius + MARGIN
+        ),
+        Shape::Box { size } => format!(
+            "<box size=\"{:.6} {:.6} {:.6}\"/>",
+            size[0] + 2.0 * MARGIN,
+            size[1] + 2.0 * MARGIN,
+            size[2] + 2.0 * MARGIN
+        ),
+        other => format!("<!-- {} -->", other.kind()),
+    };
+    format!(
+        "<collision>\n      <origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"{r:.6} {p:.6} {y:.6}\"/>\n      <geometry>\n        {geometry}\n      </geometry>\n    </collision>",
+        t.x, t.y, t.z
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use trm_collision::fit::worst_outside;
+    use trm_collision::{CollisionModel, CollisionOptions, Shape};
+    use trm_kinematics::RobotModel;
+    use trm_kinematics::nalgebra::Point3;
+
+    /// A two-link arm whose links are a scaled mesh cube: fitted, written as a URDF with boxes,
+    /// read back; the written boxes enclose every hull vertex and are that tight.
+    #[test]
+    fn fitted_proxies_are_written_into_the_urdf_and_enclose_the_meshes() {
+        let dir = crate::test_dir("fit-proxies");
+        let fixtures = crate::models_dir().join("../crates/trm-collision/tests/fixtures/meshes");
+        let mesh = |scale: &str| {
+            format!(
+                "<collision><origin xyz=\"0.01 0 0.05\" rpy=\"0.3 0 0\"/><geometry><mesh filename=\"package://demo_pkg/meshes/cube.stl\" scale=\"{scale}\"/></geometry></collision>"
+            )
+        };
+        let urdf = format!(
+            r#"<robot name="arm">
+  <link name="base">{}</link>
+  <link name="tip">{}</link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
+    <origin xyz="0 0 0.2"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"#,
+            mesh("0.1 0.2 0.05"),
+            mesh("0.05 0.05 0.3")
+        );
+        let input = dir.join("arm.urdf");
+        std::fs::write(&input, urdf).unwrap();
+        let out = dir.join("arm.fitted.urdf");
+        let args = super::Args {
+            model: input.clone(),
+            meshes: crate::MeshArgs {
+                package_paths: vec![fixtures.clone()],
+            },
+            out: Some(out.clone()),
+            compare: None,
+        };
+        super::run(&args).unwrap();
+        let options = CollisionOptions::with_ros_package_path(vec![fixtures]);
+        let meshed =
+            CollisionModel::with_options(&RobotModel::load(&input).unwrap(), &options).unwrap();
+        let fitted = CollisionModel::new(&RobotModel::load(&out).unwrap()).unwrap();
+        assert_eq!(fitted.bodies().len(), 2);
+        for (m, f) in meshed.bodies().iter().zip(fitted.bodies()) {
+            let Shape::Convex { points } = &m.shape else {
+                panic!("{:?}", m.shape)
+            };
+            let points: Vec<Point3<f64>> = points
+                .iter()
+                .map(|v| m.local * Point3::new(v[0], v[1], v[2]))
+                .collect();
+            assert_eq!(f.shape.kind(), "box", "{:?}", f.shape);
+            let written = trm_collision::fit::Fitted {
+                shape: f.shape.clone(),
+                pose: f.local,
+                volume: 0.0,
+            };
+            assert!(worst_outside(&written, &points) <= 0.0);
+            // a box around a box: the same box, to the written precision
+            assert!(worst_outside(&written, &points) > -1e-5);
+        }
+    }
+}
