@@ -311,3 +311,50 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod panda {
+    /// models/panda/panda_fitted.urdf and panda.ron are what the commands in
+    /// models/panda/NOTICE.md write today.
+    #[test]
+    fn the_committed_panda_files_are_current() {
+        let models = crate::models_dir();
+        let panda = models.join("panda");
+        let dir = crate::test_dir("panda-current");
+        let fitted = dir.join("panda_fitted.urdf");
+        super::run(&super::Args {
+            model: panda.join("example-robot-data/robots/panda_description/urdf/panda.urdf"),
+            meshes: crate::MeshArgs {
+                package_paths: vec![panda.clone()],
+            },
+            out: Some(fitted.clone()),
+            compare: None,
+        })
+        .unwrap();
+        let read = |p: &std::path::Path| std::fs::read_to_string(p).unwrap();
+        assert_eq!(
+            read(&fitted),
+            read(&panda.join("panda_fitted.urdf")),
+            "models/panda/panda_fitted.urdf is stale: run the commands in models/panda/NOTICE.md"
+        );
+        let description = dir.join("panda.ron");
+        crate::model_info::write_srdf_description(
+            &panda.join("panda_fitted.urdf"),
+            &panda.join("example-robot-data/robots/panda_description/srdf/panda.srdf"),
+            &description,
+        )
+        .unwrap();
+        // the written `urdf` field is relative to the output: compare the rest
+        let body = |text: String| -> String {
+            text.lines()
+                .filter(|l| !l.trim_start().starts_with("urdf:") && !l.starts_with("//"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        assert_eq!(
+            body(read(&description)),
+            body(read(&panda.join("panda.ron"))),
+            "models/panda/panda.ron is stale: run the commands in models/panda/NOTICE.md"
+        );
+    }
+}

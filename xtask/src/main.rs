@@ -133,6 +133,7 @@ impl Command {
                 file(&a.ros_postures)
                     .into_iter()
                     .chain(file(&a.write_srdf))
+                    .chain(file(&a.write_description))
                     .collect(),
                 vec![],
             ),

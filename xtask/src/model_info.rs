@@ -26,6 +26,10 @@ pub struct Args {
     /// states, end effectors and disabled collision pairs join the model description's.
     #[arg(long, value_name = "FILE.srdf")]
     srdf: Option<PathBuf>,
+    /// With --srdf: write the merged model description (RON, beside which the model loads
+    /// again: `urdf` names the URDF relative to it).
+    #[arg(long, value_name = "FILE.ron", requires = "srdf")]
+    pub write_description: Option<PathBuf>,
     /// Write the model's groups, named postures and allowed-collision matrix as an SRDF that
     /// MoveIt loads.
     #[arg(long, value_name = "FILE.srdf")]
@@ -95,6 +99,51 @@ fn own_description(model: Option<&std::path::Path>) -> Result<ModelDescription> 
     Ok(ModelDescription::from_ron(&text, &origin)?)
 }
 
+/// Writes `description` to `out` with its `urdf` pointing at `model` (relative to `out`'s
+/// directory when `model` lies in it).
+fn write_description(
+    description: &ModelDescription,
+    model: Option<&std::path::Path>,
+    out: &std::path::Path,
+) -> Result<()> {
+    let Some(urdf) = model.filter(|m| m.extension().is_some_and(|e| e == "urdf")) else {
+        anyhow::bail!(
+            "--write-description needs MODEL to be a .urdf file (the description names it)\n  fix: give the URDF as MODEL"
+        );
+    };
+    let dir = out.parent().unwrap_or(std::path::Path::new(""));
+    let absolute = |p: &std::path::Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let (urdf_abs, dir_abs) = (absolute(urdf), absolute(dir));
+    let mut d = description.clone();
+    d.urdf = urdf_abs
+        .strip_prefix(&dir_abs)
+        .map(|p| p.to_path_buf())
+        .unwrap_or(urdf_abs);
+    let text = ron::ser::to_string_pretty(&d, ron::ser::PrettyConfig::new().compact_arrays(true))?;
+    let text = format!(
+        "// Written by `cargo xtask model-info {} --srdf … --write-description`.\n{text}\n",
+        urdf.display()
+    );
+    crate::write_atomic(out, text.as_bytes())?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Reads `srdf` into the model description of the URDF `model` (which has none) and writes it
+/// to `out`: what `model-info MODEL --srdf SRDF --write-description OUT` does (for the
+/// generated-files test).
+#[cfg(test)]
+pub fn write_srdf_description(
+    model: &std::path::Path,
+    srdf: &std::path::Path,
+    out: &std::path::Path,
+) -> Result<()> {
+    let robot = crate::load_model(Some(model))?;
+    let (description, _) =
+        Srdf::load(srdf)?.to_description(&robot, &own_description(Some(model))?)?;
+    write_description(&description, Some(model), out)
+}
+
 /// Prints the report.
 pub fn run(args: &Args) -> Result<()> {
     let mut model = crate::load_model(args.model.as_deref())?;
@@ -104,6 +153,9 @@ pub fn run(args: &Args) -> Result<()> {
             srdf.to_description(&model, &own_description(args.model.as_deref())?)?;
         model = model.with_description(&description, None)?;
         println!("from {}: {report}", path.display());
+        if let Some(out) = &args.write_description {
+            write_description(&description, args.model.as_deref(), out)?;
+        }
     }
     if let Some(out) = &args.write_srdf {
         let collision = args.meshes.collision_model(&model)?;

@@ -861,6 +861,32 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &[".", "map.json/x.srdf"],
     ));
     cases.push(Case {
+        what: "model-info --write-description without --srdf".into(),
+        args: ["model-info", "icub_upper_body.urdf", "--write-description", "d.ron"]
+            .map(String::from)
+            .to_vec(),
+        names: "--srdf".into(),
+    });
+    std::fs::write(
+        dir.join("empty.srdf"),
+        "<robot name=\"icub_upper_body\"></robot>",
+    )
+    .unwrap();
+    cases.push(Case {
+        what: "model-info --write-description of a .ron model".into(),
+        args: [
+            "model-info",
+            "icub_upper_body.ron",
+            "--srdf",
+            "empty.srdf",
+            "--write-description",
+            "d.ron",
+        ]
+        .map(String::from)
+        .to_vec(),
+        names: "--write-description".into(),
+    });
+    cases.push(Case {
         what: "fit-proxies of a model without meshes".into(),
         args: ["fit-proxies", "icub_upper_body.urdf"]
             .map(String::from)
