@@ -7,9 +7,8 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use trm_benches::random_configurations;
 use trm_collision::fit::fit;
-use trm_collision::{CollisionModel, CollisionOptions, Shape};
+use trm_collision::{CollisionModel, CollisionOptions};
 use trm_kinematics::PoseBuffer;
-use trm_kinematics::nalgebra::Point3;
 
 fn proxies(c: &mut Criterion) {
     let Some(dir) = std::env::var_os("TRM_ICUB_MESHES") else {
@@ -25,20 +24,11 @@ fn proxies(c: &mut Criterion) {
     // the same bodies, each link's hulls replaced by its fitted primitive
     let mut bodies = Vec::new();
     for l in 0..robot.tree().links.len() {
-        let own: Vec<_> = hulls.bodies().iter().filter(|b| b.link == l).collect();
-        let points: Vec<Point3<f64>> = own
-            .iter()
-            .flat_map(|b| match &b.shape {
-                Shape::Convex { points } => points
-                    .iter()
-                    .map(|v| b.local * Point3::new(v[0], v[1], v[2]))
-                    .collect(),
-                _ => Vec::new(),
-            })
-            .collect();
-        if let (Some(first), Some(f)) = (own.first(), fit(&points)) {
+        let points = hulls.link_mesh_points(l);
+        let first = hulls.bodies().iter().find(|b| b.link == l);
+        if let (Some(first), Some(f)) = (first, fit(&points)) {
             let best = f.best().clone();
-            let mut body = (*first).clone();
+            let mut body = first.clone();
             body.shape = best.shape;
             body.local = best.pose;
             bodies.push(body);

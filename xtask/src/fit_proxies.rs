@@ -9,7 +9,6 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use trm_collision::fit::{Fitted, fit, worst_outside};
 use trm_collision::{CollisionModel, Shape};
-use trm_kinematics::nalgebra::Point3;
 
 /// Arguments of `fit-proxies`.
 #[derive(clap::Args)]
@@ -56,12 +55,7 @@ pub fn run(args: &Args) -> Result<()> {
     let links = &model.tree().links;
     let mut fits = Vec::new();
     for (l, link) in links.iter().enumerate() {
-        let mut points: Vec<Point3<f64>> = Vec::new();
-        for b in collision.bodies().iter().filter(|b| b.link == l) {
-            if let Shape::Convex { points: p } = &b.shape {
-                points.extend(p.iter().map(|v| b.local * Point3::new(v[0], v[1], v[2])));
-            }
-        }
+        let points = collision.link_mesh_points(l);
         if points.is_empty() {
             continue;
         }

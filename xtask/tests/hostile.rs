@@ -862,9 +862,14 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     ));
     cases.push(Case {
         what: "model-info --write-description without --srdf".into(),
-        args: ["model-info", "icub_upper_body.urdf", "--write-description", "d.ron"]
-            .map(String::from)
-            .to_vec(),
+        args: [
+            "model-info",
+            "icub_upper_body.urdf",
+            "--write-description",
+            "d.ron",
+        ]
+        .map(String::from)
+        .to_vec(),
         names: "--srdf".into(),
     });
     std::fs::write(

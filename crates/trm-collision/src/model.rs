@@ -132,6 +132,22 @@ impl CollisionModel {
             .map(|(c, p)| c.tight_box(p))
     }
 
+    /// The vertices of link `link`'s mesh bodies (their convex hulls), in the link frame: what
+    /// [`crate::fit::fit`] fits proxies to. Empty for a link without meshes.
+    pub fn link_mesh_points(&self, link: usize) -> Vec<nalgebra::Point3<f64>> {
+        self.bodies()
+            .iter()
+            .filter(|b| b.link == link)
+            .flat_map(|b| match &b.shape {
+                Shape::Convex { points } => points
+                    .iter()
+                    .map(|v| b.local * nalgebra::Point3::new(v[0], v[1], v[2]))
+                    .collect(),
+                _ => Vec::new(),
+            })
+            .collect()
+    }
+
     /// Bodies from the URDF's `<collision>` elements (meshes found relative to the URDF) and
     /// the allowed-collision matrix of the model description
     /// ([`AllowedCollisionMatrix::from_model`]).

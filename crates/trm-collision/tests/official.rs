@@ -101,18 +101,7 @@ fn proxies_fitted_to_the_official_meshes_enclose_every_vertex() {
     let collision = CollisionModel::with_options(&robot, &options).unwrap();
     let (mut links, mut fitted, mut hulls) = (0, 0.0, 0.0);
     for l in 0..robot.tree().links.len() {
-        let points: Vec<trm_kinematics::nalgebra::Point3<f64>> = collision
-            .bodies()
-            .iter()
-            .filter(|b| b.link == l)
-            .flat_map(|b| match &b.shape {
-                trm_collision::Shape::Convex { points } => points
-                    .iter()
-                    .map(|v| b.local * trm_kinematics::nalgebra::Point3::new(v[0], v[1], v[2]))
-                    .collect(),
-                _ => Vec::new(),
-            })
-            .collect();
+        let points = collision.link_mesh_points(l);
         if points.is_empty() {
             continue;
         }
