@@ -26,20 +26,6 @@ pub struct Args {
     compare: Option<PathBuf>,
 }
 
-/// Volume of a primitive (`None` for meshes).
-fn volume(shape: &Shape) -> Option<f64> {
-    use std::f64::consts::PI;
-    match shape {
-        Shape::Sphere { radius } => Some(4.0 / 3.0 * PI * radius.powi(3)),
-        Shape::Box { size } => Some(size[0] * size[1] * size[2]),
-        Shape::Cylinder { radius, length } => Some(PI * radius * radius * length),
-        Shape::Capsule { radius, length } => {
-            Some(PI * radius * radius * (length + 4.0 * radius / 3.0))
-        }
-        Shape::Convex { .. } => None,
-    }
-}
-
 /// One link's fit.
 struct LinkFit {
     link: String,
@@ -92,7 +78,7 @@ pub fn run(args: &Args) -> Result<()> {
             .bodies()
             .iter()
             .filter(|b| b.link == l)
-            .map(|b| volume(&b.shape))
+            .map(|b| b.shape.volume())
             .sum();
         v.filter(|v| *v > 0.0)
     };

@@ -201,6 +201,15 @@ fn check_rebuilds(map: &Roadmap, run: &ScenarioRun, options: &ScenarioOptions) -
     Ok(())
 }
 
+/// A step's action in one word (the CSV's column).
+fn action_name(action: &Action) -> &'static str {
+    match action {
+        Action::Kept => "kept",
+        Action::Replanned(_) => "replanned",
+        Action::Failed(_) => "failed",
+    }
+}
+
 /// The per-step table (Markdown).
 fn step_table(run: &ScenarioRun) -> String {
     let mut s = String::from(
@@ -209,7 +218,7 @@ fn step_table(run: &ScenarioRun) -> String {
     for step in &run.steps {
         let [inv, rep, plan] = step.seconds.map(|s| s * 1e3);
         let action = match &step.action {
-            Action::Kept => "kept".to_string(),
+            Action::Kept => action_name(&step.action).to_string(),
             Action::Replanned(why) => format!("replanned ({why})"),
             Action::Failed(why) => format!("no path ({})", why.split(';').next().unwrap_or(why)),
         };
@@ -242,11 +251,7 @@ fn steps_csv(run: &ScenarioRun) -> String {
     );
     for step in &run.steps {
         let [inv, rep, plan] = step.seconds.map(|s| s * 1e3);
-        let action = match &step.action {
-            Action::Kept => "kept",
-            Action::Replanned(_) => "replanned",
-            Action::Failed(_) => "failed",
-        };
+        let action = action_name(&step.action);
         let _ = writeln!(
             s,
             "{},{},{},{},{},{inv},{rep},{plan},{action},{},{}",

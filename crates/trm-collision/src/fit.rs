@@ -214,8 +214,7 @@ fn fit_capsule(points: &[Point3<f64>], axis: &Vector3<f64>) -> Fitted {
         if !ok {
             continue;
         }
-        let length = b - a;
-        let volume = std::f64::consts::PI * r * r * (length + 4.0 * r / 3.0);
+        let volume = capsule_volume(r, b - a);
         if best.is_none_or(|(v, ..)| volume < v) {
             best = Some((volume, r, a, b));
         }
@@ -239,6 +238,12 @@ fn fit_capsule(points: &[Point3<f64>], axis: &Vector3<f64>) -> Fitted {
     }
 }
 
+fn capsule_volume(radius: f64, length: f64) -> f64 {
+    Shape::Capsule { radius, length }
+        .volume()
+        .unwrap_or(f64::INFINITY)
+}
+
 /// An enclosing sphere: Bădoiu–Clarkson iterations for the centre, the farthest point for the
 /// radius.
 fn fit_sphere(points: &[Point3<f64>]) -> Fitted {
@@ -248,20 +253,20 @@ fn fit_sphere(points: &[Point3<f64>]) -> Fitted {
             .map(|p| (p.coords - c).norm())
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(&b.1))
-            .expect("points")
+            .unwrap_or((0, 0.0))
     };
     let mut c = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len() as f64;
     for k in 1..=400 {
         let (i, _) = farthest(&c);
         c += (points[i].coords - c) / (k as f64 + 1.0);
     }
-    let r = farthest(&c).1 + 1e-9;
+    let shape = Shape::Sphere {
+        radius: (farthest(&c).1 + 1e-9).max(1e-6),
+    };
     Fitted {
-        shape: Shape::Sphere {
-            radius: r.max(1e-6),
-        },
+        volume: shape.volume().unwrap_or(f64::INFINITY),
+        shape,
         pose: Isometry3::from_parts(Translation3::from(c), UnitQuaternion::identity()),
-        volume: 4.0 / 3.0 * std::f64::consts::PI * r.powi(3),
     }
 }
 

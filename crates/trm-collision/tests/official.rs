@@ -16,6 +16,18 @@ fn meshes() -> Option<std::path::PathBuf> {
     Some(dir)
 }
 
+/// iCubGenova04 (all its meshes are in icub-models) and its collision model on the meshes in
+/// `dir`.
+fn genova04_with_meshes(dir: std::path::PathBuf) -> (trm_kinematics::RobotModel, CollisionModel) {
+    let options = CollisionOptions {
+        package_paths: vec![dir],
+        ..Default::default()
+    };
+    let robot = trm_models::icub_genova04();
+    let collision = CollisionModel::with_options(&robot, &options).unwrap();
+    (robot, collision)
+}
+
 #[test]
 fn without_mesh_paths_the_official_urdf_reports_the_missing_mesh() {
     let robot = trm_models::icub_official();
@@ -34,13 +46,8 @@ fn the_official_urdfs_with_their_meshes_can_be_collision_checked() {
         eprintln!("TRM_ICUB_MESHES is not set: skipping the mesh check (see .ci/run)");
         return;
     };
-    let options = CollisionOptions {
-        package_paths: vec![dir],
-        ..Default::default()
-    };
     // iCubGenova04's meshes are all in icub-models; the visuomanip hands' COLLADA meshes are not.
-    let robot = trm_models::icub_genova04();
-    let collision = CollisionModel::with_options(&robot, &options).unwrap();
+    let (robot, collision) = genova04_with_meshes(dir);
     assert!(
         collision.bodies().len() >= 39,
         "{}",
@@ -93,12 +100,7 @@ fn proxies_fitted_to_the_official_meshes_enclose_every_vertex() {
         eprintln!("TRM_ICUB_MESHES is not set: skipping the fitting check (see .ci/run)");
         return;
     };
-    let options = CollisionOptions {
-        package_paths: vec![dir],
-        ..Default::default()
-    };
-    let robot = trm_models::icub_genova04();
-    let collision = CollisionModel::with_options(&robot, &options).unwrap();
+    let (robot, collision) = genova04_with_meshes(dir);
     let (mut links, mut fitted, mut hulls) = (0, 0.0, 0.0);
     for l in 0..robot.tree().links.len() {
         let points = collision.link_mesh_points(l);

@@ -67,6 +67,20 @@ fn problem(problem: impl Into<String>, fix: impl Into<String>) -> ShapeProblem {
 }
 
 impl Shape {
+    /// Volume, m³, of a primitive (`None` for a convex hull of points).
+    pub fn volume(&self) -> Option<f64> {
+        use std::f64::consts::PI;
+        match self {
+            Shape::Sphere { radius } => Some(4.0 / 3.0 * PI * radius.powi(3)),
+            Shape::Box { size } => Some(size[0] * size[1] * size[2]),
+            Shape::Cylinder { radius, length } => Some(PI * radius * radius * length),
+            Shape::Capsule { radius, length } => {
+                Some(PI * radius * radius * (length + 4.0 * radius / 3.0))
+            }
+            Shape::Convex { .. } => None,
+        }
+    }
+
     /// The shape's kind as written in files.
     pub fn kind(&self) -> &'static str {
         match self {
