@@ -891,6 +891,29 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         .to_vec(),
         names: "--write-description".into(),
     });
+    for out in [".", "beside.ros.yaml", "linked.ros.yaml"] {
+        for command in [
+            vec!["fit-proxies", "icub_upper_body.urdf", "--out"],
+            vec![
+                "model-info",
+                "icub_upper_body.urdf",
+                "--srdf",
+                "empty.srdf",
+                "--write-description",
+            ],
+            vec!["model-info", "--write-srdf"],
+        ] {
+            cases.push(Case {
+                what: format!("{} into {out}", command.join(" ")),
+                args: command
+                    .iter()
+                    .map(|s| s.to_string())
+                    .chain([out.to_string()])
+                    .collect(),
+                names: out.into(),
+            });
+        }
+    }
     cases.push(Case {
         what: "fit-proxies of a model without meshes".into(),
         args: ["fit-proxies", "icub_upper_body.urdf"]
