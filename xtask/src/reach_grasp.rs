@@ -1,15 +1,18 @@
-//! `cargo xtask reach-grasp SPEC [--at "x,y,z[,yaw]"] [--exact] [--iterations N] [--out traj.csv]`:
-//! a reaching motion of the right hand to the object of a task-map spec, optimised with its
-//! task map (or, with `--exact`, to the map's grasp nearest the object's centre); the trajectory
-//! is written like `plan` writes it.
+//! `cargo xtask reach-grasp SPEC [--at "x,y,z[,yaw]"] [--world W.ron] [--exact] [--iterations N]
+//! [--out traj.csv]`: a reaching motion of the right hand to the object of a task-map spec
+//! (Gienger et al.: 12 attractors in the hand's position and grasp-axis task, iRprop− on the
+//! analytic gradient), optimised with its task map (or, with `--exact`, to the map's grasp
+//! nearest the object's centre), around the world's obstacles; the trajectory is written like
+//! `plan` writes it.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use trm_collision::World;
+use trm_kinematics::ActiveSet;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_plan::{Trajectory, time_parametrise};
-use trm_taskmap::{MotionGoal, MotionOptions, ReachProblem};
+use trm_taskmap::{Explored, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
 
 use crate::explore_task_map::explore_spec;
 
@@ -21,10 +24,13 @@ pub struct Args {
     /// Where the object stands in the robot's root frame: "x,y,z" or "x,y,z,yaw".
     #[arg(long, default_value = "-0.3,0.2,0.05", allow_hyphen_values = true)]
     at: String,
+    /// Obstacles (RON world, root frame), e.g. specs/worlds/table.ron; none by default.
+    #[arg(long)]
+    world: Option<PathBuf>,
     /// Reach the single grasp nearest the object's centre instead of anywhere on the map.
     #[arg(long)]
     exact: bool,
-    /// RPROP iterations.
+    /// iRprop− iterations.
     #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
     iterations: usize,
     /// Trajectory output (CSV; a .json and a .ros.yaml ROS 2 JointTrajectory beside it).
@@ -46,36 +52,33 @@ pub fn run(args: &Args) -> Result<()> {
         Vector3::new(v[0], v[1], v[2]),
         Vector3::z() * v.get(3).copied().unwrap_or(0.0),
     );
-    let home = e.model.posture("home")?;
-    let active = e.model.active_set(&["torso", "right_arm"], home)?;
-    let world = World::new();
+    let world = match &args.world {
+        Some(w) => World::load(w)?,
+        None => World::new(),
+    };
+    let active = e
+        .model
+        .active_set(&["torso", "right_arm"], e.model.posture("home")?)?;
     let centre = e.map.center_grasp().context("the task map is empty")?;
     let goal = if args.exact {
         MotionGoal::Target(centre)
     } else {
         MotionGoal::Map(&e.map)
     };
-    let problem = ReachProblem {
-        active: &active,
-        collision: &e.collision,
-        world: &world,
-        hand: e.model.frame_id("r_hand")?,
-        object: at,
-        start: active.from_motors(home),
-        goal,
-        settings: MotionOptions::default(),
-    };
+    let problem = reach_problem(&e, &active, &world, at, goal)?;
     let started = std::time::Instant::now();
-    let (m, trace) = problem.optimize(args.iterations, 1e-3);
+    let (m, trace) = problem.optimize(args.iterations);
     println!(
-        "{} goal, {} map grasps: cost {:.4} (from {:.4}), joint-limit proximity {:.4}, collisions {:.2}, path {:.3} rad, end cost {:.5}; {:.2} s",
+        "{} goal, {} map grasps: cost {:.4} (from {:.4}), joint-limit cost {:.4}, closest approach {:.3} m ({} steps in contact), path {:.3} rad, end speed {:.3} m/s, end cost {:.5}; {:.2} s",
         if args.exact { "exact" } else { "task-map" },
         e.map.points.len(),
         m.cost,
         trace[0].0,
         m.limits,
+        m.min_distance,
         m.collisions,
         m.length,
+        m.end_speed,
         m.end,
         started.elapsed().as_secs_f64()
     );
@@ -104,6 +107,31 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
+/// The reach of the right hand of an explored task map's robot (torso and right arm, from
+/// home) to its object at `object`, around `world`, with the map's grasp axis.
+pub fn reach_problem<'a>(
+    e: &'a Explored,
+    active: &'a ActiveSet,
+    world: &'a World,
+    object: Isometry3<f64>,
+    goal: MotionGoal<'a>,
+) -> Result<ReachProblem<'a>> {
+    let grasp_axis = grasp_axis(&e.map, &e.object).context(
+        "the task map gives no grasp axis: it is empty or its object has no capsule, cylinder or box",
+    )?;
+    Ok(ReachProblem {
+        active,
+        collision: &e.collision,
+        world,
+        hand: e.model.frame_id("r_hand")?,
+        grasp_axis,
+        object,
+        start: active.from_motors(e.model.posture("home")?),
+        goal,
+        settings: MotionOptions::default(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,13 +143,14 @@ mod tests {
         run(&Args {
             spec: crate::models_dir().join("../specs/taskmaps/stick.ron"),
             at: "-0.3,0.2,0.05".into(),
+            world: Some(crate::models_dir().join("../specs/worlds/table.ron")),
             exact: false,
             iterations: 2,
             out: Some(out.clone()),
         })
         .unwrap();
         let csv = std::fs::read_to_string(&out).unwrap();
-        assert_eq!(csv.lines().count(), 1 + 31);
+        assert_eq!(csv.lines().count(), 1 + 61);
         assert!(csv.starts_with("time,"));
         std::fs::remove_dir_all(&dir).unwrap();
     }

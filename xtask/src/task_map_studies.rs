@@ -1,138 +1,332 @@
-//! `cargo xtask task-map-studies`: the two studies of Gienger et al. on the iCub — (a) reaching
-//! a stick with an exact target at its centre versus with its task map (joint-limit cost over the
-//! optimisation, where along the stick the grasp ends; the paper's Fig. 7) and (b) a basket
-//! handle at three placements (where along the handle the grasp ends; the paper's Fig. 9).
+//! `cargo xtask task-map-studies`: the two studies of Gienger et al. (IROS 2008) on the iCub,
+//! set as the paper set them — (a) Fig. 7: a cylinder standing on a table, reached once with
+//! the cylinder's centre as the exact target and once with its task map (the joint-limit cost
+//! over the iterations, where along the cylinder the grasp ends); (b) Fig. 9: a basket on the
+//! table at three locations, reached with the handle's task map (where on the handle the grasp
+//! ends). Each run writes its trajectory and a world file for `cargo xtask view`.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use trm_collision::World;
-use trm_kinematics::nalgebra::{Isometry3, Vector3};
-use trm_taskmap::{MotionGoal, MotionOptions, ReachProblem};
+use trm_collision::{Shape, World};
+use trm_kinematics::nalgebra::Isometry3;
+use trm_plan::{Trajectory, time_parametrise};
+use trm_taskmap::{Motion, MotionGoal};
 
 use crate::explore_task_map::{Explored, explore_spec};
+use crate::reach_grasp::reach_problem;
 
 /// Arguments of `task-map-studies`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// RPROP iterations per optimisation.
+    /// iRprop− iterations per optimisation.
     #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
     iterations: usize,
-    /// Output directory (table.md, joint_limits.svg).
+    /// Output directory (table.md, joint_limits.svg, paths.svg, one CSV and world per run).
     #[arg(long, default_value = "target/taskmap-studies")]
     pub out_dir: PathBuf,
 }
 
-fn reach<'a>(
-    e: &'a Explored,
-    active: &'a trm_kinematics::ActiveSet,
-    world: &'a World,
-    object: Isometry3<f64>,
-    goal: MotionGoal<'a>,
-) -> ReachProblem<'a> {
-    let home = e
-        .model
-        .posture("home")
-        .expect("the iCub has a home posture");
-    ReachProblem {
-        active,
-        collision: &e.collision,
-        world,
-        hand: e.model.frame_id("r_hand").expect("iCub right hand"),
-        object,
-        start: active.from_motors(home),
-        goal,
-        settings: MotionOptions::default(),
+/// The table of both studies: 50 × 80 cm, its top 20 cm below the iCub's root (8 cm lower than
+/// specs/worlds/table.ron's, so that the idle left hand clears it when the torso bends).
+const TABLE_TOP: f64 = -0.2;
+
+/// Where the cylinder stands (its centre; 30 cm tall, on the table, near the far end of the
+/// right hand's reach).
+const CYLINDER: [f64; 3] = [-0.45, 0.2, TABLE_TOP + 0.17];
+
+/// The basket's three locations on the table (handle origin x, y), from the robot's right to
+/// its left.
+const BASKET: [(&str, [f64; 2]); 3] = [
+    ("right", [-0.3, 0.2]),
+    ("centre", [-0.3, 0.05]),
+    ("left", [-0.3, -0.1]),
+];
+
+/// The basket's body under its handle: 22 × 14 × 10 cm, its top at the handle's origin, which
+/// stands 10 cm above the table.
+const BASKET_HEIGHT: f64 = 0.10;
+
+fn table() -> Result<World> {
+    let mut w = World::new();
+    w.add(
+        "table",
+        Shape::Box {
+            size: [0.5, 0.8, 0.04],
+        },
+        Isometry3::translation(-0.4, 0.0, TABLE_TOP - 0.02),
+    )?;
+    Ok(w)
+}
+
+/// The world `cargo xtask view` shows: the obstacles and the object's parts at `at`.
+fn scene(obstacles: &World, e: &Explored, at: &Isometry3<f64>) -> Result<World> {
+    let mut w = obstacles.clone();
+    for o in e.object.objects() {
+        w.add(o.name(), o.shape().clone(), at * o.pose())?;
+    }
+    Ok(w)
+}
+
+/// One optimised reach.
+struct Run {
+    name: String,
+    motion: Motion,
+    trace: Vec<(f64, f64)>,
+    seconds: f64,
+}
+
+impl Run {
+    /// The first iteration whose best cost is within 1 % of the final one.
+    fn converged(&self) -> usize {
+        let last = self.trace.last().map_or(0.0, |t| t.0);
+        self.trace
+            .iter()
+            .position(|t| t.0 <= last + 0.01 * last.abs())
+            .unwrap_or(0)
     }
 }
 
-/// Runs both studies and writes the table and the plot.
+#[allow(clippy::too_many_arguments)]
+fn reach(
+    name: &str,
+    e: &Explored,
+    obstacles: &World,
+    at: Isometry3<f64>,
+    goal: MotionGoal<'_>,
+    iterations: usize,
+    out_dir: &Path,
+) -> Result<Run> {
+    let active = e
+        .model
+        .active_set(&["torso", "right_arm"], e.model.posture("home")?)?;
+    let problem = reach_problem(e, &active, obstacles, at, goal)?;
+    let started = std::time::Instant::now();
+    let (motion, trace) = problem.optimize(iterations);
+    let seconds = started.elapsed().as_secs_f64();
+    let csv = out_dir.join(format!("{name}.csv"));
+    let trajectory = Trajectory {
+        names: e.model.motors().iter().map(|m| m.name.clone()).collect(),
+        times: time_parametrise(&motion.trajectory, &vec![1.0; active.len()], None),
+        positions: motion
+            .trajectory
+            .iter()
+            .map(|q| active.to_motors(q))
+            .collect(),
+        task_path: Vec::new(),
+    };
+    crate::write_atomic(&csv, trajectory.to_csv(&csv)?.as_bytes())?;
+    let world = scene(obstacles, e, &at)?;
+    let ron = ron::ser::to_string_pretty(&world.to_spec(), Default::default())?;
+    crate::write_atomic(&out_dir.join(format!("{name}.world.ron")), ron.as_bytes())?;
+    Ok(Run {
+        name: name.into(),
+        motion,
+        trace,
+        seconds,
+    })
+}
+
+/// Runs both studies and writes the tables, the plots, the trajectories and the worlds.
 pub fn run(args: &Args) -> Result<()> {
     let specs = crate::models_dir().join("../specs/taskmaps");
     let started = std::time::Instant::now();
+    let out = &args.out_dir;
     let stick = explore_spec(&specs.join("stick.ron"))?;
-    let active = stick
-        .model
-        .active_set(&["torso", "right_arm"], stick.model.posture("home")?)?;
-    let world = World::new();
-    let place = Isometry3::new(Vector3::new(-0.3, 0.2, 0.05), Vector3::zeros());
-    // the exact target: the map's grasp nearest the stick's centre
+    let tabletop = table()?;
+    let place = Isometry3::translation(CYLINDER[0], CYLINDER[1], CYLINDER[2]);
+    // the exact target: the map's grasp nearest the cylinder's centre
     let centre = stick.map.center_grasp().expect("a non-empty map");
-    let (exact, exact_trace) = reach(&stick, &active, &world, place, MotionGoal::Target(centre))
-        .optimize(args.iterations, 1e-3);
-    let (mapped, map_trace) = reach(&stick, &active, &world, place, MotionGoal::Map(&stick.map))
-        .optimize(args.iterations, 1e-3);
+    let runs = [
+        reach(
+            "cylinder_exact",
+            &stick,
+            &tabletop,
+            place,
+            MotionGoal::Target(centre),
+            args.iterations,
+            out,
+        )?,
+        reach(
+            "cylinder_map",
+            &stick,
+            &tabletop,
+            place,
+            MotionGoal::Map(&stick.map),
+            args.iterations,
+            out,
+        )?,
+    ];
     let mut md = format!(
-        "## (a) Stick ({} feasible grasps), {} RPROP iterations\n\n| goal | total cost | joint-limit proximity | end cost | path length (rad) | grasp position along the stick (m) |\n|---|---|---|---|---|---|\n",
+        "## (a) Cylinder on a table ({} feasible grasps), {} iRprop− iterations\n\n| goal | total cost | joint-limit cost | closest approach (m) | end cost | converged at iteration | grasp height on the cylinder (m) | time (s) |\n|---|---|---|---|---|---|---|---|\n",
         stick.map.points.len(),
         args.iterations
     );
-    for (name, m) in [
-        ("exact target at the centre", &exact),
-        ("task map", &mapped),
-    ] {
+    for (label, r) in ["exact target at the centre", "task map"].iter().zip(&runs) {
+        let m = &r.motion;
         let _ = writeln!(
             md,
-            "| {name} | {:.4} | {:.4} | {:.5} | {:.3} | {:+.3} |",
-            m.cost, m.limits, m.end, m.length, m.final_pose[2]
+            "| {label} | {:.4} | {:.4} | {:.3} | {:.5} | {} | {:+.3} | {:.2} |",
+            m.cost,
+            m.limits,
+            m.min_distance,
+            m.end,
+            r.converged(),
+            m.final_pose[2],
+            r.seconds
         );
     }
+    // what the analytic gradient saves: one backward pass against 2 × 60 simulations
+    let active = stick
+        .model
+        .active_set(&["torso", "right_arm"], stick.model.posture("home")?)?;
+    let problem = reach_problem(
+        &stick,
+        &active,
+        &tabletop,
+        place,
+        MotionGoal::Map(&stick.map),
+    )?;
+    let x0 = problem.initial_attractors();
+    let timed = |f: &dyn Fn()| {
+        let mut times: Vec<f64> = (0..5)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times[2]
+    };
+    let analytic = timed(&|| drop(problem.gradient(&x0)));
+    let numeric = timed(&|| drop(problem.numerical_gradient(&x0, 1e-5)));
+    let _ = writeln!(
+        md,
+        "\nOne gradient over the {} attractor coordinates (median of 5): analytic {analytic:.2} ms, central differences {numeric:.1} ms ({:.0}× slower).",
+        x0.len(),
+        numeric / analytic
+    );
     let handle = explore_spec(&specs.join("handle.ron"))?;
     let _ = write!(
         md,
-        "\n## (b) Basket handle ({} feasible grasps in {} clusters) at (−0.30, 0.20, −0.05) m, turned about the vertical\n\n| basket yaw (°) | total cost | end cost | grasp angle on the arc (°) |\n|---|---|---|---|\n",
+        "\n## (b) Basket on the table ({} feasible grasps on the handle, {} clusters), three locations\n\n| basket | handle origin (x, y) m | total cost | joint-limit cost | closest approach (m) | end cost | grasp angle on the handle (°; 90 = top, below 90 towards the robot) | time (s) |\n|---|---|---|---|---|---|---|---|\n",
         handle.map.points.len(),
         handle.map.clusters()
     );
-    for yaw in [-0.6f64, 0.0, 0.6] {
-        let at = Isometry3::new(Vector3::new(-0.3, 0.2, -0.05), Vector3::z() * yaw);
-        let (m, _) = reach(&handle, &active, &world, at, MotionGoal::Map(&handle.map))
-            .optimize(args.iterations, 1e-3);
+    let mut basket_runs = Vec::new();
+    for (name, [x, y]) in BASKET {
+        let z = TABLE_TOP + BASKET_HEIGHT;
+        let at = Isometry3::translation(x, y, z);
+        let mut obstacles = table()?;
+        obstacles.add(
+            "basket",
+            Shape::Box {
+                size: [0.22, 0.14, BASKET_HEIGHT],
+            },
+            Isometry3::translation(x, y, z - BASKET_HEIGHT / 2.0),
+        )?;
+        let r = reach(
+            &format!("basket_{name}"),
+            &handle,
+            &obstacles,
+            at,
+            MotionGoal::Map(&handle.map),
+            args.iterations,
+            out,
+        )?;
+        let m = &r.motion;
         let angle = m.final_pose[2].atan2(m.final_pose[0]).to_degrees();
         let _ = writeln!(
             md,
-            "| {:.0} | {:.4} | {:.5} | {angle:.0} |",
-            yaw.to_degrees(),
-            m.cost,
-            m.end
+            "| {name} | ({x:+.2}, {y:+.2}) | {:.4} | {:.4} | {:.3} | {:.5} | {angle:.0} | {:.2} |",
+            m.cost, m.limits, m.min_distance, m.end, r.seconds
         );
+        basket_runs.push(r);
     }
     let _ = writeln!(md, "\nWall time {:.1} s.", started.elapsed().as_secs_f64());
-    std::fs::create_dir_all(&args.out_dir)?;
-    crate::write_atomic(&args.out_dir.join("table.md"), md.as_bytes())?;
-    let hi = exact_trace
-        .iter()
-        .chain(&map_trace)
-        .map(|t| t.1)
-        .fold(0.0f64, f64::max)
-        * 1.1;
-    let series: Vec<crate::plot::Series> =
-        [("exact target", &exact_trace), ("task map", &map_trace)]
-            .into_iter()
-            .map(|(name, trace)| crate::plot::Series {
-                label: name.into(),
-                points: trace
-                    .iter()
-                    .enumerate()
-                    .map(|(k, t)| (k as f64, t.1))
-                    .collect(),
-                color: None,
-            })
-            .collect();
-    let svg = crate::plot::lines(
-        "Stick: joint-limit proximity of the best motion",
-        ("RPROP iteration", "joint-limit cost"),
-        0.0..args.iterations as f64,
-        0.0..hi.max(1e-3),
-        series,
-    )?;
-    crate::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
+    crate::write_atomic(&out.join("table.md"), md.as_bytes())?;
+    write_plots(args, &runs, &basket_runs)?;
     println!("{md}");
     println!(
-        "wrote {}/{{table.md, joint_limits.svg}}",
-        args.out_dir.display()
+        "wrote {}/{{table.md, joint_limits.svg, paths.svg}} and per run NAME.csv + NAME.world.ron (cargo xtask view --traj {0}/cylinder_map.csv --world {0}/cylinder_map.world.ron)",
+        out.display()
     );
+    Ok(())
+}
+
+/// One line per run.
+fn series<'a>(
+    runs: impl IntoIterator<Item = &'a Run>,
+    points: impl Fn(&Run) -> Vec<(f64, f64)>,
+) -> Vec<crate::plot::Series> {
+    runs.into_iter()
+        .map(|r| crate::plot::Series {
+            label: r.name.replace('_', " "),
+            points: points(r),
+            color: None,
+        })
+        .collect()
+}
+
+/// joint_limits.svg (Fig. 7, bottom) and paths.svg (the hand's path, seen from the side and
+/// from above).
+fn write_plots(args: &Args, cylinder: &[Run], basket: &[Run]) -> Result<()> {
+    let hi = cylinder
+        .iter()
+        .flat_map(|r| r.trace.iter().map(|t| t.1))
+        .fold(0.0f64, f64::max)
+        * 1.1;
+    let svg = crate::plot::lines(
+        "Cylinder: joint-limit cost of the best motion so far",
+        (
+            "iRprop− iteration",
+            "joint-limit cost (mean over the motion)",
+        ),
+        0.0..args.iterations as f64,
+        0.0..hi.max(1e-3),
+        series(cylinder, |r| {
+            r.trace
+                .iter()
+                .enumerate()
+                .map(|(k, t)| (k as f64, t.1))
+                .collect()
+        }),
+    )?;
+    crate::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
+    let all = || cylinder.iter().chain(basket);
+    let range = |i: usize| {
+        let (lo, hi) = all()
+            .flat_map(|r| r.motion.task_path.iter().map(move |x| x[i]))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+        (lo - 0.03)..(hi + 0.03)
+    };
+    let path = |a: usize, b: usize| {
+        series(all(), move |r: &Run| {
+            r.motion.task_path.iter().map(|x| (x[a], x[b])).collect()
+        })
+    };
+    let panels = [
+        crate::plot::Panel {
+            title: "Hand path from the side (x back, z up)".into(),
+            axes: ("x (m)".into(), "z (m)".into()),
+            x: range(0),
+            y: range(2),
+            series: path(0, 2),
+        },
+        crate::plot::Panel {
+            title: "Hand path from above (x back, y right)".into(),
+            axes: ("x (m)".into(), "y (m)".into()),
+            x: range(0),
+            y: range(1),
+            series: path(0, 1),
+        },
+    ];
+    let svg = crate::plot::panels((640, 420), &panels)?;
+    crate::write_atomic(&args.out_dir.join("paths.svg"), svg.as_bytes())?;
     Ok(())
 }
 
@@ -141,26 +335,30 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_studies_write_their_table_and_plot() {
+    fn the_studies_write_their_tables_plots_and_runs() {
         let dir = std::env::temp_dir().join(format!("trm-tms-{}", std::process::id()));
         run(&Args {
-            iterations: 3,
+            iterations: 2,
             out_dir: dir.clone(),
         })
         .unwrap();
         let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
         assert!(table.contains("| task map |") && table.contains("| exact target at the centre |"));
-        assert_eq!(
-            table.matches("\n| -34 |").count()
-                + table.matches("\n| 0 |").count()
-                + table.matches("\n| 34 |").count(),
-            3
-        );
-        assert!(
-            std::fs::read_to_string(dir.join("joint_limits.svg"))
-                .unwrap()
-                .starts_with("<svg")
-        );
+        for name in ["right", "centre", "left"] {
+            assert!(table.contains(&format!("\n| {name} |")), "{table}");
+            let world =
+                World::load(dir.join(format!("basket_{name}.world.ron"))).expect("a world file");
+            assert!(world.index("basket").is_ok() && world.index("handle_3").is_ok());
+        }
+        for svg in ["joint_limits.svg", "paths.svg"] {
+            assert!(
+                std::fs::read_to_string(dir.join(svg))
+                    .unwrap()
+                    .starts_with("<svg")
+            );
+        }
+        let csv = std::fs::read_to_string(dir.join("cylinder_map.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 61);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

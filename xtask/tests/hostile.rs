@@ -334,6 +334,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     let mut cases = Vec::new();
 
     // RON files, each through a command that reads it
+    let stick_spec = at("specs/taskmaps/stick.ron").to_string_lossy().to_string();
     for (source, args) in [
         (
             at("specs/reach.ron"),
@@ -352,6 +353,17 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         (
             at("specs/taskmaps/stick.ron"),
             vec!["explore-task-map", "{}", "--out", "o.taskmap.json"],
+        ),
+        (
+            dir.join("world.ron"),
+            vec![
+                "reach-grasp",
+                stick_spec.as_str(),
+                "--iterations",
+                "1",
+                "--world",
+                "{}",
+            ],
         ),
         (
             at("specs/scenarios/sliding_box.ron"),
@@ -1137,6 +1149,11 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &grasp,
         "--iterations",
         &["0", "-1", "18446744073709551615"],
+    ));
+    cases.extend(file_flag_cases(
+        &grasp,
+        "--world",
+        &["no_such.ron", "map.json", "/dev/zero", "."],
     ));
     let studies = ["task-map-studies", "--out-dir", "st"];
     cases.extend(flag_cases(

@@ -47,7 +47,7 @@ pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
 /// Axis-aligned boxes (parry's), as [`PlacedBodies::bounding_box`] and
 /// [`WorldObject::bounding_box`] return them.
 pub use parry3d_f64::bounding_volume::Aabb;
-pub use query::{CollidingPair, CollisionCount, Other, PairDistance};
+pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
 pub use shape::{Shape, ShapeProblem};
 pub use trm_kinematics::DisableReason;
 pub use world::{ObjectSpec, World, WorldObject, WorldSpec};

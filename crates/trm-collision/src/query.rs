@@ -2,7 +2,9 @@
 
 use crate::cull::Step;
 use crate::model::{CollisionModel, PlacedBodies};
-use crate::shape::{bounds_apart, intersects, signed_distance, sphere_apart};
+use nalgebra::{Point3, Vector3};
+
+use crate::shape::{Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart};
 use crate::world::World;
 
 /// Colliding pairs of one configuration.
@@ -45,6 +47,27 @@ pub struct CollidingPair {
     pub other_index: usize,
     /// Signed distance (≤ 0: minus the penetration depth).
     pub distance: f64,
+}
+
+/// A robot body close to another body or a world object: the signed distance and the closest
+/// points (world frame), from [`CollisionModel::near_pairs`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearPair {
+    /// Index of the robot body in [`CollisionModel::bodies`].
+    pub body: usize,
+    /// The other body's index ([`NearPair::is_object`] false) or the world object's index.
+    pub other: usize,
+    /// True when `other` indexes [`World::objects`].
+    pub is_object: bool,
+    /// Signed distance (negative when they overlap).
+    pub distance: f64,
+    /// Closest point on the robot body.
+    pub point: Point3<f64>,
+    /// Closest point on the other.
+    pub other_point: Point3<f64>,
+    /// Unit normal from the body towards the other: moving the other along it by δ raises the
+    /// distance by δ.
+    pub normal: Vector3<f64>,
 }
 
 /// The closest pair of bodies.
@@ -227,6 +250,48 @@ impl CollisionModel {
             Some(false)
         });
         out
+    }
+
+    /// Every checked body pair and every (body, world object) pair whose signed distance is
+    /// below `margin`, with closest points and normals (for smooth proximity costs and their
+    /// gradients); `out` is cleared first. Pairs are listed in the model's pair order, then
+    /// bodies × objects.
+    pub fn near_pairs(
+        &self,
+        placed: &PlacedBodies,
+        world: &World,
+        margin: f64,
+        out: &mut Vec<NearPair>,
+    ) {
+        out.clear();
+        let (c, p) = (self.compiled(), &placed.placed);
+        let mut push = |body, other, is_object, near: Option<Closest>| {
+            if let Some(c) = near {
+                out.push(NearPair {
+                    body,
+                    other,
+                    is_object,
+                    distance: c.distance,
+                    point: c.point1,
+                    other_point: c.point2,
+                    normal: c.normal,
+                });
+            }
+        };
+        for pair in self.pairs() {
+            let (a, b) = (pair.a as usize, pair.b as usize);
+            push(a, b, false, proximity(&c[a], &p[a], &c[b], &p[b], margin));
+        }
+        for (i, (ci, pi)) in c.iter().zip(p).enumerate() {
+            for (o, object) in world.objects().iter().enumerate() {
+                push(
+                    i,
+                    o,
+                    true,
+                    proximity(ci, pi, &object.compiled, &object.placed, margin),
+                );
+            }
+        }
     }
 
     /// Signed distance between bodies `a` and `b` (whether or not their pair is checked).

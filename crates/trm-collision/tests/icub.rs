@@ -284,3 +284,65 @@ proptest! {
         }
     }
 }
+
+/// `near_pairs` lists every checked pair and body–object pair closer than the margin, with the
+/// signed distance the other queries give and closest points that lie that far apart along the
+/// normal.
+#[test]
+fn near_pairs_agree_with_the_distance_queries() {
+    let mut icub = Icub::new();
+    let mut world = World::new();
+    world
+        .add(
+            "table",
+            Shape::Box {
+                size: [0.5, 0.8, 0.04],
+            },
+            Isometry3::translation(-0.3, 0.0, -0.1),
+        )
+        .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let margin = 0.05;
+    let (mut near, mut listed, mut overlapping) = (Vec::new(), 0, 0);
+    for _ in 0..50 {
+        let q = icub.random(&mut rng);
+        icub.pose(&q);
+        icub.collision
+            .near_pairs(&icub.placed, &world, margin, &mut near);
+        for p in &near {
+            let d = if p.is_object {
+                icub.collision
+                    .object_distance(&icub.placed, p.body, &world, p.other)
+            } else {
+                icub.collision.body_distance(&icub.placed, p.body, p.other)
+            };
+            // exact for capsule pairs; GJK's tolerance where a box or hull is involved
+            assert!((p.distance - d).abs() < 1e-4, "{} vs {d}", p.distance);
+            assert!(p.distance < margin);
+            // the other's point lies `distance` along the normal from the body's
+            let along = (p.other_point - p.point).dot(&p.normal);
+            assert!(
+                (along - p.distance).abs() < 1e-4,
+                "{along} vs {}",
+                p.distance
+            );
+            assert!((p.normal.norm() - 1.0).abs() < 1e-9);
+            overlapping += usize::from(p.distance < 0.0);
+        }
+        listed += near.len();
+        // the closest checked pair is among them when it is within the margin
+        if let Some(best) = icub.collision.min_self_distance(&icub.placed) {
+            if best.distance < margin {
+                assert!(
+                    near.iter()
+                        .any(|p| !p.is_object && (p.distance - best.distance).abs() < 1e-4),
+                    "the closest pair is missing"
+                );
+            }
+        }
+    }
+    assert!(
+        listed > 100 && overlapping > 0,
+        "{listed} pairs, {overlapping} overlapping"
+    );
+}

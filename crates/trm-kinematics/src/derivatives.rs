@@ -86,6 +86,75 @@ impl ActiveSet {
         });
     }
 
+    /// The derivatives of `frame`'s 6 × n Jacobian (as [`ActiveSet::jacobian`]) with respect to
+    /// each active value: `out[k]` = ∂J/∂q_k (the kinematic Hessian, in Pinocchio's
+    /// LOCAL_WORLD_ALIGNED convention). `out` is resized to n matrices of 6 × n if needed.
+    ///
+    /// A joint moves what lies beyond it: a revolute joint i with world axis aᵢ through pᵢ turns
+    /// directions v by aᵢ × v and points x by aᵢ × (x − pᵢ); a prismatic one shifts points by
+    /// aᵢ. Column j's derivative follows from its axis, origin and the frame's origin.
+    pub fn jacobian_derivatives(
+        &self,
+        poses: &PoseBuffer,
+        frame: FrameId,
+        out: &mut Vec<Matrix6xX<f64>>,
+    ) {
+        let n = self.len();
+        if out.len() != n || out.iter().any(|m| m.ncols() != n) {
+            *out = vec![Matrix6xX::zeros(n); n];
+        }
+        for m in out.iter_mut() {
+            m.fill(0.0);
+        }
+        let link = self.model().frame_link(frame);
+        let origin = Point3::from(poses.pose(frame).translation.vector);
+        let kinds = &self.model().tree().joints;
+        // (active index, factor, joint kind is prismatic, axis, joint origin), frame first
+        let mut chain = Vec::new();
+        self.for_each_ancestor_column(link, |k, factor, j| {
+            let (a, p) = self.joint_axis(poses, j);
+            chain.push((k, factor, kinds[j].kind == JointKind::Prismatic, a, p));
+        });
+        // what joint i does to a direction and to a point
+        let turn = |i: usize, v: &Vector3<f64>| -> Vector3<f64> {
+            let (_, _, prismatic, a, _) = chain[i];
+            if prismatic {
+                Vector3::zeros()
+            } else {
+                a.cross(v)
+            }
+        };
+        let shift = |i: usize, x: &Point3<f64>| -> Vector3<f64> {
+            let (_, _, prismatic, a, p) = chain[i];
+            if prismatic { a } else { a.cross(&(x - p)) }
+        };
+        for (j, &(kj, fj, prismatic_j, aj, pj)) in chain.iter().enumerate() {
+            for (i, &(ki, fi, ..)) in chain.iter().enumerate() {
+                // joint i lies before j (nearer the root) when it comes later in `chain`
+                let before = i > j;
+                let (linear, angular) = match (prismatic_j, before) {
+                    (true, true) => (turn(i, &aj), Vector3::zeros()),
+                    (true, false) => (Vector3::zeros(), Vector3::zeros()),
+                    (false, true) => {
+                        // the axis turns, the lever arm p − pⱼ turns with it
+                        let da = turn(i, &aj);
+                        let lever = origin - pj;
+                        let d_lever = if chain[i].2 {
+                            Vector3::zeros()
+                        } else {
+                            chain[i].3.cross(&lever)
+                        };
+                        (da.cross(&lever) + aj.cross(&d_lever), da)
+                    }
+                    (false, false) => (aj.cross(&shift(i, &origin)), Vector3::zeros()),
+                };
+                let mut c = out[ki].column_mut(kj);
+                c.fixed_rows_mut::<3>(0).axpy(fi * fj, &linear, 1.0);
+                c.fixed_rows_mut::<3>(3).axpy(fi * fj, &angular, 1.0);
+            }
+        }
+    }
+
     /// Mass and centre of mass of every link's subtree (index = link), in world coordinates.
     fn subtree_masses(&self, poses: &PoseBuffer) -> Vec<(f64, Vector3<f64>)> {
         let tree = self.model().tree();

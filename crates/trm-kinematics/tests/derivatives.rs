@@ -226,3 +226,54 @@ fn negative_or_non_finite_inertials_are_errors() {
         .to_string();
     assert!(e.contains("not finite"), "{e}");
 }
+
+/// ∂J/∂q_k against central differences of the Jacobian: on the coupled 41-motor iCub (a
+/// fingertip deep in the tree) and on a branched tree with prismatic, continuous and mimic
+/// joints (a link beyond the prismatic joint).
+#[test]
+fn jacobian_derivatives_match_finite_differences() {
+    let root = format!("{}/../..", env!("CARGO_MANIFEST_DIR"));
+    let icub = RobotModel::load(format!("{root}/models/icub_upper_body.ron")).unwrap();
+    let tree = RobotModel::from_urdf_file(format!("{root}/models/branched_tree.urdf")).unwrap();
+    for (model, frames) in [
+        (&icub, vec!["r_index_fingertip", "r_hand"]),
+        (&tree, vec!["left_slider", "right_finger_b"]),
+    ] {
+        let active = model.all_active();
+        let (lower, upper) = active.bounds();
+        let q: Vec<f64> = lower
+            .iter()
+            .zip(&upper)
+            .enumerate()
+            .map(|(i, (l, u))| {
+                let (l, u) = (l.max(-3.0), u.min(3.0));
+                l + (u - l) * (0.3 + 0.4 * ((i * 7 % 11) as f64 / 11.0))
+            })
+            .collect();
+        let mut poses = model.pose_buffer();
+        let (mut jp, mut jm) = (Matrix6xX::zeros(0), Matrix6xX::zeros(0));
+        let mut derivatives = Vec::new();
+        let h = 1e-6;
+        for name in frames {
+            let frame = model.frame_id(name).unwrap();
+            active.forward(&q, &mut poses).unwrap();
+            active.jacobian_derivatives(&poses, frame, &mut derivatives);
+            assert_eq!(derivatives.len(), active.len());
+            let mut largest = 0.0f64;
+            for k in 0..active.len() {
+                let (mut qp, mut qm) = (q.clone(), q.clone());
+                qp[k] += h;
+                qm[k] -= h;
+                active.forward(&qp, &mut poses).unwrap();
+                active.jacobian(&poses, frame, &mut jp);
+                active.forward(&qm, &mut poses).unwrap();
+                active.jacobian(&poses, frame, &mut jm);
+                let numeric = (&jp - &jm) / (2.0 * h);
+                largest = largest.max(numeric.amax());
+                let error = (&derivatives[k] - &numeric).amax();
+                assert!(error < 1e-6, "{name}, motor {k}: error {error}");
+            }
+            assert!(largest > 0.1, "{name}: a test that cannot fail");
+        }
+    }
+}

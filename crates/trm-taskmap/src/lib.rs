@@ -25,7 +25,7 @@ mod spec;
 pub use explore::{ExploreOptions, explore};
 pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
-pub use motion::{Motion, MotionGoal, MotionOptions, ReachProblem};
+pub use motion::{CostWeights, Motion, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
 pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};
 
 /// The file formats this crate reads and writes.

@@ -103,6 +103,8 @@ pub struct Explored {
     pub collision: CollisionModel,
     /// The map.
     pub map: TaskMap,
+    /// The object's parts, in the object's frame.
+    pub object: World,
     /// The first grasp g₀ the exploration started from.
     pub start: [f64; 6],
     /// Exploration wall time, s.
@@ -306,6 +308,7 @@ impl LoadedTaskMapSpec {
             model,
             collision,
             map,
+            object,
             start,
         })
     }

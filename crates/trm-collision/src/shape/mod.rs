@@ -12,7 +12,9 @@ mod pair;
 mod segment_box;
 
 pub(crate) use compiled::{Compiled, Geometry, Placed};
-pub(crate) use pair::{bounds_apart, intersects, signed_distance, sphere_apart};
+pub(crate) use pair::{
+    Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
+};
 
 /// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
 /// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.

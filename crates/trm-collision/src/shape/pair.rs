@@ -173,6 +173,29 @@ pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Pl
             return squared.sqrt() - radius;
         }
     }
+    with_parry(c1, p1, c2, p2, |i1, s1, i2, s2| {
+        // closest points, not `query::distance`: parry 0.25's cuboid–cuboid distance
+        // overestimates the gap (dimforge/parry#431)
+        if let Ok(query::ClosestPoints::WithinMargin(a, b)) =
+            query::closest_points(i1, s1, i2, s2, f64::MAX)
+        {
+            return (a - b).norm();
+        }
+        query::contact(i1, s1, i2, s2, 0.0)
+            .ok()
+            .flatten()
+            .map_or(0.0, |c| c.dist.min(0.0))
+    })
+}
+
+/// Calls `f` with both placed shapes in parry's form (round shapes get their parry twin).
+fn with_parry<R>(
+    c1: &Compiled,
+    p1: &Placed,
+    c2: &Compiled,
+    p2: &Placed,
+    f: impl FnOnce(&Isometry3<f64>, &dyn ParryShape, &Isometry3<f64>, &dyn ParryShape) -> R,
+) -> R {
     let own = |c: &Compiled, p: &Placed| -> (Isometry3<f64>, Option<RoundShape>) {
         match &c.geometry {
             Geometry::Round { radius, .. } => {
@@ -194,12 +217,66 @@ pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Pl
         (None, Geometry::General { shape, .. }) => shape.as_ref(),
         (None, Geometry::Round { .. }) => unreachable!("round shapes always get a parry twin"),
     };
-    let gap = query::distance(&i1, s1, &i2, s2).unwrap_or(0.0);
-    if gap > 0.0 {
-        return gap;
+    f(&i1, s1, &i2, s2)
+}
+
+/// Closest points of two placed shapes (world frame).
+pub(crate) struct Closest {
+    /// Signed distance.
+    pub distance: f64,
+    /// On shape 1.
+    pub point1: Point3<f64>,
+    /// On shape 2.
+    pub point2: Point3<f64>,
+    /// Unit normal from 1 towards 2.
+    pub normal: Vector3<f64>,
+}
+
+/// Closest points of two placed shapes whose signed distance is below `margin`; `None` when
+/// they are farther apart (bounding spheres first).
+pub(crate) fn proximity(
+    c1: &Compiled,
+    p1: &Placed,
+    c2: &Compiled,
+    p2: &Placed,
+    margin: f64,
+) -> Option<Closest> {
+    if (p1.center - p2.center).norm() - p1.bound - p2.bound >= margin {
+        return None;
     }
-    query::contact(&i1, s1, &i2, s2, 0.0)
-        .ok()
-        .flatten()
-        .map_or(0.0, |c| c.dist.min(0.0))
+    if let (Geometry::Round { radius: r1, .. }, Geometry::Round { radius: r2, .. }) =
+        (&c1.geometry, &c2.geometry)
+    {
+        // exact: the segments' closest points, moved out by the radii
+        let (l1, l2) =
+            closest_points_segment_segment_with_locations_nD((&p1.a, &p1.b), (&p2.a, &p2.b));
+        let (s1, s2) = (point_on(&p1.a, &p1.b, l1), point_on(&p2.a, &p2.b, l2));
+        let between = s2 - s1;
+        let length = between.norm();
+        let distance = length - r1 - r2;
+        if distance >= margin {
+            return None;
+        }
+        // coincident axes: any direction separates them
+        let normal = if length > 1e-12 {
+            between / length
+        } else {
+            Vector3::x()
+        };
+        return Some(Closest {
+            distance,
+            point1: s1 + normal * *r1,
+            point2: s2 - normal * *r2,
+            normal,
+        });
+    }
+    with_parry(c1, p1, c2, p2, |i1, s1, i2, s2| {
+        let c = query::contact(i1, s1, i2, s2, margin).ok().flatten()?;
+        (c.dist < margin).then(|| Closest {
+            distance: c.dist,
+            point1: c.point1,
+            point2: c.point2,
+            normal: c.normal1.into_inner(),
+        })
+    })
 }

@@ -139,3 +139,24 @@ fn degenerate_shapes_are_rejected() {
         assert!(s.compile(&Isometry3::identity()).is_none());
     }
 }
+
+/// Two boxes side by side: the gap along x (parry 0.25's `query::distance` overestimates it
+/// for cuboid pairs, dimforge/parry#431; ours goes through closest points).
+#[test]
+fn box_box_distance_is_the_gap() {
+    let (c1, p1) = placed(
+        &Shape::Box {
+            size: [0.145, 0.221, 0.187],
+        },
+        at(0.0307, 0.0, -0.062),
+    );
+    let (c2, p2) = placed(
+        &Shape::Box {
+            size: [0.5, 0.8, 0.04],
+        },
+        at(-0.3, 0.0, -0.1),
+    );
+    let gap = (0.0307 - 0.145 / 2.0) - (-0.3 + 0.25);
+    assert!((signed_distance(&c1, &p1, &c2, &p2) - gap).abs() < 1e-9);
+    assert!((signed_distance(&c2, &p2, &c1, &p1) - gap).abs() < 1e-9);
+}
