@@ -1,0 +1,170 @@
+"""The Python API end to end: kinematics (and against Pinocchio), collision, NGIK, optimisers,
+roadmaps and planning, and errors."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import trm
+
+ROOT = Path(__file__).resolve().parents[4]
+SPEC = str(ROOT / "specs" / "reach.ron")
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return trm.Robot.icub()
+
+
+def test_fk_is_batch_first_and_agrees_with_one_at_a_time(robot):
+    home = robot.posture("home")
+    assert home.shape == (robot.dof,) and robot.dof == 41
+    poses = robot.fk(home)
+    assert poses.shape == (len(robot.link_names), 4, 4)
+    rng = np.random.default_rng(0)
+    batch = rng.uniform(robot.lower, robot.upper, size=(7, robot.dof))
+    many = robot.fk(batch)
+    assert many.shape == (7, len(robot.link_names), 4, 4)
+    for k in range(7):
+        np.testing.assert_array_equal(many[k], robot.fk(batch[k]))
+    # a list works as well as an array, and frame_pose of a link is its fk entry
+    np.testing.assert_array_equal(robot.fk(list(home)), poses)
+    i = robot.link_names.index("r_hand")
+    np.testing.assert_allclose(robot.frame_pose(home, "r_hand"), poses[i], atol=1e-12)
+
+
+def test_jacobian_matches_finite_differences(robot):
+    rng = np.random.default_rng(1)
+    q = rng.uniform(robot.lower, robot.upper)
+    jac = robot.jacobian(q, "r_hand")
+    assert jac.shape == (6, robot.dof)
+    h = 1e-6
+    for k in range(robot.dof):
+        dq = np.zeros(robot.dof)
+        dq[k] = h
+        dp = (robot.frame_pose(q + dq, "r_hand")[:3, 3] - robot.frame_pose(q - dq, "r_hand")[:3, 3]) / (2 * h)
+        np.testing.assert_allclose(jac[:3, k], dp, atol=1e-6)
+    mass, com = robot.center_of_mass(q)
+    assert mass > 1.0 and com.shape == (3,)
+    assert robot.com_jacobian(np.stack([q, q])).shape == (2, 3, robot.dof)
+
+
+def test_fk_matches_pinocchio_on_the_official_icub():
+    pin = pytest.importorskip("pinocchio")
+    urdf = str(ROOT / "models" / "icub-visuomanip" / "model.urdf")
+    ours = trm.Robot.load(urdf)
+    model = pin.buildModelFromUrdf(urdf)
+    data = model.createData()
+    rng = np.random.default_rng(2)
+    names = ours.motor_names
+    worst = 0.0
+    for _ in range(20):
+        q = rng.uniform(np.maximum(ours.lower, -3.0), np.minimum(ours.upper, 3.0))
+        qp = pin.neutral(model)
+        for j in range(1, model.njoints):
+            joint = model.joints[j]
+            if model.names[j] in names and joint.nq == 1:
+                qp[joint.idx_q] = q[names.index(model.names[j])]
+        pin.framesForwardKinematics(model, data, qp)
+        poses = ours.fk(q)
+        for i, link in enumerate(ours.link_names):
+            if not model.existFrame(link):
+                continue
+            expected = data.oMf[model.getFrameId(link)].homogeneous
+            worst = max(worst, float(np.abs(poses[i] - expected).max()))
+    assert worst < 1e-9, worst
+
+
+def test_collision_counts_checks_and_pairs(robot):
+    col = trm.CollisionModel(robot)
+    home = robot.posture("home")
+    assert col.count(home) == 0 and col.is_colliding(home) is False
+    assert col.min_distance(home) > 0.0
+    world = trm.World()
+    hand = robot.frame_pose(home, "r_hand")[:3, 3]
+    world.add_box("block", [0.1, 0.1, 0.1], list(hand))
+    assert world.names == ["block"] and len(world) == 1
+    assert col.is_colliding(home, world) is True
+    pairs = col.colliding_pairs(home, world)
+    assert any(other == "block" and d <= 0.0 for _, other, d in pairs)
+    counts = col.count(np.stack([home, home]), world)
+    assert counts.shape == (2,) and counts[0] > 0
+    world.set_pose("block", [2.0, 0.0, 0.0])
+    assert col.count(home, world) == 0
+
+
+def test_ngik_solves_the_reach_spec_reproducibly():
+    problem = trm.Problem.load(SPEC)
+    start_cost = problem.cost(problem.start)
+    a = problem.solve(seed=3, max_evals=3000)
+    b = problem.solve(seed=3, max_evals=3000)
+    np.testing.assert_array_equal(a["q"], b["q"])
+    assert a["cost"] < start_cost and a["collision_free"]
+    assert abs(sum(w * v for _, w, v in a["breakdown"]) - problem.cost(a["q"])) < 1e-9
+    assert a["motors"].shape == (41,) and a["q"].shape == (len(problem.active_names),)
+
+
+@pytest.mark.parametrize("algo", ["xnes", "cmaes"])
+def test_optimisers_ask_tell_on_the_sphere(algo):
+    opt = trm.Optimizer(algo, np.full(5, 1.0), 0.5, seed=1, max_evals=20_000)
+    while not opt.done:
+        xs = opt.ask()
+        assert xs.ndim == 2 and xs.shape[1] == 5
+        opt.tell((xs**2).sum(axis=1))
+    assert opt.best_f < 1e-8, (opt.best_f, opt.stop_reasons)
+    x, f, n = trm.minimize(lambda x: float((x**2).sum()), np.ones(5), 0.5, algo=algo, seed=1, max_evals=20_000)
+    y, g, m = trm.minimize(lambda xs: (xs**2).sum(axis=1), np.ones(5), 0.5, algo=algo, seed=1, max_evals=20_000, batch=True)
+    assert f == g and n == m and f < 1e-8
+    np.testing.assert_array_equal(x, y)
+    assert set(["xnes", "cmaes"]) <= set(trm.ALGORITHMS)
+
+
+def test_a_map_builds_saves_loads_and_plans(tmp_path):
+    built = trm.Roadmap.build(SPEC, points=40, seed=0)
+    info = built.info()
+    # the build stops at the first generation that reaches the target
+    assert len(built) >= 40 and info["points"] == len(built) and info["edges"] > 0
+    path = tmp_path / "reach.map.json"
+    built.save(str(path))
+    loaded = trm.Roadmap.load(str(path))
+    np.testing.assert_array_equal(loaded.postures, built.postures)
+    assert loaded.tasks.shape == (len(built), 3)
+    goal = loaded.tasks[len(loaded) // 2]
+    plan = trm.Planner(loaded).plan(goal)
+    assert plan["positions"].shape[1] == 41 and plan["positions"].shape[0] == plan["times"].shape[0]
+    assert np.linalg.norm(plan["task_path"][-1] - goal) < 0.03
+    assert plan["times"][0] == 0.0 and np.all(np.diff(plan["times"]) >= 0)
+
+
+def test_errors_are_located_trm_errors(robot, tmp_path):
+    with pytest.raises(trm.TrmError, match="nope.urdf"):
+        trm.Robot.load("nope.urdf")
+    with pytest.raises(trm.TrmError, match=r"shape \[3\]"):
+        robot.fk(np.zeros(3))
+    with pytest.raises(trm.TrmError, match="finite"):
+        robot.fk(np.full(robot.dof, np.nan))
+    with pytest.raises(trm.TrmError, match="no_such_frame"):
+        robot.frame_pose(robot.posture("home"), "no_such_frame")
+    bad = tmp_path / "bad.ron"
+    bad.write_text(Path(SPEC).read_text().replace("r_palm", "r_plam", 1))
+    with pytest.raises(trm.TrmError, match="bad.ron"):
+        trm.Problem.load(str(bad))
+    with pytest.raises(trm.TrmError):
+        trm.Optimizer("no-such-algorithm", np.zeros(2), 1.0)
+    assert issubclass(trm.TrmError, ValueError)
+
+
+def test_the_ompl_comparison_runs(capsys, monkeypatch):
+    pytest.importorskip("ompl")
+    import runpy
+    import sys
+
+    monkeypatch.setattr(sys, "argv", ["ompl_compare.py", "--points", "60", "--time-limit", "2"])
+    monkeypatch.setattr("os._exit", lambda code: (_ for _ in ()).throw(SystemExit(code)))
+    with pytest.raises(SystemExit) as done:
+        runpy.run_path(str(ROOT / "benches" / "python" / "ompl_compare.py"), run_name="__main__")
+    assert done.value.code == 0
+    out = capsys.readouterr().out
+    for planner in ["trm roadmap", "OMPL RRTConnect", "OMPL PRM"]:
+        assert f"| {planner}" in out, out
