@@ -1060,6 +1060,156 @@ impl Planner {
     }
 }
 
+/// Minimises `fun(x) -> float` subject to `constraints(x) -> (m,)` values (feasible where
+/// every value ≤ 0) with the (1+1)-CMA-ES with constrained covariance adaptation (Arnold and
+/// Hansen 2012), bootstrapped from an infeasible start by minimising the total violation first
+/// (`bootstrap_budget` evaluations at most; `None`: `max_evals` covers both). `fun` is only
+/// called at feasible points. Returns a dict: `x`, `f`, `evaluations`, `feasible`,
+/// `bootstrap_evaluations`.
+#[pyfunction]
+#[pyo3(signature = (fun, constraints, x0, sigma, seed = 0, max_evals = 10_000, bootstrap_budget = None))]
+#[allow(clippy::too_many_arguments)]
+fn minimize_constrained<'py>(
+    py: Python<'py>,
+    fun: &Bound<'py, PyAny>,
+    constraints: &Bound<'py, PyAny>,
+    x0: &Bound<'py, PyAny>,
+    sigma: f64,
+    seed: u64,
+    max_evals: u64,
+    bootstrap_budget: Option<u64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mean = float_array(x0)?.as_slice().map_err(err)?.to_vec();
+    let to_array = |x: &[f64]| shaped(py, None, &[x.len()], x.to_vec());
+    // the number of constraints, from one call at the start
+    let m = float_array(&constraints.call1((to_array(&mean)?,))?)?.len();
+    let mut start = trm_optim::Start::new(mean, sigma);
+    start.stop.max_evaluations = Some(max_evals);
+    let mut failure: Option<PyErr> = None;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let report = {
+        let failure = std::cell::RefCell::new(&mut failure);
+        let record = |e: PyErr| {
+            let mut f = failure.borrow_mut();
+            if f.is_none() {
+                **f = Some(e);
+            }
+        };
+        trm_optim::minimize_constrained(
+            &start,
+            bootstrap_budget,
+            m,
+            &mut rng,
+            |x| {
+                let value = to_array(x)
+                    .and_then(|a| fun.call1((a,)))
+                    .and_then(|v| v.extract::<f64>());
+                value.unwrap_or_else(|e| {
+                    record(e);
+                    f64::NAN
+                })
+            },
+            |x, g| {
+                let values = to_array(x)
+                    .and_then(|a| constraints.call1((a,)))
+                    .and_then(|v| {
+                        float_array(&v).and_then(|a| Ok(a.as_slice().map_err(err)?.to_vec()))
+                    });
+                match values {
+                    Ok(v) if v.len() == g.len() => g.copy_from_slice(&v),
+                    Ok(v) => {
+                        record(err(format!(
+                            "constraints returned {} values, {} at the start",
+                            v.len(),
+                            g.len()
+                        )));
+                        g.fill(f64::NAN);
+                    }
+                    Err(e) => {
+                        record(e);
+                        g.fill(f64::NAN);
+                    }
+                }
+            },
+        )
+        .map_err(err)?
+    };
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let d = PyDict::new(py);
+    d.set_item("x", to_array(&report.report.best_x)?)?;
+    d.set_item("f", report.report.best_f)?;
+    d.set_item("evaluations", report.report.evaluations)?;
+    d.set_item("feasible", report.feasible)?;
+    d.set_item("bootstrap_evaluations", report.bootstrap_evaluations)?;
+    Ok(d)
+}
+
+/// Writes a self-contained 3-D page of `robot` (the same viewer as `cargo xtask view`): one
+/// frame per posture in `frames` (`(n,)` or `(T, n)` motor values; the home posture, else
+/// neutral, when absent) at `times` (default 0.05 s apart), `world`'s objects, and a task-space
+/// `path` `(K, 3)` drawn as a line. `out` gets the page and `out` with `.json` the scene; the
+/// page loads three.js from a CDN unless `bundle` names a built viewer (viewer/dist/viewer.js)
+/// to inline. Returns the page's path.
+#[pyfunction]
+#[pyo3(signature = (robot, out, frames = None, times = None, world = None, path = None, title = "trm", bundle = None))]
+#[allow(clippy::too_many_arguments)]
+fn view(
+    robot: &Robot,
+    out: std::path::PathBuf,
+    frames: Option<&Bound<'_, PyAny>>,
+    times: Option<Vec<f64>>,
+    world: Option<&PyWorld>,
+    path: Option<&Bound<'_, PyAny>>,
+    title: &str,
+    bundle: Option<std::path::PathBuf>,
+) -> PyResult<std::path::PathBuf> {
+    let n = robot.model.motors().len();
+    let postures = match frames {
+        Some(f) => configurations(f, n, "frames")?.0,
+        None => robot
+            .model
+            .posture("home")
+            .map(<[f64]>::to_vec)
+            .unwrap_or_else(|_| robot.model.neutral_motors()),
+    };
+    let count = postures.len() / n.max(1);
+    let times = times.unwrap_or_else(|| (0..count).map(|k| k as f64 * 0.05).collect());
+    if times.len() != count {
+        return Err(err(format!(
+            "times: {} values for {count} frames",
+            times.len()
+        )));
+    }
+    let collision = CollisionModel::new(&robot.model).map_err(err)?;
+    let mut scene = trm_view::Scene::new(title, &collision);
+    if let Some(w) = world {
+        scene.set_world(&w.world);
+    }
+    for (t, q) in times.iter().zip(postures.chunks(n.max(1))) {
+        scene.add_frame(*t, q).map_err(err)?;
+    }
+    if let Some(p) = path {
+        let a = float_array(p)?;
+        if a.ndim() != 2 || a.shape()[1] != 3 {
+            return Err(err(format!("path: shape {:?}; expected (K, 3)", a.shape())));
+        }
+        let v = a.as_slice().map_err(err)?;
+        scene.set_path(v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect());
+    }
+    let code = match &bundle {
+        Some(b) => {
+            Some(std::fs::read_to_string(b).map_err(|e| err(format!("{}: {e}", b.display())))?)
+        }
+        None => None,
+    };
+    let json = out.with_extension("json");
+    trm_kinematics::write_file(&json, &scene.to_json().map_err(err)?).map_err(err)?;
+    trm_kinematics::write_file(&out, &scene.to_html(code.as_deref()).map_err(err)?).map_err(err)?;
+    Ok(out)
+}
+
 /// The extension module.
 #[pymodule]
 fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1072,5 +1222,7 @@ fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Optimizer>()?;
     m.add_class::<Roadmap>()?;
     m.add_class::<Planner>()?;
+    m.add_function(wrap_pyfunction!(view, m)?)?;
+    m.add_function(wrap_pyfunction!(minimize_constrained, m)?)?;
     Ok(())
 }

@@ -120,6 +120,39 @@ def test_optimisers_ask_tell_on_the_sphere(algo):
     assert set(["xnes", "cmaes"]) <= set(trm.ALGORITHMS)
 
 
+def test_constrained_one_plus_one_keeps_to_the_feasible_side():
+    # minimise (x0 − 2)² + x1² subject to x0 ≤ 1, from an infeasible start
+    r = trm.minimize_constrained(
+        lambda x: float((x[0] - 2.0) ** 2 + x[1] ** 2),
+        lambda x: np.array([x[0] - 1.0]),
+        [3.0, 1.0],
+        0.5,
+        seed=2,
+        max_evals=4000,
+    )
+    assert r["feasible"] and r["bootstrap_evaluations"] > 0
+    assert r["x"][0] <= 1.0 and abs(r["x"][0] - 1.0) < 1e-3 and abs(r["x"][1]) < 1e-3, r
+    with pytest.raises(ZeroDivisionError):
+        trm.minimize_constrained(lambda x: 1 / 0, lambda x: [x[0] - 1.0], [0.0, 0.0], 0.5)
+
+
+def test_view_writes_the_page_and_its_scene(robot, tmp_path):
+    import json
+
+    home = robot.posture("home")
+    lifted = home.copy()
+    lifted[robot.motor_names.index("r_shoulder_pitch")] -= 0.5
+    world = trm.World()
+    world.add_box("table", [0.5, 0.8, 0.04], [-0.4, 0.0, -0.14])
+    out = trm.view(robot, str(tmp_path / "scene.html"), frames=np.stack([home, lifted]), world=world,
+                   path=[[-0.3, 0.2, 0.0], [-0.3, 0.1, 0.1]])
+    assert Path(out).read_text().startswith("<!DOCTYPE html>")
+    scene = json.loads((tmp_path / "scene.json").read_text())
+    assert len(scene["frames"]) == 2 and len(scene["world"]) == 1 and len(scene["path"]) == 2
+    with pytest.raises(trm.TrmError, match="times"):
+        trm.view(robot, str(tmp_path / "x.html"), frames=home, times=[0.0, 1.0])
+
+
 def test_a_map_builds_saves_loads_and_plans(tmp_path):
     built = trm.Roadmap.build(SPEC, points=40, seed=0)
     info = built.info()

@@ -21,6 +21,8 @@ from ._trm import (
     Robot,
     TrmError,
     World,
+    minimize_constrained,
+    view,
 )
 
 __all__ = [
@@ -34,6 +36,8 @@ __all__ = [
     "TrmError",
     "World",
     "minimize",
+    "minimize_constrained",
+    "view",
 ]
 
 

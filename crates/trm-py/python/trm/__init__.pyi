@@ -127,3 +127,23 @@ def minimize(
     max_evals: int = 10_000,
     batch: bool = False,
 ) -> tuple[Array, float, int]: ...
+
+def minimize_constrained(
+    fun: Callable[[Array], float],
+    constraints: Callable[[Array], ArrayLike],
+    x0: ArrayLike,
+    sigma: float,
+    seed: int = 0,
+    max_evals: int = 10_000,
+    bootstrap_budget: int | None = None,
+) -> dict: ...
+def view(
+    robot: Robot,
+    out: str,
+    frames: ArrayLike | None = None,
+    times: Sequence[float] | None = None,
+    world: World | None = None,
+    path: ArrayLike | None = None,
+    title: str = "trm",
+    bundle: str | None = None,
+) -> str: ...
