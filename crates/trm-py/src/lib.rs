@@ -235,21 +235,22 @@ impl Robot {
                 }
                 Ok::<(), String>(())
             };
-            py.detach(|| {
-                // large batches over trm's threads; one configuration on the calling thread
-                if values.len() / n >= 64 {
+            // large batches over trm's threads without the GIL; a few configurations on the
+            // calling thread (releasing the GIL costs more than they take)
+            if values.len() / n >= 64 {
+                py.detach(|| {
                     slice
                         .par_chunks_mut(per)
                         .zip(values.par_chunks(n))
                         .try_for_each_init(|| self.model.pose_buffer(), fill)
-                } else {
-                    let mut poses = self.model.pose_buffer();
-                    slice
-                        .chunks_mut(per)
-                        .zip(values.chunks(n))
-                        .try_for_each(|c| fill(&mut poses, c))
-                }
-            })
+                })
+            } else {
+                let mut poses = self.model.pose_buffer();
+                slice
+                    .chunks_mut(per)
+                    .zip(values.chunks(n))
+                    .try_for_each(|c| fill(&mut poses, c))
+            }
             .map_err(err)?;
         }
         Ok(out)
