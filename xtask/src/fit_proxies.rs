@@ -293,19 +293,20 @@ mod tests {
 }
 
 #[cfg(test)]
-mod panda {
-    /// models/panda/panda_fitted.urdf and panda.ron are what the commands in
-    /// models/panda/NOTICE.md write today.
-    #[test]
-    fn the_committed_panda_files_are_current() {
+mod committed {
+    /// Runs the commands of models/NAME/NOTICE.md into a temporary directory and compares
+    /// their output with the committed NAME_fitted.urdf and NAME.ron: fit-proxies on `urdf`,
+    /// the SRDF into a description, and (when given) gen-acm for the proxies at `posture`.
+    fn check(name: &str, urdf: &str, srdf: &str, acm: Option<(&str, usize)>) {
         let models = crate::models_dir();
-        let panda = models.join("panda");
-        let dir = crate::test_dir("panda-current");
-        let fitted = dir.join("panda_fitted.urdf");
+        let robot = models.join(name);
+        let dir = crate::test_dir(&format!("{name}-current"));
+        let fitted = dir.join(format!("{name}_fitted.urdf"));
+        let stale = format!("models/{name} is stale: run the commands in models/{name}/NOTICE.md");
         super::run(&super::Args {
-            model: panda.join("example-robot-data/robots/panda_description/urdf/panda.urdf"),
+            model: robot.join(urdf),
             meshes: crate::MeshArgs {
-                package_paths: vec![panda.clone()],
+                package_paths: vec![robot.clone()],
             },
             out: Some(fitted.clone()),
             compare: None,
@@ -314,16 +315,34 @@ mod panda {
         let read = |p: &std::path::Path| std::fs::read_to_string(p).unwrap();
         assert_eq!(
             read(&fitted),
-            read(&panda.join("panda_fitted.urdf")),
-            "models/panda/panda_fitted.urdf is stale: run the commands in models/panda/NOTICE.md"
+            read(&robot.join(format!("{name}_fitted.urdf"))),
+            "{stale}"
         );
-        let description = dir.join("panda.ron");
-        crate::model_info::write_srdf_description(
-            &panda.join("panda_fitted.urdf"),
-            &panda.join("example-robot-data/robots/panda_description/srdf/panda.srdf"),
-            &description,
-        )
-        .unwrap();
+        let description = dir.join(format!("{name}.ron"));
+        // the steps after fitting read the fitted URDF just written (the same bytes)
+        crate::model_info::write_srdf_description(&fitted, &robot.join(srdf), &description)
+            .unwrap();
+        if let Some((posture, samples)) = acm {
+            use clap::Parser;
+            let path = description.to_str().unwrap();
+            let samples = samples.to_string();
+            let cli = crate::Cli::try_parse_from([
+                "xtask",
+                "gen-acm",
+                path,
+                "--posture",
+                posture,
+                "--samples",
+                &samples,
+                "--write-description",
+                path,
+            ])
+            .unwrap();
+            let crate::Command::GenAcm(args) = cli.command else {
+                unreachable!("parsed as gen-acm")
+            };
+            crate::gen_acm::run(&args).unwrap();
+        }
         // the written `urdf` field is relative to the output: compare the rest
         let body = |text: String| -> String {
             text.lines()
@@ -333,8 +352,28 @@ mod panda {
         };
         assert_eq!(
             body(read(&description)),
-            body(read(&panda.join("panda.ron"))),
-            "models/panda/panda.ron is stale: run the commands in models/panda/NOTICE.md"
+            body(read(&robot.join(format!("{name}.ron")))),
+            "{stale}"
+        );
+    }
+
+    #[test]
+    fn the_committed_panda_files_are_current() {
+        check(
+            "panda",
+            "example-robot-data/robots/panda_description/urdf/panda.urdf",
+            "example-robot-data/robots/panda_description/srdf/panda.srdf",
+            None,
+        );
+    }
+
+    #[test]
+    fn the_committed_talos_files_are_current() {
+        check(
+            "talos",
+            "example-robot-data/robots/talos_data/robots/talos_reduced.urdf",
+            "example-robot-data/robots/talos_data/srdf/talos.srdf",
+            Some(("half_sitting", 20_000)),
         );
     }
 }

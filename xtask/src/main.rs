@@ -112,7 +112,13 @@ impl Command {
             Command::ExploreTaskMap(a) => (vec![a.out_path()], vec![]),
             Command::Collide(a) => (file(&a.out), vec![]),
             Command::Fk(a) => (file(&a.out), vec![]),
-            Command::GenAcm(a) => (file(&a.out), vec![]),
+            Command::GenAcm(a) => (
+                file(&a.out)
+                    .into_iter()
+                    .chain(file(&a.write_description))
+                    .collect(),
+                vec![],
+            ),
             Command::Plan(a) => (beside(&a.out, &["json", "ros.yaml", "svg"]), vec![]),
             Command::ReachGrasp(a) => (beside(&a.out, &["json", "ros.yaml"]), vec![]),
             Command::Solve(a) => (file(&a.out), vec![]),

@@ -848,6 +848,8 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         ("another root", "<urdf/>", "srdf_5.srdf"),
         ("a reversed chain", "<robot><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"chest\"/></group></robot>", "srdf_6.srdf"),
         ("binary", "\u{0}\u{1}\u{2}", "srdf_7.srdf"),
+        ("several values for a URDF joint", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"0.1 0.2\"/></group_state></robot>", "r_elbow"),
+        ("a NaN among a floating base's values", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"root_joint\" value=\"0 0 NaN 0 0 0 1\"/></group_state></robot>", "srdf_9.srdf"),
     ]
     .into_iter()
     .enumerate()
@@ -1172,6 +1174,45 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         "--always-fraction",
         &["-0.1", "1.5", "NaN"],
     ));
+    cases.extend(flag_cases(
+        &["gen-acm", "--samples", "10"],
+        "--posture",
+        &["hom", "no_such_posture"],
+    ));
+    // --write-description needs a .ron description and a place beside it
+    let description = at("models/panda/panda.ron").to_string_lossy().to_string();
+    for (what, args, names) in [
+        (
+            "gen-acm --write-description of a URDF model",
+            vec![
+                "gen-acm",
+                "icub_upper_body.urdf",
+                "--samples",
+                "10",
+                "--write-description",
+                "o.ron",
+            ],
+            "--write-description",
+        ),
+        (
+            "gen-acm --write-description away from the description",
+            vec![
+                "gen-acm",
+                description.as_str(),
+                "--samples",
+                "10",
+                "--write-description",
+                "elsewhere.ron",
+            ],
+            "elsewhere.ron",
+        ),
+    ] {
+        cases.push(Case {
+            what: what.into(),
+            args: args.iter().map(|s| s.to_string()).collect(),
+            names: names.into(),
+        });
+    }
     cases.extend(file_flag_cases(
         &["view", "--out", "v.html"],
         "--posture",

@@ -55,6 +55,9 @@ pub struct GroupState {
     pub group: String,
     /// Joint values, rad or m.
     pub values: BTreeMap<String, f64>,
+    /// Joints given several coordinates (a floating or planar virtual joint's pose), with the
+    /// line of each.
+    pub multi: Vec<(String, Vec<f64>, usize)>,
     /// Line of the element.
     pub line: usize,
 }
@@ -249,23 +252,29 @@ impl Srdf {
                     for j in n.children().filter(|j| j.has_tag_name("joint")) {
                         let name = attr(j, "name")?;
                         let text = attr(j, "value")?;
-                        // a joint with several coordinates lists them space-separated; one here
-                        let value: f64 = text
-                            .trim()
-                            .parse()
-                            .ok()
-                            .filter(|v: &f64| v.is_finite())
-                            .ok_or_else(|| {
-                            error(
-                                origin,
-                                line(j),
-                                format!(
-                                    "group state `{}`: joint `{name}` has value `{text}`",
-                                    s.name
-                                ),
-                                "give one finite number (rad or m)",
-                            )
-                        })?;
+                        // a joint with several coordinates lists them space-separated
+                        let values: Option<Vec<f64>> = text
+                            .split_whitespace()
+                            .map(|v| v.parse().ok().filter(|v: &f64| v.is_finite()))
+                            .collect();
+                        let value = match values.as_deref() {
+                            Some([v]) => *v,
+                            Some(many) if many.len() > 1 => {
+                                s.multi.push((name.clone(), many.to_vec(), line(j)));
+                                continue;
+                            }
+                            _ => {
+                                return Err(error(
+                                    origin,
+                                    line(j),
+                                    format!(
+                                        "group state `{}`: joint `{name}` has value `{text}`",
+                                        s.name
+                                    ),
+                                    "give finite numbers (rad or m), space-separated for a joint with several coordinates",
+                                ));
+                            }
+                        };
                         if s.values.insert(name.clone(), value).is_some() {
                             return Err(error(
                                 origin,
@@ -489,6 +498,30 @@ impl Srdf {
                 ));
                 continue;
             }
+            for (j, v, line) in &s.multi {
+                // a virtual joint's pose, or (Pinocchio's convention) the free-flyer `root_joint`
+                // that is not in the URDF
+                if self.virtual_joints.iter().any(|vj| &vj.name == j)
+                    || robot.joint_index(j).is_err()
+                {
+                    report.notes.push(format!(
+                        "group state `{}`: the pose of the floating root `{j}` ({} values) is left out: trm keeps the root link fixed",
+                        s.name,
+                        v.len()
+                    ));
+                } else {
+                    return Err(error(
+                        origin,
+                        *line,
+                        format!(
+                            "group state `{}`: joint `{j}` has {} values; a URDF joint takes one",
+                            s.name,
+                            v.len()
+                        ),
+                        "give one value (several belong to a virtual joint's pose)",
+                    ));
+                }
+            }
             let mut values = BTreeMap::new();
             for (j, v) in &s.values {
                 joint(j, s.line)?;
@@ -591,6 +624,7 @@ impl Srdf {
                         .zip(&joint_values)
                         .map(|(j, v)| (j.to_string(), *v))
                         .collect(),
+                    multi: Vec::new(),
                     line: 0,
                 })
             })

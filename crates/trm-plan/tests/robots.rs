@@ -1,6 +1,7 @@
-//! A second robot end to end: the Panda of example-robot-data with fitted proxies and its SRDF
-//! (models/panda/), a reaching map built from specs/panda_reach.ron, and a planned motion to a
-//! point off the map nodes, every segment collision-free.
+//! Robots of your own end to end: the Panda (models/panda/) and the TALOS humanoid
+//! (models/talos/) of example-robot-data, each with fitted proxies and its SRDF, build a
+//! reaching map from their spec and plan a motion to a point off the map nodes, every segment
+//! collision-free, written as a ROS JointTrajectory with the URDF's joint names.
 
 use std::path::Path;
 
@@ -8,24 +9,33 @@ use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
 use trm_roadmap::{BuildOptions, build, connect};
 use trm_tasks::Problem;
 
-#[test]
-fn the_panda_builds_a_map_and_plans_through_it() {
-    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/panda_reach.ron");
+/// Builds `points` of `spec`'s map (`dim` active motors), plans to just off node `node` and
+/// checks the motion; `joint` is a joint name the ROS trajectory must carry.
+fn builds_a_map_and_plans_through_it(
+    spec: &str,
+    dim: usize,
+    points: usize,
+    node: usize,
+    joint: &str,
+) {
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../specs")
+        .join(spec);
     let problem = Problem::load(&spec).unwrap();
-    assert_eq!(problem.objective.dim(), 7, "the arm group of the SRDF");
+    assert_eq!(problem.objective.dim(), dim, "the SRDF's group");
     let mut map = build(
         &problem,
         &BuildOptions {
-            points: Some(80),
+            points: Some(points),
             ..Default::default()
         },
         |_| {},
     )
     .unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
-    assert_eq!(map.points.len(), 80);
+    assert!(map.points.len() >= points);
     let mut planner = Planner::new(&problem.objective, &[&map]).unwrap();
-    let node = &map.points[40].t;
+    let node = &map.points[node].t;
     let goal: Vec<f64> = node
         .iter()
         .zip([0.01, -0.01, 0.01])
@@ -61,7 +71,18 @@ fn the_panda_builds_a_map_and_plans_through_it() {
     // ROS-ready: the URDF's joint names
     let yaml = plan
         .trajectory
-        .to_ros_yaml(&problem.robot, Path::new("panda.ros.yaml"))
+        .to_ros_yaml(&problem.robot, Path::new("robot.ros.yaml"))
         .unwrap();
-    assert!(yaml.contains("panda_joint7"));
+    assert!(yaml.contains(joint));
+}
+
+#[test]
+fn the_panda_builds_a_map_and_plans_through_it() {
+    builds_a_map_and_plans_through_it("panda_reach.ron", 7, 80, 40, "panda_joint7");
+}
+
+#[test]
+fn the_talos_humanoid_builds_a_map_and_plans_through_it() {
+    // torso and right arm (the SRDF's r_arm_torso), the rest in the half-sitting posture
+    builds_a_map_and_plans_through_it("talos_reach.ron", 9, 80, 40, "arm_right_7_joint");
 }
