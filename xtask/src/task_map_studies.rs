@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
 use trm_plan::{Trajectory, time_parametrise};
@@ -137,7 +137,10 @@ pub fn run(args: &Args) -> Result<()> {
     let tabletop = table()?;
     let place = Isometry3::translation(CYLINDER[0], CYLINDER[1], CYLINDER[2]);
     // the exact target: the map's grasp nearest the cylinder's centre
-    let centre = stick.map.center_grasp().expect("a non-empty map");
+    let centre = stick
+        .map
+        .center_grasp()
+        .context("the cylinder's task map is empty")?;
     let runs = [
         reach(
             "cylinder_exact",

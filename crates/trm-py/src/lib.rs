@@ -85,6 +85,35 @@ fn shaped<'py>(
         .into_pyarray(py))
 }
 
+/// The result of the one configuration (a model without motors has none).
+fn first<T: Copy>(values: &[T]) -> PyResult<T> {
+    values
+        .first()
+        .copied()
+        .ok_or_else(|| err("no configuration: the model has no motors"))
+}
+
+/// One number per configuration: the number itself for one configuration, an `(N,)` array for
+/// a batch.
+fn numbers(py: Python<'_>, batch: Option<usize>, values: Vec<f64>) -> PyResult<Py<PyAny>> {
+    Ok(match batch {
+        None => first(&values)?.into_pyobject(py)?.into_any().unbind(),
+        Some(_) => shaped(py, batch, &[], values)?.into_any().unbind(),
+    })
+}
+
+/// One flag per configuration: a bool for one configuration, a list of bools for a batch.
+fn flags(py: Python<'_>, batch: Option<usize>, values: Vec<bool>) -> PyResult<Py<PyAny>> {
+    Ok(match batch {
+        None => first(&values)?
+            .into_pyobject(py)?
+            .to_owned()
+            .into_any()
+            .unbind(),
+        Some(_) => PyList::new(py, values)?.into_any().unbind(),
+    })
+}
+
 /// 4 × 4 homogeneous matrix, row-major, into `out` (16 values).
 fn write_matrix(pose: &Isometry3<f64>, out: &mut [f64]) {
     let r = pose.rotation.to_rotation_matrix();
@@ -121,6 +150,27 @@ struct Robot {
 impl Robot {
     fn all(&self) -> ActiveSet {
         self.model.all_active()
+    }
+
+    /// Forward kinematics of each configuration in `q` (all motors), then `f` appends its
+    /// values (`shape` of them, row-major); the array gains the batch axis for a batch.
+    fn per_configuration<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        shape: &[usize],
+        mut f: impl FnMut(&ActiveSet, &trm_kinematics::PoseBuffer, &mut Vec<f64>),
+    ) -> PyResult<Array<'py>> {
+        let n = self.dof();
+        let (values, batch) = configurations(q, n, "q")?;
+        let active = self.all();
+        let mut poses = self.model.pose_buffer();
+        let mut out = Vec::new();
+        for row in values.chunks(n.max(1)) {
+            active.forward(row, &mut poses).map_err(err)?;
+            f(&active, &poses, &mut out);
+        }
+        shaped(py, batch, shape, out)
     }
 }
 
@@ -264,15 +314,7 @@ impl Robot {
         frame: &str,
     ) -> PyResult<Array<'py>> {
         let id = self.model.frame_id(frame).map_err(err)?;
-        let n = self.dof();
-        let (values, batch) = configurations(q, n, "q")?;
-        let mut poses = self.model.pose_buffer();
-        let mut out = Vec::new();
-        for row in values.chunks(n.max(1)) {
-            self.model.forward_motors(row, &mut poses).map_err(err)?;
-            matrix(poses.pose(id), &mut out);
-        }
-        shaped(py, batch, &[4, 4], out)
+        self.per_configuration(py, q, &[4, 4], |_, poses, out| matrix(poses.pose(id), out))
     }
 
     /// The 6 × n geometric Jacobian of a frame with respect to all motors (rows: linear then
@@ -285,57 +327,36 @@ impl Robot {
     ) -> PyResult<Array<'py>> {
         let id = self.model.frame_id(frame).map_err(err)?;
         let n = self.dof();
-        let (values, batch) = configurations(q, n, "q")?;
-        let active = self.all();
-        let mut poses = self.model.pose_buffer();
         let mut jac = Matrix6xX::zeros(n);
-        let mut out = Vec::new();
-        for row in values.chunks(n.max(1)) {
-            active.forward(row, &mut poses).map_err(err)?;
-            active.jacobian(&poses, id, &mut jac);
-            for r in 0..6 {
-                out.extend((0..n).map(|c| jac[(r, c)]));
-            }
-        }
-        shaped(py, batch, &[6, n], out)
+        self.per_configuration(py, q, &[6, n], |active, poses, out| {
+            active.jacobian(poses, id, &mut jac);
+            out.extend(jac.transpose().iter());
+        })
     }
 
-    /// Total mass and centre of mass: `(mass, (3,))`, or masses `(N,)` and centres `(N, 3)`.
+    /// Total mass and centre of mass: `(mass, (3,))`, or `(mass, (N, 3))` for a batch.
     fn center_of_mass<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
     ) -> PyResult<(f64, Array<'py>)> {
-        let n = self.dof();
-        let (values, batch) = configurations(q, n, "q")?;
-        let active = self.all();
-        let mut poses = self.model.pose_buffer();
-        let (mut mass, mut out) = (0.0, Vec::new());
-        for row in values.chunks(n.max(1)) {
-            active.forward(row, &mut poses).map_err(err)?;
-            let (m, c) = active.center_of_mass(&poses);
+        let mut mass = 0.0;
+        let centres = self.per_configuration(py, q, &[3], |active, poses, out| {
+            let (m, c) = active.center_of_mass(poses);
             mass = m;
             out.extend_from_slice(c.coords.as_slice());
-        }
-        Ok((mass, shaped(py, batch, &[3], out)?))
+        })?;
+        Ok((mass, centres))
     }
 
     /// The 3 × n Jacobian of the centre of mass: `(3, n)` or `(N, 3, n)`.
     fn com_jacobian<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Array<'py>> {
         let n = self.dof();
-        let (values, batch) = configurations(q, n, "q")?;
-        let active = self.all();
-        let mut poses = self.model.pose_buffer();
         let mut jac = Matrix3xX::zeros(n);
-        let mut out = Vec::new();
-        for row in values.chunks(n.max(1)) {
-            active.forward(row, &mut poses).map_err(err)?;
-            active.com_jacobian(&poses, &mut jac);
-            for r in 0..3 {
-                out.extend((0..n).map(|c| jac[(r, c)]));
-            }
-        }
-        shaped(py, batch, &[3, n], out)
+        self.per_configuration(py, q, &[3, n], |active, poses, out| {
+            active.com_jacobian(poses, &mut jac);
+            out.extend(jac.transpose().iter());
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -459,6 +480,22 @@ struct Collision {
 }
 
 impl Collision {
+    /// The configurations in `q` placed one by one (without the GIL), `f` on each against
+    /// `world` (none: empty); the results and `Some(N)` for a batch.
+    fn map<T: Send>(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        world: Option<&PyWorld>,
+        f: impl Fn(&trm_collision::PlacedBodies, &World) -> T + Sync,
+    ) -> PyResult<(Vec<T>, Option<usize>)> {
+        let empty = World::new();
+        let w = world.map_or(&empty, |w| &w.world);
+        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
+        let out = py.detach(|| self.each(&values, |p| f(p, w))).map_err(err)?;
+        Ok((out, batch))
+    }
+
     /// Runs `f` on every configuration placed.
     fn each<T>(
         &self,
@@ -506,16 +543,15 @@ impl Collision {
         q: &Bound<'py, PyAny>,
         world: Option<&PyWorld>,
     ) -> PyResult<Py<PyAny>> {
-        let empty = World::new();
-        let w = world.map_or(&empty, |w| &w.world);
-        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
-        let counts = py
-            .detach(|| self.each(&values, |p| self.model.count(p, w).total() as f64))
-            .map_err(err)?;
-        Ok(match batch {
-            None => (counts[0] as usize).into_pyobject(py)?.into_any().unbind(),
-            Some(_) => shaped(py, batch, &[], counts)?.into_any().unbind(),
-        })
+        let (counts, batch) =
+            self.map(py, q, world, |p, w| self.model.count(p, w).total() as f64)?;
+        match batch {
+            None => Ok((first(&counts)? as usize)
+                .into_pyobject(py)?
+                .into_any()
+                .unbind()),
+            Some(_) => numbers(py, batch, counts),
+        }
     }
 
     /// Whether anything collides (early exit): a bool, or a bool list for a batch.
@@ -526,16 +562,8 @@ impl Collision {
         q: &Bound<'py, PyAny>,
         world: Option<&PyWorld>,
     ) -> PyResult<Py<PyAny>> {
-        let empty = World::new();
-        let w = world.map_or(&empty, |w| &w.world);
-        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
-        let hits = py
-            .detach(|| self.each(&values, |p| self.model.is_colliding(p, w)))
-            .map_err(err)?;
-        Ok(match batch {
-            None => hits[0].into_pyobject(py)?.to_owned().into_any().unbind(),
-            Some(_) => PyList::new(py, hits)?.into_any().unbind(),
-        })
+        let (hits, batch) = self.map(py, q, world, |p, w| self.model.is_colliding(p, w))?;
+        flags(py, batch, hits)
     }
 
     /// The colliding pairs of one configuration: `[(body, other, signed distance)]`.
@@ -569,20 +597,12 @@ impl Collision {
     /// The smallest signed distance between checked body pairs (negative when penetrating): a
     /// float, or `(N,)` for a batch.
     fn min_distance<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Py<PyAny>> {
-        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
-        let d = py
-            .detach(|| {
-                self.each(&values, |p| {
-                    self.model
-                        .min_self_distance(p)
-                        .map_or(f64::INFINITY, |d| d.distance)
-                })
-            })
-            .map_err(err)?;
-        Ok(match batch {
-            None => d[0].into_pyobject(py)?.into_any().unbind(),
-            Some(_) => shaped(py, batch, &[], d)?.into_any().unbind(),
-        })
+        let (d, batch) = self.map(py, q, None, |p, _| {
+            self.model
+                .min_self_distance(p)
+                .map_or(f64::INFINITY, |d| d.distance)
+        })?;
+        numbers(py, batch, d)
     }
 }
 
@@ -638,10 +658,7 @@ impl Problem {
             .chunks(o.dim().max(1))
             .map(|row| o.eval(row, &mut scratch))
             .collect();
-        Ok(match batch {
-            None => costs[0].into_pyobject(py)?.into_any().unbind(),
-            Some(_) => shaped(py, batch, &[], costs)?.into_any().unbind(),
-        })
+        numbers(py, batch, costs)
     }
 
     /// Active motor limits `(lower (d,), upper (d,))`.
@@ -671,10 +688,7 @@ impl Problem {
             .chunks(o.dim().max(1))
             .map(|row| o.is_collision_free_in(row, w, &mut scratch))
             .collect();
-        Ok(match batch {
-            None => free[0].into_pyobject(py)?.to_owned().into_any().unbind(),
-            Some(_) => PyList::new(py, free)?.into_any().unbind(),
-        })
+        flags(py, batch, free)
     }
 
     /// Clearance of active values: the smallest signed distance between checked body pairs and

@@ -694,17 +694,18 @@ impl ReachProblem<'_> {
         mut gradient: impl FnMut(&[f64]) -> (Motion, Vec<f64>),
     ) -> (Motion, Vec<(f64, f64)>) {
         let x0 = self.initial_attractors();
-        let mut rprop = Rprop::new(
-            &x0,
-            &RpropOptions {
-                initial_step: 0.01,
-                max_step: 0.1,
-                ..Default::default()
-            },
-        )
-        .expect("valid settings");
         let (mut best, mut g) = gradient(&x0);
         let mut trace = vec![(best.cost, best.limits)];
+        let settings = RpropOptions {
+            initial_step: 0.01,
+            max_step: 0.1,
+            ..Default::default()
+        };
+        // the settings are valid; only a non-finite start (from a non-finite `start`) fails:
+        // nothing to optimise then
+        let Ok(mut rprop) = Rprop::new(&x0, &settings) else {
+            return (best, trace);
+        };
         for _ in 0..iterations {
             rprop.step(&g);
             let (m, next) = gradient(rprop.x());
