@@ -147,7 +147,7 @@ pub fn run(args: &Args) -> Result<()> {
     if args.mpi {
         return crate::distributed::build_map(job, resumed);
     }
-    job.run(resumed, &mut Threads)
+    job.run(resumed, &mut Threads::default())
 }
 
 /// A build-map run, ready to go: its evaluations on this process's threads or spread over the

@@ -37,7 +37,7 @@ impl PoseBatch {
     }
 
     /// Whether the batch was made for a model with these many joints and frames.
-    pub(crate) fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
+    pub fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
         self.poses.len() == num_frames && self.slots.len() == num_joints + 1
     }
 

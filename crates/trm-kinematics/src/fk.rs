@@ -252,7 +252,7 @@ pub struct PoseBuffer {
 
 impl PoseBuffer {
     /// Whether the buffer was made for a model with these many joints and frames.
-    pub(crate) fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
+    pub fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
         self.poses.len() == num_frames && self.slots.len() == num_joints + 1
     }
 

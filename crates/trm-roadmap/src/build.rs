@@ -95,6 +95,8 @@ struct Search {
     from: Option<usize>,
     centre_t: Vec<f64>,
     centre_f: f64,
+    /// The last ask's candidates, copied into buffers kept from generation to generation.
+    candidates: Vec<Vec<f64>>,
 }
 
 /// The map under construction: points, their index and the SELECTPROPORTIONAL bookkeeping.
@@ -194,9 +196,12 @@ pub trait Evaluator {
     ) -> Result<()>;
 }
 
-/// Evaluates on the threads of the current rayon pool, [`LANES`] candidates at a time.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Threads;
+/// Evaluates on the threads of the current rayon pool, [`LANES`] candidates at a time, with
+/// scratch buffers kept from call to call (no allocation per evaluation).
+#[derive(Debug, Default)]
+pub struct Threads {
+    scratch: ScratchPool,
+}
 
 impl Evaluator for Threads {
     fn evaluate(
@@ -206,17 +211,63 @@ impl Evaluator for Threads {
         fitness: &mut [f64],
         tasks: &mut [f64],
     ) -> Result<()> {
-        evaluate_on_threads(objective, qs, fitness, tasks);
+        evaluate_on_threads(objective, qs, fitness, tasks, &self.scratch);
         Ok(())
     }
 }
 
-/// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time ([`Threads`]).
+thread_local! {
+    /// Each worker's kNN result buffer for h_map (kept: no allocation per candidate).
+    static NEAREST: std::cell::RefCell<Vec<(f64, usize)>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Scratch buffers of an [`Objective`] kept between parallel evaluations: each worker borrows
+/// one (or makes one) and gives it back when its share is done. A buffer that does not fit the
+/// objective at hand ([`Objective::scratch_fits`]) is dropped, not used.
+#[derive(Debug, Default)]
+pub struct ScratchPool(std::sync::Mutex<Vec<trm_tasks::Scratch>>);
+
+/// A scratch buffer borrowed from a [`ScratchPool`], returned to it when dropped.
+struct Lease<'a> {
+    pool: &'a ScratchPool,
+    scratch: Option<trm_tasks::Scratch>,
+}
+
+impl<'a> Lease<'a> {
+    fn take(pool: &'a ScratchPool, objective: &Objective) -> Self {
+        let kept = pool
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .pop()
+            .filter(|s| objective.scratch_fits(s));
+        Lease {
+            pool,
+            scratch: Some(kept.unwrap_or_else(|| objective.scratch())),
+        }
+    }
+}
+
+impl Drop for Lease<'_> {
+    fn drop(&mut self) {
+        if let Some(s) = self.scratch.take() {
+            self.pool
+                .0
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .push(s);
+        }
+    }
+}
+
+/// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time ([`Threads`]),
+/// with scratch buffers from `pool`.
 pub fn evaluate_on_threads(
     objective: &Objective,
     qs: &[&[f64]],
     fitness: &mut [f64],
     tasks: &mut [f64],
+    pool: &ScratchPool,
 ) {
     let dim = objective.task().map_or(0, |t| t.dim());
     fitness
@@ -224,9 +275,11 @@ pub fn evaluate_on_threads(
         .zip(tasks.par_chunks_mut((LANES * dim).max(1)))
         .zip(qs.par_chunks(LANES))
         .for_each_init(
-            || objective.scratch(),
-            |scratch, ((fitness, tasks), qs)| {
-                objective.eval_with_task_batch(qs, scratch, fitness, tasks);
+            || Lease::take(pool, objective),
+            |lease, ((fitness, tasks), qs)| {
+                if let Some(scratch) = lease.scratch.as_mut() {
+                    objective.eval_with_task_batch(qs, scratch, fitness, tasks);
+                }
             },
         );
 }
@@ -430,6 +483,7 @@ impl State {
                     from: s.from,
                     centre_t: s.centre_t,
                     centre_f: s.centre_f,
+                    candidates: Vec::new(),
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -466,7 +520,7 @@ pub fn build(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    build_with(problem, options, &mut Threads, progress)
+    build_with(problem, options, &mut Threads::default(), progress)
 }
 
 /// [`build`] with the candidates evaluated by `evaluator` (e.g. across MPI processes): the
@@ -501,7 +555,13 @@ pub fn resume(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    resume_with(problem, checkpoint, options, &mut Threads, progress)
+    resume_with(
+        problem,
+        checkpoint,
+        options,
+        &mut Threads::default(),
+        progress,
+    )
 }
 
 /// [`resume`] with the candidates evaluated by `evaluator`, as [`build_with`].
@@ -655,6 +715,7 @@ pub(crate) fn run(
                 from,
                 centre_t: vec![0.0; dim],
                 centre_f: f64::NAN,
+                candidates: Vec::new(),
             });
         }
         // one generation of every search: ask, evaluate all candidates in parallel, tell
@@ -665,14 +726,17 @@ pub(crate) fn run(
             .map(|s| s.centre_f.is_finite())
             .collect::<Vec<_>>();
         // asks in parallel (each search draws from its own stream)
-        let asked: Vec<Vec<Vec<f64>>> = searches
-            .par_iter_mut()
-            .map(|s| s.xnes.ask(&mut s.rng).to_vec())
-            .collect();
-        let jobs: Vec<(usize, &[f64])> = asked
+        searches.par_iter_mut().for_each(|s| {
+            let xs = s.xnes.ask(&mut s.rng);
+            s.candidates.resize_with(xs.len(), Vec::new);
+            for (c, x) in s.candidates.iter_mut().zip(xs) {
+                c.clone_from(x);
+            }
+        });
+        let jobs: Vec<(usize, &[f64])> = searches
             .iter()
             .enumerate()
-            .flat_map(|(i, xs)| xs.iter().map(move |x| (i, x.as_slice())))
+            .flat_map(|(i, s)| s.candidates.iter().map(move |x| (i, x.as_slice())))
             .collect();
         // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
         let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {
@@ -706,11 +770,13 @@ pub(crate) fn run(
                 .par_chunks_mut(LANES)
                 .zip(tasks.par_chunks(LANES * dim))
                 .zip(jobs.par_chunks(LANES))
-                .for_each_init(Vec::new, |nn, ((fitness, tasks), jobs)| {
-                    for (k, &(i, q)) in jobs.iter().enumerate() {
-                        let t = &tasks[k * dim..(k + 1) * dim];
-                        fitness[k] = h_star(i, q, fitness[k], t, nn);
-                    }
+                .for_each(|((fitness, tasks), jobs)| {
+                    NEAREST.with_borrow_mut(|nn| {
+                        for (k, &(i, q)) in jobs.iter().enumerate() {
+                            let t = &tasks[k * dim..(k + 1) * dim];
+                            fitness[k] = h_star(i, q, fitness[k], t, nn);
+                        }
+                    })
                 });
             Ok(())
         };

@@ -26,7 +26,7 @@ use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 use trm_tasks::Objective;
 
-use crate::build::{Evaluator, evaluate_on_threads};
+use crate::build::{Evaluator, ScratchPool, evaluate_on_threads};
 use crate::error::{Result, RoadmapError};
 
 /// Message tags: a slice of postures to evaluate, and the end of the build.
@@ -48,6 +48,7 @@ fn slice(n: usize, size: usize, rank: usize) -> std::ops::Range<usize> {
 pub struct Ranks<'w> {
     world: &'w SimpleCommunicator,
     flat: Vec<f64>,
+    scratch: ScratchPool,
 }
 
 impl<'w> Ranks<'w> {
@@ -56,6 +57,7 @@ impl<'w> Ranks<'w> {
         Ranks {
             world,
             flat: Vec::new(),
+            scratch: ScratchPool::default(),
         }
     }
 }
@@ -86,6 +88,7 @@ impl Evaluator for Ranks<'_> {
             &qs[own.clone()],
             &mut fitness[own.clone()],
             &mut tasks[own.start * dim..own.end * dim],
+            &self.scratch,
         );
         for rank in 1..size {
             // h of the slice, then g of each of its candidates
@@ -124,6 +127,7 @@ pub fn serve(world: &SimpleCommunicator, objective: &Objective) -> Result<()> {
     let d = objective.active().len();
     let dim = objective.task().map_or(0, |t| t.dim());
     let mut reply = Vec::new();
+    let scratch = ScratchPool::default();
     loop {
         let (flat, status) = root.receive_vec::<f64>();
         if status.tag() == STOP {
@@ -141,7 +145,7 @@ pub fn serve(world: &SimpleCommunicator, objective: &Objective) -> Result<()> {
         reply.clear();
         reply.resize(n * (1 + dim), 0.0);
         let (h, g) = reply.split_at_mut(n);
-        evaluate_on_threads(objective, &qs, h, g);
+        evaluate_on_threads(objective, &qs, h, g, &scratch);
         root.send(&reply[..]);
     }
 }

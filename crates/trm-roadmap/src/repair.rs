@@ -301,7 +301,7 @@ impl<'p> LiveMap<'p> {
             &setup,
             State::from_points(&setup, current),
             None,
-            &mut Threads,
+            &mut Threads::default(),
             |_| {},
         )?;
         report.stopped_because = grown.stats.stopped_because.clone();
@@ -319,7 +319,7 @@ impl<'p> LiveMap<'p> {
                 .evaluations
                 .map(|m| m.saturating_sub(grown.stats.evaluations));
             let state = State::from_points(&setup, points);
-            let refilled = run(&setup, state, None, &mut Threads, |_| {})?;
+            let refilled = run(&setup, state, None, &mut Threads::default(), |_| {})?;
             report.stopped_because = refilled.stats.stopped_because;
             points = refilled.points;
         }

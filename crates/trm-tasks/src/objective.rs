@@ -181,6 +181,18 @@ impl Objective {
         }
     }
 
+    /// Whether `scratch` has this objective's sizes (poses, bodies, variables), so that a
+    /// scratch kept from an earlier call can serve it: evaluations overwrite everything else.
+    pub fn scratch_fits(&self, scratch: &Scratch) -> bool {
+        let model = self.active.model();
+        let (joints, frames) = (model.num_joints(), model.num_frames());
+        scratch.poses.fits(joints, frames)
+            && scratch.batch.fits(joints, frames)
+            && scratch.placed.len() == self.collision.bodies().len()
+            && scratch.noisy.len() == self.dim()
+            && scratch.lanes.len() == LANES * self.dim()
+    }
+
     /// Forward kinematics (and collision placement when needed) of `q` into `scratch`, through
     /// the batched kinematics like every other evaluation of the objective (in all lanes, so
     /// the values are those of any batch holding `q`): a single check and a population's
