@@ -142,6 +142,21 @@ fn derivatives_match_pinocchio_with_prismatic_continuous_and_mimic_joints() {
     compare("branched_tree.derivatives.json");
 }
 
+/// A configuration spread inside the limits (30–70 % of each range, unbounded ranges cut to
+/// ±3), the same for every run.
+fn interior(active: &trm_kinematics::ActiveSet) -> Vec<f64> {
+    let (lower, upper) = active.bounds();
+    lower
+        .iter()
+        .zip(&upper)
+        .enumerate()
+        .map(|(i, (l, u))| {
+            let (l, u) = (l.max(-3.0), u.min(3.0));
+            l + (u - l) * (0.3 + 0.4 * ((i * 7 % 11) as f64 / 11.0))
+        })
+        .collect()
+}
+
 /// Central differences on the 41-motor iCub (couplings included) for a named frame's Jacobian,
 /// the centre-of-mass Jacobian and gravity torques as the gradient of the potential energy.
 #[test]
@@ -152,13 +167,7 @@ fn derivatives_match_finite_differences_through_the_couplings() {
     ))
     .unwrap();
     let active = model.all_active();
-    let (lower, upper) = active.bounds();
-    let q: Vec<f64> = lower
-        .iter()
-        .zip(&upper)
-        .enumerate()
-        .map(|(i, (l, u))| l + (u - l) * (0.3 + 0.4 * ((i * 7 % 11) as f64 / 11.0)))
-        .collect();
+    let q = interior(&active);
     let frame = model.frame_id("r_index_fingertip").unwrap();
     let mut poses = model.pose_buffer();
     active.forward(&q, &mut poses).unwrap();
@@ -240,16 +249,7 @@ fn jacobian_derivatives_match_finite_differences() {
         (&tree, vec!["left_slider", "right_finger_b"]),
     ] {
         let active = model.all_active();
-        let (lower, upper) = active.bounds();
-        let q: Vec<f64> = lower
-            .iter()
-            .zip(&upper)
-            .enumerate()
-            .map(|(i, (l, u))| {
-                let (l, u) = (l.max(-3.0), u.min(3.0));
-                l + (u - l) * (0.3 + 0.4 * ((i * 7 % 11) as f64 / 11.0))
-            })
-            .collect();
+        let q = interior(&active);
         let mut poses = model.pose_buffer();
         let (mut jp, mut jm) = (Matrix6xX::zeros(0), Matrix6xX::zeros(0));
         let mut derivatives = Vec::new();

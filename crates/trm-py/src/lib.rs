@@ -37,7 +37,9 @@ fn float_array<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArrayDyn<'py,
         return Ok(a);
     }
     let np = obj.py().import("numpy")?;
-    let a = np.call_method1("ascontiguousarray", (obj, "float64"))?;
+    let a = np
+        .call_method1("ascontiguousarray", (obj, "float64"))
+        .map_err(|e| err(format!("expected numbers: {e}")))?;
     a.extract::<PyReadonlyArrayDyn<'py, f64>>()
         .map_err(|e| err(format!("expected a float array: {e}")))
 }

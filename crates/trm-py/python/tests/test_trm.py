@@ -201,3 +201,38 @@ def test_the_ompl_comparison_runs(capsys, monkeypatch):
     out = capsys.readouterr().out
     for planner in ["trm roadmap", "OMPL RRTConnect", "OMPL PRM"]:
         assert f"| {planner}" in out, out
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda r, d: r.fk("abc"), "expected numbers"),
+        (lambda r, d: r.fk(np.zeros((2, 2, 41))), "shape"),
+        (lambda r, d: trm.view(r, d), "directory"),
+        (lambda r, d: trm.view(r, str(Path(d) / "x.html"), path=[[1, 2]]), r"\(K, 3\)"),
+        (lambda r, d: trm.Optimizer("xnes", [0, 0], float("nan")), "step size"),
+        (lambda r, d: trm.Optimizer("xnes", [0, np.inf], 1.0), "not finite"),
+        (lambda r, d: trm.Optimizer("xnes", [], 1.0), "dimension 0"),
+        (lambda r, d: trm.minimize_constrained(lambda x: 0.0, lambda x: [0.0], [0, 0], 0.0), "step size"),
+        (lambda r, d: trm.Planner([]), "at least one map"),
+        (lambda r, d: trm.World().add_box("b", [-1, 1, 1], [0, 0, 0]), "positive"),
+        (lambda r, d: trm.World().add_box("b", [1, 1, 1], [np.nan, 0, 0]), "not finite"),
+        (lambda r, d: trm.World().remove("zz"), "zz"),
+        (lambda r, d: trm.Roadmap.load(str(Path(d) / "missing.json")), "missing.json"),
+        (lambda r, d: trm.Roadmap.build(SPEC, points=0), "0 points"),
+    ],
+)
+def test_bad_input_is_a_located_error(robot, tmp_path, call, message):
+    with pytest.raises(trm.TrmError, match=message):
+        call(robot, str(tmp_path))
+
+
+def test_an_optimiser_refuses_values_for_other_candidates():
+    opt = trm.Optimizer("xnes", [0.0, 0.0], 1.0)
+    opt.ask()
+    with pytest.raises(trm.TrmError, match="fitness values"):
+        opt.tell([1.0])
+    world = trm.World()
+    world.add_box("a", [1, 1, 1], [0, 0, 0])
+    with pytest.raises(trm.TrmError, match="already exists"):
+        world.add_box("a", [1, 1, 1], [0, 0, 0])
