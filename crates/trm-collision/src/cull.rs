@@ -356,7 +356,7 @@ impl PlacedBodies {
 mod tests {
     use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
     use proptest::prelude::*;
-    use trm_kinematics::{ActiveSet, PoseBuffer, RobotModel};
+    use trm_kinematics::{ActiveSet, LANES, PoseBuffer, RobotModel};
 
     use super::Step;
     use crate::shape::{bounds_apart, intersects};
@@ -437,6 +437,58 @@ mod tests {
             f.model.colliding_pair_indices(&placed).len(),
             want.self_pairs
         );
+    }
+
+    /// Up to [`LANES`] configurations through batched kinematics and [`CollisionModel::place_batch`]:
+    /// every batched count and verdict equals the one-configuration path on the same lane's
+    /// poses and the exhaustive answer, and the lane's placed bodies are those `place` makes.
+    fn check_batch(f: &Fixture, qs: &[Vec<f64>], world: &World) {
+        let d = f.active.len();
+        let mut flat = Vec::new();
+        for l in 0..LANES {
+            flat.extend_from_slice(&qs[l.min(qs.len() - 1)]);
+        }
+        assert_eq!(flat.len(), LANES * d);
+        let mut batch = f.robot.pose_batch();
+        f.active.forward_batch(&flat, &mut batch).unwrap();
+        let mut placed_batch = f.model.placed_batch();
+        f.model.place_batch(&batch, qs.len(), &mut placed_batch);
+        assert_eq!(placed_batch.lanes(), qs.len());
+        let counts = f.model.count_batch(&placed_batch, world);
+        let own = f.model.any_self_collision_batch(&placed_batch);
+        let objects = f.model.any_world_collision_batch(&placed_batch, world);
+        let either = f.model.is_colliding_batch(&placed_batch, world);
+        let (mut poses, mut placed, mut copied) = (
+            f.robot.pose_buffer(),
+            f.model.placed_bodies(),
+            f.model.placed_bodies(),
+        );
+        for l in qs.len()..LANES {
+            assert_eq!(counts[l], CollisionCount::default(), "unused lane {l}");
+            assert!(!own[l] && !objects[l] && !either[l], "unused lane {l}");
+        }
+        for l in 0..qs.len() {
+            batch.lane_into(l, &mut poses);
+            f.model.place(&poses, &mut placed);
+            f.model.lane_into(&placed_batch, l, &mut copied);
+            for (a, b) in placed.placed.iter().zip(&copied.placed) {
+                let fields = |p: &crate::shape::Placed| (p.center, p.bound, p.a, p.b, p.iso);
+                assert_eq!(fields(a), fields(b), "lane {l}: bit for bit");
+            }
+            assert_eq!(placed.origins, copied.origins);
+            let want = exhaustive(&f.model, &placed, world);
+            assert_eq!(f.model.count(&placed, world), want);
+            assert_eq!(
+                counts[l],
+                want,
+                "lane {l} at {:?}",
+                &flat[l * d..(l + 1) * d]
+            );
+            assert_eq!(own[l], want.self_pairs > 0, "lane {l}");
+            assert_eq!(objects[l], want.world_pairs > 0, "lane {l}");
+            assert_eq!(either[l], want.total() > 0, "lane {l}");
+            assert_eq!(f.model.count(&copied, world), want, "lane {l} copied back");
+        }
     }
 
     #[test]
@@ -524,6 +576,21 @@ mod tests {
         for q in &boundaries {
             check(f, q, &empty, &mut poses);
         }
+        // batched: contact and free lanes side by side, and a table across the body
+        let mut table = World::new();
+        table
+            .add(
+                "table",
+                Shape::Box {
+                    size: [0.5, 0.8, 0.04],
+                },
+                Isometry3::translation(-0.4, 0.0, -0.14),
+            )
+            .unwrap();
+        for lanes in boundaries.chunks(LANES) {
+            check_batch(f, lanes, &empty);
+            check_batch(f, lanes, &table);
+        }
     }
 
     fn object() -> impl Strategy<Value = (Shape, Isometry3<f64>)> {
@@ -558,6 +625,7 @@ mod tests {
         #[test]
         fn random_configurations_and_worlds_give_the_exhaustive_answer(
             unit in proptest::collection::vec(0.0..=1.0f64, 41),
+            others in proptest::collection::vec(proptest::collection::vec(0.0..=1.0f64, 41), 0..LANES),
             objects in proptest::collection::vec(object(), 0..5),
             shift in -0.05..0.05f64,
         ) {
@@ -572,6 +640,9 @@ mod tests {
             }
             let mut poses = f.robot.pose_buffer();
             check(f, &configuration(f, &unit), &world, &mut poses);
+            let mut lanes = vec![configuration(f, &unit)];
+            lanes.extend(others.iter().map(|u| configuration(f, u)));
+            check_batch(f, &lanes, &world);
         }
     }
 }

@@ -30,6 +30,7 @@
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
 
 mod acm;
+mod batch;
 mod cull;
 mod error;
 pub mod fit;
@@ -41,6 +42,7 @@ mod shape;
 mod world;
 
 pub use acm::AllowedCollisionMatrix;
+pub use batch::PlacedBatch;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};
 pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};

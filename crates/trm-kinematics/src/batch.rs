@@ -16,8 +16,9 @@ pub const LANES: usize = 4;
 /// One number in every lane.
 pub type Lanes = [f64; LANES];
 
-/// A pose in every lane: quaternion `w, i, j, k` then translation `x, y, z`.
-type PoseLanes = [Lanes; 7];
+/// A pose in every lane: quaternion `w, i, j, k` then translation `x, y, z`, each one value per
+/// lane.
+pub type PoseLanes = [Lanes; 7];
 
 /// Caller-owned scratch for batched forward kinematics (made by
 /// [`RobotModel::pose_batch`](crate::RobotModel::pose_batch)): the world pose of every link and
@@ -57,6 +58,13 @@ impl PoseBatch {
         lane_pose(&self.poses[frame.index()], lane)
     }
 
+    /// Every pose (links, then named frames, as [`PoseBuffer::poses`] orders them) in every lane:
+    /// the structure-of-arrays form batched consumers (collision placement, costs) read.
+    #[inline]
+    pub fn lanes(&self) -> &[PoseLanes] {
+        &self.poses
+    }
+
     /// Copies the poses of configuration `lane` (< [`LANES`]) into a one-configuration buffer
     /// of the same model, so everything written for [`PoseBuffer`] (costs, collision placement)
     /// runs on it. No allocation.
@@ -83,8 +91,9 @@ impl PoseBatch {
     }
 }
 
+/// The pose of configuration `lane` (< [`LANES`]) out of a pose in every lane.
 #[inline]
-fn lane_pose(p: &PoseLanes, lane: usize) -> Isometry3<f64> {
+pub fn lane_pose(p: &PoseLanes, lane: usize) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(p[4][lane], p[5][lane], p[6][lane]),
         UnitQuaternion::new_unchecked(Quaternion::new(

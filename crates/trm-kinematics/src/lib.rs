@@ -49,7 +49,7 @@ pub mod srdf;
 mod tree;
 
 pub use active::ActiveSet;
-pub use batch::{LANES, Lanes, PoseBatch, sin_cos};
+pub use batch::{LANES, Lanes, PoseBatch, PoseLanes, lane_pose, sin_cos};
 pub use derivatives::GRAVITY;
 pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,

@@ -1,9 +1,9 @@
 //! What cost and task functions see: one candidate's active values, motors, link poses and
 //! placed collision bodies, plus the world.
 
-use trm_collision::{CollisionModel, PlacedBodies, World};
+use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World};
 use trm_kinematics::nalgebra::{Point3, Vector3};
-use trm_kinematics::{FrameId, PoseBuffer, RobotModel};
+use trm_kinematics::{FrameId, PoseBatch, PoseBuffer, RobotModel};
 
 /// One evaluated candidate. Built by [`crate::Objective`] after one forward-kinematics pass.
 pub struct Context<'a> {
@@ -47,5 +47,63 @@ impl Context<'_> {
     #[inline]
     pub fn axis(&self, frame: FrameId, local: &Vector3<f64>) -> Vector3<f64> {
         self.poses.pose(frame).rotation * local
+    }
+}
+
+/// Up to [`LANES`](trm_kinematics::LANES) candidates evaluated together: their poses after one
+/// batched forward-kinematics pass and their bodies placed in one batch. Built by
+/// [`crate::Objective`]; costs and task functions that implement `eval_batch` read it directly,
+/// the others see one [`Context`] per lane through [`BatchContext::lane`].
+pub struct BatchContext<'a> {
+    /// The robot.
+    pub robot: &'a RobotModel,
+    /// Active values of each candidate (one slice per lane in use).
+    pub q: &'a [&'a [f64]],
+    /// World poses of every frame in every lane.
+    pub poses: &'a PoseBatch,
+    /// Collision geometry.
+    pub collision: &'a CollisionModel,
+    /// Collision bodies placed in every lane (placed only when a term needs them).
+    pub placed: &'a PlacedBatch,
+    /// The world.
+    pub world: &'a World,
+    /// One-candidate copies of the poses and placed bodies, made when some term reads them.
+    pub(crate) lane_poses: &'a [PoseBuffer],
+    pub(crate) lane_placed: &'a [PlacedBodies],
+}
+
+impl<'a> BatchContext<'a> {
+    /// Number of candidates (lanes in use).
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    /// Whether the batch holds no candidate.
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+
+    /// World position of a frame in lane `lane`, as [`Context::position`] gives it.
+    #[inline]
+    pub fn frame_position(&self, frame: FrameId, lane: usize) -> Point3<f64> {
+        let p = &self.poses.lanes()[frame.index()];
+        Point3::new(p[4][lane], p[5][lane], p[6][lane])
+    }
+
+    /// The one-candidate context of lane `lane` (what the default `eval_batch` of costs and task
+    /// functions evaluates).
+    ///
+    /// # Panics
+    /// When the objective did not make one-candidate copies: it makes them whenever one of its
+    /// terms or its task function does not say it is `batched`.
+    pub fn lane(&self, lane: usize) -> Context<'a> {
+        Context {
+            robot: self.robot,
+            q: self.q[lane],
+            poses: &self.lane_poses[lane],
+            collision: self.collision,
+            placed: &self.lane_placed[lane],
+            world: self.world,
+        }
     }
 }

@@ -4,7 +4,7 @@
 use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::Vector3;
 
-use crate::context::{Anchor, Context};
+use crate::context::{Anchor, BatchContext, Context};
 use crate::error::{Result, TaskError};
 use crate::tasks::TaskFunction;
 
@@ -18,6 +18,20 @@ pub trait Cost: Send + Sync + std::fmt::Debug {
     }
     /// The cost of one candidate.
     fn eval(&self, ctx: &Context) -> f64;
+    /// The cost of every candidate of a batch: `out[l]` for each lane `l < ctx.len()`. The
+    /// default evaluates each lane's [`BatchContext::lane`]; override it (and
+    /// [`Cost::batched`]) where the whole batch is cheaper at once. Must equal `eval` lane by
+    /// lane.
+    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+        for (l, o) in out[..ctx.len()].iter_mut().enumerate() {
+            *o = self.eval(&ctx.lane(l));
+        }
+    }
+    /// Whether [`Cost::eval_batch`] reads only the batch (never [`BatchContext::lane`]), so the
+    /// objective need not copy each candidate's poses and bodies out of it.
+    fn batched(&self) -> bool {
+        false
+    }
 }
 
 #[inline]
@@ -78,6 +92,22 @@ impl Cost for Collision {
             n += ctx.collision.count_world(ctx.placed, ctx.world);
         }
         n as f64
+    }
+    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+        let mut n = [0; trm_kinematics::LANES];
+        if self.self_collision {
+            n = ctx.collision.count_self_batch(ctx.placed);
+        }
+        if self.world {
+            let world = ctx.collision.count_world_batch(ctx.placed, ctx.world);
+            n.iter_mut().zip(world).for_each(|(n, w)| *n += w);
+        }
+        for (o, n) in out[..ctx.len()].iter_mut().zip(n) {
+            *o = n as f64;
+        }
+    }
+    fn batched(&self) -> bool {
+        true
     }
 }
 

@@ -6,10 +6,10 @@ use std::sync::Arc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use trm_collision::{CollisionModel, PlacedBodies, World};
+use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World};
 use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
-use crate::context::Context;
+use crate::context::{BatchContext, Context};
 use crate::costs::{Cost, TaskTarget};
 use crate::error::{Result, TaskError};
 use crate::tasks::TaskFunction;
@@ -45,6 +45,10 @@ pub struct Objective {
     /// Noise offsets of the robust objective (common random numbers, drawn once).
     noise: Vec<Vec<f64>>,
     needs_collision: bool,
+    /// Some term or the task function reads one-candidate poses ([`BatchContext::lane`]).
+    copies_poses: bool,
+    /// Some term reading one-candidate contexts needs placed bodies.
+    copies_placed: bool,
 }
 
 /// Per-thread buffers for evaluating an [`Objective`], one candidate or a batch at a time.
@@ -52,11 +56,15 @@ pub struct Objective {
 pub struct Scratch {
     poses: PoseBuffer,
     placed: PlacedBodies,
-    noisy: Vec<f64>,
-    /// Batched evaluation: the poses of [`LANES`] candidates, their values one after the
-    /// other, and every candidate's noisy copies.
+    /// Batched evaluation: the poses and placed bodies of [`LANES`] candidates, their values
+    /// one after the other, one-candidate copies for unbatched terms, task values per lane,
+    /// and every candidate's noisy copies.
     batch: PoseBatch,
+    placed_batch: PlacedBatch,
     lanes: Vec<f64>,
+    lane_poses: Vec<PoseBuffer>,
+    lane_placed: Vec<PlacedBodies>,
+    task_lanes: Vec<f64>,
     noisy_batch: Vec<f64>,
     noisy_owner: Vec<usize>,
 }
@@ -72,6 +80,8 @@ impl Objective {
             task: None,
             noise: Vec::new(),
             needs_collision: false,
+            copies_poses: false,
+            copies_placed: false,
         }
     }
 
@@ -95,6 +105,8 @@ impl Objective {
             });
         }
         self.needs_collision |= cost.needs_collision();
+        self.copies_poses |= !cost.batched();
+        self.copies_placed |= !cost.batched() && cost.needs_collision();
         self.terms.push(Term {
             weight,
             cost: Arc::from(cost),
@@ -104,6 +116,7 @@ impl Objective {
 
     /// Sets the task function.
     pub fn set_task(&mut self, task: Box<dyn TaskFunction>) {
+        self.copies_poses |= !task.batched();
         self.task = Some(Arc::from(task));
     }
 
@@ -170,12 +183,16 @@ impl Objective {
 
     /// Buffers for one thread.
     pub fn scratch(&self) -> Scratch {
+        let model = self.active.model();
         Scratch {
-            poses: self.active.model().pose_buffer(),
+            poses: model.pose_buffer(),
             placed: self.collision.placed_bodies(),
-            noisy: vec![0.0; self.dim()],
-            batch: self.active.model().pose_batch(),
+            batch: model.pose_batch(),
+            placed_batch: self.collision.placed_batch(),
             lanes: vec![0.0; LANES * self.dim()],
+            lane_poses: vec![model.pose_buffer(); LANES],
+            lane_placed: vec![self.collision.placed_bodies(); LANES],
+            task_lanes: Vec::new(),
             noisy_batch: Vec::new(),
             noisy_owner: Vec::new(),
         }
@@ -186,17 +203,20 @@ impl Objective {
     pub fn scratch_fits(&self, scratch: &Scratch) -> bool {
         let model = self.active.model();
         let (joints, frames) = (model.num_joints(), model.num_frames());
+        let bodies = self.collision.bodies().len();
         scratch.poses.fits(joints, frames)
             && scratch.batch.fits(joints, frames)
-            && scratch.placed.len() == self.collision.bodies().len()
-            && scratch.noisy.len() == self.dim()
+            && scratch.lane_poses.iter().all(|p| p.fits(joints, frames))
+            && scratch.placed.len() == bodies
+            && scratch.placed_batch.len() == bodies
+            && scratch.lane_placed.iter().all(|p| p.len() == bodies)
             && scratch.lanes.len() == LANES * self.dim()
     }
 
-    /// Forward kinematics (and collision placement when needed) of `q` into `scratch`, through
-    /// the batched kinematics like every other evaluation of the objective (in all lanes, so
-    /// the values are those of any batch holding `q`): a single check and a population's
-    /// evaluation never disagree, not even at exact contact. NaN in `q` gives NaN poses.
+    /// Forward kinematics (and collision placement when asked) of `q` into `scratch`'s
+    /// one-configuration buffers, through the batched kinematics like every other evaluation
+    /// (in all lanes, so the values are those of any batch holding `q`). NaN in `q` gives NaN
+    /// poses.
     fn pose(&self, q: &[f64], scratch: &mut Scratch, place: bool) {
         let d = self.dim();
         for lane in 0..LANES {
@@ -221,69 +241,108 @@ impl Objective {
         }
     }
 
-    fn weighted(&self, q: &[f64], scratch: &mut Scratch) -> f64 {
-        self.pose(q, scratch, self.needs_collision);
-        self.weighted_posed(q, scratch)
-    }
-
-    /// Σ aᵢ hᵢ at `q`, posed in `scratch` already.
-    fn weighted_posed(&self, q: &[f64], scratch: &Scratch) -> f64 {
-        let ctx = self.context(q, scratch);
-        self.terms
-            .iter()
-            .filter(|t| t.weight != 0.0)
-            .map(|t| t.weight * t.cost.eval(&ctx))
-            .sum()
-    }
-
     fn is_valid(&self, q: &[f64]) -> bool {
         q.len() == self.dim() && !q.iter().any(|v| v.is_nan())
     }
 
-    /// Poses the `n` candidates `q(k)` with batched forward kinematics, [`LANES`] at a time (a
-    /// partial batch is padded), and calls `f(k, q, scratch)` with candidate `k` posed (and its
-    /// bodies placed when `place`) in `scratch`, in order of `k`, until `f` returns false.
-    /// Invalid candidates (wrong length, NaN) are skipped. A candidate's poses do not depend on
-    /// the others in its batch.
-    fn pose_each<'q>(
+    /// Loads the next valid candidates `q(k)`, from `*k` on, into the lanes (at most
+    /// [`LANES`]; invalid ones — wrong length, NaN — are skipped), runs batched forward
+    /// kinematics and, when `place`, places the bodies of the batch. Their indices go to `ks`,
+    /// their values to `qs`; returns how many (0 when none is left). A partial batch is padded
+    /// with its first candidate, whose results are not used: a candidate's values never depend
+    /// on the others in its batch.
+    fn load<'q>(
+        &self,
+        n: usize,
+        q: &impl Fn(usize) -> &'q [f64],
+        k: &mut usize,
+        scratch: &mut Scratch,
+        place: bool,
+        (ks, qs): (&mut [usize; LANES], &mut [&'q [f64]; LANES]),
+    ) -> usize {
+        let d = self.dim();
+        let mut used = 0;
+        while used < LANES && *k < n {
+            let candidate = q(*k);
+            if self.is_valid(candidate) {
+                ks[used] = *k;
+                qs[used] = candidate;
+                scratch.lanes[used * d..(used + 1) * d].copy_from_slice(candidate);
+                used += 1;
+            }
+            *k += 1;
+        }
+        if used == 0 {
+            return 0;
+        }
+        for l in used..LANES {
+            scratch.lanes.copy_within(0..d, l * d);
+        }
+        self.active
+            .forward_batch_unchecked(&scratch.lanes, &mut scratch.batch);
+        if place {
+            self.collision
+                .place_batch(&scratch.batch, used, &mut scratch.placed_batch);
+        }
+        used
+    }
+
+    /// Evaluates the `n` candidates `q(k)` [`LANES`] at a time and calls `f(ks, ctx)` for each
+    /// batch (the candidates' indices and their [`BatchContext`]), in order, until `f` returns
+    /// false. Makes one-candidate copies of poses and bodies only when an unbatched term or
+    /// task function reads them.
+    fn batches<'q>(
         &self,
         n: usize,
         q: impl Fn(usize) -> &'q [f64],
         scratch: &mut Scratch,
-        place: bool,
-        mut f: impl FnMut(usize, &'q [f64], &mut Scratch) -> bool,
+        mut f: impl FnMut(&[usize], &BatchContext) -> bool,
     ) {
-        let d = self.dim();
-        let mut lanes = [0usize; LANES];
+        let place = self.needs_collision;
+        let (mut ks, mut qs) = ([0; LANES], [&[][..]; LANES]);
         let mut k = 0;
-        while k < n {
-            let mut used = 0;
-            while used < LANES && k < n {
-                if self.is_valid(q(k)) {
-                    lanes[used] = k;
-                    scratch.lanes[used * d..(used + 1) * d].copy_from_slice(q(k));
-                    used += 1;
-                }
-                k += 1;
-            }
+        loop {
+            let used = self.load(n, &q, &mut k, scratch, place, (&mut ks, &mut qs));
             if used == 0 {
-                break;
+                return;
             }
-            for l in used..LANES {
-                scratch.lanes.copy_within(0..d, l * d);
+            if self.copies_poses {
+                for l in 0..used {
+                    scratch.batch.lane_into(l, &mut scratch.lane_poses[l]);
+                }
             }
-            self.active
-                .forward_batch_unchecked(&scratch.lanes, &mut scratch.batch);
-            for (l, &k) in lanes[..used].iter().enumerate() {
-                scratch.batch.lane_into(l, &mut scratch.poses);
-                if place {
-                    self.collision.place(&scratch.poses, &mut scratch.placed);
+            if place && self.copies_placed {
+                for l in 0..used {
+                    self.collision
+                        .lane_into(&scratch.placed_batch, l, &mut scratch.lane_placed[l]);
                 }
-                if !f(k, q(k), scratch) {
-                    return;
-                }
+            }
+            let ctx = BatchContext {
+                robot: self.active.model(),
+                q: &qs[..used],
+                poses: &scratch.batch,
+                collision: &self.collision,
+                placed: &scratch.placed_batch,
+                world: &self.world,
+                lane_poses: &scratch.lane_poses,
+                lane_placed: &scratch.lane_placed,
+            };
+            if !f(&ks[..used], &ctx) {
+                return;
             }
         }
+    }
+
+    /// Σ aᵢ hᵢ of every lane of a batch, summed term by term in order.
+    fn weighted_batch(&self, ctx: &BatchContext, values: &mut [f64; LANES]) -> [f64; LANES] {
+        let mut total = [-0.0; LANES];
+        for t in self.terms.iter().filter(|t| t.weight != 0.0) {
+            t.cost.eval_batch(ctx, values);
+            for (s, v) in total.iter_mut().zip(&values[..ctx.len()]) {
+                *s += t.weight * v;
+            }
+        }
+        total
     }
 
     /// Whether every configuration of `qs` (`n × dim` values, one configuration after the
@@ -294,8 +353,8 @@ impl Objective {
     /// # Panics
     /// If `qs.len()` is not a multiple of [`Objective::dim`].
     pub fn all_collision_free_in(&self, qs: &[f64], world: &World, scratch: &mut Scratch) -> bool {
-        self.all_placed(qs, scratch, |placed| {
-            !self.collision.is_colliding(placed, world)
+        self.all_placed_batch(qs, scratch, |placed| {
+            self.collision.is_colliding_batch(placed, world)
         })
     }
 
@@ -306,15 +365,43 @@ impl Objective {
     /// # Panics
     /// If `qs.len()` is not a multiple of [`Objective::dim`].
     pub fn all_clear_of(&self, qs: &[f64], world: &World, scratch: &mut Scratch) -> bool {
-        self.all_placed(qs, scratch, |placed| {
-            !self.collision.any_world_collision(placed, world)
+        self.all_placed_batch(qs, scratch, |placed| {
+            self.collision.any_world_collision_batch(placed, world)
         })
     }
 
+    /// Whether `hits` finds no collision in any batch of the configurations of `qs` (`n ×
+    /// dim` values), placed [`LANES`] at a time; false at once for NaN.
+    fn all_placed_batch(
+        &self,
+        qs: &[f64],
+        scratch: &mut Scratch,
+        hits: impl Fn(&PlacedBatch) -> [bool; LANES],
+    ) -> bool {
+        let d = self.dim();
+        assert!(d > 0 && qs.len() % d == 0, "whole configurations");
+        if qs.iter().any(|v| v.is_nan()) {
+            return false;
+        }
+        let n = qs.len() / d;
+        let q = |k: usize| &qs[k * d..(k + 1) * d];
+        let (mut ks, mut qv) = ([0; LANES], [&[][..]; LANES]);
+        let mut k = 0;
+        loop {
+            let used = self.load(n, &q, &mut k, scratch, true, (&mut ks, &mut qv));
+            if used == 0 {
+                return true;
+            }
+            if hits(&scratch.placed_batch)[..used].iter().any(|&h| h) {
+                return false;
+            }
+        }
+    }
+
     /// Calls `f` with the robot's bodies placed at each configuration of `qs` (`n × dim`
-    /// values), in order, with forward kinematics [`LANES`] configurations at a time, until `f`
-    /// returns false; returns whether it held for all. A configuration holding NaN makes it
-    /// false without a call.
+    /// values), in order, with forward kinematics and placement [`LANES`] configurations at a
+    /// time, until `f` returns false; returns whether it held for all. A configuration holding
+    /// NaN makes it false without a call.
     ///
     /// # Panics
     /// If `qs.len()` is not a multiple of [`Objective::dim`].
@@ -326,27 +413,32 @@ impl Objective {
     ) -> bool {
         let d = self.dim();
         assert!(d > 0 && qs.len() % d == 0, "whole configurations");
-        let n = qs.len() / d;
         if qs.iter().any(|v| v.is_nan()) {
             return false;
         }
-        let mut all = true;
-        self.pose_each(
-            n,
-            |k| &qs[k * d..(k + 1) * d],
-            scratch,
-            true,
-            |_, _, s| {
-                all = free(&s.placed);
-                all
-            },
-        );
-        all
+        let n = qs.len() / d;
+        let q = |k: usize| &qs[k * d..(k + 1) * d];
+        let (mut ks, mut qv) = ([0; LANES], [&[][..]; LANES]);
+        let mut k = 0;
+        loop {
+            let used = self.load(n, &q, &mut k, scratch, true, (&mut ks, &mut qv));
+            if used == 0 {
+                return true;
+            }
+            for l in 0..used {
+                self.collision
+                    .lane_into(&scratch.placed_batch, l, &mut scratch.placed);
+                if !free(&scratch.placed) {
+                    return false;
+                }
+            }
+        }
     }
 
-    /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), with forward kinematics
-    /// for [`LANES`] candidates at a time (and every noise sample of a candidate as one more
-    /// lane). Equal to `eval`, bit for bit: each value depends on its own candidate only, so
+    /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), [`LANES`] candidates at a
+    /// time through batched kinematics, batched collision placement and counts and each term's
+    /// `eval_batch` (every noise sample of a candidate is one more lane). `eval` is a batch of
+    /// one, so the two agree bit for bit, and each value depends on its own candidate only:
     /// splitting `qs` differently (over threads, say) gives the same values. Allocation-free
     /// once `scratch` has grown to the largest batch with noise.
     ///
@@ -397,26 +489,35 @@ impl Objective {
                 return;
             }
         }
-        let place = nominal && self.needs_collision;
-        self.pose_each(
+        let m = task.as_ref().map_or(0, |(t, _)| t.dim());
+        let mut lanes_out = std::mem::take(&mut scratch.task_lanes);
+        lanes_out.resize(LANES * m, 0.0);
+        let mut values = [0.0; LANES];
+        self.batches(
             qs.len(),
             |k| qs[k].as_ref(),
             scratch,
-            place,
-            |k, q, s| {
+            |ks, ctx| {
                 if nominal {
-                    out[k] = self.weighted_posed(q, s);
+                    let h = self.weighted_batch(ctx, &mut values);
+                    for (&k, h) in ks.iter().zip(h) {
+                        out[k] = h;
+                    }
                 }
                 if let Some((task, tasks)) = &mut task {
-                    let m = task.dim();
-                    task.eval(&self.context(q, s), &mut tasks[k * m..(k + 1) * m]);
+                    task.eval_batch(ctx, &mut lanes_out);
+                    for (l, &k) in ks.iter().enumerate() {
+                        tasks[k * m..(k + 1) * m].copy_from_slice(&lanes_out[l * m..(l + 1) * m]);
+                    }
                 }
                 true
             },
         );
+        scratch.task_lanes = lanes_out;
     }
 
-    /// The robust h: the mean over every valid candidate's noisy copies, all posed in batches.
+    /// The robust h: the mean over every valid candidate's noisy copies, all evaluated in
+    /// batches.
     fn eval_noisy_batch<Q: AsRef<[f64]>>(&self, qs: &[Q], scratch: &mut Scratch, out: &mut [f64]) {
         out.fill(f64::NAN);
         let d = self.dim();
@@ -435,14 +536,16 @@ impl Objective {
                 owner.push(k);
             }
         }
-        let place = self.needs_collision;
-        self.pose_each(
+        let mut values = [0.0; LANES];
+        self.batches(
             owner.len(),
             |j| &noisy[j * d..(j + 1) * d],
             scratch,
-            place,
-            |j, q, s| {
-                out[owner[j]] += self.weighted_posed(q, s);
+            |js, ctx| {
+                let h = self.weighted_batch(ctx, &mut values);
+                for (&j, h) in js.iter().zip(h) {
+                    out[owner[j]] += h;
+                }
                 true
             },
         );
@@ -457,41 +560,39 @@ impl Objective {
     }
 
     /// h(q) = Σ aᵢ hᵢ (the mean over the noise samples when noise is set). NaN for a q of the
-    /// wrong length or with NaN values.
+    /// wrong length or with NaN values. One candidate through each term's `eval` (cheaper than
+    /// a batch of one); equal to [`Objective::eval_batch`] bit for bit, as each term's
+    /// `eval_batch` equals its `eval`.
     pub fn eval(&self, q: &[f64], scratch: &mut Scratch) -> f64 {
-        if q.len() != self.dim() || q.iter().any(|v| v.is_nan()) {
+        if !self.is_valid(q) {
             return f64::NAN;
         }
-        if self.noise.is_empty() {
-            return self.weighted(q, scratch);
+        if !self.noise.is_empty() {
+            let mut out = [0.0];
+            self.eval_batch(&[q], scratch, &mut out);
+            return out[0];
         }
-        let mut total = 0.0;
-        let mut noisy = std::mem::take(&mut scratch.noisy);
-        for offsets in &self.noise {
-            for ((n, q), e) in noisy.iter_mut().zip(q).zip(offsets) {
-                *n = q + e;
-            }
-            total += self.weighted(&noisy, scratch);
-        }
-        scratch.noisy = noisy;
-        total / self.noise.len() as f64
+        self.pose(q, scratch, self.needs_collision);
+        let ctx = self.context(q, scratch);
+        self.terms
+            .iter()
+            .filter(|t| t.weight != 0.0)
+            .map(|t| t.weight * t.cost.eval(&ctx))
+            .sum()
     }
 
     /// h(q) as [`Objective::eval`], and the task vector g(q) at the nominal q written to `task`
     /// (length of the task function's dimension), from the same forward-kinematics pass when there
     /// is no noise. Without a task function `task` is left untouched.
     pub fn eval_with_task(&self, q: &[f64], scratch: &mut Scratch, task: &mut [f64]) -> f64 {
-        let cost =
-            if self.noise.is_empty() && q.len() == self.dim() && !q.iter().any(|v| v.is_nan()) {
-                self.weighted(q, scratch)
-            } else {
-                let c = self.eval(q, scratch);
-                if q.len() == self.dim() {
-                    self.pose(q, scratch, false);
-                }
-                c
-            };
+        let mut out = [0.0];
+        if self.is_valid(q) {
+            self.eval_with_task_batch(&[q], scratch, &mut out, task);
+            return out[0];
+        }
+        let cost = self.eval(q, scratch);
         if let (Some(t), true) = (&self.task, q.len() == self.dim()) {
+            self.pose(q, scratch, false);
             t.eval(&self.context(q, scratch), task);
         }
         cost

@@ -4,7 +4,7 @@
 use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::{UnitQuaternion, Vector3};
 
-use crate::context::{Anchor, Context};
+use crate::context::{Anchor, BatchContext, Context};
 
 /// A task function.
 pub trait TaskFunction: Send + Sync + std::fmt::Debug {
@@ -14,6 +14,21 @@ pub trait TaskFunction: Send + Sync + std::fmt::Debug {
     fn label(&self) -> String;
     /// Writes g into `out` (length `dim()`).
     fn eval(&self, ctx: &Context, out: &mut [f64]);
+    /// Writes g of every candidate of a batch: lane `l`'s into `out[l·m..(l+1)·m]` (m =
+    /// `dim()`). The default evaluates each lane's [`BatchContext::lane`]; override it (and
+    /// [`TaskFunction::batched`]) where the whole batch is cheaper at once. Must equal `eval`
+    /// lane by lane.
+    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+        let m = self.dim();
+        for l in 0..ctx.len() {
+            self.eval(&ctx.lane(l), &mut out[l * m..(l + 1) * m]);
+        }
+    }
+    /// Whether [`TaskFunction::eval_batch`] reads only the batch (never
+    /// [`BatchContext::lane`]).
+    fn batched(&self) -> bool {
+        false
+    }
 }
 
 fn write_masked(v: Vector3<f64>, mask: [bool; 3], out: &mut [f64]) {
@@ -54,6 +69,16 @@ impl TaskFunction for PositionTask {
             self.mask,
             out,
         );
+    }
+    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+        let m = self.dim();
+        for l in 0..ctx.len() {
+            let p = ctx.frame_position(self.part, l);
+            write_masked(p.coords, self.mask, &mut out[l * m..(l + 1) * m]);
+        }
+    }
+    fn batched(&self) -> bool {
+        true
     }
 }
 

@@ -1,0 +1,499 @@
+//! Collision checks of [`LANES`] configurations at once.
+//!
+//! [`CollisionModel::place_batch`] moves every body into the world frame for all lanes of a
+//! [`PoseBatch`] in structure-of-arrays form (sphere and capsule ends as one value per lane), so
+//! the broad phase — the culling spheres of the kinematic tree and each pair's bounding spheres —
+//! tests all lanes in one vector instruction stream. Each lane carries a bit in a mask; a cull
+//! skips its block only when every live lane is clear of it, and the exact narrow-phase test of
+//! a pair runs only for the lanes its bounding spheres could not clear. The arithmetic repeats
+//! the one-configuration path operation for operation, so counts and verdicts are identical to
+//! [`CollisionModel::count_self`], [`CollisionModel::count_world`] and friends, lane by lane.
+
+use nalgebra::{Isometry3, Point3};
+use trm_kinematics::{LANES, Lanes, PoseBatch, lane_pose};
+
+use crate::cull::{Ball, Step};
+use crate::model::{CollisionModel, PlacedBodies};
+use crate::query::CollisionCount;
+use crate::shape::{Compiled, Geometry, Placed, intersects, sphere_apart};
+use crate::world::World;
+
+/// One bit per lane.
+type Mask = u8;
+
+/// Every lane of a batch.
+const ALL: Mask = (1 << LANES) - 1;
+
+/// Deepest nesting of culls followed lane by lane; deeper culls are passed through (still
+/// exact: culls only skip work).
+const MAX_DEPTH: usize = 64;
+
+/// A point in every lane: `[x, y, z]`, one value per lane each.
+type PointLanes = [Lanes; 3];
+
+/// World-frame geometry of every body in [`LANES`] configurations (a reusable scratch buffer,
+/// made by [`CollisionModel::placed_batch`] and filled by [`CollisionModel::place_batch`]).
+#[derive(Debug, Clone)]
+pub struct PlacedBatch {
+    /// Bounding-sphere centres.
+    centers: Vec<PointLanes>,
+    /// Round shapes: segment ends.
+    ends: Vec<[PointLanes; 2]>,
+    /// General shapes: the shape's pose per lane.
+    isos: Vec<[Isometry3<f64>; LANES]>,
+    /// World origins of the links the culling spheres are centred on.
+    origins: Vec<PointLanes>,
+    /// The lanes in use (the first `n` of the batch).
+    live: Mask,
+}
+
+impl PlacedBatch {
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.centers.len()
+    }
+
+    /// True for a robot without collision geometry.
+    pub fn is_empty(&self) -> bool {
+        self.centers.is_empty()
+    }
+
+    /// Number of configurations placed (the first lanes of the batch; queries answer 0 and
+    /// false for the others).
+    pub fn lanes(&self) -> usize {
+        self.live.count_ones() as usize
+    }
+
+    /// Body `body` of lane `lane` in the one-configuration form the exact tests take.
+    #[inline]
+    fn placed(&self, compiled: &Compiled, body: usize, lane: usize) -> Placed {
+        let center = point(&self.centers[body], lane);
+        match compiled.geometry {
+            Geometry::Round { .. } => {
+                let [a, b] = &self.ends[body];
+                Placed {
+                    center,
+                    bound: compiled.bound,
+                    a: point(a, lane),
+                    b: point(b, lane),
+                    iso: Isometry3::identity(),
+                }
+            }
+            Geometry::General { .. } => Placed {
+                center,
+                bound: compiled.bound,
+                a: Point3::origin(),
+                b: Point3::origin(),
+                iso: self.isos[body][lane],
+            },
+        }
+    }
+
+    /// Centre and radius of a culling ball in every lane.
+    #[inline(always)]
+    fn sphere(&self, compiled: &[Compiled], ball: Ball) -> (&PointLanes, f64) {
+        match ball {
+            Ball::Body(i) => (&self.centers[i as usize], compiled[i as usize].bound),
+            Ball::Origin { slot, radius } => (&self.origins[slot as usize], radius),
+        }
+    }
+}
+
+#[inline(always)]
+fn point(p: &PointLanes, lane: usize) -> Point3<f64> {
+    Point3::new(p[0][lane], p[1][lane], p[2][lane])
+}
+
+/// Lanes whose spheres `(a, ra)` and `(b, rb)` are apart, as the one-configuration test
+/// computes it: ‖a − b‖² > (ra + rb)².
+#[inline(always)]
+fn apart(a: &PointLanes, b: &PointLanes, r: f64) -> Mask {
+    let mut mask = 0;
+    for l in 0..LANES {
+        let (dx, dy, dz) = (a[0][l] - b[0][l], a[1][l] - b[1][l], a[2][l] - b[2][l]);
+        mask |= u8::from(dx * dx + dy * dy + dz * dz > r * r) << l;
+    }
+    mask
+}
+
+/// The lanes of a mask, lowest first.
+#[inline(always)]
+fn lanes_of(mask: Mask) -> impl Iterator<Item = usize> {
+    (0..LANES).filter(move |l| mask & (1 << l) != 0)
+}
+
+/// What a visitor says about a colliding pair in one lane: go on, skip the rest of this link
+/// pair (or link) in this lane, or stop this lane altogether.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Next {
+    SkipRest,
+    StopLane,
+}
+
+/// Culls followed lane by lane: the lanes still live inside each open cull, and where it ends.
+struct Nest {
+    open: [(u32, Mask); MAX_DEPTH],
+    depth: usize,
+}
+
+impl Nest {
+    fn new() -> Self {
+        Nest {
+            open: [(0, 0); MAX_DEPTH],
+            depth: 0,
+        }
+    }
+
+    /// Closes every cull that ends at or before step `i`; returns the lanes live after them.
+    #[inline(always)]
+    fn close(&mut self, i: usize, mut mask: Mask, live: Mask) -> Mask {
+        while self.depth > 0 && self.open[self.depth - 1].0 as usize <= i {
+            self.depth -= 1;
+            mask = self.open[self.depth].1;
+        }
+        mask & live
+    }
+
+    /// Where the innermost open cull ends (the end of the steps when none is open).
+    #[inline(always)]
+    fn next_end(&self, steps: usize) -> usize {
+        if self.depth > 0 {
+            self.open[self.depth - 1].0 as usize
+        } else {
+            steps
+        }
+    }
+
+    /// Opens a cull ending at `end`; `outer` are the lanes live before it. Beyond
+    /// [`MAX_DEPTH`] the cull is not narrowed (returns `outer`).
+    #[inline(always)]
+    fn open(&mut self, end: u32, outer: Mask, inner: Mask) -> Mask {
+        if self.depth == MAX_DEPTH {
+            return outer;
+        }
+        self.open[self.depth] = (end, outer);
+        self.depth += 1;
+        inner
+    }
+}
+
+impl CollisionModel {
+    /// A scratch buffer for [`CollisionModel::place_batch`].
+    pub fn placed_batch(&self) -> PlacedBatch {
+        let n = self.bodies().len();
+        let zero = [[0.0; LANES]; 3];
+        PlacedBatch {
+            centers: vec![zero; n],
+            ends: vec![[zero; 2]; n],
+            isos: vec![[Isometry3::identity(); LANES]; n],
+            origins: vec![zero; self.culling().origin_links.len()],
+            live: 0,
+        }
+    }
+
+    /// Moves every body to the world pose of its link in the first `lanes` (≤ [`LANES`])
+    /// configurations of `poses` (no allocation); the queries then answer for those lanes and
+    /// give 0 or false for the rest. Lane `l` holds exactly what [`CollisionModel::place`] makes
+    /// of [`PoseBatch::lane_into`]'s poses of lane `l`.
+    ///
+    /// # Panics
+    /// If the buffers do not belong to this model (wrong lengths) or `lanes` > [`LANES`].
+    pub fn place_batch(&self, poses: &PoseBatch, lanes: usize, out: &mut PlacedBatch) {
+        assert_eq!(
+            out.len(),
+            self.bodies().len(),
+            "placed batch of another model"
+        );
+        assert!(lanes <= LANES, "at most {LANES} lanes");
+        out.live = ALL >> (LANES - lanes);
+        place_round(self, poses, out);
+        let links = poses.lanes();
+        let mut one = Placed::default();
+        for (i, (b, c)) in self.bodies().iter().zip(self.compiled()).enumerate() {
+            if let Geometry::General { .. } = c.geometry {
+                for l in 0..LANES {
+                    c.place(&lane_pose(&links[b.link], l), &mut one);
+                    out.isos[i][l] = one.iso;
+                    for (axis, v) in out.centers[i].iter_mut().zip(one.center.iter()) {
+                        axis[l] = *v;
+                    }
+                }
+            }
+        }
+        for (o, &link) in out.origins.iter_mut().zip(&self.culling().origin_links) {
+            let p = &links[link as usize];
+            *o = [p[4], p[5], p[6]];
+        }
+    }
+
+    /// Copies lane `lane` of `batch` into a one-configuration buffer (for code written for
+    /// [`PlacedBodies`]). No allocation.
+    ///
+    /// # Panics
+    /// If either buffer belongs to another model.
+    pub fn lane_into(&self, batch: &PlacedBatch, lane: usize, out: &mut PlacedBodies) {
+        assert_eq!(batch.len(), out.placed.len(), "buffers of another model");
+        for (i, (c, p)) in self
+            .compiled()
+            .iter()
+            .zip(out.placed.iter_mut())
+            .enumerate()
+        {
+            *p = batch.placed(c, i, lane);
+        }
+        for (o, b) in out.origins.iter_mut().zip(&batch.origins) {
+            *o = point(b, lane);
+        }
+    }
+
+    /// Calls `hit(pair, lane)` for every checked body pair that collides in a live lane of
+    /// `live`, as [`CollisionModel::count_self`]'s walk does lane by lane.
+    fn walk_self_batch(
+        &self,
+        placed: &PlacedBatch,
+        live: Mask,
+        mut hit: impl FnMut(usize, usize) -> Option<Next>,
+    ) {
+        walk_self(self, placed, live, &mut hit);
+    }
+
+    /// As [`CollisionModel::walk_self_batch`], over (body, object) pairs: `hit(body, object,
+    /// lane)`.
+    fn walk_world_batch(
+        &self,
+        placed: &PlacedBatch,
+        world: &World,
+        live: Mask,
+        mut hit: impl FnMut(usize, usize, usize) -> Option<Next>,
+    ) {
+        walk_world(self, placed, world, live, &mut hit);
+    }
+
+    /// [`CollisionModel::count_self`] of every lane.
+    pub fn count_self_batch(&self, placed: &PlacedBatch) -> [usize; LANES] {
+        let mut n = [0; LANES];
+        self.walk_self_batch(placed, placed.live, |_, l| {
+            n[l] += 1;
+            Some(Next::SkipRest)
+        });
+        n
+    }
+
+    /// [`CollisionModel::count_world`] of every lane.
+    pub fn count_world_batch(&self, placed: &PlacedBatch, world: &World) -> [usize; LANES] {
+        let mut n = [0; LANES];
+        self.walk_world_batch(placed, world, placed.live, |_, _, l| {
+            n[l] += 1;
+            Some(Next::SkipRest)
+        });
+        n
+    }
+
+    /// [`CollisionModel::count`] of every lane.
+    pub fn count_batch(&self, placed: &PlacedBatch, world: &World) -> [CollisionCount; LANES] {
+        let (own, objects) = (
+            self.count_self_batch(placed),
+            self.count_world_batch(placed, world),
+        );
+        std::array::from_fn(|l| CollisionCount {
+            self_pairs: own[l],
+            world_pairs: objects[l],
+        })
+    }
+
+    /// [`CollisionModel::any_self_collision`] of every lane (each lane stops at its first).
+    pub fn any_self_collision_batch(&self, placed: &PlacedBatch) -> [bool; LANES] {
+        let mut any = [false; LANES];
+        self.walk_self_batch(placed, placed.live, |_, l| {
+            any[l] = true;
+            Some(Next::StopLane)
+        });
+        any
+    }
+
+    /// [`CollisionModel::any_world_collision`] of every lane.
+    pub fn any_world_collision_batch(&self, placed: &PlacedBatch, world: &World) -> [bool; LANES] {
+        let mut any = [false; LANES];
+        self.walk_world_batch(placed, world, placed.live, |_, _, l| {
+            any[l] = true;
+            Some(Next::StopLane)
+        });
+        any
+    }
+
+    /// [`CollisionModel::is_colliding`] of every lane: the world first, then self-collisions
+    /// in the lanes still free.
+    pub fn is_colliding_batch(&self, placed: &PlacedBatch, world: &World) -> [bool; LANES] {
+        let mut any = self.any_world_collision_batch(placed, world);
+        let free = (0..LANES).filter(|&l| !any[l]).fold(0, |m, l| m | (1 << l)) & placed.live;
+        self.walk_self_batch(placed, free, |_, l| {
+            any[l] = true;
+            Some(Next::StopLane)
+        });
+        any
+    }
+}
+
+/// The self-collision walk of [`CollisionModel::walk_self_batch`], compiled for several
+/// instruction sets (the lane tests are one vector instruction each), the best chosen at run
+/// time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn walk_self(
+    model: &CollisionModel,
+    placed: &PlacedBatch,
+    mut live: Mask,
+    hit: &mut dyn FnMut(usize, usize) -> Option<Next>,
+) {
+    let (pairs, compiled) = (model.pairs(), model.compiled());
+    let steps = &model.culling().self_steps;
+    let mut nest = Nest::new();
+    let mut mask = live;
+    let mut i = 0;
+    while i < steps.len() && live != 0 {
+        mask = nest.close(i, mask, live);
+        if mask == 0 {
+            i = nest.next_end(steps.len());
+            continue;
+        }
+        match steps[i] {
+            Step::Cull { a, b, end } => {
+                let ((ca, ra), (cb, rb)) = (placed.sphere(compiled, a), placed.sphere(compiled, b));
+                let inner = mask & !apart(ca, cb, ra + rb);
+                if inner == 0 {
+                    i = end as usize;
+                    continue;
+                }
+                mask = nest.open(end, mask, inner);
+            }
+            Step::Test { start, end } => {
+                let mut pending = mask;
+                let block = &pairs[start as usize..end as usize];
+                for (k, pair) in (start as usize..).zip(block) {
+                    let (a, b) = (pair.a as usize, pair.b as usize);
+                    let near = pending
+                        & !apart(
+                            &placed.centers[a],
+                            &placed.centers[b],
+                            compiled[a].bound + compiled[b].bound,
+                        );
+                    for l in lanes_of(near) {
+                        let (pa, pb) = (
+                            placed.placed(&compiled[a], a, l),
+                            placed.placed(&compiled[b], b, l),
+                        );
+                        if intersects(&compiled[a], &pa, &compiled[b], &pb) {
+                            match hit(k, l) {
+                                None => {}
+                                Some(Next::SkipRest) => pending &= !(1 << l),
+                                Some(Next::StopLane) => {
+                                    pending &= !(1 << l);
+                                    live &= !(1 << l);
+                                    mask &= !(1 << l);
+                                }
+                            }
+                        }
+                    }
+                    if pending == 0 {
+                        break;
+                    }
+                }
+            }
+        }
+        i += 1;
+    }
+}
+
+/// The world walk of [`CollisionModel::walk_world_batch`]: lane by lane, as the
+/// one-configuration walk (measured: following the lanes together through the world's culls
+/// was slower, as the lanes part ways at the first subtree a box clears for some of them), on
+/// the batch's structure-of-arrays data.
+fn walk_world(
+    model: &CollisionModel,
+    placed: &PlacedBatch,
+    world: &World,
+    live: Mask,
+    hit: &mut dyn FnMut(usize, usize, usize) -> Option<Next>,
+) {
+    let compiled = model.compiled();
+    let steps = &model.culling().world_steps;
+    'lanes: for l in lanes_of(live) {
+        for (o, object) in world.objects().iter().enumerate() {
+            let (oc, op) = (&object.compiled, &object.placed);
+            let mut s = 0;
+            while s < steps.len() {
+                match steps[s] {
+                    Step::Cull { a, end, .. } => {
+                        let (c, r) = placed.sphere(compiled, a);
+                        if sphere_apart(&point(c, l), r, oc, op) {
+                            s = end as usize;
+                            continue;
+                        }
+                    }
+                    Step::Test { start, end } => {
+                        let bodies = &compiled[start as usize..end as usize];
+                        for (i, body) in (start as usize..).zip(bodies) {
+                            let r = body.bound + op.bound;
+                            let c = point(&placed.centers[i], l);
+                            if (c - op.center).norm_squared() > r * r {
+                                continue;
+                            }
+                            let p = placed.placed(body, i, l);
+                            if intersects(body, &p, oc, op) {
+                                match hit(i, o, l) {
+                                    None => {}
+                                    Some(Next::SkipRest) => break,
+                                    Some(Next::StopLane) => continue 'lanes,
+                                }
+                            }
+                        }
+                    }
+                }
+                s += 1;
+            }
+        }
+    }
+}
+
+/// The ends and centres of every round body, for all lanes: the parent's rotation applied as
+/// nalgebra's `UnitQuaternion * Vector3` does (t = 2 q×v; v + w t + q×t), then its translation,
+/// so each lane equals [`Compiled::place`] bit for bit. Compiled for several instruction sets,
+/// the best chosen at run time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn place_round(model: &CollisionModel, poses: &PoseBatch, out: &mut PlacedBatch) {
+    let links = poses.lanes();
+    for (i, (body, c)) in model.bodies().iter().zip(model.compiled()).enumerate() {
+        let Geometry::Round { a, b, .. } = &c.geometry else {
+            continue;
+        };
+        let p = &links[body.link];
+        let mut ends = [[[0.0; LANES]; 3]; 2];
+        for (end, v) in ends.iter_mut().zip([a, b]) {
+            for l in 0..LANES {
+                let (w, x, y, z) = (p[0][l], p[1][l], p[2][l], p[3][l]);
+                let t = [
+                    (y * v.z - z * v.y) * 2.0,
+                    (z * v.x - x * v.z) * 2.0,
+                    (x * v.y - y * v.x) * 2.0,
+                ];
+                let cross = [
+                    y * t[2] - z * t[1],
+                    z * t[0] - x * t[2],
+                    x * t[1] - y * t[0],
+                ];
+                for k in 0..3 {
+                    end[k][l] = (t[k] * w + cross[k] + v[k]) + p[4 + k][l];
+                }
+            }
+        }
+        let mut center = [[0.0; LANES]; 3];
+        for k in 0..3 {
+            for l in 0..LANES {
+                center[k][l] = (ends[0][k][l] + ends[1][k][l]) * 0.5;
+            }
+        }
+        out.ends[i] = ends;
+        out.centers[i] = center;
+    }
+}
