@@ -378,6 +378,21 @@ impl Objective {
         scratch: &mut Scratch,
         hits: impl Fn(&PlacedBatch) -> [bool; LANES],
     ) -> bool {
+        self.each_placed_batch(qs, scratch, |used, s| {
+            !hits(&s.placed_batch)[..used].iter().any(|&h| h)
+        })
+    }
+
+    /// Calls `f(used, scratch)` with each batch of the configurations of `qs` (`n × dim`
+    /// values) placed in `scratch.placed_batch` (its first `used` lanes), in order, until `f`
+    /// returns false; returns whether it held for all. NaN anywhere makes it false without a
+    /// call.
+    fn each_placed_batch(
+        &self,
+        qs: &[f64],
+        scratch: &mut Scratch,
+        mut f: impl FnMut(usize, &mut Scratch) -> bool,
+    ) -> bool {
         let d = self.dim();
         assert!(d > 0 && qs.len() % d == 0, "whole configurations");
         if qs.iter().any(|v| v.is_nan()) {
@@ -392,7 +407,7 @@ impl Objective {
             if used == 0 {
                 return true;
             }
-            if hits(&scratch.placed_batch)[..used].iter().any(|&h| h) {
+            if !f(used, scratch) {
                 return false;
             }
         }
@@ -411,28 +426,12 @@ impl Objective {
         scratch: &mut Scratch,
         mut free: impl FnMut(&PlacedBodies) -> bool,
     ) -> bool {
-        let d = self.dim();
-        assert!(d > 0 && qs.len() % d == 0, "whole configurations");
-        if qs.iter().any(|v| v.is_nan()) {
-            return false;
-        }
-        let n = qs.len() / d;
-        let q = |k: usize| &qs[k * d..(k + 1) * d];
-        let (mut ks, mut qv) = ([0; LANES], [&[][..]; LANES]);
-        let mut k = 0;
-        loop {
-            let used = self.load(n, &q, &mut k, scratch, true, (&mut ks, &mut qv));
-            if used == 0 {
-                return true;
-            }
-            for l in 0..used {
-                self.collision
-                    .lane_into(&scratch.placed_batch, l, &mut scratch.placed);
-                if !free(&scratch.placed) {
-                    return false;
-                }
-            }
-        }
+        self.each_placed_batch(qs, scratch, |used, s| {
+            (0..used).all(|l| {
+                self.collision.lane_into(&s.placed_batch, l, &mut s.placed);
+                free(&s.placed)
+            })
+        })
     }
 
     /// [`Objective::eval`] of many candidates: `out[k]` = h(`qs[k]`), [`LANES`] candidates at a
