@@ -4,6 +4,11 @@ use nalgebra::DMatrix;
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
+/// Whether every value is finite (no early exit: the loop vectorises).
+pub(crate) fn all_finite(values: &[f64]) -> bool {
+    values.iter().fold(true, |ok, v| ok & v.is_finite())
+}
+
 /// Fills `out` with standard normal samples.
 #[inline]
 pub(crate) fn fill_normal(rng: &mut dyn Rng, out: &mut [f64]) {
@@ -90,9 +95,10 @@ pub(crate) fn phim(a: &DMatrix<f64>, out: &mut DMatrix<f64>, s: &mut ExpmScratch
 
 /// Copies `a` into `s.a`, scaled by 2^-k so that its 1-norm is at most 1/4; returns k.
 fn scaled(a: &DMatrix<f64>, s: &mut ExpmScratch) -> i32 {
-    let n = a.nrows();
-    let norm = (0..n)
-        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
+    let norm = a
+        .as_slice()
+        .chunks_exact(a.nrows().max(1))
+        .map(|column| column.iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max);
     let k = if norm > 0.25 {
         (norm / 0.25).log2().ceil() as i32
@@ -112,12 +118,19 @@ fn taylor(c: &[f64; 13], out: &mut DMatrix<f64>, s: &mut ExpmScratch) {
     // B_j = c_{4j} I + c_{4j+1} A + c_{4j+2} A² + c_{4j+3} A³
     let block =
         |m: &mut DMatrix<f64>, j: usize, a: &DMatrix<f64>, a2: &DMatrix<f64>, a3: &DMatrix<f64>| {
-            m.zip_zip_apply(a, a2, |v, x1, x2| {
-                *v += c[4 * j + 1] * x1 + c[4 * j + 2] * x2;
-            });
-            m.zip_apply(a3, |v, x3| *v += c[4 * j + 3] * x3);
-            for i in 0..m.nrows() {
-                m[(i, i)] += c[4 * j];
+            let [c0, c1, c2, c3] = [c[4 * j], c[4 * j + 1], c[4 * j + 2], c[4 * j + 3]];
+            let n = m.nrows();
+            for (((v, x1), x2), x3) in m
+                .as_mut_slice()
+                .iter_mut()
+                .zip(a.as_slice())
+                .zip(a2.as_slice())
+                .zip(a3.as_slice())
+            {
+                *v += c1 * x1 + c2 * x2 + c3 * x3;
+            }
+            for v in m.as_mut_slice().iter_mut().step_by(n + 1) {
+                *v += c0;
             }
         };
     // p = B0 + A⁴ (B1 + A⁴ (B2 + c12 A⁴))

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
 use crate::error::{Result, invalid};
-use crate::linalg::fill_normal;
+use crate::linalg::{all_finite, fill_normal};
 
 /// (1+1)-CMA-ES settings; `None` = the papers' defaults.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -295,7 +295,7 @@ impl Optimizer for OnePlusOne {
                 }
             }
         }
-        if !(self.sigma.is_finite() && self.sigma > 0.0) || self.a.iter().any(|v| !v.is_finite()) {
+        if !(self.sigma.is_finite() && self.sigma > 0.0 && all_finite(self.a.as_slice())) {
             self.state.set_degenerate();
         }
         Ok(())

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::core::{Optimizer, Start, State};
 use crate::error::{Result, invalid, positive};
-use crate::linalg::{ExpmScratch, expm, fill_normal, phim, rank};
+use crate::linalg::{ExpmScratch, all_finite, expm, fill_normal, phim, rank};
 
 /// xNES settings; `None` = the paper's default.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -240,9 +240,15 @@ impl Optimizer for Xnes {
     fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
         fill_normal(rng, self.z.as_mut_slice());
         self.bz.gemm(1.0, &self.b, &self.z, 0.0);
-        for (k, x) in self.candidates.iter_mut().enumerate() {
-            for (i, v) in x.iter_mut().enumerate() {
-                *v = self.mean[i] + self.sigma * self.bz[(i, k)];
+        let (mean, sigma) = (self.mean.as_slice(), self.sigma);
+        let d = mean.len();
+        for (x, bz) in self
+            .candidates
+            .iter_mut()
+            .zip(self.bz.as_slice().chunks_exact(d))
+        {
+            for ((v, m), b) in x.iter_mut().zip(mean).zip(bz) {
+                *v = m + sigma * b;
             }
             self.state.clamp(x);
         }
@@ -256,24 +262,20 @@ impl Optimizer for Xnes {
         let d = self.mean.len();
         // Natural gradients: G_δ = Σ u_k z_k, G_M = Σ u_k (z_k z_kᵀ − I) (Σ u_k = 0).
         // U Zᵀ (λ × d), then G_M = Z (U Zᵀ) and G_δ = (U Zᵀ)ᵀ 1
-        for (rank_k, &k) in self.order.iter().enumerate() {
-            let u = self.utilities[rank_k];
-            for i in 0..d {
-                self.uzt[(k, i)] = u * self.z[(i, k)];
+        // and G_σ = tr(G_M)/d = Σ u_k |z_k|² / d
+        let (lambda, z, uzt) = (self.lambda, self.z.as_slice(), self.uzt.as_mut_slice());
+        let mut g_sigma = 0.0;
+        for (&u, &k) in self.utilities.iter().zip(&self.order) {
+            let zk = &z[k * d..(k + 1) * d];
+            for (i, &v) in zk.iter().enumerate() {
+                uzt[i * lambda + k] = u * v;
             }
+            g_sigma += u * zk.iter().map(|v| v * v).sum::<f64>();
         }
-        for i in 0..d {
-            self.grad_mean[i] = self.uzt.column(i).sum();
+        g_sigma /= d as f64;
+        for (g, column) in self.grad_mean.iter_mut().zip(uzt.chunks_exact(lambda)) {
+            *g = column.iter().sum();
         }
-        // G_σ = tr(G_M)/d = Σ u_k |z_k|² / d
-        let g_sigma = (0..self.lambda)
-            .map(|k| {
-                (0..d)
-                    .map(|i| self.uzt[(k, i)] * self.z[(i, k)])
-                    .sum::<f64>()
-            })
-            .sum::<f64>()
-            / d as f64;
         // μ ← μ + η_μ σ B G_δ
         self.step.gemv(1.0, &self.b, &self.grad_mean, 0.0);
         self.mean.axpy(self.eta_mean * self.sigma, &self.step, 1.0);
@@ -305,7 +307,7 @@ impl Optimizer for Xnes {
             self.t1.gemm(1.0, &self.b, &self.e, 0.0);
             std::mem::swap(&mut self.b, &mut self.t1);
         }
-        if !(self.sigma.is_finite() && self.sigma > 0.0) || self.b.iter().any(|v| !v.is_finite()) {
+        if !(self.sigma.is_finite() && self.sigma > 0.0 && all_finite(self.b.as_slice())) {
             self.state.set_degenerate();
         }
         self.mean_slice.copy_from_slice(self.mean.as_slice());

@@ -2,7 +2,7 @@
 //! placed collision bodies, plus the world.
 
 use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World};
-use trm_kinematics::nalgebra::{Point3, Vector3};
+use trm_kinematics::nalgebra::{Isometry3, Point3, Vector3};
 use trm_kinematics::{FrameId, PoseBatch, PoseBuffer, RobotModel};
 
 /// One evaluated candidate. Built by [`crate::Objective`] after one forward-kinematics pass.
@@ -32,21 +32,92 @@ pub enum Anchor {
     Point([f64; 3]),
 }
 
-impl Context<'_> {
+/// What cost and task formulas read of one candidate, whether it was evaluated alone
+/// ([`Context`]) or as a lane of a batch ([`LaneView`]): a term written once against it serves
+/// `eval` and `eval_batch` alike, with the same values bit for bit.
+pub trait Frames {
+    /// Active values (the optimisation variables).
+    fn q(&self) -> &[f64];
+    /// The world.
+    fn world(&self) -> &World;
+    /// World pose of a link or named frame.
+    fn pose(&self, frame: FrameId) -> Isometry3<f64>;
+    /// World position of a link or named frame (cheaper than the whole [`Frames::pose`]).
+    fn frame_position(&self, frame: FrameId) -> Point3<f64>;
+
     /// World position of an anchor.
     #[inline]
-    pub fn position(&self, anchor: &Anchor) -> Point3<f64> {
+    fn position(&self, anchor: &Anchor) -> Point3<f64> {
         match anchor {
-            Anchor::Frame(f) => Point3::from(self.poses.pose(*f).translation.vector),
-            Anchor::Object(o) => Point3::from(self.world.objects()[*o].pose().translation.vector),
+            Anchor::Frame(f) => self.frame_position(*f),
+            Anchor::Object(o) => Point3::from(self.world().objects()[*o].pose().translation.vector),
             Anchor::Point(p) => Point3::from(*p),
         }
     }
 
     /// A frame's axis (given in the frame) in world coordinates.
     #[inline]
+    fn axis(&self, frame: FrameId, local: &Vector3<f64>) -> Vector3<f64> {
+        self.pose(frame).rotation * local
+    }
+}
+
+impl Context<'_> {
+    /// World position of an anchor.
+    #[inline]
+    pub fn position(&self, anchor: &Anchor) -> Point3<f64> {
+        Frames::position(self, anchor)
+    }
+
+    /// A frame's axis (given in the frame) in world coordinates.
+    #[inline]
     pub fn axis(&self, frame: FrameId, local: &Vector3<f64>) -> Vector3<f64> {
-        self.poses.pose(frame).rotation * local
+        Frames::axis(self, frame, local)
+    }
+}
+
+impl Frames for Context<'_> {
+    #[inline]
+    fn q(&self) -> &[f64] {
+        self.q
+    }
+    #[inline]
+    fn world(&self) -> &World {
+        self.world
+    }
+    #[inline]
+    fn pose(&self, frame: FrameId) -> Isometry3<f64> {
+        *self.poses.pose(frame)
+    }
+    #[inline]
+    fn frame_position(&self, frame: FrameId) -> Point3<f64> {
+        Point3::from(self.poses.pose(frame).translation.vector)
+    }
+}
+
+/// One lane of a [`BatchContext`] seen as one candidate, read in place (no copy).
+#[derive(Clone, Copy)]
+pub struct LaneView<'b, 'a> {
+    batch: &'b BatchContext<'a>,
+    lane: usize,
+}
+
+impl Frames for LaneView<'_, '_> {
+    #[inline]
+    fn q(&self) -> &[f64] {
+        self.batch.q[self.lane]
+    }
+    #[inline]
+    fn world(&self) -> &World {
+        self.batch.world
+    }
+    #[inline]
+    fn pose(&self, frame: FrameId) -> Isometry3<f64> {
+        self.batch.poses.pose(self.lane, frame)
+    }
+    #[inline]
+    fn frame_position(&self, frame: FrameId) -> Point3<f64> {
+        self.batch.frame_position(frame, self.lane)
     }
 }
 
@@ -88,6 +159,14 @@ impl<'a> BatchContext<'a> {
     pub fn frame_position(&self, frame: FrameId, lane: usize) -> Point3<f64> {
         let p = &self.poses.lanes()[frame.index()];
         Point3::new(p[4][lane], p[5][lane], p[6][lane])
+    }
+
+    /// Lane `lane` as one candidate, read in place: what batched terms written against
+    /// [`Frames`] evaluate.
+    #[inline]
+    pub fn view(&self, lane: usize) -> LaneView<'_, 'a> {
+        debug_assert!(lane < self.len());
+        LaneView { batch: self, lane }
     }
 
     /// The one-candidate context of lane `lane` (what the default `eval_batch` of costs and task

@@ -4,7 +4,7 @@
 use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::Vector3;
 
-use crate::context::{Anchor, BatchContext, Context};
+use crate::context::{Anchor, BatchContext, Context, Frames};
 use crate::error::{Result, TaskError};
 use crate::tasks::TaskFunction;
 
@@ -34,6 +34,24 @@ pub trait Cost: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// `eval`, `eval_batch` (each lane read in place) and `batched` of a cost through its
+/// `value(&self, &impl Frames) -> f64`, written once for both.
+macro_rules! on_frames {
+    () => {
+        fn eval(&self, ctx: &Context) -> f64 {
+            self.value(ctx)
+        }
+        fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+            for (l, o) in out[..ctx.len()].iter_mut().enumerate() {
+                *o = self.value(&ctx.view(l));
+            }
+        }
+        fn batched(&self) -> bool {
+            true
+        }
+    };
+}
+
 #[inline]
 fn masked_norm(v: Vector3<f64>, mask: [bool; 3]) -> f64 {
     (0..3)
@@ -56,8 +74,12 @@ impl Cost for HomePosture {
     fn label(&self) -> String {
         "home posture".into()
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        ctx.q
+    on_frames!();
+}
+
+impl HomePosture {
+    fn value(&self, f: &impl Frames) -> f64 {
+        f.q()
             .iter()
             .zip(&self.home)
             .zip(&self.weights)
@@ -150,17 +172,21 @@ impl Cost for Position {
     fn label(&self) -> String {
         format!("position {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        let v = ctx.position(&Anchor::Frame(self.part));
+    on_frames!();
+}
+
+impl Position {
+    fn value(&self, f: &impl Frames) -> f64 {
+        let v = f.position(&Anchor::Frame(self.part));
         match &self.target {
-            Region::Point(a) => masked_norm(v - ctx.position(a), self.mask),
+            Region::Point(a) => masked_norm(v - f.position(a), self.mask),
             Region::Box { min, max } => {
                 let outside =
                     Vector3::from_fn(|i, _| (min[i] - v[i]).max(0.0) + (v[i] - max[i]).max(0.0));
                 masked_norm(outside, self.mask)
             }
             Region::Sphere { center, radius } => {
-                (masked_norm(v - ctx.position(center), self.mask) - radius).max(0.0)
+                (masked_norm(v - f.position(center), self.mask) - radius).max(0.0)
             }
         }
     }
@@ -192,11 +218,15 @@ impl Cost for Orientation {
     fn label(&self) -> String {
         format!("orientation {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        let u = ctx.axis(self.part, &self.axis);
+    on_frames!();
+}
+
+impl Orientation {
+    fn value(&self, f: &impl Frames) -> f64 {
+        let u = f.axis(self.part, &self.axis);
         let want = match &self.target {
             Direction::Fixed(d) => *d,
-            Direction::Axis(f, a) => ctx.axis(*f, a),
+            Direction::Axis(frame, a) => f.axis(*frame, a),
         };
         (1.0 - u.dot(&want)) / 2.0
     }
@@ -222,11 +252,15 @@ impl Cost for Pointing {
     fn label(&self) -> String {
         format!("pointing {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        let v = ctx.position(&Anchor::Frame(self.part));
-        let to = ctx.position(&self.target) - v;
+    on_frames!();
+}
+
+impl Pointing {
+    fn value(&self, f: &impl Frames) -> f64 {
+        let v = f.position(&Anchor::Frame(self.part));
+        let to = f.position(&self.target) - v;
         let norm = to.norm();
-        let u = ctx.axis(self.part, &self.axis);
+        let u = f.axis(self.part, &self.axis);
         let aim = if norm > 0.0 {
             (1.0 - u.dot(&to) / norm) / 2.0
         } else {
@@ -255,8 +289,12 @@ impl Cost for Repel {
     fn label(&self) -> String {
         format!("repel {}", self.names)
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        let d = masked_norm(ctx.position(&self.a) - ctx.position(&self.b), self.mask);
+    on_frames!();
+}
+
+impl Repel {
+    fn value(&self, f: &impl Frames) -> f64 {
+        let d = masked_norm(f.position(&self.a) - f.position(&self.b), self.mask);
         (self.min_distance - d).max(0.0) / self.min_distance
     }
 }
@@ -277,9 +315,13 @@ impl Cost for JointLimits {
     fn label(&self) -> String {
         "joint limits".into()
     }
-    fn eval(&self, ctx: &Context) -> f64 {
+    on_frames!();
+}
+
+impl JointLimits {
+    fn value(&self, f: &impl Frames) -> f64 {
         let m = self.margin;
-        ctx.q
+        f.q()
             .iter()
             .zip(self.lower.iter().zip(&self.upper))
             .map(|(q, (l, u))| ((l + m - q).max(0.0) + (q - u + m).max(0.0)) / m)
@@ -298,8 +340,12 @@ impl Cost for Displacement {
     fn label(&self) -> String {
         "displacement".into()
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        ctx.q
+    on_frames!();
+}
+
+impl Displacement {
+    fn value(&self, f: &impl Frames) -> f64 {
+        f.q()
             .iter()
             .zip(&self.start)
             .map(|(q, s)| (q - s).powi(2))
@@ -327,9 +373,13 @@ impl Cost for TaskMapCost {
     fn label(&self) -> String {
         format!("task map {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context) -> f64 {
-        let object = ctx.world.objects()[self.object].pose();
-        let relative = object.inverse() * ctx.poses.pose(self.part);
+    on_frames!();
+}
+
+impl TaskMapCost {
+    fn value(&self, f: &impl Frames) -> f64 {
+        let object = f.world().objects()[self.object].pose();
+        let relative = object.inverse() * f.pose(self.part);
         self.map.cost(&trm_taskmap::to_params(&relative)).0
     }
 }
@@ -384,6 +434,24 @@ impl Cost for TaskTarget {
         let mut g = [0.0; Self::MAX_DIM];
         let g = &mut g[..self.target.len()];
         self.task.eval(ctx, g);
+        self.distance(g)
+    }
+    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+        let m = self.target.len();
+        let mut g = [0.0; Self::MAX_DIM * trm_kinematics::LANES];
+        self.task.eval_batch(ctx, &mut g[..m * ctx.len()]);
+        for (o, g) in out[..ctx.len()].iter_mut().zip(g.chunks_exact(m.max(1))) {
+            *o = self.distance(&g[..m]);
+        }
+    }
+    fn batched(&self) -> bool {
+        self.task.batched()
+    }
+}
+
+impl TaskTarget {
+    /// ‖g − t*‖.
+    fn distance(&self, g: &[f64]) -> f64 {
         g.iter()
             .zip(&self.target)
             .map(|(a, b)| (a - b).powi(2))

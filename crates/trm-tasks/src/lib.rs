@@ -35,7 +35,7 @@ pub mod spec;
 pub mod tasks;
 
 pub use comparison::{Comparison, ComparisonResult, ComparisonRun, ComparisonSummary};
-pub use context::{Anchor, BatchContext, Context};
+pub use context::{Anchor, BatchContext, Context, Frames, LaneView};
 pub use costs::{Cost, TaskTarget};
 pub use error::{Result, TaskError};
 pub use ngik::{Solution, solve, solve_with, solver_start};

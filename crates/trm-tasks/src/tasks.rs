@@ -4,7 +4,7 @@
 use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::{UnitQuaternion, Vector3};
 
-use crate::context::{Anchor, BatchContext, Context};
+use crate::context::{Anchor, BatchContext, Context, Frames};
 
 /// A task function.
 pub trait TaskFunction: Send + Sync + std::fmt::Debug {
@@ -29,6 +29,25 @@ pub trait TaskFunction: Send + Sync + std::fmt::Debug {
     fn batched(&self) -> bool {
         false
     }
+}
+
+/// `eval`, `eval_batch` (each lane read in place) and `batched` of a task function through its
+/// `write(&self, &impl Frames, out)`, written once for both.
+macro_rules! on_frames {
+    () => {
+        fn eval(&self, ctx: &Context, out: &mut [f64]) {
+            self.write(ctx, out);
+        }
+        fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
+            let m = self.dim();
+            for l in 0..ctx.len() {
+                self.write(&ctx.view(l), &mut out[l * m..(l + 1) * m]);
+            }
+        }
+        fn batched(&self) -> bool {
+            true
+        }
+    };
 }
 
 fn write_masked(v: Vector3<f64>, mask: [bool; 3], out: &mut [f64]) {
@@ -63,22 +82,12 @@ impl TaskFunction for PositionTask {
     fn label(&self) -> String {
         format!("position {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        write_masked(
-            ctx.position(&Anchor::Frame(self.part)).coords,
-            self.mask,
-            out,
-        );
-    }
-    fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
-        let m = self.dim();
-        for l in 0..ctx.len() {
-            let p = ctx.frame_position(self.part, l);
-            write_masked(p.coords, self.mask, &mut out[l * m..(l + 1) * m]);
-        }
-    }
-    fn batched(&self) -> bool {
-        true
+    on_frames!();
+}
+
+impl PositionTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        write_masked(f.frame_position(self.part).coords, self.mask, out);
     }
 }
 
@@ -108,10 +117,14 @@ impl TaskFunction for RotationTask {
             None => format!("rotation {}", self.part_name),
         }
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        let axis = ctx.axis(self.part, &self.axis);
+    on_frames!();
+}
+
+impl RotationTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        let axis = f.axis(self.part, &self.axis);
         let axis = match &self.relative_to {
-            Some((r, _)) => ctx.poses.pose(*r).rotation.inverse_transform_vector(&axis),
+            Some((r, _)) => f.pose(*r).rotation.inverse_transform_vector(&axis),
             None => axis,
         };
         write_masked(axis, self.mask, out);
@@ -139,8 +152,12 @@ impl TaskFunction for PoseTask {
     fn label(&self) -> String {
         format!("pose {}", self.part_name)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        let pose = ctx.poses.pose(self.part);
+    on_frames!();
+}
+
+impl PoseTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        let pose = f.pose(self.part);
         let p = pose.translation.vector;
         let r = (self.reference_inverse * pose.rotation).scaled_axis() * self.scale;
         out[..6].copy_from_slice(&[p.x, p.y, p.z, r.x, r.y, r.z]);
@@ -165,8 +182,12 @@ impl TaskFunction for DistanceTask {
     fn label(&self) -> String {
         format!("distance {}", self.names)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        out[0] = (ctx.position(&self.a) - ctx.position(&self.b)).norm();
+    on_frames!();
+}
+
+impl DistanceTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        out[0] = (f.position(&self.a) - f.position(&self.b)).norm();
     }
 }
 
@@ -193,8 +214,12 @@ impl TaskFunction for AngleTask {
     fn label(&self) -> String {
         format!("angle {}", self.names)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        let v = ctx.position(&self.a) - ctx.position(&self.b);
+    on_frames!();
+}
+
+impl AngleTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        let v = f.position(&self.a) - f.position(&self.b);
         out[0] = self.u2.dot(&v).atan2(self.u1.dot(&v));
     }
 }
@@ -219,8 +244,12 @@ impl TaskFunction for MidpointTask {
     fn label(&self) -> String {
         format!("midpoint {}", self.names)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        let m = (ctx.position(&self.a).coords + ctx.position(&self.b).coords) / 2.0;
+    on_frames!();
+}
+
+impl MidpointTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        let m = (f.position(&self.a).coords + f.position(&self.b).coords) / 2.0;
         write_masked(m, self.mask, out);
     }
 }
@@ -245,8 +274,12 @@ impl TaskFunction for RodDirectionTask {
     fn label(&self) -> String {
         format!("rod direction {}", self.names)
     }
-    fn eval(&self, ctx: &Context, out: &mut [f64]) {
-        let v = ctx.position(&self.b) - ctx.position(&self.a);
+    on_frames!();
+}
+
+impl RodDirectionTask {
+    fn write(&self, f: &impl Frames, out: &mut [f64]) {
+        let v = f.position(&self.b) - f.position(&self.a);
         let n = v.norm();
         let u = if n > 0.0 { v / n } else { Vector3::zeros() };
         write_masked(u, self.mask, out);

@@ -66,6 +66,18 @@ fn ngik_brings_the_hand_onto_a_task_map() {
         .unwrap()
         .value;
     assert!(start_cost > 1.0, "{start_cost}");
+    // the task-map term reads a batch's lanes in place, giving what one evaluation gives
+    let objective = &problem.objective;
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(8);
+    let qs: Vec<Vec<f64>> = (0..9)
+        .map(|_| objective.active().random(&mut rng))
+        .collect();
+    let mut scratch = objective.scratch();
+    let mut batch = vec![0.0; qs.len()];
+    objective.eval_batch(&qs, &mut scratch, &mut batch);
+    for (q, b) in qs.iter().zip(&batch) {
+        assert_eq!(objective.eval(q, &mut scratch).to_bits(), b.to_bits());
+    }
     assert!(c_map < 1e-4, "c_map {c_map} (from {start_cost})");
     // a missing map file is a located error
     let bad = spec.replace("stick.taskmap.json", "nope.json");
