@@ -10,12 +10,15 @@
 //! [`CollisionModel::count_self`], [`CollisionModel::count_world`] and friends, lane by lane.
 
 use nalgebra::{Isometry3, Point3};
-use trm_kinematics::{LANES, Lanes, PoseBatch, lane_pose};
+use trm_kinematics::{LANES, PoseBatch, lane_pose};
 
 use crate::cull::{Ball, Step};
 use crate::model::{CollisionModel, PlacedBodies};
 use crate::query::CollisionCount;
-use crate::shape::{Compiled, Geometry, Placed, intersects, sphere_apart};
+use crate::shape::{
+    Compiled, Geometry, Placed, PointLanes, intersects, segment_distance_squared_lanes,
+    sphere_apart,
+};
 use crate::world::World;
 
 /// One bit per lane.
@@ -27,9 +30,6 @@ const ALL: Mask = (1 << LANES) - 1;
 /// Deepest nesting of culls followed lane by lane; deeper culls are passed through (still
 /// exact: culls only skip work).
 const MAX_DEPTH: usize = 64;
-
-/// A point in every lane: `[x, y, z]`, one value per lane each.
-type PointLanes = [Lanes; 3];
 
 /// World-frame geometry of every body in [`LANES`] configurations (a reusable scratch buffer,
 /// made by [`CollisionModel::placed_batch`] and filled by [`CollisionModel::place_batch`]).
@@ -377,20 +377,36 @@ fn walk_self(
                             &placed.centers[b],
                             compiled[a].bound + compiled[b].bound,
                         );
-                    for l in lanes_of(near) {
-                        let (pa, pb) = (
-                            placed.placed(&compiled[a], a, l),
-                            placed.placed(&compiled[b], b, l),
-                        );
-                        if intersects(&compiled[a], &pa, &compiled[b], &pb) {
-                            match hit(k, l) {
-                                None => {}
-                                Some(Next::SkipRest) => pending &= !(1 << l),
-                                Some(Next::StopLane) => {
-                                    pending &= !(1 << l);
-                                    live &= !(1 << l);
-                                    mask &= !(1 << l);
-                                }
+                    if near == 0 {
+                        continue;
+                    }
+                    let touching = match (&compiled[a].geometry, &compiled[b].geometry) {
+                        // two capsules or spheres near in several lanes: one vector test
+                        (
+                            Geometry::Round { radius: ra, .. },
+                            Geometry::Round { radius: rb, .. },
+                        ) => {
+                            let r = ra + rb;
+                            let d2 =
+                                segment_distance_squared_lanes(&placed.ends[a], &placed.ends[b]);
+                            near & (0..LANES).fold(0, |m, l| m | (u8::from(d2[l] <= r * r) << l))
+                        }
+                        _ => lanes_of(near).fold(0, |m, l| {
+                            let (pa, pb) = (
+                                placed.placed(&compiled[a], a, l),
+                                placed.placed(&compiled[b], b, l),
+                            );
+                            m | (u8::from(intersects(&compiled[a], &pa, &compiled[b], &pb)) << l)
+                        }),
+                    };
+                    for l in lanes_of(touching) {
+                        match hit(k, l) {
+                            None => {}
+                            Some(Next::SkipRest) => pending &= !(1 << l),
+                            Some(Next::StopLane) => {
+                                pending &= !(1 << l);
+                                live &= !(1 << l);
+                                mask &= !(1 << l);
                             }
                         }
                     }

@@ -10,11 +10,13 @@ use serde::{Deserialize, Serialize};
 mod compiled;
 mod pair;
 mod segment_box;
+mod segment_lanes;
 
 pub(crate) use compiled::{Compiled, Geometry, Placed};
 pub(crate) use pair::{
     Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
 };
+pub(crate) use segment_lanes::{PointLanes, segment_distance_squared_lanes};
 
 /// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
 /// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.

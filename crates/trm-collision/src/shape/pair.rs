@@ -21,7 +21,7 @@ fn point_on(a: &Point3<f64>, b: &Point3<f64>, loc: SegmentPointLocation) -> Poin
 
 /// Squared distance between segments `[a1, b1]` and `[a2, b2]`.
 #[inline]
-fn segment_distance_squared(
+pub(super) fn segment_distance_squared(
     a1: &Point3<f64>,
     b1: &Point3<f64>,
     a2: &Point3<f64>,
