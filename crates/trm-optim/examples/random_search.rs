@@ -7,7 +7,9 @@
 use rand::{Rng, RngExt, SeedableRng};
 use rand_distr::StandardNormal;
 use trm_optim::functions::TestFunction;
-use trm_optim::{OptimError, Optimizer, Start, State, StopOptions, Xnes, XnesOptions, minimize_fn};
+use trm_optim::{
+    OptimError, Optimizer, Population, Start, State, StopOptions, Xnes, XnesOptions, minimize_fn,
+};
 
 /// A (1+1)-ES: one candidate per generation around the current point; the step grows after a
 /// success and shrinks after a failure so that about one in five candidates succeeds.
@@ -16,7 +18,7 @@ struct OnePlusOneEs {
     current: Vec<f64>,
     current_f: f64,
     sigma: f64,
-    candidate: Vec<Vec<f64>>,
+    candidate: Population,
 }
 
 impl OnePlusOneEs {
@@ -27,7 +29,7 @@ impl OnePlusOneEs {
             current: start.mean.clone(),
             current_f: f64::INFINITY,
             sigma: steps.iter().copied().fold(0.0, f64::max),
-            candidate: vec![start.mean.clone()],
+            candidate: Population::from_candidates(&[&start.mean]),
         })
     }
 }
@@ -39,7 +41,7 @@ impl Optimizer for OnePlusOneEs {
     fn dim(&self) -> usize {
         self.current.len()
     }
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         if self.current_f.is_finite() {
             for (x, c) in self.candidate[0].iter_mut().zip(&self.current) {
                 let z: f64 = rng.sample(StandardNormal);

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, invalid};
 use crate::linalg::{fill_normal, rank};
 use crate::xnes::default_population;
@@ -49,7 +49,7 @@ pub struct Cmaes {
     y: DMatrix<f64>,
     /// Scratch: D Z (columns) in `ask`, W° Yᵀ (rows) in `tell`.
     wyt: DMatrix<f64>,
-    candidates: Vec<Vec<f64>>,
+    candidates: Population,
     order: Vec<usize>,
     step_y: DVector<f64>,
     step_z: DVector<f64>,
@@ -131,7 +131,7 @@ impl Cmaes {
             z: DMatrix::zeros(n, lambda),
             y: DMatrix::zeros(n, lambda),
             wyt: DMatrix::zeros(n.max(lambda), n.max(lambda)),
-            candidates: vec![vec![0.0; n]; lambda],
+            candidates: Population::new(n, lambda),
             order: Vec::with_capacity(lambda),
             step_y: DVector::zeros(n),
             step_z: DVector::zeros(n),
@@ -187,7 +187,7 @@ impl Optimizer for Cmaes {
         self.mean.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         let n = self.mean.len();
         let gap = match self.eigen_interval {
             Some(g) => (g * self.lambda as u64) as f64 - 0.5,

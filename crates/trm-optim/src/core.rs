@@ -319,7 +319,7 @@ impl State {
 
     /// Records a generation's values for its candidates (call at the start of `tell`); returns
     /// an error on a count mismatch or a `tell` without `ask`.
-    pub fn told(&mut self, candidates: &[Vec<f64>], fitness: &[f64]) -> Result<()> {
+    pub fn told(&mut self, candidates: &Population, fitness: &[f64]) -> Result<()> {
         if self.pending == 0 {
             return Err(OptimError::NoPendingAsk);
         }
@@ -460,6 +460,118 @@ impl State {
     }
 }
 
+/// The candidates of one generation in one contiguous buffer, one after the other: candidate
+/// `k` is `as_slice()[k·dim..(k + 1)·dim]` (a `dim × n` column-major matrix, ready for batched
+/// evaluation or to be handed to other languages without a copy per candidate). Index it
+/// (`population[k]`), iterate it (`for x in &population`) or read the whole buffer.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Population {
+    values: Vec<f64>,
+    dim: usize,
+}
+
+impl Population {
+    /// `n` candidates of `dim` zeros.
+    pub fn new(dim: usize, n: usize) -> Self {
+        Population {
+            values: vec![0.0; dim * n],
+            dim,
+        }
+    }
+
+    /// Copies of `candidates` (all of one length).
+    ///
+    /// # Panics
+    /// If the candidates differ in length.
+    pub fn from_candidates<Q: AsRef<[f64]>>(candidates: &[Q]) -> Self {
+        let mut p = Population::default();
+        p.fill_from(candidates);
+        p
+    }
+
+    /// Number of candidates.
+    pub fn len(&self) -> usize {
+        self.values.len().checked_div(self.dim).unwrap_or(0)
+    }
+
+    /// Whether there is no candidate.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// Values per candidate.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Every value, candidate after candidate.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Every value, writable (for optimisers filling their population).
+    pub fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.values
+    }
+
+    /// Candidate `k`, if there is one.
+    pub fn get(&self, k: usize) -> Option<&[f64]> {
+        (k < self.len()).then(|| &self.values[k * self.dim..(k + 1) * self.dim])
+    }
+
+    /// The candidates in order.
+    pub fn iter(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.values.chunks_exact(self.dim.max(1))
+    }
+
+    /// The candidates in order, writable.
+    pub fn iter_mut(&mut self) -> std::slice::ChunksExactMut<'_, f64> {
+        self.values.chunks_exact_mut(self.dim.max(1))
+    }
+
+    /// Makes it `n` candidates of `dim` values (new values are zeros; keeps the allocation
+    /// when it shrinks).
+    pub fn resize(&mut self, dim: usize, n: usize) {
+        self.dim = dim;
+        self.values.resize(dim * n, 0.0);
+    }
+
+    /// Replaces the candidates with copies of `candidates` (all of one length).
+    ///
+    /// # Panics
+    /// If the candidates differ in length.
+    pub fn fill_from<Q: AsRef<[f64]>>(&mut self, candidates: &[Q]) {
+        let dim = candidates.first().map_or(self.dim, |q| q.as_ref().len());
+        self.resize(dim, candidates.len());
+        for (x, q) in self.iter_mut().zip(candidates) {
+            x.copy_from_slice(q.as_ref());
+        }
+    }
+}
+
+impl std::ops::Index<usize> for Population {
+    type Output = [f64];
+    fn index(&self, k: usize) -> &[f64] {
+        assert!(k < self.len(), "candidate {k} of {}", self.len());
+        &self.values[k * self.dim..(k + 1) * self.dim]
+    }
+}
+
+impl std::ops::IndexMut<usize> for Population {
+    fn index_mut(&mut self, k: usize) -> &mut [f64] {
+        assert!(k < self.len(), "candidate {k} of {}", self.len());
+        &mut self.values[k * self.dim..(k + 1) * self.dim]
+    }
+}
+
+impl<'a> IntoIterator for &'a Population {
+    type Item = &'a [f64];
+    type IntoIter = std::slice::ChunksExact<'a, f64>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
 /// An ask/tell optimiser minimising a function of `dim()` variables.
 ///
 /// Implement it for your own algorithm and every runner of trm accepts it ([`crate::minimize`],
@@ -476,8 +588,8 @@ pub trait Optimizer {
     fn name(&self) -> &'static str;
     /// Number of variables.
     fn dim(&self) -> usize;
-    /// Candidates of the next generation.
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>];
+    /// Candidates of the next generation, in one contiguous buffer.
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population;
     /// Values of the candidates of the last `ask`, in order.
     fn tell(&mut self, fitness: &[f64]) -> Result<()>;
     /// The centre of the search distribution (the current point for single-point methods).

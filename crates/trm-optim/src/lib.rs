@@ -57,7 +57,7 @@ pub mod xnes;
 
 pub use algorithms::{ALGORITHMS, by_name};
 pub use cmaes::{Cmaes, CmaesOptions};
-pub use core::{Bounds, Optimizer, Start, State, StepSize, StopOptions, StopReason};
+pub use core::{Bounds, Optimizer, Population, Start, State, StepSize, StopOptions, StopReason};
 pub use error::{OptimError, Result};
 pub use mh::{MetropolisHastings, MhOptions};
 pub use oneplusone::{ConstrainedReport, OnePlusOne, OnePlusOneOptions, minimize_constrained};

@@ -5,7 +5,7 @@
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, positive};
 use crate::linalg::fill_normal;
 
@@ -32,7 +32,7 @@ pub struct MetropolisHastings {
     steps: Vec<f64>,
     current: Vec<f64>,
     current_f: Option<f64>,
-    candidate: Vec<Vec<f64>>,
+    candidate: Population,
     uniform: f64,
     accepted: u64,
 }
@@ -50,7 +50,7 @@ impl MetropolisHastings {
             state: State::new(start, 1),
             temperature: options.temperature,
             steps,
-            candidate: vec![current.clone()],
+            candidate: Population::from_candidates(&[&current]),
             current,
             current_f: None,
             uniform: 0.0,
@@ -73,7 +73,7 @@ impl Optimizer for MetropolisHastings {
         self.current.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         if self.current_f.is_some() {
             let x = &mut self.candidate[0];
             fill_normal(rng, x);

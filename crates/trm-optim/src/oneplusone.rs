@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, invalid};
 use crate::linalg::{all_finite, fill_normal};
 
@@ -53,7 +53,7 @@ pub struct OnePlusOne {
     success: f64,
     z: DVector<f64>,
     az: DVector<f64>,
-    candidate: Vec<Vec<f64>>,
+    candidate: Population,
     traces: Vec<DVector<f64>>,
     w: Vec<DVector<f64>>,
     t1: DVector<f64>,
@@ -99,7 +99,7 @@ impl OnePlusOne {
             success: target,
             z: DVector::zeros(n),
             az: DVector::zeros(n),
-            candidate: vec![start.mean.clone()],
+            candidate: Population::from_candidates(&[&start.mean]),
             traces: vec![DVector::zeros(n); options.constraints],
             w: vec![DVector::zeros(n); options.constraints],
             t1: DVector::zeros(n),
@@ -258,7 +258,7 @@ impl Optimizer for OnePlusOne {
         self.parent.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         if self.parent_f.is_some() {
             fill_normal(rng, self.z.as_mut_slice());
             self.az.gemv(1.0, &self.a, &self.z, 0.0);
@@ -391,7 +391,7 @@ where
                     constraint_values(x, &mut g);
                     *o = violation(&g);
                     if *o == 0.0 && found.borrow().is_none() {
-                        *found.borrow_mut() = Some(x.clone());
+                        *found.borrow_mut() = Some(x.to_vec());
                     }
                 }
             },

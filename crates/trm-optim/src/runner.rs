@@ -3,7 +3,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, StopReason};
+use crate::core::{Optimizer, Population, StopReason};
 
 /// One generation, as the observer sees it.
 #[derive(Debug, Clone, Copy)]
@@ -54,11 +54,11 @@ pub fn minimize<O, F, B>(
 ) -> Report
 where
     O: Optimizer + ?Sized,
-    F: FnMut(&[Vec<f64>], &mut [f64]),
+    F: FnMut(&Population, &mut [f64]),
     B: FnMut(&Generation) -> bool,
 {
     let mut fitness = Vec::new();
-    let mut centre = vec![vec![0.0; optimizer.dim()]];
+    let mut centre = Population::new(optimizer.dim(), 1);
     let mut centre_f = [0.0];
     let with_centre = optimizer.state().stop_options().center_stagnation.is_some();
     let mut trace = Vec::new();
@@ -73,7 +73,7 @@ where
             unreachable!("minimize always tells as many values as it was asked");
         }
         if with_centre {
-            centre[0].copy_from_slice(optimizer.mean());
+            centre.as_mut_slice().copy_from_slice(optimizer.mean());
             objective(&centre, &mut centre_f);
             optimizer.record_center_fitness(&centre[0], centre_f[0]);
         }

@@ -6,7 +6,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::Result;
 
 /// Nelder–Mead settings.
@@ -42,8 +42,7 @@ pub struct NelderMead {
     centroid: Vec<f64>,
     reflected: Vec<f64>,
     reflected_f: f64,
-    batch: Vec<Vec<f64>>,
-    batch_len: usize,
+    batch: Population,
     phase: Phase,
 }
 
@@ -73,12 +72,12 @@ impl NelderMead {
             centroid: vec![0.0; d],
             reflected: vec![0.0; d],
             reflected_f: f64::INFINITY,
-            batch: vertices.clone(),
-            batch_len: d + 1,
+            batch: Population::default(),
             vertices,
             phase: Phase::Init,
         };
-        for v in &mut s.batch {
+        s.batch.fill_from(&s.vertices);
+        for v in &mut s.batch.iter_mut() {
             s.state.clamp(v);
         }
         Ok(s)
@@ -108,11 +107,11 @@ impl NelderMead {
         } else {
             &self.vertices[from]
         };
+        self.batch.resize(self.centroid.len(), 1);
         for i in 0..self.centroid.len() {
             self.batch[0][i] = self.centroid[i] + t * (from[i] - self.centroid[i]);
         }
         self.state.clamp(&mut self.batch[0]);
-        self.batch_len = 1;
     }
 
     fn start_reflection(&mut self) {
@@ -141,6 +140,8 @@ impl NelderMead {
 
     fn start_shrink(&mut self) {
         let best = self.order[0];
+        self.batch
+            .resize(self.centroid.len(), self.vertices.len() - 1);
         let mut j = 0;
         for k in 0..self.vertices.len() {
             if k == best {
@@ -153,7 +154,6 @@ impl NelderMead {
             self.state.clamp(&mut self.batch[j]);
             j += 1;
         }
-        self.batch_len = j;
         self.phase = Phase::Shrink;
     }
 }
@@ -167,13 +167,13 @@ impl Optimizer for NelderMead {
         self.centroid.len()
     }
 
-    fn ask(&mut self, _rng: &mut dyn Rng) -> &[Vec<f64>] {
-        self.state.asked(self.batch_len);
-        &self.batch[..self.batch_len]
+    fn ask(&mut self, _rng: &mut dyn Rng) -> &Population {
+        self.state.asked(self.batch.len());
+        &self.batch
     }
 
     fn tell(&mut self, fitness: &[f64]) -> Result<()> {
-        self.state.told(&self.batch[..self.batch_len], fitness)?;
+        self.state.told(&self.batch, fitness)?;
         let f = |v: f64| if v.is_nan() { f64::INFINITY } else { v };
         match self.phase {
             Phase::Init => {

@@ -8,7 +8,7 @@
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, invalid, positive};
 use crate::linalg::fill_normal;
 
@@ -55,7 +55,7 @@ pub struct Sir {
     particles: Vec<Vec<f64>>,
     values: Vec<f64>,
     log_weights: Vec<f64>,
-    proposals: Vec<Vec<f64>>,
+    proposals: Population,
     initialised: bool,
     scratch: Vec<Vec<f64>>,
     scratch_values: Vec<f64>,
@@ -83,7 +83,7 @@ impl Sir {
             particles: vec![start.mean.clone(); n],
             values: vec![f64::INFINITY; n],
             log_weights: vec![0.0; n],
-            proposals: vec![vec![0.0; d]; n],
+            proposals: Population::new(d, n),
             initialised: false,
             scratch: vec![vec![0.0; d]; n],
             scratch_values: vec![0.0; n],
@@ -154,7 +154,7 @@ impl Optimizer for Sir {
         self.mean.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         for (x, p) in self.proposals.iter_mut().zip(&self.particles) {
             fill_normal(rng, x);
             for i in 0..x.len() {

@@ -5,7 +5,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, invalid, positive};
 use crate::linalg::{fill_normal, rank};
 use crate::xnes::{default_population, nes_utilities};
@@ -33,7 +33,7 @@ pub struct Snes {
     mean: Vec<f64>,
     sigma: Vec<f64>,
     z: Vec<Vec<f64>>,
-    candidates: Vec<Vec<f64>>,
+    candidates: Population,
     order: Vec<usize>,
     grad_mean: Vec<f64>,
     grad_sigma: Vec<f64>,
@@ -62,7 +62,7 @@ impl Snes {
             mean: start.mean.clone(),
             sigma,
             z: vec![vec![0.0; d]; lambda],
-            candidates: vec![vec![0.0; d]; lambda],
+            candidates: Population::new(d, lambda),
             order: Vec::with_capacity(lambda),
             grad_mean: vec![0.0; d],
             grad_sigma: vec![0.0; d],
@@ -79,7 +79,7 @@ impl Optimizer for Snes {
         self.mean.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         for (z, x) in self.z.iter_mut().zip(self.candidates.iter_mut()) {
             fill_normal(rng, z);
             for i in 0..x.len() {

@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::core::{Optimizer, Start, State};
+use crate::core::{Optimizer, Population, Start, State};
 use crate::error::{Result, invalid, positive};
 use crate::linalg::{ExpmScratch, all_finite, expm, fill_normal, phim, rank};
 
@@ -71,7 +71,7 @@ pub struct Xnes {
     z: DMatrix<f64>,
     bz: DMatrix<f64>,
     uzt: DMatrix<f64>,
-    candidates: Vec<Vec<f64>>,
+    candidates: Population,
     order: Vec<usize>,
     grad_mean: DVector<f64>,
     step: DVector<f64>,
@@ -145,7 +145,7 @@ impl Xnes {
             z: DMatrix::zeros(d, lambda),
             bz: DMatrix::zeros(d, lambda),
             uzt: DMatrix::zeros(lambda, d),
-            candidates: vec![vec![0.0; d]; lambda],
+            candidates: Population::new(d, lambda),
             order: Vec::with_capacity(lambda),
             grad_mean: DVector::zeros(d),
             step: DVector::zeros(d),
@@ -237,7 +237,7 @@ impl Optimizer for Xnes {
         self.mean.len()
     }
 
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         fill_normal(rng, self.z.as_mut_slice());
         self.bz.gemm(1.0, &self.b, &self.z, 0.0);
         let (mean, sigma) = (self.mean.as_slice(), self.sigma);
@@ -401,7 +401,7 @@ mod tests {
             let mut whole = Xnes::new(&start, &options).unwrap();
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
             let step = |x: &mut Xnes, rng: &mut rand_chacha::ChaCha8Rng| {
-                let fitness: Vec<f64> = x.ask(rng).iter().map(|c| f(c)).collect();
+                let fitness: Vec<f64> = x.ask(rng).iter().map(&f).collect();
                 x.tell(&fitness).unwrap();
                 let m = x.mean().to_vec();
                 x.record_center_fitness(&m, f(&m));

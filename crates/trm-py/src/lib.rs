@@ -825,8 +825,7 @@ impl Optimizer {
         let (rows, d, flat) = self.with(|o, rng| {
             let d = o.dim();
             let xs = o.ask(rng);
-            let flat: Vec<f64> = xs.iter().flatten().copied().collect();
-            (xs.len(), d, flat)
+            (xs.len(), d, xs.as_slice().to_vec())
         });
         shaped(py, None, &[rows, d], flat)
     }

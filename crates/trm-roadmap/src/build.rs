@@ -16,7 +16,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use trm_kinematics::LANES;
-use trm_optim::{Bounds, Optimizer, Start, StopOptions, Xnes, XnesOptions};
+use trm_optim::{Bounds, Optimizer, Population, Start, StopOptions, Xnes, XnesOptions};
 
 use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
 use trm_tasks::spec::{FailureCount, MapSpec};
@@ -95,8 +95,8 @@ struct Search {
     from: Option<usize>,
     centre_t: Vec<f64>,
     centre_f: f64,
-    /// The last ask's candidates, copied into buffers kept from generation to generation.
-    candidates: Vec<Vec<f64>>,
+    /// The last ask's candidates, copied into a buffer kept from generation to generation.
+    candidates: Population,
 }
 
 /// The map under construction: points, their index and the SELECTPROPORTIONAL bookkeeping.
@@ -483,7 +483,7 @@ impl State {
                     from: s.from,
                     centre_t: s.centre_t,
                     centre_f: s.centre_f,
-                    candidates: Vec::new(),
+                    candidates: Population::default(),
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -715,7 +715,7 @@ pub(crate) fn run(
                 from,
                 centre_t: vec![0.0; dim],
                 centre_f: f64::NAN,
-                candidates: Vec::new(),
+                candidates: Population::default(),
             });
         }
         // one generation of every search: ask, evaluate all candidates in parallel, tell
@@ -727,16 +727,12 @@ pub(crate) fn run(
             .collect::<Vec<_>>();
         // asks in parallel (each search draws from its own stream)
         searches.par_iter_mut().for_each(|s| {
-            let xs = s.xnes.ask(&mut s.rng);
-            s.candidates.resize_with(xs.len(), Vec::new);
-            for (c, x) in s.candidates.iter_mut().zip(xs) {
-                c.clone_from(x);
-            }
+            s.candidates.clone_from(s.xnes.ask(&mut s.rng));
         });
         let jobs: Vec<(usize, &[f64])> = searches
             .iter()
             .enumerate()
-            .flat_map(|(i, s)| s.candidates.iter().map(move |x| (i, x.as_slice())))
+            .flat_map(|(i, s)| s.candidates.iter().map(move |x| (i, x)))
             .collect();
         // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
         let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {

@@ -108,11 +108,19 @@ pub fn solve_with(
         optimizer,
         rng,
         |xs, out| {
-            xs.par_chunks(LANES)
+            let d = xs.dim().max(1);
+            xs.as_slice()
+                .par_chunks(LANES * d)
                 .zip(out.par_chunks_mut(LANES))
                 .for_each_init(
                     || objective.scratch(),
-                    |scratch, (xs, out)| objective.eval_batch(xs, scratch, out),
+                    |scratch, (xs, out)| {
+                        let mut rows = [&[][..]; LANES];
+                        for (r, x) in rows.iter_mut().zip(xs.chunks_exact(d)) {
+                            *r = x;
+                        }
+                        objective.eval_batch(&rows[..out.len()], scratch, out);
+                    },
                 );
         },
         |_| true,

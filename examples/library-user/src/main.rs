@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use rand::{Rng, RngExt, SeedableRng};
 use trm_kinematics::{FrameId, PostureFile};
-use trm_optim::{OptimError, Optimizer, Start, State};
+use trm_optim::{OptimError, Optimizer, Population, Start, State};
 use trm_plan::{Goal, PlanOptions, Planner, Trajectory};
 use trm_roadmap::{BuildOptions, Roadmap};
 use trm_tasks::{Comparison, Context, Cost, Problem};
@@ -45,7 +45,7 @@ struct CompassSearch {
     current_f: f64,
     step: f64,
     failures: usize,
-    candidates: Vec<Vec<f64>>,
+    candidates: Population,
 }
 
 impl CompassSearch {
@@ -57,7 +57,7 @@ impl CompassSearch {
             current_f: f64::INFINITY,
             step: steps.iter().copied().fold(0.0, f64::max),
             failures: 0,
-            candidates: vec![start.mean.clone(); 2],
+            candidates: Population::from_candidates(&[&start.mean, &start.mean]),
         })
     }
 }
@@ -69,7 +69,7 @@ impl Optimizer for CompassSearch {
     fn dim(&self) -> usize {
         self.current.len()
     }
-    fn ask(&mut self, rng: &mut dyn Rng) -> &[Vec<f64>] {
+    fn ask(&mut self, rng: &mut dyn Rng) -> &Population {
         let axis = rng.random_range(0..self.current.len());
         for (c, sign) in self.candidates.iter_mut().zip([1.0, -1.0]) {
             c.copy_from_slice(&self.current);
