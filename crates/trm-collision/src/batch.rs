@@ -17,7 +17,6 @@ use crate::model::{CollisionModel, PlacedBodies};
 use crate::query::CollisionCount;
 use crate::shape::{
     Compiled, Geometry, Placed, PointLanes, intersects, segment_distance_squared_lanes,
-    sphere_apart,
 };
 use crate::world::World;
 
@@ -420,53 +419,163 @@ fn walk_self(
     }
 }
 
-/// The world walk of [`CollisionModel::walk_world_batch`]: lane by lane, as the
-/// one-configuration walk (measured: following the lanes together through the world's culls
-/// was slower, as the lanes part ways at the first subtree a box clears for some of them), on
-/// the batch's structure-of-arrays data.
+/// A world object as the world walk tests spheres against it in every lane at once: its
+/// bounding sphere and, for a box, its pose (the inverse rotation as nalgebra applies it) and
+/// half extents.
+struct Obstacle {
+    center: [f64; 3],
+    bound: f64,
+    /// Boxes: the conjugate quaternion (w, x, y, z), the translation and the half extents.
+    slabs: Option<([f64; 4], [f64; 3], [f64; 3])>,
+}
+
+impl Obstacle {
+    fn new(object: &crate::world::WorldObject) -> Self {
+        let (c, p) = (&object.compiled, &object.placed);
+        let slabs = match &c.geometry {
+            Geometry::General {
+                half_extents: Some(h),
+                ..
+            } => {
+                let q = p.iso.rotation.conjugate();
+                let t = p.iso.translation.vector;
+                Some(([q.w, q.i, q.j, q.k], [t.x, t.y, t.z], [h.x, h.y, h.z]))
+            }
+            _ => None,
+        };
+        Obstacle {
+            center: [p.center.x, p.center.y, p.center.z],
+            bound: p.bound,
+            slabs,
+        }
+    }
+
+    /// Of the lanes `of`, those where the sphere `(c, r)` cannot touch the object: outside its
+    /// bounding sphere or, for a box, outside one of its slabs — `sphere_apart` of the
+    /// one-configuration walk, operation for operation.
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // lane-indexed loops, written as the vectoriser reads them
+    fn sphere_apart(&self, c: &PointLanes, r: f64, of: Mask) -> Mask {
+        let rr = r + self.bound;
+        let mut far = 0;
+        for l in 0..LANES {
+            let (dx, dy, dz) = (
+                c[0][l] - self.center[0],
+                c[1][l] - self.center[1],
+                c[2][l] - self.center[2],
+            );
+            far |= u8::from(dx * dx + dy * dy + dz * dz > rr * rr) << l;
+        }
+        let Some((q, t, half)) = &self.slabs else {
+            return far & of;
+        };
+        if far & of == of {
+            return of;
+        }
+        // the centre in the box frame, q⁻¹ (c − t) as UnitQuaternion * Vector3 computes it
+        // (for an axis-aligned box that is c − t exactly)
+        let mut local = [[0.0; LANES]; 3];
+        for (k, axis) in local.iter_mut().enumerate() {
+            for l in 0..LANES {
+                axis[l] = c[k][l] - t[k];
+            }
+        }
+        if let [w, x, y, z] = *q
+            && (x, y, z) != (0.0, 0.0, 0.0)
+        {
+            for l in 0..LANES {
+                let v = [local[0][l], local[1][l], local[2][l]];
+                let u = [
+                    (y * v[2] - z * v[1]) * 2.0,
+                    (z * v[0] - x * v[2]) * 2.0,
+                    (x * v[1] - y * v[0]) * 2.0,
+                ];
+                let cross = [
+                    y * u[2] - z * u[1],
+                    z * u[0] - x * u[2],
+                    x * u[1] - y * u[0],
+                ];
+                for k in 0..3 {
+                    local[k][l] = u[k] * w + cross[k] + v[k];
+                }
+            }
+        }
+        let mut outside = 0;
+        for (axis, h) in local.iter().zip(half) {
+            for (l, v) in axis.iter().enumerate() {
+                outside |= u8::from(v.abs() > h + r) << l;
+            }
+        }
+        (far | outside) & of
+    }
+}
+
+/// The world walk of [`CollisionModel::walk_world_batch`]: for each object, the lanes followed
+/// together through the culling steps as in the self walk; a cull sphere or a body's bounding
+/// sphere is tested against the object (its bounding sphere, a box's slabs) in every lane at
+/// once, and the exact test runs only in the lanes those could not clear. Compiled for several
+/// instruction sets, the best chosen at run time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
 fn walk_world(
     model: &CollisionModel,
     placed: &PlacedBatch,
     world: &World,
-    live: Mask,
+    mut live: Mask,
     hit: &mut dyn FnMut(usize, usize, usize) -> Option<Next>,
 ) {
     let compiled = model.compiled();
     let steps = &model.culling().world_steps;
-    'lanes: for l in lanes_of(live) {
-        for (o, object) in world.objects().iter().enumerate() {
-            let (oc, op) = (&object.compiled, &object.placed);
-            let mut s = 0;
-            while s < steps.len() {
-                match steps[s] {
-                    Step::Cull { a, end, .. } => {
-                        let (c, r) = placed.sphere(compiled, a);
-                        if sphere_apart(&point(c, l), r, oc, op) {
-                            s = end as usize;
-                            continue;
-                        }
+    for (o, object) in world.objects().iter().enumerate() {
+        let (oc, op) = (&object.compiled, &object.placed);
+        let obstacle = Obstacle::new(object);
+        let mut nest = Nest::new();
+        let mut mask = live;
+        let mut s = 0;
+        while s < steps.len() && live != 0 {
+            mask = nest.close(s, mask, live);
+            if mask == 0 {
+                s = nest.next_end(steps.len());
+                continue;
+            }
+            match steps[s] {
+                Step::Cull { a, end, .. } => {
+                    let (c, r) = placed.sphere(compiled, a);
+                    let inner = mask & !obstacle.sphere_apart(c, r, mask);
+                    if inner == 0 {
+                        s = end as usize;
+                        continue;
                     }
-                    Step::Test { start, end } => {
-                        let bodies = &compiled[start as usize..end as usize];
-                        for (i, body) in (start as usize..).zip(bodies) {
-                            let r = body.bound + op.bound;
-                            let c = point(&placed.centers[i], l);
-                            if (c - op.center).norm_squared() > r * r {
+                    mask = nest.open(end, mask, inner);
+                }
+                Step::Test { start, end } => {
+                    let mut pending = mask;
+                    let bodies = &compiled[start as usize..end as usize];
+                    for (i, body) in (start as usize..).zip(bodies) {
+                        let near = pending
+                            & !obstacle.sphere_apart(&placed.centers[i], body.bound, pending);
+                        for l in lanes_of(near) {
+                            let p = placed.placed(body, i, l);
+                            if !intersects(body, &p, oc, op) {
                                 continue;
                             }
-                            let p = placed.placed(body, i, l);
-                            if intersects(body, &p, oc, op) {
-                                match hit(i, o, l) {
-                                    None => {}
-                                    Some(Next::SkipRest) => break,
-                                    Some(Next::StopLane) => continue 'lanes,
+                            match hit(i, o, l) {
+                                None => {}
+                                Some(Next::SkipRest) => pending &= !(1 << l),
+                                Some(Next::StopLane) => {
+                                    pending &= !(1 << l);
+                                    live &= !(1 << l);
+                                    mask &= !(1 << l);
                                 }
                             }
                         }
+                        if pending == 0 {
+                            break;
+                        }
                     }
                 }
-                s += 1;
             }
+            s += 1;
         }
     }
 }
