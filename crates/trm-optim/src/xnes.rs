@@ -88,6 +88,20 @@ pub struct Xnes {
     phi_wzt: DMatrix<f64>,
     phi_scratch: ExpmScratch,
     mean_slice: Vec<f64>,
+    /// σ times B's largest row norm (the largest standard deviation), kept up to date.
+    spread: f64,
+}
+
+/// σ times the largest row norm of `b`, the rows summed column by column into `rows` (in the
+/// order `b.row(i).norm_squared()` sums them).
+fn largest_deviation(b: &DMatrix<f64>, sigma: f64, rows: &mut [f64]) -> f64 {
+    rows.fill(0.0);
+    for column in b.as_slice().chunks_exact(b.nrows().max(1)) {
+        for (r, v) in rows.iter_mut().zip(column) {
+            *r += v * v;
+        }
+    }
+    sigma * rows.iter().copied().fold(0.0, f64::max).sqrt()
 }
 
 impl Xnes {
@@ -139,6 +153,7 @@ impl Xnes {
             eta_b,
             utilities: nes_utilities(lambda),
             mean_slice: mean.as_slice().to_vec(),
+            spread: largest_deviation(&b, sigma, &mut vec![0.0; d]),
             mean,
             sigma,
             b,
@@ -311,6 +326,7 @@ impl Optimizer for Xnes {
             self.state.set_degenerate();
         }
         self.mean_slice.copy_from_slice(self.mean.as_slice());
+        self.spread = largest_deviation(&self.b, self.sigma, self.step.as_mut_slice());
         Ok(())
     }
 
@@ -319,11 +335,7 @@ impl Optimizer for Xnes {
     }
 
     fn spread(&self) -> f64 {
-        let d = self.mean.len();
-        let max_row = (0..d)
-            .map(|i| self.b.row(i).norm_squared())
-            .fold(0.0, f64::max);
-        self.sigma * max_row.sqrt()
+        self.spread
     }
 
     fn state(&self) -> &State {

@@ -20,7 +20,7 @@ use trm_optim::{Bounds, Optimizer, Population, Start, StopOptions, Xnes, XnesOpt
 
 use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
 use trm_tasks::spec::{FailureCount, MapSpec};
-use trm_tasks::{Objective, Problem};
+use trm_tasks::{Objective, Problem, ScratchPool};
 
 use crate::edges::distance;
 use crate::error::{Result, RoadmapError};
@@ -221,45 +221,6 @@ thread_local! {
     static NEAREST: std::cell::RefCell<Vec<(f64, usize)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// Scratch buffers of an [`Objective`] kept between parallel evaluations: each worker borrows
-/// one (or makes one) and gives it back when its share is done. A buffer that does not fit the
-/// objective at hand ([`Objective::scratch_fits`]) is dropped, not used.
-#[derive(Debug, Default)]
-pub struct ScratchPool(std::sync::Mutex<Vec<trm_tasks::Scratch>>);
-
-/// A scratch buffer borrowed from a [`ScratchPool`], returned to it when dropped.
-struct Lease<'a> {
-    pool: &'a ScratchPool,
-    scratch: Option<trm_tasks::Scratch>,
-}
-
-impl<'a> Lease<'a> {
-    fn take(pool: &'a ScratchPool, objective: &Objective) -> Self {
-        let kept = pool
-            .0
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .pop()
-            .filter(|s| objective.scratch_fits(s));
-        Lease {
-            pool,
-            scratch: Some(kept.unwrap_or_else(|| objective.scratch())),
-        }
-    }
-}
-
-impl Drop for Lease<'_> {
-    fn drop(&mut self) {
-        if let Some(s) = self.scratch.take() {
-            self.pool
-                .0
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner)
-                .push(s);
-        }
-    }
-}
-
 /// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time ([`Threads`]),
 /// with scratch buffers from `pool`.
 pub fn evaluate_on_threads(
@@ -275,11 +236,9 @@ pub fn evaluate_on_threads(
         .zip(tasks.par_chunks_mut((LANES * dim).max(1)))
         .zip(qs.par_chunks(LANES))
         .for_each_init(
-            || Lease::take(pool, objective),
-            |lease, ((fitness, tasks), qs)| {
-                if let Some(scratch) = lease.scratch.as_mut() {
-                    objective.eval_with_task_batch(qs, scratch, fitness, tasks);
-                }
+            || pool.lease(objective),
+            |scratch, ((fitness, tasks), qs)| {
+                objective.eval_with_task_batch(qs, scratch, fitness, tasks);
             },
         );
 }

@@ -26,8 +26,8 @@ mod repair;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
-    BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, ScratchPool,
-    Threads, build, build_with, evaluate_on_threads, resume, resume_with,
+    BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, Threads, build,
+    build_with, evaluate_on_threads, resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
@@ -38,3 +38,5 @@ pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Parked, Roadmap, VERSION};
 pub use repair::{LiveMap, REPAIR_FAILURE_LIMIT, RepairOptions, RepairReport, repair};
+/// Scratch buffers kept between a build's parallel evaluations (from `trm_tasks`).
+pub use trm_tasks::ScratchPool;

@@ -26,8 +26,9 @@ use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 use trm_tasks::Objective;
 
-use crate::build::{Evaluator, ScratchPool, evaluate_on_threads};
+use crate::build::{Evaluator, evaluate_on_threads};
 use crate::error::{Result, RoadmapError};
+use trm_tasks::ScratchPool;
 
 /// Message tags: a slice of postures to evaluate, and the end of the build.
 const WORK: i32 = 1;

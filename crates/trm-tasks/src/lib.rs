@@ -31,6 +31,7 @@ pub mod costs;
 mod error;
 mod ngik;
 mod objective;
+mod pool;
 pub mod spec;
 pub mod tasks;
 
@@ -40,6 +41,7 @@ pub use costs::{Cost, TaskTarget};
 pub use error::{Result, TaskError};
 pub use ngik::{Solution, solve, solve_with, solver_start};
 pub use objective::{Objective, Scratch, TermValue};
+pub use pool::{Lease, ScratchPool};
 pub use spec::{Problem, Spec};
 pub use tasks::TaskFunction;
 

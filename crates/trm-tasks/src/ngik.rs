@@ -104,6 +104,7 @@ pub fn solve_with(
         });
     }
     let started = Instant::now();
+    let pool = crate::ScratchPool::default();
     let report = minimize(
         optimizer,
         rng,
@@ -113,8 +114,14 @@ pub fn solve_with(
                 .par_chunks(LANES * d)
                 .zip(out.par_chunks_mut(LANES))
                 .for_each_init(
-                    || objective.scratch(),
+                    || pool.lease(objective),
                     |scratch, (xs, out)| {
+                        if let [one] = out {
+                            // one candidate (MH, (1+1)-ES, simplex steps, centres): the
+                            // one-configuration path, equal to a batch of one bit for bit
+                            *one = objective.eval(xs, scratch);
+                            return;
+                        }
                         let mut rows = [&[][..]; LANES];
                         for (r, x) in rows.iter_mut().zip(xs.chunks_exact(d)) {
                             *r = x;
