@@ -80,8 +80,11 @@ fn evaluating_on_the_threads_does_not_allocate() {
     let dim = objective.task().map_or(0, |t| t.dim());
     let (mut fitness, mut tasks) = (vec![0.0; qs.len()], vec![0.0; qs.len() * dim]);
     let pool = trm_roadmap::ScratchPool::default();
-    // the first call fills the pool
-    trm_roadmap::evaluate_on_threads(objective, &qs, &mut fitness, &mut tasks, &pool);
+    // the first calls fill the pool (as many buffers as rayon ever runs pieces of one call at
+    // once: a thread waiting in a join may run a stolen piece with a second buffer)
+    for _ in 0..20 {
+        trm_roadmap::evaluate_on_threads(objective, &qs, &mut fitness, &mut tasks, &pool);
+    }
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     for _ in 0..100 {
         trm_roadmap::evaluate_on_threads(objective, &qs, &mut fitness, &mut tasks, &pool);
