@@ -9,8 +9,8 @@
 //! the one-configuration path operation for operation, so counts and verdicts are identical to
 //! [`CollisionModel::count_self`], [`CollisionModel::count_world`] and friends, lane by lane.
 
-use nalgebra::{Isometry3, Point3};
-use trm_kinematics::{LANES, PoseBatch, lane_pose};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use trm_kinematics::{LANES, PoseBatch, PoseLanes};
 
 use crate::cull::{Ball, Step};
 use crate::model::{CollisionModel, PlacedBodies};
@@ -205,20 +205,8 @@ impl CollisionModel {
         );
         assert!(lanes <= LANES, "at most {LANES} lanes");
         out.live = ALL >> (LANES - lanes);
-        place_round(self, poses, out);
+        place_lanes(self, poses, out);
         let links = poses.lanes();
-        let mut one = Placed::default();
-        for (i, (b, c)) in self.bodies().iter().zip(self.compiled()).enumerate() {
-            if let Geometry::General { .. } = c.geometry {
-                for l in 0..LANES {
-                    c.place(&lane_pose(&links[b.link], l), &mut one);
-                    out.isos[i][l] = one.iso;
-                    for (axis, v) in out.centers[i].iter_mut().zip(one.center.iter()) {
-                        axis[l] = *v;
-                    }
-                }
-            }
-        }
         for (o, &link) in out.origins.iter_mut().zip(&self.culling().origin_links) {
             let p = &links[link as usize];
             *o = [p[4], p[5], p[6]];
@@ -580,45 +568,83 @@ fn walk_world(
     }
 }
 
-/// The ends and centres of every round body, for all lanes: the parent's rotation applied as
-/// nalgebra's `UnitQuaternion * Vector3` does (t = 2 q×v; v + w t + q×t), then its translation,
-/// so each lane equals [`Compiled::place`] bit for bit. Compiled for several instruction sets,
-/// the best chosen at run time.
+/// `q v` for the rotation `q = (w, x, y, z)` of each lane and a fixed vector `v`, as nalgebra's
+/// `UnitQuaternion * Vector3` computes it (t = 2 q×v; v + w t + q×t).
+#[inline(always)]
+fn rotate(p: &PoseLanes, v: &Vector3<f64>, l: usize) -> [f64; 3] {
+    let (w, x, y, z) = (p[0][l], p[1][l], p[2][l], p[3][l]);
+    let t = [
+        (y * v.z - z * v.y) * 2.0,
+        (z * v.x - x * v.z) * 2.0,
+        (x * v.y - y * v.x) * 2.0,
+    ];
+    let cross = [
+        y * t[2] - z * t[1],
+        z * t[0] - x * t[2],
+        x * t[1] - y * t[0],
+    ];
+    [
+        t[0] * w + cross[0] + v[0],
+        t[1] * w + cross[1] + v[1],
+        t[2] * w + cross[2] + v[2],
+    ]
+}
+
+/// `p v`: the fixed point `v` moved by the pose of each lane (rotated, then translated).
+#[inline(always)]
+fn moved(p: &PoseLanes, v: &Vector3<f64>) -> PointLanes {
+    let mut out = [[0.0; LANES]; 3];
+    for l in 0..LANES {
+        let r = rotate(p, v, l);
+        for k in 0..3 {
+            out[k][l] = r[k] + p[4 + k][l];
+        }
+    }
+    out
+}
+
+/// Every body in the world frame for all lanes, as [`Compiled::place`] computes it operation
+/// for operation (so each lane equals it bit for bit): round bodies' segment ends and centres;
+/// general bodies' pose (the parent's rotation times the body's, the parent's translation plus
+/// the rotated offset, as nalgebra composes isometries) and bounding-sphere centre. Compiled for
+/// several instruction sets, the best chosen at run time.
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
-fn place_round(model: &CollisionModel, poses: &PoseBatch, out: &mut PlacedBatch) {
+fn place_lanes(model: &CollisionModel, poses: &PoseBatch, out: &mut PlacedBatch) {
     let links = poses.lanes();
     for (i, (body, c)) in model.bodies().iter().zip(model.compiled()).enumerate() {
-        let Geometry::Round { a, b, .. } = &c.geometry else {
-            continue;
-        };
         let p = &links[body.link];
-        let mut ends = [[[0.0; LANES]; 3]; 2];
-        for (end, v) in ends.iter_mut().zip([a, b]) {
-            for l in 0..LANES {
-                let (w, x, y, z) = (p[0][l], p[1][l], p[2][l], p[3][l]);
-                let t = [
-                    (y * v.z - z * v.y) * 2.0,
-                    (z * v.x - x * v.z) * 2.0,
-                    (x * v.y - y * v.x) * 2.0,
-                ];
-                let cross = [
-                    y * t[2] - z * t[1],
-                    z * t[0] - x * t[2],
-                    x * t[1] - y * t[0],
-                ];
+        match &c.geometry {
+            Geometry::Round { a, b, .. } => {
+                let ends = [moved(p, &a.coords), moved(p, &b.coords)];
+                let mut center = [[0.0; LANES]; 3];
                 for k in 0..3 {
-                    end[k][l] = (t[k] * w + cross[k] + v[k]) + p[4 + k][l];
+                    for l in 0..LANES {
+                        center[k][l] = (ends[0][k][l] + ends[1][k][l]) * 0.5;
+                    }
                 }
+                out.ends[i] = ends;
+                out.centers[i] = center;
+            }
+            Geometry::General { local, .. } => {
+                let translation = moved(p, &local.translation.vector);
+                let r = local.rotation.quaternion();
+                let (w2, i2, j2, k2) = (r.w, r.i, r.j, r.k);
+                for l in 0..LANES {
+                    let (w1, i1, j1, k1) = (p[0][l], p[1][l], p[2][l], p[3][l]);
+                    let q = Quaternion::new(
+                        w1 * w2 - i1 * i2 - j1 * j2 - k1 * k2,
+                        w1 * i2 + i1 * w2 + j1 * k2 - k1 * j2,
+                        w1 * j2 - i1 * k2 + j1 * w2 + k1 * i2,
+                        w1 * k2 + i1 * j2 - j1 * i2 + k1 * w2,
+                    );
+                    out.isos[i][l] = Isometry3::from_parts(
+                        Translation3::new(translation[0][l], translation[1][l], translation[2][l]),
+                        UnitQuaternion::new_unchecked(q),
+                    );
+                }
+                out.centers[i] = moved(p, &c.center.coords);
             }
         }
-        let mut center = [[0.0; LANES]; 3];
-        for k in 0..3 {
-            for l in 0..LANES {
-                center[k][l] = (ends[0][k][l] + ends[1][k][l]) * 0.5;
-            }
-        }
-        out.ends[i] = ends;
-        out.centers[i] = center;
     }
 }
