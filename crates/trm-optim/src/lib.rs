@@ -1,7 +1,7 @@
 //! Seeded ask/tell black-box optimisers: the engine of NGIK, usable on its own.
 //!
-//! Every algorithm implements [`Optimizer`]: `ask(&mut rng)` hands out candidates (reused
-//! buffers, no allocation), `tell(&fitness)` updates, `stop()` lists every [`StopReason`] that
+//! Every algorithm implements [`Optimizer`]: `ask(&mut rng)` hands out candidates as one
+//! contiguous [`Population`] (a reused buffer, no allocation), `tell(&fitness)` updates, `stop()` lists every [`StopReason`] that
 //! fired. [`minimize`] runs the loop over a batch objective (evaluate the population in parallel
 //! if you like) and returns a [`Report`] with the best point, when it was found, and the
 //! best-so-far trace.

@@ -23,7 +23,10 @@
 //! ```
 //!
 //! The catalogue is closed in the file format and open in code: implement [`Cost`] or
-//! [`TaskFunction`] and add it to an [`Objective`].
+//! [`TaskFunction`] and add it to an [`Objective`]. Populations are evaluated in batches of
+//! [`trm_kinematics::LANES`] ([`Objective::eval_batch`]); a term written against [`Frames`] (as
+//! every catalogue term is) reads each lane of a batch in place and gives the one-candidate
+//! value bit for bit.
 
 mod comparison;
 mod context;

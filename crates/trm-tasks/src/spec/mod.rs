@@ -1,6 +1,6 @@
 //! Task specs in RON: robot model and active motors, start posture, world, weighted costs, task
 //! function, robustness noise, solver and map settings. The format is documented in
-//! [`crate::formats::task_spec`]; [`Problem::load`] turns a file into an [`Objective`] with errors that name
+//! [`crate::formats::task_spec`]; [`Problem::load`] turns a file into an [`Objective`](crate::Objective) with errors that name
 //! the file, line, column and field, and suggest the closest valid names.
 //!
 //! The schema is in this module; `problem` turns a parsed spec into a [`Problem`] (model,
