@@ -2,7 +2,9 @@
 //! global counter sees the build's worker threads and nothing else): evaluating candidates on
 //! the threads allocates nothing once the scratch pool is warm; a whole E-TRM build allocates
 //! per generation and per search (bookkeeping), not per candidate — 1.5 allocations per
-//! evaluation on average, from 3.8 before the scratch pool and the kept candidate buffers.
+//! evaluation on average, from 3.8 before the scratch pool and the kept candidate buffers; an
+//! NGIK search allocates per generation, not per candidate (its scratch buffers come from a pool
+//! kept across generations), for a population of 30 and for a lone candidate.
 
 // A global allocator can only be written with `unsafe`; it forwards to the system allocator.
 #![allow(unsafe_code)]
@@ -32,6 +34,46 @@ static GLOBAL: Counting = Counting;
 fn map_building_does_not_allocate_per_candidate() {
     evaluating_on_the_threads_does_not_allocate();
     a_map_build_does_not_allocate_per_evaluation();
+    an_ngik_search_does_not_allocate_per_candidate();
+}
+
+fn an_ngik_search_does_not_allocate_per_candidate() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../specs/table_iii/posture1.ron"
+    );
+    let problem = trm_tasks::Problem::load(path).unwrap();
+    for (algo, population) in [("xnes", Some(30)), ("oneplusone", None)] {
+        let run = |max_evaluations: u64| {
+            let solver = trm_tasks::spec::SolverSpec {
+                algo: algo.into(),
+                population,
+                max_evaluations,
+                no_improvement: None,
+                ..problem.spec.solver.clone()
+            };
+            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            let s = trm_tasks::solve(&problem.objective, &problem.start, &solver).unwrap();
+            let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+            (allocations, s.evaluations, s.trace.len())
+        };
+        let (a1, e1, g1) = run(3_000);
+        let (a2, e2, g2) = run(12_000);
+        let per_generation = (a2 as f64 - a1 as f64) / (g2 - g1) as f64;
+        let per_evaluation = (a2 as f64 - a1 as f64) / (e2 - e1) as f64;
+        println!(
+            "{algo}: {a1} allocations, {e1} evaluations, {g1} generations; {a2}, {e2}, {g2}: \
+             {per_generation:.2} per generation, {per_evaluation:.3} per evaluation"
+        );
+        assert!(e2 > e1 + 5_000, "a test that cannot fail");
+        // xNES: each of its 9 matrix products per generation allocates matrixmultiply's
+        // packing buffer; nothing allocates per candidate
+        let bound = if population.is_some() { 10.0 } else { 0.5 };
+        assert!(
+            per_generation < bound,
+            "{algo}: {per_generation:.2} allocations per generation"
+        );
+    }
 }
 
 fn a_map_build_does_not_allocate_per_evaluation() {

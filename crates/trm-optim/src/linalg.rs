@@ -25,7 +25,7 @@ pub(crate) fn rank(fitness: &[f64], order: &mut Vec<usize>) {
         let f = fitness[i];
         if f.is_nan() { f64::INFINITY } else { f }
     };
-    order.sort_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
+    order.sort_unstable_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
 }
 
 /// Scratch space for [`expm`], sized once for n × n matrices.

@@ -93,7 +93,7 @@ impl NelderMead {
             }
         };
         self.order
-            .sort_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
+            .sort_unstable_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
     }
 
     fn worst(&self) -> usize {
