@@ -612,3 +612,37 @@ pub trait Optimizer {
         self.state_mut().record_center(centre, f);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Population;
+
+    /// A population is its candidates one after the other: indexing, iterating, resizing and
+    /// copying agree with the flat buffer, and an empty or zero-dimensional one has none.
+    #[test]
+    fn a_population_is_its_candidates_one_after_the_other() {
+        let mut p = Population::from_candidates(&[vec![1.0, 2.0], vec![3.0, 4.0], vec![5.0, 6.0]]);
+        assert_eq!((p.len(), p.dim(), p.is_empty()), (3, 2, false));
+        assert_eq!(p.as_slice(), &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(&p[1], &[3.0, 4.0]);
+        assert_eq!(p.get(2), Some(&[5.0, 6.0][..]));
+        assert_eq!(p.get(3), None);
+        p[0][1] = -2.0;
+        for x in p.iter_mut() {
+            x[0] += 10.0;
+        }
+        let rows: Vec<&[f64]> = (&p).into_iter().collect();
+        assert_eq!(rows, [&[11.0, -2.0][..], &[13.0, 4.0], &[15.0, 6.0]]);
+        p.resize(2, 1);
+        assert_eq!((p.len(), p.as_slice()), (1, &[11.0, -2.0][..]));
+        p.resize(2, 2);
+        assert_eq!(p.as_slice(), &[11.0, -2.0, 0.0, 0.0]);
+        let mut q = Population::default();
+        q.clone_from(&p);
+        assert_eq!(q, p);
+        assert_eq!(Population::default().len(), 0);
+        assert_eq!(Population::new(0, 5).len(), 0);
+        assert!(Population::new(3, 0).is_empty());
+        assert!(std::panic::catch_unwind(|| Population::new(2, 2)[2].len()).is_err());
+    }
+}
