@@ -129,6 +129,22 @@ enum Next {
     StopLane,
 }
 
+/// Applies a visitor's answer for lane `l`: `SkipRest` drops the lane from the block's
+/// `pending` lanes, `StopLane` from the walk's `live` and current `mask` lanes too.
+#[inline(always)]
+fn follow(answer: Option<Next>, l: usize, pending: &mut Mask, live: &mut Mask, mask: &mut Mask) {
+    let other = !(1 << l);
+    match answer {
+        None => {}
+        Some(Next::SkipRest) => *pending &= other,
+        Some(Next::StopLane) => {
+            *pending &= other;
+            *live &= other;
+            *mask &= other;
+        }
+    }
+}
+
 /// Culls followed lane by lane: the lanes still live inside each open cull, and where it ends.
 struct Nest {
     open: [(u32, Mask); MAX_DEPTH],
@@ -387,15 +403,7 @@ fn walk_self(
                         }),
                     };
                     for l in lanes_of(touching) {
-                        match hit(k, l) {
-                            None => {}
-                            Some(Next::SkipRest) => pending &= !(1 << l),
-                            Some(Next::StopLane) => {
-                                pending &= !(1 << l);
-                                live &= !(1 << l);
-                                mask &= !(1 << l);
-                            }
-                        }
+                        follow(hit(k, l), l, &mut pending, &mut live, &mut mask);
                     }
                     if pending == 0 {
                         break;
@@ -468,23 +476,11 @@ impl Obstacle {
                 axis[l] = c[k][l] - t[k];
             }
         }
-        if let [w, x, y, z] = *q
-            && (x, y, z) != (0.0, 0.0, 0.0)
-        {
+        if q[1..] != [0.0; 3] {
             for l in 0..LANES {
-                let v = [local[0][l], local[1][l], local[2][l]];
-                let u = [
-                    (y * v[2] - z * v[1]) * 2.0,
-                    (z * v[0] - x * v[2]) * 2.0,
-                    (x * v[1] - y * v[0]) * 2.0,
-                ];
-                let cross = [
-                    y * u[2] - z * u[1],
-                    z * u[0] - x * u[2],
-                    x * u[1] - y * u[0],
-                ];
+                let r = rotate(*q, [local[0][l], local[1][l], local[2][l]]);
                 for k in 0..3 {
-                    local[k][l] = u[k] * w + cross[k] + v[k];
+                    local[k][l] = r[k];
                 }
             }
         }
@@ -547,15 +543,7 @@ fn walk_world(
                             if !intersects(body, &p, oc, op) {
                                 continue;
                             }
-                            match hit(i, o, l) {
-                                None => {}
-                                Some(Next::SkipRest) => pending &= !(1 << l),
-                                Some(Next::StopLane) => {
-                                    pending &= !(1 << l);
-                                    live &= !(1 << l);
-                                    mask &= !(1 << l);
-                                }
-                            }
+                            follow(hit(i, o, l), l, &mut pending, &mut live, &mut mask);
                         }
                         if pending == 0 {
                             break;
@@ -568,15 +556,14 @@ fn walk_world(
     }
 }
 
-/// `q v` for the rotation `q = (w, x, y, z)` of each lane and a fixed vector `v`, as nalgebra's
-/// `UnitQuaternion * Vector3` computes it (t = 2 q×v; v + w t + q×t).
+/// `q v` for the rotation `q = (w, x, y, z)`, as nalgebra's `UnitQuaternion * Vector3` computes
+/// it (t = 2 q×v; v + w t + q×t).
 #[inline(always)]
-fn rotate(p: &PoseLanes, v: &Vector3<f64>, l: usize) -> [f64; 3] {
-    let (w, x, y, z) = (p[0][l], p[1][l], p[2][l], p[3][l]);
+fn rotate([w, x, y, z]: [f64; 4], v: [f64; 3]) -> [f64; 3] {
     let t = [
-        (y * v.z - z * v.y) * 2.0,
-        (z * v.x - x * v.z) * 2.0,
-        (x * v.y - y * v.x) * 2.0,
+        (y * v[2] - z * v[1]) * 2.0,
+        (z * v[0] - x * v[2]) * 2.0,
+        (x * v[1] - y * v[0]) * 2.0,
     ];
     let cross = [
         y * t[2] - z * t[1],
@@ -595,7 +582,7 @@ fn rotate(p: &PoseLanes, v: &Vector3<f64>, l: usize) -> [f64; 3] {
 fn moved(p: &PoseLanes, v: &Vector3<f64>) -> PointLanes {
     let mut out = [[0.0; LANES]; 3];
     for l in 0..LANES {
-        let r = rotate(p, v, l);
+        let r = rotate([p[0][l], p[1][l], p[2][l], p[3][l]], [v.x, v.y, v.z]);
         for k in 0..3 {
             out[k][l] = r[k] + p[4 + k][l];
         }
