@@ -247,8 +247,8 @@ fn reference_count(icub: &Icub) -> usize {
         .bodies()
         .iter()
         .map(|b| {
-            let pose = icub.poses.poses()[b.link] * b.local;
-            (b.link, pose, b.shape.to_parry().unwrap())
+            let (frame, shape) = b.shape.to_parry().unwrap();
+            (b.link, icub.poses.poses()[b.link] * b.local * frame, shape)
         })
         .collect();
     let mut links = std::collections::BTreeSet::new();

@@ -148,19 +148,25 @@ impl Shape {
         }
     }
 
-    /// A parry shape of the same geometry (for queries parry offers and this crate does not).
-    pub fn to_parry(&self) -> Option<SharedShape> {
+    /// A parry shape of the same geometry and its pose in this shape's frame (for queries
+    /// parry offers and this crate does not). The pose is the identity except for cylinders:
+    /// parry's run along y, URDF's along z, so theirs is turned a quarter about x.
+    pub fn to_parry(&self) -> Option<(Isometry3<f64>, SharedShape)> {
         self.check().ok()?;
-        Some(match self {
+        let shape = match self {
             Shape::Sphere { radius } => SharedShape::ball(*radius),
             Shape::Box { size } => SharedShape::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0),
-            Shape::Cylinder { radius, length } => SharedShape::cylinder(length / 2.0, *radius),
+            Shape::Cylinder { radius, length } => {
+                let y_to_z = Isometry3::rotation(Vector3::x() * std::f64::consts::FRAC_PI_2);
+                return Some((y_to_z, SharedShape::cylinder(length / 2.0, *radius)));
+            }
             Shape::Capsule { radius, length } => SharedShape::capsule_z(length / 2.0, *radius),
             Shape::Convex { points } => {
                 let pts: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
                 SharedShape::convex_hull(&pts)?
             }
-        })
+        };
+        Some((Isometry3::identity(), shape))
     }
 
     /// The shape placed at `local` in its parent frame, in the form the queries use.
@@ -180,7 +186,8 @@ impl Shape {
             Shape::Sphere { radius } => round(0.0, *radius),
             Shape::Capsule { radius, length } => round(length / 2.0, *radius),
             _ => {
-                let shape = self.to_parry()?;
+                let (frame, shape) = self.to_parry()?;
+                let local = local * frame;
                 let sphere = shape.compute_local_bounding_sphere();
                 let half_extents = match self {
                     Shape::Box { size } => Some(Vector3::from(*size) / 2.0),
@@ -190,7 +197,7 @@ impl Shape {
                     center: local * sphere.center,
                     bound: sphere.radius,
                     geometry: Geometry::General {
-                        local: *local,
+                        local,
                         shape,
                         half_extents,
                     },

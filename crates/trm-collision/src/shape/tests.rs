@@ -38,7 +38,7 @@ fn analytic_and_parry_agree_on_round_pairs() {
         radius: 0.05,
         length: 0.3,
     };
-    let parry_cap = cap.to_parry().unwrap();
+    let (_, parry_cap) = cap.to_parry().unwrap();
     for k in 0..50 {
         let t = k as f64 * 0.37;
         let pose = Isometry3::new(
@@ -91,7 +91,7 @@ fn segment_box_distance_matches_parry() {
     let cuboid = Shape::Box {
         size: [0.3, 0.2, 0.1],
     };
-    let parry_box = cuboid.to_parry().unwrap();
+    let (_, parry_box) = cuboid.to_parry().unwrap();
     let h = Vector3::new(0.15, 0.1, 0.05);
     let mut state = 12345u64;
     let mut uniform = || {
@@ -159,4 +159,26 @@ fn box_box_distance_is_the_gap() {
     let gap = (0.0307 - 0.145 / 2.0) - (-0.3 + 0.25);
     assert!((signed_distance(&c1, &p1, &c2, &p2) - gap).abs() < 1e-9);
     assert!((signed_distance(&c2, &p2, &c1, &p1) - gap).abs() < 1e-9);
+}
+
+#[test]
+fn cylinders_run_along_z_as_in_urdf() {
+    let post = Shape::Cylinder {
+        radius: 0.01,
+        length: 1.0,
+    };
+    let ball = Shape::Sphere { radius: 0.05 };
+    let (c1, p1) = placed(&post, Isometry3::identity());
+    for (at, touching) in [
+        ((0.0, 0.0, 0.45), true),
+        ((0.0, 0.0, -0.45), true),
+        ((0.0, 0.45, 0.0), false),
+        ((0.45, 0.0, 0.0), false),
+    ] {
+        let (c2, p2) = placed(&ball, Isometry3::translation(at.0, at.1, at.2));
+        assert_eq!(intersects(&c2, &p2, &c1, &p1), touching, "ball at {at:?}");
+    }
+    let (frame, parry) = post.to_parry().unwrap();
+    let aabb = parry.compute_aabb(&frame);
+    assert!((aabb.maxs.z - 0.5).abs() < 1e-12 && (aabb.maxs.y - 0.01).abs() < 1e-12);
 }
