@@ -26,7 +26,9 @@
 //! ```
 //!
 //! Round shapes (spheres, capsules) are tested analytically (segment distance minus radii);
-//! everything else goes through parry. Every pair test starts with a bounding-sphere reject.
+//! everything else goes through parry. Every pair test starts with a bounding-sphere reject;
+//! boxes add their slabs, and other shapes their [`Shape::enclosing_spheres`] (a few spheres
+//! that enclose the shape, tighter than one) before parry runs.
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
 
 mod acm;
@@ -50,7 +52,7 @@ pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
 /// [`WorldObject::bounding_box`] return them.
 pub use parry3d_f64::bounding_volume::Aabb;
 pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
-pub use shape::{Shape, ShapeProblem};
+pub use shape::{Shape, ShapeProblem, Sphere};
 pub use trm_kinematics::DisableReason;
 pub use world::{ObjectSpec, World, WorldObject, WorldSpec};
 

@@ -244,6 +244,21 @@ impl CollisionModel {
         &self.inner.bodies
     }
 
+    /// The spheres enclosing body `body` completely ([`crate::Shape::enclosing_spheres`]) in
+    /// its link's frame: the set the queries test against a box's slabs before running parry
+    /// on two general shapes.
+    ///
+    /// # Panics
+    /// If `body` is out of range.
+    pub fn enclosing_spheres(&self, body: usize) -> Vec<crate::Sphere> {
+        let b = &self.inner.bodies[body];
+        let mut spheres = b.shape.enclosing_spheres();
+        for s in &mut spheres {
+            s.center = b.local * s.center;
+        }
+        spheres
+    }
+
     /// Index of the body with this name.
     pub fn body_index(&self, name: &str) -> Result<usize> {
         self.inner

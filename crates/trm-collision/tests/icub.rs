@@ -346,3 +346,32 @@ fn near_pairs_agree_with_the_distance_queries() {
         "{listed} pairs, {overlapping} overlapping"
     );
 }
+
+#[test]
+fn every_body_lies_inside_its_enclosing_spheres_in_the_link_frame() {
+    let robot = trm_models::icub_upper_body();
+    let c = CollisionModel::new(&robot).unwrap();
+    for (i, b) in c.bodies().iter().enumerate() {
+        let spheres = c.enclosing_spheres(i);
+        assert!(!spheres.is_empty(), "{}", b.name);
+        let (frame, shape) = b.shape.to_parry().unwrap();
+        let support = shape.as_support_map().unwrap();
+        // 400 directions spread over the sphere (a Fibonacci lattice)
+        for k in 0..400 {
+            let z = 1.0 - (2 * k + 1) as f64 / 400.0;
+            let phi = k as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+            let r = (1.0 - z * z).sqrt();
+            let dir = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(
+                r * phi.cos(),
+                r * phi.sin(),
+                z,
+            ));
+            let p = b.local * frame * support.local_support_point_toward(&dir);
+            assert!(
+                spheres.iter().any(|s| (p - s.center).norm() <= s.radius),
+                "{}: {p} outside every sphere",
+                b.name
+            );
+        }
+    }
+}

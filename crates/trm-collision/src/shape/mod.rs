@@ -11,12 +11,14 @@ mod compiled;
 mod pair;
 mod segment_box;
 mod segment_lanes;
+mod spheres;
 
 pub(crate) use compiled::{Compiled, Geometry, Placed};
 pub(crate) use pair::{
     Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
 };
 pub(crate) use segment_lanes::{PointLanes, segment_distance_squared_lanes};
+pub use spheres::Sphere;
 
 /// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
 /// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.
@@ -200,6 +202,14 @@ impl Shape {
                         local,
                         shape,
                         half_extents,
+                        spheres: self
+                            .enclosing_spheres()
+                            .into_iter()
+                            .map(|s| Sphere {
+                                center: frame.inverse_transform_point(&s.center),
+                                radius: s.radius,
+                            })
+                            .collect(),
                     },
                 }
             }

@@ -182,3 +182,66 @@ fn cylinders_run_along_z_as_in_urdf() {
     let aabb = parry.compute_aabb(&frame);
     assert!((aabb.maxs.z - 0.5).abs() < 1e-12 && (aabb.maxs.y - 0.01).abs() < 1e-12);
 }
+
+mod general_pairs {
+    use super::*;
+    use proptest::prelude::*;
+    use std::f64::consts::PI;
+
+    fn general_shape() -> impl Strategy<Value = Shape> {
+        let size = 0.01..0.4f64;
+        prop_oneof![
+            [size.clone(), size.clone(), size.clone()].prop_map(|size| Shape::Box { size }),
+            (size.clone(), size.clone())
+                .prop_map(|(radius, length)| Shape::Cylinder { radius, length }),
+            proptest::collection::vec([-0.2..0.2f64, -0.2..0.2, -0.2..0.2], 6..12)
+                .prop_map(|points| Shape::Convex { points })
+                .prop_filter("spans a volume", |s| s.check().is_ok()),
+        ]
+    }
+
+    fn pose() -> impl Strategy<Value = Isometry3<f64>> {
+        (
+            [-0.5..0.5f64, -0.5..0.5, -0.5..0.5],
+            [-PI..PI, -PI..PI, -PI..PI],
+        )
+            .prop_map(|(t, r)| Isometry3::new(Vector3::from(t), Vector3::from(r)))
+    }
+
+    /// Plain parry on the two shapes, each at its pose.
+    fn parry(a: &Shape, pa: &Isometry3<f64>, b: &Shape, pb: &Isometry3<f64>) -> bool {
+        let ((fa, sa), (fb, sb)) = (a.to_parry().unwrap(), b.to_parry().unwrap());
+        query::intersection_test(&(pa * fa), sa.as_ref(), &(pb * fb), sb.as_ref()).unwrap()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+        /// The sphere sets and slabs in front of parry never change its answer, at random poses
+        /// and at poses bisected to within 1e-12 of contact along the line between the two.
+        #[test]
+        fn sphere_sets_before_parry_keep_its_answer_up_to_contact(
+            a in general_shape(),
+            b in general_shape(),
+            pa in pose(),
+            pb in pose(),
+        ) {
+            let check = |pb: &Isometry3<f64>| {
+                let (c1, p1) = placed(&a, pa);
+                let (c2, p2) = placed(&b, *pb);
+                let want = parry(&a, &pa, &b, pb);
+                let ours = !bounds_apart(&p1, &p2) && intersects(&c1, &p1, &c2, &p2);
+                prop_assert_eq!(ours, want, "at {:?}", pb.translation);
+                Ok(want)
+            };
+            let far = pa.translation.vector + (pb.translation.vector - pa.translation.vector).normalize() * 2.0;
+            let at = |t: f64| Isometry3::from_parts((pa.translation.vector * (1.0 - t) + far * t).into(), pb.rotation);
+            let (mut lo, mut hi) = (0.0, 1.0);
+            prop_assume!(check(&at(lo))? && !check(&at(hi))?);
+            while hi - lo > 1e-12 {
+                let mid = 0.5 * (lo + hi);
+                if check(&at(mid))? { lo = mid } else { hi = mid }
+            }
+            check(&pb)?;
+        }
+    }
+}

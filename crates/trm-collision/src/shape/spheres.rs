@@ -1,0 +1,233 @@
+//! Conservative sphere sets: a few spheres whose union encloses a shape completely, tighter than
+//! its one bounding sphere — the broad phase the batch queries run across lanes before an exact
+//! test (a body whose spheres all miss another body cannot touch it).
+
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::Shape;
+
+/// A sphere: centre and radius (metres).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Point3<f64>,
+    /// Radius.
+    pub radius: f64,
+}
+
+/// Added to every radius so that neither rounding (≈ 1e-16 m on robot-sized coordinates) nor
+/// the tolerance of parry's exact tests can make a set clear a pair the exact test calls
+/// touching: a micrometre.
+const MARGIN: f64 = 1e-6;
+
+impl Shape {
+    /// Spheres whose union encloses the shape completely, in the shape's own frame (move them by
+    /// [`crate::Body::local`] for the link frame), each radius rounded up by a micrometre.
+    ///
+    /// A sphere is itself; a capsule gets one sphere per piece of its segment no longer than
+    /// its radius; a cylinder one per piece of its axis no longer than its diameter; a box and
+    /// the axis-aligned box of a convex hull are cut in two along every side at least half as
+    /// long as the longest (up to 8 cells, one sphere around each). An empty vector for a shape
+    /// that fails [`Shape::check`].
+    pub fn enclosing_spheres(&self) -> Vec<Sphere> {
+        if self.check().is_err() {
+            return Vec::new();
+        }
+        match self {
+            Shape::Sphere { radius } => vec![sphere(Point3::origin(), *radius)],
+            Shape::Capsule { radius, length } => {
+                along_z(*length, *radius, |piece| radius + piece / 2.0)
+            }
+            Shape::Cylinder { radius, length } => {
+                along_z(*length, 2.0 * radius, |piece| radius.hypot(piece / 2.0))
+            }
+            Shape::Box { size } => grid(Point3::origin(), Vector3::from(*size) / 2.0),
+            Shape::Convex { points } => {
+                let (mut lo, mut hi) = (
+                    Vector3::repeat(f64::INFINITY),
+                    -Vector3::repeat(f64::INFINITY),
+                );
+                for p in points {
+                    let p = Vector3::from(*p);
+                    lo = lo.inf(&p);
+                    hi = hi.sup(&p);
+                }
+                grid(Point3::from((lo + hi) / 2.0), (hi - lo) / 2.0)
+            }
+        }
+    }
+}
+
+fn sphere(center: Point3<f64>, radius: f64) -> Sphere {
+    Sphere {
+        center,
+        radius: radius + MARGIN,
+    }
+}
+
+/// Spheres centred on the pieces of the z segment of `length` (centred on the origin), cut into
+/// pieces no longer than `longest`; `radius(piece length)` encloses one piece's part of the shape.
+fn along_z(length: f64, longest: f64, radius: impl Fn(f64) -> f64) -> Vec<Sphere> {
+    let pieces = (length / longest).ceil().max(1.0) as usize;
+    let piece = length / pieces as f64;
+    (0..pieces)
+        .map(|k| {
+            let z = -length / 2.0 + piece * (k as f64 + 0.5);
+            sphere(Point3::new(0.0, 0.0, z), radius(piece))
+        })
+        .collect()
+}
+
+/// Spheres around the cells of the box `center ± half`, cut in two along every side at least
+/// half as long as the longest.
+fn grid(center: Point3<f64>, half: Vector3<f64>) -> Vec<Sphere> {
+    let longest = half.max();
+    let cuts = half.map(|h| if h >= 0.5 * longest { 2usize } else { 1 });
+    let cell = Vector3::new(
+        half.x / cuts.x as f64,
+        half.y / cuts.y as f64,
+        half.z / cuts.z as f64,
+    );
+    let radius = cell.norm();
+    let mut out = Vec::with_capacity(cuts.iter().product());
+    for i in 0..cuts.x {
+        for j in 0..cuts.y {
+            for k in 0..cuts.z {
+                let offset = Vector3::new(
+                    cell.x * (2 * i + 1) as f64 - half.x,
+                    cell.y * (2 * j + 1) as f64 - half.y,
+                    cell.z * (2 * k + 1) as f64 - half.z,
+                );
+                out.push(sphere(center + offset, radius));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Whether every sample lies in some sphere of the shape's set. Samples are points of the
+    /// shape's box (unit coordinates scaled to its half extents), kept when inside the shape,
+    /// and surface points (parry's support point along each sample taken as a direction).
+    fn encloses(shape: &Shape, samples: &[Vector3<f64>]) -> bool {
+        let spheres = shape.enclosing_spheres();
+        let (frame, parry) = shape.to_parry().expect("valid shape");
+        let aabb = parry.compute_local_aabb();
+        let inside = samples.iter().filter_map(|u| {
+            let p = aabb.center() + aabb.half_extents().component_mul(u);
+            parry.contains_local_point(&p).then_some(p)
+        });
+        let support = parry.as_support_map().expect("convex");
+        let surface = samples.iter().filter_map(|u| {
+            nalgebra::Unit::try_new(*u, 1e-9).map(|dir| support.local_support_point_toward(&dir))
+        });
+        inside
+            .chain(surface)
+            .map(|p| frame * p)
+            .all(|p| spheres.iter().any(|s| (p - s.center).norm() <= s.radius))
+    }
+
+    fn shape() -> impl Strategy<Value = Shape> {
+        let size = 0.005..0.5f64;
+        prop_oneof![
+            size.clone().prop_map(|radius| Shape::Sphere { radius }),
+            (size.clone(), 0.0..0.6f64)
+                .prop_map(|(radius, length)| Shape::Capsule { radius, length }),
+            (size.clone(), size.clone())
+                .prop_map(|(radius, length)| Shape::Cylinder { radius, length }),
+            [size.clone(), size.clone(), size.clone()].prop_map(|size| Shape::Box { size }),
+            proptest::collection::vec([-0.3..0.3f64, -0.3..0.3, -0.3..0.3], 8..16)
+                .prop_map(|points| Shape::Convex { points })
+                .prop_filter("spans a volume", |s| s.check().is_ok()),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn every_point_of_a_shape_lies_in_one_of_its_spheres(
+            shape in shape(),
+            samples in proptest::collection::vec([-1.0..=1.0f64, -1.0..=1.0, -1.0..=1.0], 256),
+        ) {
+            let samples: Vec<_> = samples.into_iter().map(Vector3::from).collect();
+            prop_assert!(encloses(&shape, &samples));
+        }
+    }
+
+    #[test]
+    fn corners_and_cap_tips_lie_on_the_spheres_within_the_margin() {
+        let size = [0.17, 0.18, 0.21];
+        let spheres = Shape::Box { size }.enclosing_spheres();
+        assert_eq!(spheres.len(), 8);
+        let reach = |p: Point3<f64>| {
+            spheres
+                .iter()
+                .map(|s| (p - s.center).norm() - s.radius)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let corner = Point3::new(0.085, -0.09, 0.105);
+        assert!(
+            (-2.0 * MARGIN..=0.0).contains(&reach(corner)),
+            "{}",
+            reach(corner)
+        );
+        let flat = Shape::Box {
+            size: [0.08, 0.03, 0.07],
+        }
+        .enclosing_spheres();
+        assert_eq!(flat.len(), 4, "the short side is not cut");
+        let capsule = Shape::Capsule {
+            radius: 0.05,
+            length: 0.12,
+        }
+        .enclosing_spheres();
+        assert_eq!(capsule.len(), 3);
+        let tip = Point3::new(0.0, 0.0, 0.06 + 0.05);
+        let nearest = capsule
+            .iter()
+            .map(|s| (tip - s.center).norm() - s.radius)
+            .fold(f64::INFINITY, f64::min);
+        assert!((-2.0 * MARGIN..=0.0).contains(&nearest), "{nearest}");
+        assert!(
+            Shape::Box {
+                size: [0.1, f64::NAN, 0.1]
+            }
+            .enclosing_spheres()
+            .is_empty()
+        );
+    }
+
+    #[test]
+    fn a_set_is_tighter_than_the_bounding_sphere() {
+        for shape in [
+            Shape::Box {
+                size: [0.24, 0.23, 0.28],
+            },
+            Shape::Cylinder {
+                radius: 0.02,
+                length: 0.3,
+            },
+            Shape::Capsule {
+                radius: 0.02,
+                length: 0.3,
+            },
+        ] {
+            let bound = shape
+                .to_parry()
+                .unwrap()
+                .1
+                .compute_local_bounding_sphere()
+                .radius;
+            let largest = shape
+                .enclosing_spheres()
+                .iter()
+                .map(|s| s.radius)
+                .fold(0.0, f64::max);
+            assert!(largest < 0.6 * bound, "{shape:?}: {largest} vs {bound}");
+        }
+    }
+}
