@@ -27,8 +27,8 @@
 //!
 //! Round shapes (spheres, capsules) are tested analytically (segment distance minus radii);
 //! everything else goes through parry. Every pair test starts with a bounding-sphere reject;
-//! boxes add their slabs, and other shapes their [`Shape::enclosing_spheres`] (a few spheres
-//! that enclose the shape, tighter than one) before parry runs.
+//! boxes add their slabs. [`Shape::enclosing_spheres`] gives a sphere model of any shape (a few
+//! spheres that enclose it, tighter than one).
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
 
 mod acm;

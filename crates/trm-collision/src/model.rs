@@ -245,8 +245,7 @@ impl CollisionModel {
     }
 
     /// The spheres enclosing body `body` completely ([`crate::Shape::enclosing_spheres`]) in
-    /// its link's frame: the set the queries test against a box's slabs before running parry
-    /// on two general shapes.
+    /// its link's frame: a sphere model of the robot, e.g. for sphere-based planners.
     ///
     /// # Panics
     /// If `body` is out of range.

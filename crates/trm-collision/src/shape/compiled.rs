@@ -29,8 +29,6 @@ pub(crate) enum Geometry {
         local: Isometry3<f64>,
         shape: SharedShape,
         half_extents: Option<Vector3<f64>>,
-        /// [`crate::Shape::enclosing_spheres`] in the frame of `shape` (placed by `local`).
-        spheres: Box<[super::Sphere]>,
     },
 }
 

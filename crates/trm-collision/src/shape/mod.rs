@@ -202,14 +202,6 @@ impl Shape {
                         local,
                         shape,
                         half_extents,
-                        spheres: self
-                            .enclosing_spheres()
-                            .into_iter()
-                            .map(|s| Sphere {
-                                center: frame.inverse_transform_point(&s.center),
-                                radius: s.radius,
-                            })
-                            .collect(),
                     },
                 }
             }

@@ -9,7 +9,6 @@ use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape};
 
 use super::compiled::{Compiled, Geometry, Placed, RoundShape};
 use super::segment_box::segment_box_distance_squared;
-use super::spheres::Sphere;
 
 #[inline]
 fn point_on(a: &Point3<f64>, b: &Point3<f64>, loc: SegmentPointLocation) -> Point3<f64> {
@@ -43,36 +42,6 @@ fn sphere_box_apart(
 ) -> bool {
     let c = cuboid.iso.inverse_transform_point(center);
     (0..3).any(|i| c[i].abs() > half[i] + radius)
-}
-
-/// True when every sphere of a set (in the frame of the placed shape `owner`) lies outside one
-/// of a box's slabs: the union of the spheres, which encloses the shape, misses the box. False
-/// for an empty set.
-fn spheres_box_apart(
-    spheres: &[Sphere],
-    owner: &Placed,
-    cuboid: &Placed,
-    half: &Vector3<f64>,
-) -> bool {
-    !spheres.is_empty()
-        && spheres
-            .iter()
-            .all(|s| sphere_box_apart(&(owner.iso * s.center), s.radius, cuboid, half))
-}
-
-/// True when every sphere of one set lies apart from every sphere of the other (each set in
-/// the frame of its placed shape). False when either set is empty.
-fn spheres_apart(s1: &[Sphere], p1: &Placed, s2: &[Sphere], p2: &Placed) -> bool {
-    let to_2 = p2.iso.inverse() * p1.iso;
-    !s1.is_empty()
-        && !s2.is_empty()
-        && s1.iter().all(|a| {
-            let c = to_2 * a.center;
-            s2.iter().all(|b| {
-                let reach = a.radius + b.radius;
-                (c - b.center).norm_squared() > reach * reach
-            })
-        })
 }
 
 #[inline]
@@ -148,27 +117,17 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
             Geometry::General {
                 shape: s1,
                 half_extents: h1,
-                spheres: e1,
                 ..
             },
             Geometry::General {
                 shape: s2,
                 half_extents: h2,
-                spheres: e2,
                 ..
             },
         ) => {
-            // boxes: each bounding sphere against the other's slabs, then each sphere set
-            // against the other's slabs; other shapes: the two sphere sets; then SAT/GJK
-            let apart = match (h1, h2) {
-                (None, None) => spheres_apart(e1, p1, e2, p2),
-                _ => {
-                    h2.is_some_and(|h| sphere_box_apart(&p1.center, p1.bound, p2, &h))
-                        || h1.is_some_and(|h| sphere_box_apart(&p2.center, p2.bound, p1, &h))
-                        || h2.is_some_and(|h| spheres_box_apart(e1, p1, p2, &h))
-                        || h1.is_some_and(|h| spheres_box_apart(e2, p2, p1, &h))
-                }
-            };
+            // boxes: each bounding sphere against the other's slabs before SAT/GJK
+            let apart = h2.is_some_and(|h| sphere_box_apart(&p1.center, p1.bound, p2, &h))
+                || h1.is_some_and(|h| sphere_box_apart(&p2.center, p2.bound, p1, &h));
             !apart && parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref())
         }
     }

@@ -1,6 +1,6 @@
 //! Conservative sphere sets: a few spheres whose union encloses a shape completely, tighter than
-//! its one bounding sphere — the broad phase the batch queries run across lanes before an exact
-//! test (a body whose spheres all miss another body cannot touch it).
+//! its one bounding sphere — a sphere model of a shape (a body whose spheres all miss another
+//! body cannot touch it), as sphere-based planners such as VAMP or cuRobo take robots.
 
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -16,9 +16,8 @@ pub struct Sphere {
     pub radius: f64,
 }
 
-/// Added to every radius so that neither rounding (≈ 1e-16 m on robot-sized coordinates) nor
-/// the tolerance of parry's exact tests can make a set clear a pair the exact test calls
-/// touching: a micrometre.
+/// Added to every radius so that rounding (≈ 1e-16 m on robot-sized coordinates) can never make
+/// a set smaller than its shape, with room to spare for other tools' tolerances: a micrometre.
 const MARGIN: f64 = 1e-6;
 
 impl Shape {

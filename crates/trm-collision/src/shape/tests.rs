@@ -216,10 +216,11 @@ mod general_pairs {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(512))]
-        /// The sphere sets and slabs in front of parry never change its answer, at random poses
-        /// and at poses bisected to within 1e-12 of contact along the line between the two.
+        /// The bounding spheres and slabs in front of parry never change its answer, at random
+        /// poses and at poses bisected to within 1e-12 of contact along the line between the
+        /// two (cylinders included, turned to run along z).
         #[test]
-        fn sphere_sets_before_parry_keep_its_answer_up_to_contact(
+        fn rejects_before_parry_keep_its_answer_up_to_contact(
             a in general_shape(),
             b in general_shape(),
             pa in pose(),
