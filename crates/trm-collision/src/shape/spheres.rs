@@ -25,7 +25,8 @@ impl Shape {
     /// [`crate::Body::local`] for the link frame), each radius rounded up by a micrometre.
     ///
     /// A sphere is itself; a capsule gets one sphere per piece of its segment no longer than
-    /// its radius; a cylinder one per piece of its axis no longer than its diameter; a box and
+    /// its radius; a cylinder one per piece of its axis no longer than its diameter (both at
+    /// most 64 pieces); a box and
     /// the axis-aligned box of a convex hull are cut in two along every side at least half as
     /// long as the longest (up to 8 cells, one sphere around each). An empty vector for a shape
     /// that fails [`Shape::check`].
@@ -65,10 +66,14 @@ fn sphere(center: Point3<f64>, radius: f64) -> Sphere {
     }
 }
 
+/// Most pieces a capsule or cylinder is cut into (a needle gets longer pieces, not millions).
+const MAX_PIECES: f64 = 64.0;
+
 /// Spheres centred on the pieces of the z segment of `length` (centred on the origin), cut into
-/// pieces no longer than `longest`; `radius(piece length)` encloses one piece's part of the shape.
+/// pieces no longer than `longest` (at most [`MAX_PIECES`]); `radius(piece length)` encloses one
+/// piece's part of the shape.
 fn along_z(length: f64, longest: f64, radius: impl Fn(f64) -> f64) -> Vec<Sphere> {
-    let pieces = (length / longest).ceil().max(1.0) as usize;
+    let pieces = (length / longest).ceil().clamp(1.0, MAX_PIECES) as usize;
     let piece = length / pieces as f64;
     (0..pieces)
         .map(|k| {
@@ -191,6 +196,18 @@ mod tests {
             .map(|s| (tip - s.center).norm() - s.radius)
             .fold(f64::INFINITY, f64::min);
         assert!((-2.0 * MARGIN..=0.0).contains(&nearest), "{nearest}");
+        let needle = Shape::Capsule {
+            radius: 1e-9,
+            length: 1.0,
+        }
+        .enclosing_spheres();
+        assert_eq!(
+            needle.len(),
+            64,
+            "a needle is cut into a bounded number of pieces"
+        );
+        let tip = Point3::new(0.0, 0.0, 0.5 + 1e-9);
+        assert!(needle.iter().any(|s| (tip - s.center).norm() <= s.radius));
         assert!(
             Shape::Box {
                 size: [0.1, f64::NAN, 0.1]
