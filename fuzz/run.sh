@@ -15,7 +15,7 @@ cd "$(dirname "$0")"
 root=..
 
 targets=(urdf model_description task_spec world motion_spec taskmap_spec map checkpoint taskmap scene
-         configurations posture trajectory_csv trajectory_json)
+         configurations posture trajectory_csv trajectory_json srdf mesh)
 
 # The seed files of a target, one per line.
 seeds() {
@@ -27,6 +27,7 @@ seeds() {
     motion_spec) ls "$root"/specs/wholebody/*.ron ;;
     taskmap_spec) ls "$root"/specs/taskmaps/*.ron ;;
     configurations) ls "$root"/specs/configs/*.json ;;
+    srdf) ls "$root"/models/*/example-robot-data/robots/*/srdf/*.srdf ;;
   esac
   if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
 }
@@ -36,7 +37,7 @@ seeds() {
 # explore faster.
 flags() {
   case "$1" in
-    model_description | scene | urdf) echo -max_len=8192 ;;
+    model_description | scene | urdf | srdf | mesh) echo -max_len=8192 ;;
   esac
 }
 

@@ -115,11 +115,13 @@ pub fn run(args: &Args) -> Result<()> {
             let problem = checkpoint
                 .problem()
                 .with_context(|| format!("the spec stored in checkpoint {}", file.display()))?;
+            let target = checkpoint
+                .resume_target(options.points)
+                .with_context(|| format!("--points with checkpoint {}", file.display()))?;
             println!(
-                "resuming {} from {} points (of {}), P = {}, seed {}",
+                "resuming {} from {} points (of {target}), P = {}, seed {}",
                 checkpoint.spec_path(),
                 checkpoint.points(),
-                options.points.unwrap_or(checkpoint.target()),
                 checkpoint.seed_and_searches().1,
                 checkpoint.seed_and_searches().0
             );

@@ -137,8 +137,13 @@ pub fn run(args: &Args) -> Result<()> {
 /// Mean best-so-far cost against evaluations (log scale), one panel per posture.
 fn plot(result: &ComparisonResult) -> Result<String> {
     let max_evals = result.settings.max_evaluations;
+    // from 100 evaluations (or 1 for smaller budgets) to the budget
+    let (first, last) = (
+        (max_evals as f64).log10().min(2.0),
+        (max_evals as f64).log10(),
+    );
     let grid: Vec<u64> = (0..=60)
-        .map(|i| (10f64.powf(2.0 + i as f64 * ((max_evals as f64).log10() - 2.0) / 60.0)) as u64)
+        .map(|i| 10f64.powf(first + i as f64 * (last - first) / 60.0) as u64)
         .collect();
     let mut panels = Vec::new();
     for p in 0..result.labels.len() {
@@ -162,7 +167,7 @@ fn plot(result: &ComparisonResult) -> Result<String> {
         panels.push(crate::plot::Panel {
             title: format!("Posture ({}): mean best cost", p + 1),
             axes: ("evaluations (log10)".into(), "cost (log10)".into()),
-            x: 2.0..(max_evals as f64).log10(),
+            x: first..last,
             y: (lo.max(1e-3) * 0.8).log10()..(hi.max(1e-2) * 1.2).log10(),
             series,
         });

@@ -302,7 +302,7 @@ fn default_out(out: &Option<PathBuf>, spec: &Path, dir: &str, extension: &str) -
 pub struct MeshArgs {
     /// A directory searched for `package://NAME/...` meshes (repeatable); the directories of
     /// ROS_PACKAGE_PATH are searched after these.
-    #[arg(long = "package-path", value_name = "DIR")]
+    #[arg(long = "package-path", value_name = "DIR", value_parser = parse::directory)]
     package_paths: Vec<PathBuf>,
 }
 
@@ -350,6 +350,16 @@ mod parse {
                 Err(format!("{v} is not above 0"))
             }
         })
+    }
+
+    /// An existing directory.
+    pub fn directory(text: &str) -> Result<std::path::PathBuf, String> {
+        let path = std::path::PathBuf::from(text);
+        match std::fs::metadata(&path) {
+            Ok(m) if m.is_dir() => Ok(path),
+            Ok(_) => Err(format!("`{text}` is a file, not a directory")),
+            Err(e) => Err(format!("`{text}`: {e} (give a directory that exists)")),
+        }
     }
 
     /// A number in [0, 1].

@@ -29,6 +29,23 @@ pub struct Panel {
     pub series: Vec<Series>,
 }
 
+/// An axis range plotters can draw: a range that is empty, reversed, narrower than a
+/// millionth of its magnitude (plotters' tick search never ends on it) or not finite is
+/// widened to its centre ± 5 % (± 0.5 near zero); non-finite ends become 0..1.
+pub fn drawable(range: &Range<f64>) -> Range<f64> {
+    let (a, b) = (range.start, range.end);
+    if !(a.is_finite() && b.is_finite()) {
+        return 0.0..1.0;
+    }
+    let (lo, hi) = (a.min(b), a.max(b));
+    if hi - lo > 1e-6 * lo.abs().max(hi.abs()).max(1e-300) {
+        return lo..hi;
+    }
+    let centre = 0.5 * (lo + hi);
+    let half = (0.05 * centre.abs()).max(0.5);
+    centre - half..centre + half
+}
+
 /// Panels stacked vertically (each `size` pixels), each a line chart with a legend, as an SVG
 /// document.
 pub fn panels(size: (u32, u32), panels: &[Panel]) -> Result<String> {
@@ -47,7 +64,7 @@ pub fn panels(size: (u32, u32), panels: &[Panel]) -> Result<String> {
                 .margin(12)
                 .x_label_area_size(38)
                 .y_label_area_size(55)
-                .build_cartesian_2d(panel.x.clone(), panel.y.clone())?;
+                .build_cartesian_2d(drawable(&panel.x), drawable(&panel.y))?;
             chart
                 .configure_mesh()
                 .x_desc(panel.axes.0.as_str())
@@ -57,7 +74,10 @@ pub fn panels(size: (u32, u32), panels: &[Panel]) -> Result<String> {
                 let color = s.color.unwrap_or_else(|| Palette99::pick(i).to_rgba());
                 chart
                     .draw_series(LineSeries::new(
-                        s.points.iter().copied(),
+                        s.points
+                            .iter()
+                            .copied()
+                            .filter(|(x, y)| x.is_finite() && y.is_finite()),
                         color.stroke_width(2),
                     ))?
                     .label(s.label.as_str())
@@ -158,4 +178,33 @@ pub fn scatter_points(
         root.present()?;
     }
     Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degenerate_reversed_and_non_finite_ranges_are_drawn_widened() {
+        assert_eq!(drawable(&(2.0..2.0)), 1.5..2.5);
+        assert_eq!(drawable(&(3.0..1.0)), 1.0..3.0);
+        assert_eq!(drawable(&(f64::NAN..1.0)), 0.0..1.0);
+        assert_eq!(drawable(&(100.0..100.0)), 95.0..105.0);
+        let svg = panels(
+            (300, 200),
+            &[Panel {
+                title: "flat".into(),
+                axes: ("x".into(), "y".into()),
+                x: 2.0..2.0,
+                y: 0.0..0.0,
+                series: vec![Series {
+                    label: "one point".into(),
+                    points: vec![(2.0, 0.0), (f64::NAN, 1.0)],
+                    color: None,
+                }],
+            }],
+        )
+        .unwrap();
+        assert!(svg.starts_with("<svg"));
+    }
 }

@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, default_value = "target/scenario")]
     pub out_dir: PathBuf,
     /// Repair budget per step, milliseconds (repairs then depend on the machine's speed).
-    #[arg(long, default_value_t = 40.0, value_parser = crate::parse::positive)]
+    #[arg(long, default_value_t = 40.0, value_parser = crate::parse::positive, conflicts_with = "repair_evaluations")]
     repair_ms: f64,
     /// Repair budget per step in cost evaluations instead of time: a reproducible run.
     #[arg(long, value_parser = crate::parse::count(1, usize::MAX))]

@@ -465,9 +465,27 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         ),
         (
             "specs/wholebody/standup.ron",
+            "dt: 0.01",
+            "dt: 0.00001",
+            &stand[..],
+        ),
+        (
+            "specs/wholebody/standup.ron",
             "rbfs: 5",
             "rbfs: 0",
             &stand[..],
+        ),
+        (
+            "specs/worlds/reach_with_box.ron",
+            "\"new_box\"",
+            "\"\"",
+            &collide[..],
+        ),
+        (
+            "specs/worlds/reach_with_box.ron",
+            "\"new_box\"",
+            "\"  \"",
+            &collide[..],
         ),
         (
             "specs/wholebody/standup.ron",
@@ -632,6 +650,10 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         }),
         ("a row too short".into(), csv.replacen(row, "0", 1)),
         (
+            "a header and no rows".into(),
+            csv.lines().next().unwrap().to_string() + "\n",
+        ),
+        (
             "a negative time".into(),
             csv.replacen(row, &format!("-1{}", &row[1..]), 1),
         ),
@@ -722,6 +744,22 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         "o.json",
     ];
     cases.extend(flag_cases(&resume, "--seed", &["3"]));
+    // the checkpoint holds 2 points (of 4): a resumed build does not shrink the map
+    cases.push(Case {
+        what: "build-map --resume with --points below the checkpoint's".into(),
+        args: [
+            "build-map",
+            "--resume",
+            "ck.map.checkpoint",
+            "--points",
+            "1",
+            "--out",
+            "o.json",
+        ]
+        .map(String::from)
+        .to_vec(),
+        names: "--points".into(),
+    });
     cases.extend(flag_cases(&resume, "--searches", &["2"]));
     cases.push(Case {
         what: "build-map with a spec and --resume".into(),
@@ -781,6 +819,17 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             serde_json::json!({"points": [p], "edges": []})
         }),
         ("parked", serde_json::json!({"points": []})),
+        ("edges", serde_json::json!([[0, 1, -0.5]])),
+        ("settings", {
+            let mut settings = map["settings"].clone();
+            settings["spacing"] = serde_json::json!(-0.025);
+            settings
+        }),
+        ("settings", {
+            let mut settings = map["settings"].clone();
+            settings["edge_neighbours"] = serde_json::json!(0);
+            settings
+        }),
     ];
     for (k, (key, value)) in bad_maps.into_iter().enumerate() {
         let mut bad = map.clone();
@@ -819,6 +868,19 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &["0", "-1", "x"],
     ));
     cases.extend(flag_cases(&run_scenario, "--threads", &["0", "x"]));
+    // one budget or the other, not both
+    let both: Vec<&str> = run_scenario
+        .iter()
+        .copied()
+        .chain(["--repair-ms", "10"])
+        .collect();
+    cases.extend(flag_cases(&both, "--repair-evaluations", &["100"]));
+    // a package path that is not there
+    cases.extend(file_flag_cases(
+        &["model-info", "icub_upper_body.urdf"],
+        "--package-path",
+        &["no/such/dir", "map.json"],
+    ));
     cases.extend(file_flag_cases(
         &["scenario", sliding, "--out-dir", "sc"],
         "--map",
@@ -841,21 +903,30 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     // SRDF files: malformed, unknown names, missing attributes, wrong values
     for (k, (what, text, names)) in [
         ("truncated XML", "<robot name=\"r\">\n  <group name=\"a\">", "srdf_0.srdf"),
-        ("an unknown joint", "<robot>\n<group name=\"a\"><joint name=\"r_elbw\"/></group>\n</robot>", "r_elbow"),
-        ("an unknown link", "<robot>\n<disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/>\n</robot>", "r_hand"),
-        ("a missing attribute", "<robot>\n<end_effector name=\"e\" group=\"a\"/>\n</robot>", "parent_link"),
-        ("a non-number", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"x\"/></group_state></robot>", "srdf_4.srdf"),
+        ("an unknown joint", "<robot name=\"icub_upper_body\">\n<group name=\"a\"><joint name=\"r_elbw\"/></group>\n</robot>", "r_elbow"),
+        ("an unknown link", "<robot name=\"icub_upper_body\">\n<disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/>\n</robot>", "r_hand"),
+        ("a missing attribute", "<robot name=\"icub_upper_body\">\n<end_effector name=\"e\" group=\"a\"/>\n</robot>", "parent_link"),
+        ("a non-number", "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"x\"/></group_state></robot>", "srdf_4.srdf"),
         ("another root", "<urdf/>", "srdf_5.srdf"),
-        ("a reversed chain", "<robot><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"chest\"/></group></robot>", "srdf_6.srdf"),
+        ("a reversed chain", "<robot name=\"icub_upper_body\"><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"chest\"/></group></robot>", "srdf_6.srdf"),
         ("binary", "\u{0}\u{1}\u{2}", "srdf_7.srdf"),
-        ("several values for a URDF joint", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"0.1 0.2\"/></group_state></robot>", "r_elbow"),
-        ("a NaN among a floating base's values", "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"root_joint\" value=\"0 0 NaN 0 0 0 1\"/></group_state></robot>", "srdf_9.srdf"),
+        ("several values for a URDF joint", "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"0.1 0.2\"/></group_state></robot>", "r_elbow"),
+        ("a NaN among a floating base's values", "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"root_joint\" value=\"0 0 NaN 0 0 0 1\"/></group_state></robot>", "srdf_9.srdf"),
+        ("a robot name other than the URDF's", "<robot name=\"panda\">\n</robot>", "icub_upper_body"),
+        ("a group defined twice", "<robot name=\"icub_upper_body\">\n<group name=\"a\"><joint name=\"r_elbow\"/></group>\n<group name=\"a\"><joint name=\"l_elbow\"/></group>\n</robot>", "srdf_11.srdf:3"),
+        ("a group state setting a joint outside its group", "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group>\n<group_state name=\"s\" group=\"a\"><joint name=\"l_elbow\" value=\"0.1\"/></group_state></robot>", "srdf_12.srdf:2"),
+        ("groups nested 100 000 deep", "DEEP", "srdf_13.srdf:2"),
     ]
     .into_iter()
     .enumerate()
     {
         let name = format!("srdf_{k}.srdf");
-        std::fs::write(dir.join(&name), text).unwrap();
+        let deep = format!(
+            "<robot name=\"icub_upper_body\">\n{}{}</robot>",
+            "<group name=\"g\">".repeat(100_000),
+            "</group>".repeat(100_000)
+        );
+        std::fs::write(dir.join(&name), if text == "DEEP" { &deep } else { text }).unwrap();
         cases.push(Case {
             what: format!("model-info --srdf with {what}"),
             args: ["model-info", "icub_upper_body.urdf", "--srdf", name.as_str()]
@@ -1470,7 +1541,10 @@ fn a_killed_build_leaves_the_old_map_or_a_complete_new_one() {
 }
 
 /// `kill -9` in the middle of a checkpointed build, then `--resume`: the same map file as an
-/// uninterrupted build, byte for byte apart from the timing statistics.
+/// uninterrupted build, byte for byte apart from the timing statistics. The kill comes as soon
+/// as the first checkpoint is on disk; should a machine finish the whole build before that
+/// (the map file is there), the test doubles the map and tries again, so its verdict does not
+/// depend on the machine's speed.
 #[test]
 fn a_killed_build_resumes_to_the_uninterrupted_map() {
     let dir = std::env::temp_dir().join(format!("trm-resume-{}", std::process::id()));
@@ -1482,30 +1556,49 @@ fn a_killed_build_resumes_to_the_uninterrupted_map() {
         command.args(args).current_dir(&dir).stderr(Stdio::null());
         command
     };
-    let build = |out: &str, more: &[&str]| {
-        let mut args = vec!["build-map", spec.to_str().unwrap(), "--points", "300"];
+    let build = |points: &str, out: &str, more: &[&str]| {
+        let mut args = vec!["build-map", spec.to_str().unwrap(), "--points", points];
         args.extend(["--out", out]);
         args.extend(more);
         xtask(&args)
     };
-    let status = build("whole.map.json", &[]).stdout(Stdio::null()).status();
-    assert!(status.unwrap().success());
-    let mut child = build("killed.map.json", &["--checkpoint-every", "20"])
+    let checkpoint = dir.join("killed.map.checkpoint");
+    let mut points = 300;
+    let killed_mid_way = loop {
+        assert!(
+            points <= 4800,
+            "every build finished before it could be killed"
+        );
+        let _ = std::fs::remove_file(&checkpoint);
+        let _ = std::fs::remove_file(dir.join("killed.map.json"));
+        let mut child = build(
+            &points.to_string(),
+            "killed.map.json",
+            &["--checkpoint-every", "20"],
+        )
         .stdout(Stdio::null())
         .spawn()
         .unwrap();
-    let checkpoint = dir.join("killed.map.checkpoint");
-    let started = std::time::Instant::now();
-    while !checkpoint.exists() && started.elapsed() < Duration::from_secs(60) {
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    std::thread::sleep(Duration::from_millis(100));
-    let _ = child.kill(); // SIGKILL
-    let _ = child.wait();
-    assert!(
-        !dir.join("killed.map.json").exists(),
-        "the build ended before the kill"
-    );
+        let finished = loop {
+            if checkpoint.exists() {
+                break false;
+            }
+            if child.try_wait().unwrap().is_some() {
+                break true;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        let _ = child.kill(); // SIGKILL
+        let _ = child.wait();
+        if !finished && !dir.join("killed.map.json").exists() {
+            break points;
+        }
+        points *= 2;
+    };
+    let status = build(&killed_mid_way.to_string(), "whole.map.json", &[])
+        .stdout(Stdio::null())
+        .status();
+    assert!(status.unwrap().success());
     let resumed = xtask(&["build-map", "--resume", "killed.map.checkpoint"])
         .output()
         .unwrap();

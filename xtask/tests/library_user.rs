@@ -7,6 +7,7 @@ use std::path::Path;
 use std::process::Command;
 
 #[test]
+#[ignore = "slow (~3 min: builds the libraries again in the example's own workspace); CI runs it with --ignored"]
 fn a_crate_outside_the_workspace_uses_the_library_end_to_end() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let manifest = root.join("examples/library-user/Cargo.toml");

@@ -50,10 +50,38 @@ pub fn resolve_mesh(
         .ok_or(candidates)
 }
 
-/// Loads a mesh file, scales it and returns the vertices of its convex hull.
+/// Loads a mesh file (STL, COLLADA or OBJ; at most [`trm_kinematics::MAX_INPUT_BYTES`]),
+/// scales it and returns the vertices of its convex hull.
 pub fn convex_hull_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<[f64; 3]>, String> {
+    let bytes = trm_kinematics::read_input_bytes(path).map_err(|e| e.to_string())?;
+    convex_hull_of_mesh_bytes(&bytes, path, scale)
+}
+
+/// [`convex_hull_of_mesh`] of a file's bytes; `path` gives the format (by extension, else by
+/// content) and names the file in errors. An OBJ file's material library is not read (a
+/// hull needs no materials); COLLADA is refused nested deeper than
+/// [`trm_kinematics::XML_NESTING_LIMIT`] before it is parsed.
+pub fn convex_hull_of_mesh_bytes(
+    bytes: &[u8],
+    path: &Path,
+    scale: [f64; 3],
+) -> Result<Vec<[f64; 3]>, String> {
+    let collada = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("dae"))
+        || bytes.trim_ascii_start().starts_with(b"<");
+    if collada {
+        trm_kinematics::check_xml_nesting(bytes, trm_kinematics::XML_NESTING_LIMIT)
+            .map_err(|e| format!("{e}: flatten the COLLADA scene"))?;
+    }
+    let no_materials = |p: &Path| -> std::io::Result<Vec<u8>> {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("{}: materials are not read", p.display()),
+        ))
+    };
     let scene = mesh_loader::Loader::default()
-        .load(path)
+        .load_from_slice_with_reader(bytes, path, no_materials)
         .map_err(|e| e.to_string())?;
     let points: Vec<Point3<f64>> = scene
         .meshes

@@ -196,6 +196,12 @@ impl World {
 
     /// Adds an object and returns its index.
     pub fn add(&mut self, name: &str, shape: Shape, pose: Isometry3<f64>) -> Result<usize> {
+        if name.trim().is_empty() || name.chars().any(char::is_control) {
+            return Err(CollisionError::InvalidValue {
+                what: format!("world object name {name:?}"),
+                problem: "a name must hold a visible character and no control characters (queries, repairs and scenarios address objects by name)".into(),
+            });
+        }
         if self.objects.iter().any(|o| o.name == name) {
             return Err(CollisionError::DuplicateObject(name.to_string()));
         }

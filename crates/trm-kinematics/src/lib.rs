@@ -47,6 +47,7 @@ mod ron_path;
 pub mod ros;
 pub mod srdf;
 mod tree;
+mod xml;
 
 pub use active::ActiveSet;
 pub use batch::{LANES, Lanes, PoseBatch, PoseLanes, lane_pose, sin_cos};
@@ -71,6 +72,7 @@ pub use tree::{
     Inertial, Joint, JointKind, LIMIT_TOLERANCE, Limits, Link, Mimic, Tree, pose_from_xyz_rpy,
 };
 pub use urdf_rs;
+pub use xml::{TooDeep, XML_NESTING_LIMIT, check_xml_nesting};
 
 /// The file formats this crate reads and writes.
 pub mod formats {

@@ -103,6 +103,8 @@ fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
         origin: origin.to_string(),
         message,
     };
+    crate::check_xml_nesting(text.as_bytes(), crate::XML_NESTING_LIMIT)
+        .map_err(|e| malformed(format!("{e}: flatten the file (trm's XML nesting limit)")))?;
     // urdf-rs's XML layer (RustyXML) panics on some malformed namespace declarations (found by
     // fuzzing: an attribute in a namespace bound to no prefix); that is an error, not a crash
     match quietly(|| urdf_rs::read_from_string(text)) {

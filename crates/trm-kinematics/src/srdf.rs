@@ -97,8 +97,10 @@ pub struct VirtualJoint {
 pub struct Srdf {
     /// Where it came from (a file name, or `<string>`).
     pub origin: String,
-    /// The robot's name.
+    /// The robot's name (it must be the URDF's).
     pub robot: String,
+    /// Line of the `<robot>` element.
+    pub robot_line: usize,
     /// Virtual joints.
     pub virtual_joints: Vec<VirtualJoint>,
     /// Groups, in document order.
@@ -175,6 +177,14 @@ fn did_you_mean<'a>(
 impl Srdf {
     /// Parses SRDF text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
+        crate::check_xml_nesting(text.as_bytes(), crate::XML_NESTING_LIMIT).map_err(|e| {
+            error(
+                origin,
+                e.line,
+                format!("elements nested more than {} deep", e.limit),
+                "an SRDF nests groups by name (<group name=\"…\"/> members), not by element",
+            )
+        })?;
         let doc = roxmltree::Document::parse(text).map_err(|e| {
             let p = e.pos();
             error(
@@ -206,7 +216,8 @@ impl Srdf {
         };
         let mut srdf = Srdf {
             origin: origin.to_string(),
-            robot: root.attribute("name").unwrap_or_default().to_string(),
+            robot: attr(root, "name")?,
+            robot_line: line(root),
             ..Default::default()
         };
         for n in root.children().filter(|n| n.is_element()) {
@@ -314,6 +325,35 @@ impl Srdf {
                 _ => {} // sphere approximations and other MoveIt extensions
             }
         }
+        for (k, g) in srdf.groups.iter().enumerate() {
+            if let Some(first) = srdf.groups[..k].iter().find(|o| o.name == g.name) {
+                return Err(error(
+                    origin,
+                    g.line,
+                    format!(
+                        "group `{}` is defined twice (first at line {})",
+                        g.name, first.line
+                    ),
+                    "define each group once (a group can include another by <group name=\"…\"/>)",
+                ));
+            }
+        }
+        for (k, s) in srdf.group_states.iter().enumerate() {
+            let twin = srdf.group_states[..k]
+                .iter()
+                .find(|o| o.name == s.name && o.group == s.group);
+            if let Some(first) = twin {
+                return Err(error(
+                    origin,
+                    s.line,
+                    format!(
+                        "group state `{}` of group `{}` is defined twice (first at line {})",
+                        s.name, s.group, first.line
+                    ),
+                    "give each group state of a group a name of its own",
+                ));
+            }
+        }
         Ok(srdf)
     }
 
@@ -369,6 +409,18 @@ impl Srdf {
                 .map(|&(m, _)| robot.motors()[m].name.clone())
                 .collect()
         };
+        if self.robot != robot.name() {
+            return Err(error(
+                origin,
+                self.robot_line,
+                format!(
+                    "the SRDF describes robot `{}`, the URDF is robot `{}`",
+                    self.robot,
+                    robot.name()
+                ),
+                "give the SRDF of this URDF (MoveIt refuses a pair whose robot names differ)",
+            ));
+        }
         let mut out = base.clone();
         let mut report = SrdfReport::default();
         for vj in &self.virtual_joints {
@@ -391,31 +443,18 @@ impl Srdf {
                 ));
             }
         }
+        // the URDF joints of each SRDF group (subgroups included), as MoveIt resolves them;
+        // None for a group that includes one only the model description defines
+        let mut group_joints: BTreeMap<&str, Option<Vec<usize>>> = BTreeMap::new();
         let mut defined: Vec<String> = out.groups.iter().map(|g| g.name.clone()).collect();
         for g in &self.groups {
-            if defined.contains(&g.name) {
-                report.notes.push(format!(
-                    "group `{}` is also in the model description, which keeps its definition",
-                    g.name
-                ));
-                continue;
-            }
-            let mut members: Vec<String> = Vec::new();
-            let mut add = |names: Vec<String>| {
-                for n in names {
-                    if !members.contains(&n) {
-                        members.push(n);
-                    }
-                }
-            };
+            let mut joints: Vec<usize> = Vec::new();
             for j in &g.joints {
-                add(motors_of(joint(j, g.line)?));
+                joints.push(joint(j, g.line)?);
             }
             for l in &g.links {
                 let i = link(l, g.line)?;
-                if let Some(j) = tree.links[i].parent_joint {
-                    add(motors_of(j));
-                }
+                joints.extend(tree.links[i].parent_joint);
             }
             for (base_link, tip) in &g.chains {
                 let (b, mut t) = (link(base_link, g.line)?, link(tip, g.line)?);
@@ -433,10 +472,9 @@ impl Srdf {
                     chain.push(j);
                     t = p;
                 }
-                for j in chain.into_iter().rev() {
-                    add(motors_of(j));
-                }
+                joints.extend(chain.into_iter().rev());
             }
+            let mut resolved = Some(joints.clone());
             for s in &g.subgroups {
                 if !defined.contains(s) {
                     return Err(error(
@@ -449,7 +487,25 @@ impl Srdf {
                         did_you_mean(s, defined.iter().map(String::as_str), "group"),
                     ));
                 }
-                add(vec![s.clone()]);
+                match (&mut resolved, group_joints.get(s.as_str())) {
+                    (Some(all), Some(Some(sub))) => all.extend(sub),
+                    _ => resolved = None,
+                }
+            }
+            group_joints.insert(g.name.as_str(), resolved);
+            if defined.contains(&g.name) {
+                report.notes.push(format!(
+                    "group `{}` is also in the model description, which keeps its definition",
+                    g.name
+                ));
+                continue;
+            }
+            let mut members: Vec<String> = Vec::new();
+            let own_motors = joints.iter().flat_map(|&j| motors_of(j));
+            for n in own_motors.chain(g.subgroups.iter().cloned()) {
+                if !members.contains(&n) {
+                    members.push(n);
+                }
             }
             if members.is_empty() {
                 report
@@ -524,7 +580,24 @@ impl Srdf {
             }
             let mut values = BTreeMap::new();
             for (j, v) in &s.values {
-                joint(j, s.line)?;
+                let index = joint(j, s.line)?;
+                if let Some(Some(members)) = group_joints.get(s.group.as_str()) {
+                    if !members.contains(&index) {
+                        return Err(error(
+                            origin,
+                            s.line,
+                            format!(
+                                "group state `{}` sets joint `{j}`, which is not in group `{}`",
+                                s.name, s.group
+                            ),
+                            did_you_mean(
+                                j,
+                                members.iter().map(|&m| tree.joints[m].name.as_str()),
+                                "joint of the group",
+                            ),
+                        ));
+                    }
+                }
                 if motor_names.contains(&j.as_str()) {
                     values.insert(j.clone(), *v);
                 } else {
@@ -605,9 +678,10 @@ impl Srdf {
             })
             .collect();
         let all: Vec<usize> = (0..robot.motors().len()).collect();
+        let all_joints = joints_of(&all);
         groups.push(SrdfGroup {
             name: "all_motors".into(),
-            joints: joints_of(&all),
+            joints: all_joints.clone(),
             ..Default::default()
         });
         let mut joint_values = vec![0.0; robot.num_joints()];
@@ -622,6 +696,7 @@ impl Srdf {
                     values: movable
                         .iter()
                         .zip(&joint_values)
+                        .filter(|(j, _)| all_joints.iter().any(|a| a == *j))
                         .map(|(j, v)| (j.to_string(), *v))
                         .collect(),
                     multi: Vec::new(),
@@ -633,6 +708,7 @@ impl Srdf {
         Srdf {
             origin: robot.origin().to_string(),
             robot: robot.name().to_string(),
+            robot_line: 0,
             virtual_joints: vec![VirtualJoint {
                 name: "world_joint".into(),
                 kind: "fixed".into(),

@@ -32,6 +32,21 @@ fn malformed_xml_is_reported_with_the_file() {
 }
 
 #[test]
+fn nesting_a_hundred_thousand_deep_is_an_error_not_a_stack_overflow() {
+    let n = 100_000;
+    let body = format!(
+        "<link name=\"a\">\n{}{}</link>",
+        "<visual>".repeat(n),
+        "</visual>".repeat(n)
+    );
+    let message = error_of(&urdf(&body));
+    assert!(
+        message.contains("line 4") && message.contains("nested more than 256 deep"),
+        "{message}"
+    );
+}
+
+#[test]
 fn missing_child_link_names_the_joint_line_and_the_closest_link() {
     let text = urdf(&format!(
         "<link name=\"base\"/>\n<link name=\"upper_arm\"/>\n{}",

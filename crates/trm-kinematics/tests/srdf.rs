@@ -173,37 +173,84 @@ fn bad_srdf_names_the_file_the_line_and_the_closest_names() {
         }
     };
     let e = apply(
-        "<robot name=\"r\">\n  <group name=\"a\">\n    <joint name=\"r_elbw\"/>\n  </group>\n</robot>",
+        "<robot name=\"icub_upper_body\">\n  <group name=\"a\">\n    <joint name=\"r_elbw\"/>\n  </group>\n</robot>",
     );
     assert!(e.contains("bad.srdf:2") && e.contains("`r_elbow`"), "{e}");
-    let e = apply("<robot name=\"r\">\n  <group name=\"a\">\n");
+    let e = apply("<robot name=\"icub_upper_body\">\n  <group name=\"a\">\n");
     assert!(e.contains("bad.srdf:") && e.contains("XML"), "{e}");
-    let e = apply("<robot name=\"r\">\n<disable_collisions link1=\"chest\"/>\n</robot>");
+    let e =
+        apply("<robot name=\"icub_upper_body\">\n<disable_collisions link1=\"chest\"/>\n</robot>");
     assert!(e.contains("bad.srdf:2") && e.contains("link2"), "{e}");
     let e = apply(
-        "<robot><disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/></robot>",
+        "<robot name=\"icub_upper_body\"><disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/></robot>",
     );
     assert!(e.contains("`r_hand`"), "{e}");
     let e = apply(
-        "<robot><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"torso_2\"/></group></robot>",
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><chain base_link=\"r_hand\" tip_link=\"torso_2\"/></group></robot>",
     );
     assert!(e.contains("not above"), "{e}");
     let e = apply(
-        "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"b\"><joint name=\"r_elbow\" value=\"1\"/></group_state></robot>",
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"b\"><joint name=\"r_elbow\" value=\"1\"/></group_state></robot>",
     );
     assert!(e.contains("group `b`"), "{e}");
     let e = apply(
-        "<robot><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"nan\"/></group_state></robot>",
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"nan\"/></group_state></robot>",
     );
     assert!(e.contains("finite"), "{e}");
     let e = apply(
-        "<robot><group name=\"u\"><group name=\"later\"/></group><group name=\"later\"><joint name=\"r_elbow\"/></group></robot>",
+        "<robot name=\"icub_upper_body\"><group name=\"u\"><group name=\"later\"/></group><group name=\"later\"><joint name=\"r_elbow\"/></group></robot>",
     );
     assert!(e.contains("defined later"), "{e}");
     let e = apply(
-        "<robot><virtual_joint name=\"v\" type=\"fixed\" parent_frame=\"w\" child_link=\"chest\"/></robot>",
+        "<robot name=\"icub_upper_body\"><virtual_joint name=\"v\" type=\"fixed\" parent_frame=\"w\" child_link=\"chest\"/></robot>",
     );
     assert!(e.contains("root link"), "{e}");
     let e = apply("<model/>");
     assert!(e.contains("root element"), "{e}");
+    // MoveIt's rules: the URDF's robot, each group and group state once, a state sets only
+    // joints of its group
+    let e = apply("<robot name=\"panda\">\n</robot>");
+    assert!(
+        e.contains("bad.srdf:1") && e.contains("`panda`") && e.contains("`icub_upper_body`"),
+        "{e}"
+    );
+    let e = apply("<robot>\n</robot>");
+    assert!(e.contains("bad.srdf:1") && e.contains("`name`"), "{e}");
+    let e = apply(
+        "<robot name=\"icub_upper_body\">\n<group name=\"a\"><joint name=\"r_elbow\"/></group>\n<group name=\"a\"><joint name=\"l_elbow\"/></group></robot>",
+    );
+    assert!(
+        e.contains("bad.srdf:3") && e.contains("defined twice (first at line 2)"),
+        "{e}"
+    );
+    let e = apply(
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group>\n<group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"1\"/></group_state>\n<group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"0\"/></group_state></robot>",
+    );
+    assert!(
+        e.contains("bad.srdf:3") && e.contains("defined twice"),
+        "{e}"
+    );
+    let e = apply(
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/><joint name=\"r_wrist_prosup\"/></group>\n<group name=\"b\"><group name=\"a\"/></group>\n<group_state name=\"s\" group=\"b\"><joint name=\"r_shoulder_roll\" value=\"1\"/></group_state></robot>",
+    );
+    assert!(
+        e.contains("bad.srdf:3") && e.contains("not in group `b`"),
+        "{e}"
+    );
+    // a state of a group that includes the other's joints through a subgroup is fine
+    let ok = apply(
+        "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group>\n<group name=\"b\"><group name=\"a\"/></group>\n<group_state name=\"s\" group=\"b\"><joint name=\"r_elbow\" value=\"1\"/></group_state><disable_collisions link1=\"chest\" link2=\"r_hnd\"/></robot>",
+    );
+    assert!(ok.contains("`r_hand`"), "{ok}");
+    // nesting a hundred thousand deep is refused before any parser recurses
+    let deep = format!(
+        "<robot name=\"icub_upper_body\">\n{}{}</robot>",
+        "<group name=\"g\">".repeat(100_000),
+        "</group>".repeat(100_000)
+    );
+    let e = apply(&deep);
+    assert!(
+        e.contains("bad.srdf:2") && e.contains("nested more than 256 deep"),
+        "{e}"
+    );
 }

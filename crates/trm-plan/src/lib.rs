@@ -13,9 +13,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod moveit;
 mod planner;
 pub mod scenario;
 mod trajectory;
+pub mod yaml;
 
 pub use planner::{
     EXACT_WEIGHT, ExactGoal, Goal, PlanError, PlanOptions, PlanStats, Planned, Planner,

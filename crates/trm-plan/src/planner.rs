@@ -48,6 +48,18 @@ pub enum PlanError {
         /// What differs.
         problem: String,
     },
+    /// A MoveIt scene or request file holds something trm cannot read.
+    #[error("{}{}: {problem}\n  fix: {fix}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
+    InvalidMoveIt {
+        /// The file.
+        path: std::path::PathBuf,
+        /// 1-based line, 0 when unknown.
+        line: usize,
+        /// What is wrong.
+        problem: String,
+        /// What to do about it.
+        fix: String,
+    },
     /// A query setting out of range.
     #[error("plan options: {what} {problem}")]
     InvalidOptions {
@@ -59,6 +71,15 @@ pub enum PlanError {
     /// The start configuration collides in the current world, or has the wrong length.
     #[error("the start configuration is invalid: {0}")]
     InvalidStart(String),
+    /// The goal does not fit the maps' spaces (wrong dimension, non-finite values, a region
+    /// whose corners are swapped, a negative tolerance).
+    #[error("the goal is invalid: {problem}\n  fix: {fix}")]
+    InvalidGoal {
+        /// What is wrong.
+        problem: String,
+        /// What to give.
+        fix: String,
+    },
     /// No collision-free path; `closest` is the reachable node nearest to the goal.
     #[error(
         "goal unreachable: {reason}{}", match closest_node { Some(n) => format!("; the closest reachable node is {n}, at task distance {closest_distance:.4}"), None => "; no map node is reachable".into() }
@@ -92,6 +113,63 @@ pub enum Goal {
         /// Upper corner.
         max: Vec<f64>,
     },
+}
+
+impl Goal {
+    /// Checks the goal against a configuration space of `active` motors and a task space of
+    /// `task` dimensions: vectors of the right length, finite values, a finite non-negative
+    /// tolerance, region corners in order.
+    pub fn check(&self, active: usize, task: usize) -> Result<(), PlanError> {
+        let bad = |problem: String, fix: &str| PlanError::InvalidGoal {
+            problem,
+            fix: fix.to_string(),
+        };
+        let vector = |what: &str, v: &[f64], n: usize, space: &str| {
+            if v.len() != n {
+                return Err(bad(
+                    format!("{what} has {} values; the {space} has {n}", v.len()),
+                    &format!("give {n} values"),
+                ));
+            }
+            match v.iter().position(|x| !x.is_finite()) {
+                Some(k) => Err(bad(
+                    format!("{what}[{k}] is {}", v[k]),
+                    "give finite values",
+                )),
+                None => Ok(()),
+            }
+        };
+        match self {
+            Goal::Configuration(q) => vector(
+                "the goal configuration",
+                q,
+                active,
+                "configuration space (active motors)",
+            ),
+            Goal::TaskPoint { t, tolerance } => {
+                vector("the goal point", t, task, "task space")?;
+                if tolerance.is_finite() && *tolerance >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(bad(
+                        format!("the tolerance is {tolerance}"),
+                        "give a finite tolerance, 0 or more (task-space units)",
+                    ))
+                }
+            }
+            Goal::TaskRegion { min, max } => {
+                vector("the region's min", min, task, "task space")?;
+                vector("the region's max", max, task, "task space")?;
+                match (0..task).find(|&k| min[k] > max[k]) {
+                    Some(k) => Err(bad(
+                        format!("min[{k}] = {} is above max[{k}] = {}", min[k], max[k]),
+                        "give the lower corner as min and the upper as max",
+                    )),
+                    None => Ok(()),
+                }
+            }
+        }
+    }
 }
 
 /// Query settings.
@@ -443,6 +521,14 @@ impl<'a> Planner<'a> {
                 self.active.len()
             )));
         }
+        if let Some(k) = start.iter().position(|v| !v.is_finite()) {
+            return Err(PlanError::InvalidStart(format!(
+                "start[{k}] is {}",
+                start[k]
+            )));
+        }
+        let task_dim = self.objective.task().map_or(0, |t| t.dim());
+        goal.check(self.active.len(), task_dim)?;
         if !self.is_free(start) {
             return Err(PlanError::InvalidStart(
                 "it collides in the current world".into(),
@@ -466,13 +552,6 @@ impl<'a> Planner<'a> {
         attach(start, n, &mut extra, &self.nodes);
         let goal_q = match goal {
             Goal::Configuration(q) => {
-                if q.len() != self.active.len() {
-                    return Err(PlanError::Unreachable {
-                        reason: "the goal has the wrong length".into(),
-                        closest_node: None,
-                        closest_distance: f64::INFINITY,
-                    });
-                }
                 if !self.is_free(q) {
                     return Err(PlanError::Unreachable {
                         reason: "the goal configuration collides in the current world".into(),

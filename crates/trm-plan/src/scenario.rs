@@ -316,6 +316,7 @@ pub struct ScenarioOptions {
     /// Repair budget per step, s (`None`: only the evaluation budget).
     pub repair_seconds: Option<f64>,
     /// Repair budget per step in evaluations (reproducible; `None`: only the time budget).
+    /// With both budgets set, a repair stops at whichever is spent first.
     pub repair_evaluations: Option<u64>,
     /// Task-space tolerance of the map node a goal's path goes through.
     pub tolerance: f64,

@@ -90,6 +90,14 @@ impl Trajectory {
     /// every waypoint, a task path empty or one finite vector per waypoint of one dimension,
     /// finite values, times from 0 up that never decrease. `origin` names the file in errors.
     pub fn check(&self, origin: &Path) -> Result<(), PlanError> {
+        if self.times.is_empty() && self.positions.is_empty() {
+            return Err(invalid(
+                origin,
+                0,
+                "no waypoints".into(),
+                "give at least one waypoint (a motion holds two or more)",
+            ));
+        }
         for (i, name) in self.names.iter().enumerate() {
             if self.names[..i].contains(name) {
                 return Err(invalid(
@@ -324,6 +332,14 @@ impl Trajectory {
                     .map(|&(c, _)| number(c))
                     .collect::<Result<_, _>>()?,
             );
+        }
+        if t.times.is_empty() {
+            return Err(invalid(
+                origin,
+                2,
+                "the header is followed by no rows".into(),
+                "add one row per waypoint: the time, then a value per motor column",
+            ));
         }
         check_times(&t.times, origin, |i| (line_of[i], "time".into()))?;
         t.check_robot(robot, origin, |i| line_of[i])?;

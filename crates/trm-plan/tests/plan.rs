@@ -199,6 +199,69 @@ fn impossible_queries_are_clear_errors() {
         .plan(&p.start[..3], &far, &PlanOptions::default())
         .unwrap_err();
     assert!(matches!(e, PlanError::InvalidStart(_)));
+    let mut nan_start = p.start.clone();
+    nan_start[2] = f64::NAN;
+    let e = planner.plan(&nan_start, &far, &PlanOptions::default());
+    assert!(
+        matches!(&e, Err(PlanError::InvalidStart(m)) if m.contains("start[2] is NaN")),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn goals_that_do_not_fit_the_spaces_are_named_not_searched_for() {
+    let p = problem();
+    let mut planner = Planner::new(&p.objective, &[map()]).unwrap();
+    let point = |t: Vec<f64>, tolerance: f64| Goal::TaskPoint { t, tolerance };
+    let mut wrong_length = p.start.clone();
+    wrong_length.pop();
+    for (goal, says) in [
+        (
+            point(vec![0.1, 0.2], 0.03),
+            "the goal point has 2 values; the task space has 3",
+        ),
+        (
+            point(vec![0.1, f64::NAN, 0.0], 0.03),
+            "the goal point[1] is NaN",
+        ),
+        (point(vec![0.1, 0.2, 0.0], f64::NAN), "the tolerance is NaN"),
+        (point(vec![0.1, 0.2, 0.0], -0.1), "the tolerance is -0.1"),
+        (
+            Goal::Configuration(wrong_length),
+            "the goal configuration has",
+        ),
+        (
+            Goal::Configuration(vec![f64::INFINITY; p.start.len()]),
+            "the goal configuration[0] is inf",
+        ),
+        (
+            Goal::TaskRegion {
+                min: vec![0.0, 0.0, 1.0],
+                max: vec![1.0, 1.0, 0.0],
+            },
+            "min[2] = 1 is above max[2] = 0",
+        ),
+        (
+            Goal::TaskRegion {
+                min: vec![0.0; 3],
+                max: vec![1.0; 4],
+            },
+            "the region's max has 4 values",
+        ),
+    ] {
+        let e = planner
+            .plan(&p.start, &goal, &PlanOptions::default())
+            .unwrap_err();
+        assert!(
+            matches!(e, PlanError::InvalidGoal { .. }),
+            "{goal:?}: {e:?}"
+        );
+        let text = e.to_string();
+        assert!(
+            text.contains(says) && text.contains("fix:"),
+            "{goal:?}: {text}"
+        );
+    }
 }
 
 #[test]

@@ -78,6 +78,14 @@ fn malformed_csv_is_a_located_error() {
         ("time,joint1\n0,zero\n", "t.csv:2: column 2"),
         ("time,joint1\n1,0\n0.5,0\n", "t.csv:3: time"),
         ("time,joint1\n-inf,0\n", "t.csv:2: column 1"),
+        (
+            "time,joint1\n",
+            "t.csv:2: the header is followed by no rows",
+        ),
+        (
+            "time,joint1\n\n\n",
+            "t.csv:2: the header is followed by no rows",
+        ),
     ] {
         let e = csv_error(text);
         assert!(e.starts_with(expected), "{text:?}: {e}");
@@ -120,6 +128,10 @@ fn malformed_json_is_a_located_error() {
         (
             "{\"names\": [\"a\"], \"times\": [0], \"positions\": [[0]], \"task_path\": [[1], [2]]}",
             "task_path has 2 points for 1 waypoints",
+        ),
+        (
+            "{\"names\": [\"a\"], \"times\": [], \"positions\": [], \"task_path\": []}",
+            "no waypoints",
         ),
     ] {
         let e = json_error(text);

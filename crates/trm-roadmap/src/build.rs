@@ -551,7 +551,7 @@ pub fn resume_with(
             checkpoint.spec_path
         )));
     }
-    let target = options.points.unwrap_or(checkpoint.target);
+    let target = checkpoint.resume_target(options.points)?;
     let mut setup = Setup::new(
         problem,
         Some(target),

@@ -90,6 +90,23 @@ impl Checkpoint {
         self.target
     }
 
+    /// The point count a resumed build goes to: `points` when given, else the build's own
+    /// target. A count below the points the checkpoint already holds is an error (a map does
+    /// not shrink by resuming).
+    pub fn resume_target(&self, points: Option<usize>) -> crate::Result<usize> {
+        match points {
+            Some(n) if n < self.points() => Err(crate::RoadmapError::Unsuitable(format!(
+                "the checkpoint already holds {} points, more than the {n} points asked for: \
+                 ask for at least {} points, or leave the count out to go on to the build's {}",
+                self.points(),
+                self.points(),
+                self.target
+            ))),
+            Some(n) => Ok(n),
+            None => Ok(self.target),
+        }
+    }
+
     /// The interval (points) at which the build wrote checkpoints.
     pub fn every(&self) -> usize {
         self.every

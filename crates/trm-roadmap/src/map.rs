@@ -165,6 +165,9 @@ impl Roadmap {
             .chain(&parked.points)
             .next()
             .map_or(0, |p| p.t.len());
+        self.settings
+            .check()
+            .map_err(|p| format!("settings.{}: {}", p.field, p.problem))?;
         check_points("points", &self.points, self.active.len(), dim)?;
         check_points("parked.points", &parked.points, self.active.len(), dim)?;
         let edges = self.edges.len() + parked.edges.len();
@@ -375,9 +378,15 @@ fn check_edges(
     nodes: usize,
 ) -> std::result::Result<(), String> {
     for (k, &(a, b, w)) in edges.iter().enumerate() {
-        if a >= nodes || b >= nodes || a == b || !w.is_finite() {
+        if a >= nodes || b >= nodes || a == b {
             return Err(format!(
                 "{what}[{k}] = ({a}, {b}, {w}) does not join two of the {nodes} points"
+            ));
+        }
+        // searches through the map (A*) are only right with non-negative costs
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(format!(
+                "{what}[{k}] = ({a}, {b}, {w}): an edge's cost is a finite length, 0 or more"
             ));
         }
     }

@@ -34,7 +34,8 @@ pub struct RepairOptions {
     /// Stop growing after this long (a scenario's per-step budget). A repair under a time
     /// budget depends on the machine's speed; one without is reproducible.
     pub seconds: Option<f64>,
-    /// Stop growing after this many cost evaluations (reproducible).
+    /// Stop growing after this many cost evaluations (reproducible). With both budgets set,
+    /// growing stops at whichever is spent first.
     pub evaluations: Option<u64>,
     /// After the hole, grow wherever the map can until it has its size again (nodes clear
     /// and parked counted).

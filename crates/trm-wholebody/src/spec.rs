@@ -193,6 +193,10 @@ pub struct TrajectorySpec {
 /// The most control steps a rollout may simulate (duration / dt).
 pub const MAX_STEPS: usize = 1_000_000;
 
+/// The most control steps a whole optimisation may simulate (rollouts × duration / dt): 30×
+/// the stand-up spec's 1.65 million.
+pub const MAX_TOTAL_STEPS: u64 = 50_000_000;
+
 impl MotionSpec {
     /// Reads and checks a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
@@ -278,21 +282,6 @@ impl MotionSpec {
                 ));
             }
         }
-        // every rollout simulates duration / dt control steps
-        let steps = ends.last().copied().unwrap_or(0.0) / spec.dt;
-        if steps > MAX_STEPS as f64 {
-            return Err(err(
-                "dt",
-                format!(
-                    "{} s in steps of {} s is {steps:.3e} control steps",
-                    ends.last().copied().unwrap_or(0.0),
-                    spec.dt
-                ),
-                &format!(
-                    "give a time step that makes at most {MAX_STEPS} steps (the paper uses 0.01 s)"
-                ),
-            ));
-        }
         if spec.rbfs > 1000 {
             return Err(err(
                 "rbfs",
@@ -322,6 +311,39 @@ impl MotionSpec {
                     spec.phases.len()
                 ),
                 "give one end time per phase",
+            ));
+        }
+        // every rollout simulates duration / dt control steps; the optimiser runs
+        // bootstrap_rollouts + rollouts of them, and the hand-tuned motion once
+        let duration = ends
+            .iter()
+            .chain(&spec.hand_tuned.ends)
+            .fold(0.0f64, |a, &b| a.max(b));
+        let steps = duration / spec.dt;
+        if steps > MAX_STEPS as f64 {
+            return Err(err(
+                "dt",
+                format!(
+                    "{duration} s in steps of {} s is {steps:.3e} control steps",
+                    spec.dt
+                ),
+                &format!(
+                    "give a time step that makes at most {MAX_STEPS} steps per rollout (the paper uses 0.01 s)"
+                ),
+            ));
+        }
+        let rollouts = spec.optimiser.bootstrap_rollouts + spec.optimiser.rollouts + 1;
+        let total = steps * rollouts as f64;
+        if total > MAX_TOTAL_STEPS as f64 {
+            return Err(err(
+                "dt",
+                format!(
+                    "{rollouts} rollouts of {steps:.3e} control steps ({duration} s in steps of {} s) are {total:.3e} steps in all",
+                    spec.dt
+                ),
+                &format!(
+                    "give a larger time step or fewer rollouts: at most {MAX_TOTAL_STEPS} steps in all (the paper: 0.01 s, 1000 rollouts)"
+                ),
             ));
         }
         let n = 3 * spec.rbfs;

@@ -168,6 +168,14 @@ def test_a_map_builds_saves_loads_and_plans(tmp_path):
     assert plan["positions"].shape[1] == 41 and plan["positions"].shape[0] == plan["times"].shape[0]
     assert np.linalg.norm(plan["task_path"][-1] - goal) < 0.03
     assert plan["times"][0] == 0.0 and np.all(np.diff(plan["times"]) >= 0)
+    # a goal that does not fit the task space is named, not searched for
+    planner = trm.Planner(loaded)
+    with pytest.raises(trm.TrmError, match="the goal point has 2 values; the task space has 3"):
+        planner.plan(goal[:2])
+    with pytest.raises(trm.TrmError, match=r"the goal point\[1\] is NaN"):
+        planner.plan([goal[0], np.nan, goal[2]])
+    with pytest.raises(trm.TrmError, match="the goal configuration has 3 values"):
+        planner.plan([0.0, 0.0, 0.0], posture=True)
 
 
 def test_errors_are_located_trm_errors(robot, tmp_path):
@@ -218,6 +226,8 @@ def test_the_ompl_comparison_runs(capsys, monkeypatch):
         (lambda r, d: trm.World().add_box("b", [-1, 1, 1], [0, 0, 0]), "positive"),
         (lambda r, d: trm.World().add_box("b", [1, 1, 1], [np.nan, 0, 0]), "not finite"),
         (lambda r, d: trm.World().remove("zz"), "zz"),
+        (lambda r, d: trm.World().add_box("", [1, 1, 1], [0, 0, 0]), "visible character"),
+        (lambda r, d: trm.World().add_box(" ", [1, 1, 1], [0, 0, 0]), "visible character"),
         (lambda r, d: trm.Roadmap.load(str(Path(d) / "missing.json")), "missing.json"),
         (lambda r, d: trm.Roadmap.build(SPEC, points=0), "0 points"),
     ],

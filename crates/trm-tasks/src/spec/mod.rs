@@ -395,6 +395,65 @@ impl Default for MapSpec {
     }
 }
 
+/// A value out of its range, found by a settings check: the field (relative to the settings),
+/// what is wrong and the fix.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldProblem {
+    /// Field path relative to the checked value (`spacing`, `first_search`).
+    pub field: String,
+    /// What is wrong.
+    pub problem: String,
+    /// How to fix it.
+    pub fix: String,
+}
+
+impl MapSpec {
+    /// Checks every setting's range, as a spec's `map` and a map file's `settings` are checked:
+    /// positive finite spacing and step sizes, non-negative finite weights, counts within
+    /// bounds that keep a build finite.
+    pub fn check(&self) -> std::result::Result<(), FieldProblem> {
+        let problem = |field: &str, problem: String, fix: &str| FieldProblem {
+            field: field.to_string(),
+            problem,
+            fix: fix.to_string(),
+        };
+        let count = |field: &str, v: usize, lo: usize, hi: usize| {
+            if (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(problem(
+                    field,
+                    format!("{v} is not in {lo}..={hi}"),
+                    "give a count in that range",
+                ))
+            }
+        };
+        let number = |field: &str, v: f64, positive: bool| {
+            if v.is_finite() && (v > 0.0 || (!positive && v >= 0.0)) {
+                Ok(())
+            } else {
+                let what = if positive { "above 0" } else { "0 or more" };
+                Err(problem(
+                    field,
+                    format!("{v} is not a finite number {what}"),
+                    "give a finite number",
+                ))
+            }
+        };
+        number("spacing", self.spacing, true)?;
+        number("construct_weight", self.construct_weight, false)?;
+        number("smoothness", self.smoothness, false)?;
+        count("failure_limit", self.failure_limit, 1, 10_000_000)?;
+        count("max_points", self.max_points, 1, 10_000_000)?;
+        count("first_search", self.first_search.0, 2, 1_000_000)?;
+        number("first_search", self.first_search.1, true)?;
+        count("later_search", self.later_search.0, 2, 1_000_000)?;
+        number("later_search", self.later_search.1, true)?;
+        count("searches", self.searches, 1, 4096)?;
+        count("edge_neighbours", self.edge_neighbours, 1, 10_000)
+    }
+}
+
 /// A RON error with its position and, for unknown names, the closest valid ones.
 pub fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
     TaskError::Spec(Box::new(trm_kinematics::SpecError::from_ron(e, origin)))

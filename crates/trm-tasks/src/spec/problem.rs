@@ -231,18 +231,6 @@ fn check_numbers(spec: &Spec, ctx: &Ctx) -> Result<()> {
             ))
         }
     };
-    let number = |field: &str, v: f64, positive: bool| {
-        if v.is_finite() && (v > 0.0 || (!positive && v >= 0.0)) {
-            Ok(())
-        } else {
-            let what = if positive { "above 0" } else { "0 or more" };
-            Err(ctx.err(
-                field,
-                format!("{v} is not a finite number {what}"),
-                "give a finite number",
-            ))
-        }
-    };
     if let Some(p) = s.population {
         count("solver.population", p, 2, 1_000_000)?;
     }
@@ -270,17 +258,8 @@ fn check_numbers(spec: &Spec, ctx: &Ctx) -> Result<()> {
         }
     }
     if let Some(m) = &spec.map {
-        number("map.spacing", m.spacing, true)?;
-        number("map.construct_weight", m.construct_weight, false)?;
-        number("map.smoothness", m.smoothness, false)?;
-        count("map.failure_limit", m.failure_limit, 1, 10_000_000)?;
-        count("map.max_points", m.max_points, 1, 10_000_000)?;
-        count("map.first_search", m.first_search.0, 2, 1_000_000)?;
-        number("map.first_search", m.first_search.1, true)?;
-        count("map.later_search", m.later_search.0, 2, 1_000_000)?;
-        number("map.later_search", m.later_search.1, true)?;
-        count("map.searches", m.searches, 1, 4096)?;
-        count("map.edge_neighbours", m.edge_neighbours, 1, 10_000)?;
+        m.check()
+            .map_err(|p| ctx.err(&format!("map.{}", p.field), p.problem, p.fix))?;
     }
     Ok(())
 }

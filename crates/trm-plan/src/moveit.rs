@@ -1,0 +1,825 @@
+//! MoveIt's planning inputs as YAML (the ROS message layout MotionBenchMaker and
+//! `moveit_msgs` tools write): a `PlanningScene` (world collision objects made of box, sphere
+//! and cylinder primitives, the allowed-collision matrix, the robot state) and a
+//! `MotionPlanRequest` (start state, joint-space goal, group, planning time).
+//!
+//! ```
+//! use trm_plan::moveit::PlanningScene;
+//! let scene = PlanningScene::parse(
+//!     "world:\n  collision_objects:\n    - id: shelf\n      primitives: [{type: box, dimensions: [1.2, 1, 0.04]}]\n      primitive_poses: [{position: [0.6, 0, 0.2], orientation: [0, 0, 0, 1]}]\n",
+//!     "scene.yaml".as_ref(),
+//! )?;
+//! let world = scene.to_world()?;
+//! assert_eq!(world.objects().len(), 1);
+//! # Ok::<(), trm_plan::PlanError>(())
+//! ```
+//!
+//! Each primitive becomes one world object, posed by the object's `pose` (identity when absent)
+//! times its `primitive_poses` entry; an object of several primitives names them `id/0`,
+//! `id/1`, …. Poses are read as `position: [x, y, z]` or `{x:, y:, z:}` and `orientation:
+//! [x, y, z, w]` or `{x:, y:, z:, w:}`. Meshes, planes, cones and attached objects are refused
+//! with the object named (trm's worlds hold convex primitives). Every error names the file and
+//! the line.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use trm_collision::{Shape, World};
+use trm_kinematics::nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+
+use crate::PlanError;
+use crate::yaml::{self, Node};
+
+/// A joint state: names and positions.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointState {
+    /// Joint names.
+    pub names: Vec<String>,
+    /// Positions, rad or m.
+    pub positions: Vec<f64>,
+}
+
+impl JointState {
+    /// The position of `name`, if the state gives it.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.positions[i])
+    }
+}
+
+/// One primitive of a collision object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Primitive {
+    /// The shape (MoveIt's cylinders run along z, as trm's).
+    pub shape: Shape,
+    /// Its pose in the world frame (object pose × primitive pose).
+    pub pose: Isometry3<f64>,
+}
+
+/// A collision object of the scene's world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionObject {
+    /// Its id.
+    pub id: String,
+    /// Its primitives.
+    pub primitives: Vec<Primitive>,
+    /// Line of the object in the file.
+    pub line: usize,
+}
+
+/// The allowed-collision matrix of a scene: `entry_names` and, for each pair, whether it is
+/// allowed (not checked).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct AllowedCollisions {
+    /// Entry names (links or objects).
+    pub names: Vec<String>,
+    /// `allowed[i][j]`: the pair (names[i], names[j]) is not checked.
+    pub allowed: Vec<Vec<bool>>,
+}
+
+impl AllowedCollisions {
+    /// The allowed pairs, each once (i < j).
+    pub fn allowed_pairs(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.allowed.iter().enumerate().flat_map(move |(i, row)| {
+            row.iter()
+                .enumerate()
+                .skip(i + 1)
+                .filter(|(_, a)| **a)
+                .map(move |(j, _)| (self.names[i].as_str(), self.names[j].as_str()))
+        })
+    }
+}
+
+/// A MoveIt `PlanningScene`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlanningScene {
+    /// Where it came from.
+    pub origin: PathBuf,
+    /// `name`.
+    pub name: String,
+    /// `robot_model_name`.
+    pub robot_model_name: String,
+    /// `world.collision_objects`.
+    pub objects: Vec<CollisionObject>,
+    /// `allowed_collision_matrix`, when given.
+    pub allowed_collisions: Option<AllowedCollisions>,
+    /// `robot_state.joint_state`, when given.
+    pub robot_state: Option<JointState>,
+}
+
+/// A joint-space goal: target positions and tolerances.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointGoal {
+    /// Joint names.
+    pub names: Vec<String>,
+    /// Target positions.
+    pub positions: Vec<f64>,
+    /// Tolerances (below, above), rad or m.
+    pub tolerances: Vec<(f64, f64)>,
+}
+
+/// A MoveIt `MotionPlanRequest` with a joint-space goal.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MotionPlanRequest {
+    /// Where it came from.
+    pub origin: PathBuf,
+    /// `start_state.joint_state`.
+    pub start: JointState,
+    /// `goal_constraints[0].joint_constraints`.
+    pub goal: JointGoal,
+    /// `group_name`.
+    pub group: String,
+    /// `allowed_planning_time`, s (`None` when absent or 0).
+    pub planning_time: Option<f64>,
+}
+
+/// Reads fields of one file, naming the file and line in errors.
+struct Reader<'a> {
+    origin: &'a Path,
+}
+
+impl Reader<'_> {
+    fn err(&self, line: usize, problem: impl Into<String>, fix: impl Into<String>) -> PlanError {
+        PlanError::InvalidMoveIt {
+            path: self.origin.to_path_buf(),
+            line,
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+
+    fn parse(&self, text: &str) -> Result<Node, PlanError> {
+        let doc = yaml::parse(text).map_err(|p| {
+            self.err(
+                p.line,
+                format!("not readable YAML: {}", p.problem),
+                "write the message as ROS's YAML layout does",
+            )
+        })?;
+        if !matches!(doc.value, yaml::Value::Map(_)) {
+            return Err(self.err(
+                doc.line,
+                format!("the document is {}", doc.kind()),
+                "give a mapping of the message's fields",
+            ));
+        }
+        Ok(doc)
+    }
+
+    fn field<'n>(&self, node: &'n Node, key: &str, what: &str) -> Result<&'n Node, PlanError> {
+        node.get(key).ok_or_else(|| {
+            self.err(
+                node.line,
+                format!("{what} has no `{key}`"),
+                format!("give `{key}`"),
+            )
+        })
+    }
+
+    fn seq<'n>(&self, node: &'n Node, what: &str) -> Result<&'n [Node], PlanError> {
+        node.items().ok_or_else(|| {
+            self.err(
+                node.line,
+                format!("{what} is {}, not a list", node.kind()),
+                format!("give {what} as a list"),
+            )
+        })
+    }
+
+    fn text(&self, node: &Node, what: &str) -> Result<String, PlanError> {
+        node.scalar().map(str::to_string).ok_or_else(|| {
+            self.err(
+                node.line,
+                format!("{what} is {}", node.kind()),
+                format!("give {what} as a string"),
+            )
+        })
+    }
+
+    fn number(&self, node: &Node, what: &str) -> Result<f64, PlanError> {
+        node.scalar()
+            .and_then(|s| s.trim().parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                self.err(
+                    node.line,
+                    format!(
+                        "{what} is `{}`, not a finite number",
+                        node.scalar().unwrap_or(node.kind())
+                    ),
+                    "give a finite number",
+                )
+            })
+    }
+
+    fn numbers(&self, node: &Node, what: &str) -> Result<Vec<f64>, PlanError> {
+        self.seq(node, what)?
+            .iter()
+            .enumerate()
+            .map(|(i, n)| self.number(n, &format!("{what}[{i}]")))
+            .collect()
+    }
+
+    /// `[x, y, z]` or `{x:, y:, z:}` (and `w` for quaternions).
+    fn vector(&self, node: &Node, what: &str, keys: &[&str]) -> Result<Vec<f64>, PlanError> {
+        let values = if node.items().is_some() {
+            self.numbers(node, what)?
+        } else {
+            keys.iter()
+                .map(|k| self.number(self.field(node, k, what)?, &format!("{what}.{k}")))
+                .collect::<Result<_, _>>()?
+        };
+        if values.len() != keys.len() {
+            return Err(self.err(
+                node.line,
+                format!("{what} has {} values", values.len()),
+                format!("give {} values ({})", keys.len(), keys.join(", ")),
+            ));
+        }
+        Ok(values)
+    }
+
+    fn pose(&self, node: &Node, what: &str) -> Result<Isometry3<f64>, PlanError> {
+        let p = match node.get("position") {
+            Some(p) => self.vector(p, &format!("{what}.position"), &["x", "y", "z"])?,
+            None => vec![0.0; 3],
+        };
+        let q = match node.get("orientation") {
+            Some(o) => self.vector(o, &format!("{what}.orientation"), &["x", "y", "z", "w"])?,
+            None => vec![0.0, 0.0, 0.0, 1.0],
+        };
+        let quaternion = Quaternion::new(q[3], q[0], q[1], q[2]);
+        let norm = quaternion.norm();
+        if !(0.9..=1.1).contains(&norm) {
+            return Err(self.err(
+                node.line,
+                format!("{what}.orientation has norm {norm:.4}"),
+                "give a unit quaternion [x, y, z, w]",
+            ));
+        }
+        Ok(Isometry3::from_parts(
+            Translation3::new(p[0], p[1], p[2]),
+            UnitQuaternion::new_normalize(quaternion),
+        ))
+    }
+
+    fn joint_state(&self, node: &Node, what: &str) -> Result<JointState, PlanError> {
+        let names: Vec<String> = match node.get("name") {
+            Some(n) => self
+                .seq(n, &format!("{what}.name"))?
+                .iter()
+                .map(|s| self.text(s, &format!("{what}.name[]")))
+                .collect::<Result<_, _>>()?,
+            None => Vec::new(),
+        };
+        let positions = match node.get("position") {
+            Some(p) => self.numbers(p, &format!("{what}.position"))?,
+            None => Vec::new(),
+        };
+        if names.len() != positions.len() {
+            return Err(self.err(
+                node.line,
+                format!(
+                    "{what} names {} joints and gives {} positions",
+                    names.len(),
+                    positions.len()
+                ),
+                "give one position per name",
+            ));
+        }
+        if let Some((i, n)) = names
+            .iter()
+            .enumerate()
+            .find(|(i, n)| names[..*i].contains(n))
+        {
+            return Err(self.err(
+                node.line,
+                format!("{what}.name[{i}]: `{n}` is named twice"),
+                "name each joint once",
+            ));
+        }
+        Ok(JointState { names, positions })
+    }
+
+    fn object(&self, node: &Node, k: usize) -> Result<CollisionObject, PlanError> {
+        let what = format!("world.collision_objects[{k}]");
+        let id = self.text(self.field(node, "id", &what)?, &format!("{what}.id"))?;
+        if id.trim().is_empty() {
+            return Err(self.err(
+                node.line,
+                format!("{what} has an empty id"),
+                "give every object an id",
+            ));
+        }
+        let what = format!("object `{id}`");
+        if let Some(op) = node.get("operation").and_then(Node::scalar) {
+            if !matches!(op, "0" | "ADD" | "add" | "\x00") {
+                return Err(self.err(
+                    node.line,
+                    format!("{what} has operation `{op}`"),
+                    "a scene file adds objects (operation 0, ADD)",
+                ));
+            }
+        }
+        for unsupported in ["meshes", "planes", "subframe_names"] {
+            if node
+                .get(unsupported)
+                .and_then(Node::items)
+                .is_some_and(|l| !l.is_empty())
+            {
+                return Err(self.err(
+                    node.line,
+                    format!("{what} has {unsupported}"),
+                    "trm's worlds hold boxes, spheres and cylinders: replace meshes and planes by primitives",
+                ));
+            }
+        }
+        let object_pose = match node.get("pose") {
+            Some(p) => self.pose(p, &format!("{what}.pose"))?,
+            None => Isometry3::identity(),
+        };
+        let shapes = match node.get("primitives") {
+            Some(p) => self.seq(p, &format!("{what}.primitives"))?,
+            None => &[],
+        };
+        let poses = match node.get("primitive_poses") {
+            Some(p) => self.seq(p, &format!("{what}.primitive_poses"))?,
+            None => &[],
+        };
+        if shapes.is_empty() || shapes.len() != poses.len() {
+            return Err(self.err(
+                node.line,
+                format!(
+                    "{what} has {} primitives and {} primitive poses",
+                    shapes.len(),
+                    poses.len()
+                ),
+                "give at least one primitive and one pose per primitive",
+            ));
+        }
+        let mut primitives = Vec::new();
+        for (i, (s, p)) in shapes.iter().zip(poses).enumerate() {
+            let here = format!("{what}.primitives[{i}]");
+            let kind = self.text(self.field(s, "type", &here)?, &format!("{here}.type"))?;
+            let d = self.numbers(
+                self.field(s, "dimensions", &here)?,
+                &format!("{here}.dimensions"),
+            )?;
+            let need = |n: usize, names: &str| -> Result<(), PlanError> {
+                if d.len() == n && d.iter().all(|v| *v > 0.0) {
+                    Ok(())
+                } else {
+                    Err(self.err(
+                        s.line,
+                        format!("{here}: a {kind} with dimensions {d:?}"),
+                        format!("give {n} positive dimensions ({names})"),
+                    ))
+                }
+            };
+            // shape_msgs/SolidPrimitive: BOX = 1, SPHERE = 2, CYLINDER = 3, CONE = 4
+            let shape = match kind.to_ascii_lowercase().as_str() {
+                "box" | "1" => {
+                    need(3, "x, y, z")?;
+                    Shape::Box {
+                        size: [d[0], d[1], d[2]],
+                    }
+                }
+                "sphere" | "2" => {
+                    need(1, "radius")?;
+                    Shape::Sphere { radius: d[0] }
+                }
+                "cylinder" | "3" => {
+                    need(2, "height, radius")?;
+                    Shape::Cylinder {
+                        radius: d[1],
+                        length: d[0],
+                    }
+                }
+                _ => {
+                    return Err(self.err(
+                        s.line,
+                        format!("{here} is a `{kind}`"),
+                        "use box, sphere or cylinder (cones and other primitives are not supported)",
+                    ));
+                }
+            };
+            let pose = object_pose * self.pose(p, &format!("{what}.primitive_poses[{i}]"))?;
+            primitives.push(Primitive { shape, pose });
+        }
+        Ok(CollisionObject {
+            id,
+            primitives,
+            line: node.line,
+        })
+    }
+
+    fn allowed(&self, node: &Node) -> Result<AllowedCollisions, PlanError> {
+        let what = "allowed_collision_matrix";
+        let names: Vec<String> = match node.get("entry_names") {
+            Some(n) => self
+                .seq(n, "allowed_collision_matrix.entry_names")?
+                .iter()
+                .map(|s| self.text(s, "an entry name"))
+                .collect::<Result<_, _>>()?,
+            None => Vec::new(),
+        };
+        let rows = match node.get("entry_values") {
+            Some(v) => self.seq(v, "allowed_collision_matrix.entry_values")?,
+            None => &[],
+        };
+        if rows.len() != names.len() {
+            return Err(self.err(
+                node.line,
+                format!(
+                    "{what}: {} rows for {} entry names",
+                    rows.len(),
+                    names.len()
+                ),
+                "give one row per entry name",
+            ));
+        }
+        let mut allowed = Vec::new();
+        for (i, row) in rows.iter().enumerate() {
+            let here = format!("{what}.entry_values[{i}]");
+            let values = match row.get("enabled") {
+                Some(e) => self.seq(e, &here)?,
+                None => self.seq(row, &here)?,
+            };
+            if values.len() != names.len() {
+                return Err(self.err(
+                    row.line,
+                    format!(
+                        "{here} has {} values for {} names",
+                        values.len(),
+                        names.len()
+                    ),
+                    "give one value per entry name",
+                ));
+            }
+            let parsed: Vec<bool> = values
+                .iter()
+                .map(|v| match v.scalar() {
+                    Some("true" | "True" | "1") => Ok(true),
+                    Some("false" | "False" | "0") => Ok(false),
+                    _ => Err(self.err(
+                        v.line,
+                        format!(
+                            "{here}: `{}` is not true or false",
+                            v.scalar().unwrap_or(v.kind())
+                        ),
+                        "give true or false",
+                    )),
+                })
+                .collect::<Result<_, _>>()?;
+            allowed.push(parsed);
+        }
+        for i in 0..names.len() {
+            for j in 0..i {
+                if allowed[i][j] != allowed[j][i] {
+                    return Err(self.err(
+                        rows[i].line,
+                        format!(
+                            "{what}: ({}, {}) is {} one way and {} the other",
+                            names[i], names[j], allowed[i][j], allowed[j][i]
+                        ),
+                        "give a symmetric matrix",
+                    ));
+                }
+            }
+        }
+        Ok(AllowedCollisions { names, allowed })
+    }
+}
+
+impl PlanningScene {
+    /// Parses a scene's YAML; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, PlanError> {
+        let r = Reader { origin };
+        let doc = r.parse(text)?;
+        let mut scene = PlanningScene {
+            origin: origin.to_path_buf(),
+            ..Default::default()
+        };
+        if let Some(n) = doc.get("name") {
+            scene.name = r.text(n, "name")?;
+        }
+        if let Some(n) = doc.get("robot_model_name") {
+            scene.robot_model_name = r.text(n, "robot_model_name")?;
+        }
+        if let Some(world) = doc.get("world") {
+            if let Some(objects) = world.get("collision_objects") {
+                for (k, o) in r
+                    .seq(objects, "world.collision_objects")?
+                    .iter()
+                    .enumerate()
+                {
+                    let object = r.object(o, k)?;
+                    if let Some(first) = scene.objects.iter().find(|f| f.id == object.id) {
+                        return Err(r.err(
+                            o.line,
+                            format!(
+                                "object `{}` is given twice (first at line {})",
+                                object.id, first.line
+                            ),
+                            "give every object its own id",
+                        ));
+                    }
+                    scene.objects.push(object);
+                }
+            }
+        }
+        if let Some(acm) = doc.get("allowed_collision_matrix") {
+            scene.allowed_collisions = Some(r.allowed(acm)?);
+        }
+        if let Some(state) = doc.get("robot_state") {
+            if let Some(js) = state.get("joint_state") {
+                scene.robot_state = Some(r.joint_state(js, "robot_state.joint_state")?);
+            }
+            if state
+                .get("attached_collision_objects")
+                .and_then(Node::items)
+                .is_some_and(|l| !l.is_empty())
+            {
+                return Err(r.err(
+                    state.line,
+                    "the robot state has attached collision objects",
+                    "detach them into the world (trm does not carry objects with the robot yet)",
+                ));
+            }
+        }
+        Ok(scene)
+    }
+
+    /// Reads a scene file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
+        let path = path.as_ref();
+        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// The world of the scene: one object per primitive (`id`, or `id/k` for an object of
+    /// several).
+    pub fn to_world(&self) -> Result<World, PlanError> {
+        let mut world = World::new();
+        for o in &self.objects {
+            for (k, p) in o.primitives.iter().enumerate() {
+                let name = if o.primitives.len() == 1 {
+                    o.id.clone()
+                } else {
+                    format!("{}/{k}", o.id)
+                };
+                world.add(&name, p.shape.clone(), p.pose).map_err(|e| {
+                    PlanError::InvalidMoveIt {
+                        path: self.origin.clone(),
+                        line: o.line,
+                        problem: format!("object `{}`: {e}", o.id),
+                        fix: "give positive finite dimensions and finite poses, and unique ids"
+                            .into(),
+                    }
+                })?;
+            }
+        }
+        Ok(world)
+    }
+
+    /// The scene as YAML in the layout [`PlanningScene::parse`] reads (a round trip keeps every
+    /// field it reads; numbers are written in their shortest exact form).
+    pub fn to_yaml(&self) -> String {
+        let mut out = String::new();
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let _ = writeln!(out, "name: {}", quote(&self.name));
+        let _ = writeln!(out, "robot_model_name: {}", quote(&self.robot_model_name));
+        if let Some(state) = &self.robot_state {
+            let names: Vec<String> = state.names.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(
+                out,
+                "robot_state:\n  joint_state:\n    name: [{}]\n    position: [{}]",
+                names.join(", "),
+                list(&state.positions)
+            );
+        }
+        if let Some(acm) = &self.allowed_collisions {
+            let names: Vec<String> = acm.names.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(
+                out,
+                "allowed_collision_matrix:\n  entry_names: [{}]\n  entry_values:",
+                names.join(", ")
+            );
+            for row in &acm.allowed {
+                let _ = writeln!(
+                    out,
+                    "    - [{}]",
+                    row.iter()
+                        .map(|b| b.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+        }
+        let _ = writeln!(
+            out,
+            "world:\n  collision_objects:{}",
+            if self.objects.is_empty() { " []" } else { "" }
+        );
+        for o in &self.objects {
+            let _ = writeln!(out, "    - id: {}\n      primitives:", quote(&o.id));
+            for p in &o.primitives {
+                let (kind, d) = match &p.shape {
+                    Shape::Box { size } => ("box", size.to_vec()),
+                    Shape::Sphere { radius } => ("sphere", vec![*radius]),
+                    Shape::Cylinder { radius, length } => ("cylinder", vec![*length, *radius]),
+                    other => unreachable!("a scene holds only what it reads, not {other:?}"),
+                };
+                let _ = writeln!(
+                    out,
+                    "        - type: {kind}\n          dimensions: [{}]",
+                    list(&d)
+                );
+            }
+            let _ = writeln!(out, "      primitive_poses:");
+            for p in &o.primitives {
+                let t = p.pose.translation.vector;
+                let q = p.pose.rotation.coords; // x, y, z, w
+                let _ = writeln!(
+                    out,
+                    "        - position: [{}]\n          orientation: [{}]",
+                    list(&[t.x, t.y, t.z]),
+                    list(&[q.x, q.y, q.z, q.w])
+                );
+            }
+        }
+        out
+    }
+}
+
+/// A YAML double-quoted string.
+fn quote(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => {
+                let _ = write!(out, "\\u{:04x}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+impl MotionPlanRequest {
+    /// Parses a request's YAML; `origin` names it in errors. The goal is the first goal
+    /// constraint's joint constraints; position and orientation constraints are refused (not
+    /// read yet).
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, PlanError> {
+        let r = Reader { origin };
+        let doc = r.parse(text)?;
+        let mut request = MotionPlanRequest {
+            origin: origin.to_path_buf(),
+            ..Default::default()
+        };
+        if let Some(start) = doc.get("start_state") {
+            if let Some(js) = start.get("joint_state") {
+                request.start = r.joint_state(js, "start_state.joint_state")?;
+            }
+        }
+        let goals = r.seq(
+            r.field(&doc, "goal_constraints", "the request")?,
+            "goal_constraints",
+        )?;
+        let Some(goal) = goals.first() else {
+            return Err(r.err(
+                doc.line,
+                "goal_constraints is empty",
+                "give one goal constraint with joint constraints",
+            ));
+        };
+        for unsupported in [
+            "position_constraints",
+            "orientation_constraints",
+            "visibility_constraints",
+        ] {
+            if goal
+                .get(unsupported)
+                .and_then(Node::items)
+                .is_some_and(|l| !l.is_empty())
+            {
+                return Err(r.err(
+                    goal.line,
+                    format!("the goal has {unsupported}"),
+                    "give the goal as joint constraints (task-space goals are not read yet)",
+                ));
+            }
+        }
+        let joints = r.seq(
+            r.field(goal, "joint_constraints", "the goal")?,
+            "goal_constraints[0].joint_constraints",
+        )?;
+        if joints.is_empty() {
+            return Err(r.err(
+                goal.line,
+                "the goal has no joint constraints",
+                "give a joint constraint per joint of the group",
+            ));
+        }
+        for (i, c) in joints.iter().enumerate() {
+            let here = format!("goal_constraints[0].joint_constraints[{i}]");
+            let name = r.text(
+                r.field(c, "joint_name", &here)?,
+                &format!("{here}.joint_name"),
+            )?;
+            if request.goal.names.contains(&name) {
+                return Err(r.err(
+                    c.line,
+                    format!("joint `{name}` is constrained twice"),
+                    "constrain each joint once",
+                ));
+            }
+            let position = r.number(r.field(c, "position", &here)?, &format!("{here}.position"))?;
+            let tolerance = |k: &str| -> Result<f64, PlanError> {
+                match c.get(k) {
+                    Some(t) => {
+                        let v = r.number(t, &format!("{here}.{k}"))?;
+                        if v < 0.0 {
+                            return Err(r.err(
+                                t.line,
+                                format!("{here}.{k} is {v}"),
+                                "give a tolerance of 0 or more",
+                            ));
+                        }
+                        Ok(v)
+                    }
+                    None => Ok(0.0),
+                }
+            };
+            request
+                .goal
+                .tolerances
+                .push((tolerance("tolerance_below")?, tolerance("tolerance_above")?));
+            request.goal.names.push(name);
+            request.goal.positions.push(position);
+        }
+        if let Some(g) = doc.get("group_name") {
+            request.group = r.text(g, "group_name")?;
+        }
+        if let Some(t) = doc.get("allowed_planning_time") {
+            let v = r.number(t, "allowed_planning_time")?;
+            if v < 0.0 {
+                return Err(r.err(
+                    t.line,
+                    format!("allowed_planning_time is {v}"),
+                    "give seconds, 0 or more (0: no limit given)",
+                ));
+            }
+            request.planning_time = (v > 0.0).then_some(v);
+        }
+        Ok(request)
+    }
+
+    /// Reads a request file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
+        let path = path.as_ref();
+        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+}
+
+/// Values of `state` for the motors of `robot` it names (other names are skipped and
+/// returned): the robot's motor vector with `base` where the state is silent.
+pub fn motors_from_state(
+    robot: &trm_kinematics::RobotModel,
+    state: &JointState,
+    base: &[f64],
+) -> (Vec<f64>, Vec<String>) {
+    let mut motors = base.to_vec();
+    let mut skipped = Vec::new();
+    let index: BTreeMap<&str, usize> = robot
+        .motors()
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.name.as_str(), i))
+        .collect();
+    for (name, value) in state.names.iter().zip(&state.positions) {
+        match index.get(name.as_str()) {
+            Some(&i) => motors[i] = *value,
+            None => skipped.push(name.clone()),
+        }
+    }
+    (motors, skipped)
+}
