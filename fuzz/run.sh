@@ -15,7 +15,7 @@ cd "$(dirname "$0")"
 root=..
 
 targets=(urdf model_description task_spec world motion_spec taskmap_spec map checkpoint taskmap scene
-         configurations posture trajectory_csv trajectory_json srdf mesh)
+         configurations posture trajectory_csv trajectory_json srdf mesh moveit)
 
 # The seed files of a target, one per line.
 seeds() {
@@ -27,7 +27,8 @@ seeds() {
     motion_spec) ls "$root"/specs/wholebody/*.ron ;;
     taskmap_spec) ls "$root"/specs/taskmaps/*.ron ;;
     configurations) ls "$root"/specs/configs/*.json ;;
-    srdf) ls "$root"/models/*/example-robot-data/robots/*/srdf/*.srdf ;;
+    srdf) ls "$root"/models/*/example-robot-data/robots/*/srdf/*.srdf "$root"/models/*/*.srdf ;;
+    moveit) ls "$root"/crates/trm-plan/tests/fixtures/mbm/box_panda/*.yaml ;;
   esac
   if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
 }
@@ -37,7 +38,7 @@ seeds() {
 # explore faster.
 flags() {
   case "$1" in
-    model_description | scene | urdf | srdf | mesh) echo -max_len=8192 ;;
+    model_description | scene | urdf | srdf | mesh | moveit) echo -max_len=8192 ;;
   esac
 }
 

@@ -1,5 +1,6 @@
 //! `cargo xtask <command>`: the commands people run with trm. `cargo xtask --help` lists them.
 
+mod benchmark_mbm;
 mod build_map;
 mod collide;
 mod compare;
@@ -76,6 +77,9 @@ enum Command {
     FitProxies(fit_proxies::Args),
     /// Plan a motion through one or several maps in the current world (lazy A*).
     Plan(plan::Args),
+    /// A MotionBenchMaker set (MoveIt scenes and joint-goal requests) solved by RRT-Connect:
+    /// solved %, median and p95 time per family.
+    BenchmarkMbm(benchmark_mbm::Args),
     /// The task-map studies: a stick with an exact target vs its map; a basket handle at three places.
     TaskMapStudies(task_map_studies::Args),
     /// A reaching motion to grasp an object, optimised with its task map (or an exact target).
@@ -128,6 +132,7 @@ impl Command {
             Command::MapScaling(a) => (vec![], vec![a.out_dir.clone()]),
             Command::RepairMap(a) => (vec![a.out_path()], vec![]),
             Command::Scenario(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::BenchmarkMbm(a) => (vec![], vec![a.out_dir.clone()]),
             Command::FitProxies(a) => (file(&a.out), vec![]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
@@ -253,6 +258,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::MapScaling(args) => map_scaling::run(&args),
         Command::RepairMap(args) => repair_map::run(&args),
         Command::Scenario(args) => scenario::run(&args),
+        Command::BenchmarkMbm(args) => benchmark_mbm::run(&args),
         Command::FitProxies(args) => fit_proxies::run(&args),
         Command::StandUp(args) => stand_up::run(&args),
         Command::View(args) => view::run(&args),

@@ -904,7 +904,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     for (k, (what, text, names)) in [
         ("truncated XML", "<robot name=\"r\">\n  <group name=\"a\">", "srdf_0.srdf"),
         ("an unknown joint", "<robot name=\"icub_upper_body\">\n<group name=\"a\"><joint name=\"r_elbw\"/></group>\n</robot>", "r_elbow"),
-        ("an unknown link", "<robot name=\"icub_upper_body\">\n<disable_collisions link1=\"chest\" link2=\"r_hnd\" reason=\"Never\"/>\n</robot>", "r_hand"),
+        ("an unknown link in a group", "<robot name=\"icub_upper_body\">\n<group name=\"a\"><link name=\"r_hnd\"/></group>\n</robot>", "r_hand"),
         ("a missing attribute", "<robot name=\"icub_upper_body\">\n<end_effector name=\"e\" group=\"a\"/>\n</robot>", "parent_link"),
         ("a non-number", "<robot name=\"icub_upper_body\"><group name=\"a\"><joint name=\"r_elbow\"/></group><group_state name=\"s\" group=\"a\"><joint name=\"r_elbow\" value=\"x\"/></group_state></robot>", "srdf_4.srdf"),
         ("another root", "<urdf/>", "srdf_5.srdf"),

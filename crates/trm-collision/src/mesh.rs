@@ -9,7 +9,9 @@ use parry3d_f64::shape::ConvexPolyhedron;
 /// Where a mesh URI may live, in the order they are tried.
 ///
 /// * `package://NAME/REST`: for every directory `D` of `package_paths`, `D/NAME/REST`, then
-///   `D/REST` when `D` itself is named `NAME` (as `ROS_PACKAGE_PATH` entries work);
+///   `D/REST` when `D` itself is named `NAME` (as `ROS_PACKAGE_PATH` entries work); then the
+///   same for the URDF's directory and each directory above it, nearest first (a robot's files
+///   kept together as they ship, no package path needed);
 /// * `file:///ABS` or an absolute path: that path;
 /// * a relative path: relative to the URDF's directory, when known.
 pub fn mesh_candidates(
@@ -20,7 +22,11 @@ pub fn mesh_candidates(
     if let Some(rest) = uri.strip_prefix("package://") {
         let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
         let mut out = Vec::new();
-        for dir in package_paths {
+        let ancestors = urdf_dir.into_iter().flat_map(Path::ancestors);
+        for dir in package_paths.iter().map(PathBuf::as_path).chain(ancestors) {
+            if dir.as_os_str().is_empty() {
+                continue;
+            }
             out.push(dir.join(package).join(inner));
             if dir.file_name().is_some_and(|n| n == package) {
                 out.push(dir.join(inner));
@@ -49,6 +55,10 @@ pub fn resolve_mesh(
         .cloned()
         .ok_or(candidates)
 }
+
+/// The farthest a scaled mesh vertex may lie from its mesh's origin, m: a robot link's mesh
+/// spans metres, and a vertex a kilometre away is a misread file or a wrong scale.
+pub const MAX_VERTEX_DISTANCE: f64 = 1e3;
 
 /// Loads a mesh file (STL, COLLADA or OBJ; at most [`trm_kinematics::MAX_INPUT_BYTES`]),
 /// scales it and returns the vertices of its convex hull.
@@ -104,17 +114,54 @@ pub fn convex_hull_of_mesh_bytes(
     {
         return Err("the file holds non-finite vertices".to_string());
     }
+    if let Some(far) = points
+        .iter()
+        .find(|p| p.coords.amax() > MAX_VERTEX_DISTANCE)
+    {
+        return Err(format!(
+            "a vertex lies at ({:e}, {:e}, {:e}), more than {MAX_VERTEX_DISTANCE} m from the mesh's origin: check the file's format and the scale",
+            far.x, far.y, far.z
+        ));
+    }
     let flat = || "the mesh is flat: its convex hull has no volume".to_string();
     if !crate::shape::spans_volume(&points) {
         return Err(flat());
     }
     let hull = ConvexPolyhedron::from_convex_hull(&points).ok_or_else(flat)?;
-    Ok(hull.points().iter().map(|p| [p.x, p.y, p.z]).collect())
+    let corners: Vec<Point3<f64>> = hull.points().to_vec();
+    if corners.len() < 4 || !crate::shape::spans_volume(&corners) {
+        return Err(flat());
+    }
+    Ok(corners.iter().map(|p| [p.x, p.y, p.z]).collect())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn misread_or_degenerate_meshes_are_errors() {
+        // found by fuzzing: ASCII STL with a damaged `solid` line is read as binary, giving
+        // vertices 1e34 m away whose hull is numerically flat
+        let mut text = String::from("solid$t\n");
+        for f in [[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]] {
+            let v = [[0, 0, 0], [0, 1, 0], [1, 0, 0], [0, 0, 1]];
+            text.push_str("facet normal 0 0 0\n outer loop\n");
+            for i in f {
+                text.push_str(&format!(" vertex {} {} {}\n", v[i][0], v[i][1], v[i][2]));
+            }
+            text.push_str(" endloop\nendfacet\n");
+        }
+        text.push_str("endsolid t\n");
+        let e = convex_hull_of_mesh_bytes(text.as_bytes(), Path::new("t.stl"), [1.0; 3]);
+        assert!(e.is_err(), "{e:?}");
+        let good = text.replacen("solid$t", "solid t", 1);
+        let hull =
+            convex_hull_of_mesh_bytes(good.as_bytes(), Path::new("t.stl"), [1.0; 3]).unwrap();
+        assert_eq!(hull.len(), 4);
+        let far = convex_hull_of_mesh_bytes(good.as_bytes(), Path::new("t.stl"), [1e4; 3]);
+        assert!(far.unwrap_err().contains("more than 1000 m"));
+    }
 
     #[test]
     fn package_uris_follow_ros_rules() {
@@ -137,5 +184,21 @@ mod tests {
             [PathBuf::from("/abs/c.obj")]
         );
         assert!(mesh_candidates("rel.stl", None, &[]).is_empty());
+        // then beside the URDF and above it
+        assert_eq!(
+            mesh_candidates(
+                "package://p/m.stl",
+                Some(Path::new("/r/p/urdf")),
+                &paths[..1]
+            ),
+            [
+                PathBuf::from("/opt/share/p/m.stl"),
+                PathBuf::from("/r/p/urdf/p/m.stl"),
+                PathBuf::from("/r/p/p/m.stl"),
+                PathBuf::from("/r/p/m.stl"),
+                PathBuf::from("/r/p/m.stl"),
+                PathBuf::from("/p/m.stl"),
+            ]
+        );
     }
 }

@@ -113,6 +113,8 @@ pub struct Srdf {
     pub disabled: Vec<(DisabledCollisionSpec, usize)>,
     /// Passive joints.
     pub passive_joints: Vec<String>,
+    /// What the reader skipped, and why (MoveIt warns about the same and goes on).
+    pub notes: Vec<String>,
 }
 
 /// What [`Srdf::to_description`] took over and what it left out.
@@ -241,14 +243,13 @@ impl Srdf {
                             "link" => g.links.push(attr(m, "name")?),
                             "chain" => g.chains.push((attr(m, "base_link")?, attr(m, "tip_link")?)),
                             "group" => g.subgroups.push(attr(m, "name")?),
-                            other => {
-                                return Err(error(
-                                    origin,
-                                    line(m),
-                                    format!("<{other}> in group `{}`", g.name),
-                                    "a group holds <joint>, <link>, <chain> and <group> members",
-                                ));
-                            }
+                            // MoveIt's reader skips other elements (SRDFs in the wild put
+                            // <passive_joint> there); so does trm, saying so
+                            other => srdf.notes.push(format!(
+                                "line {}: <{other}> in group `{}` skipped (a group holds <joint>, <link>, <chain> and <group> members)",
+                                line(m),
+                                g.name
+                            )),
                         }
                     }
                     srdf.groups.push(g);
@@ -422,7 +423,10 @@ impl Srdf {
             ));
         }
         let mut out = base.clone();
-        let mut report = SrdfReport::default();
+        let mut report = SrdfReport {
+            notes: self.notes.clone(),
+            ..Default::default()
+        };
         for vj in &self.virtual_joints {
             let child = link(&vj.child_link, vj.line)?;
             if tree.links[child].parent.is_some() {
@@ -447,7 +451,23 @@ impl Srdf {
         // None for a group that includes one only the model description defines
         let mut group_joints: BTreeMap<&str, Option<Vec<usize>>> = BTreeMap::new();
         let mut defined: Vec<String> = out.groups.iter().map(|g| g.name.clone()).collect();
-        for g in &self.groups {
+        // groups in an order where each comes after the groups it includes (as MoveIt, the
+        // SRDF may name a group before defining it); what is left is an error below
+        let mut left_out: Vec<String> = Vec::new();
+        let mut order: Vec<&SrdfGroup> = Vec::new();
+        let mut left: Vec<&SrdfGroup> = self.groups.iter().collect();
+        loop {
+            let known = |n: &String| defined.contains(n) || order.iter().any(|o| &o.name == n);
+            let (ready, rest): (Vec<&SrdfGroup>, Vec<&SrdfGroup>) =
+                left.iter().partition(|g| g.subgroups.iter().all(known));
+            if ready.is_empty() {
+                order.extend(rest);
+                break;
+            }
+            order.extend(ready);
+            left = rest;
+        }
+        for g in order {
             let mut joints: Vec<usize> = Vec::new();
             for j in &g.joints {
                 joints.push(joint(j, g.line)?);
@@ -476,12 +496,12 @@ impl Srdf {
             }
             let mut resolved = Some(joints.clone());
             for s in &g.subgroups {
-                if !defined.contains(s) {
+                if !defined.contains(s) && !left_out.contains(s) {
                     return Err(error(
                         origin,
                         g.line,
                         format!(
-                            "group `{}` includes group `{s}`, defined later or not at all",
+                            "group `{}` includes group `{s}`, which is not defined (or includes it in turn)",
                             g.name
                         ),
                         did_you_mean(s, defined.iter().map(String::as_str), "group"),
@@ -502,7 +522,12 @@ impl Srdf {
             }
             let mut members: Vec<String> = Vec::new();
             let own_motors = joints.iter().flat_map(|&j| motors_of(j));
-            for n in own_motors.chain(g.subgroups.iter().cloned()) {
+            let subgroups = g
+                .subgroups
+                .iter()
+                .filter(|s| !left_out.contains(s))
+                .cloned();
+            for n in own_motors.chain(subgroups) {
                 if !members.contains(&n) {
                     members.push(n);
                 }
@@ -511,6 +536,7 @@ impl Srdf {
                 report
                     .notes
                     .push(format!("group `{}` drives no motor: left out", g.name));
+                left_out.push(g.name.clone());
                 continue;
             }
             out.groups.push(GroupSpec {
@@ -631,8 +657,20 @@ impl Srdf {
             report.counts[2] += 1;
         }
         for (d, line) in &self.disabled {
-            link(&d.a, *line)?;
-            link(&d.b, *line)?;
+            // MoveIt skips a pair naming a link the URDF lacks (SRDFs written for another
+            // variant of the robot, e.g. a spherized URDF); so does trm, saying so
+            if let Some(missing) = [&d.a, &d.b]
+                .into_iter()
+                .find(|l| !links.contains(&l.as_str()))
+            {
+                report.notes.push(format!(
+                    "line {line}: disabled pair ({}, {}) skipped: link `{missing}` is not in the URDF ({})",
+                    d.a,
+                    d.b,
+                    did_you_mean(missing, links.iter().copied(), "link")
+                ));
+                continue;
+            }
             let same = |x: &DisabledCollisionSpec| {
                 (x.a == d.a && x.b == d.b) || (x.a == d.b && x.b == d.a)
             };
@@ -721,6 +759,7 @@ impl Srdf {
             end_effectors: Vec::new(),
             disabled: disabled.iter().map(|d| (d.clone(), 0)).collect(),
             passive_joints: Vec::new(),
+            notes: Vec::new(),
         }
     }
 

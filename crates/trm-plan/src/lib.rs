@@ -13,8 +13,10 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod mbm;
 pub mod moveit;
 mod planner;
+pub mod rrt;
 pub mod scenario;
 mod trajectory;
 pub mod yaml;

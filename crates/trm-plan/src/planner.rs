@@ -196,6 +196,10 @@ pub struct PlanOptions {
     pub exact_tolerance: f64,
     /// Evaluation budget of the exact finish.
     pub exact_evaluations: u64,
+    /// When the maps do not join the start and a configuration goal in the current world,
+    /// RRT-Connect with these settings finishes the query ([`PlanStats::sampled`] says so);
+    /// `None`: the maps alone answer.
+    pub sampling: Option<crate::rrt::RrtOptions>,
 }
 
 /// Weight of the task error in the exact finish of a task-point goal: large enough to dominate
@@ -239,6 +243,10 @@ impl Default for PlanOptions {
             exact_goal: true,
             exact_tolerance: 1e-3,
             exact_evaluations: 30_000,
+            sampling: Some(crate::rrt::RrtOptions {
+                max_iterations: 20_000,
+                ..Default::default()
+            }),
         }
     }
 }
@@ -292,6 +300,9 @@ impl PlanOptions {
                 ),
             );
         }
+        if let Some(rrt) = &self.sampling {
+            rrt.check()?;
+        }
         if self.exact_goal && self.exact_evaluations == 0 {
             return bad(
                 "exact_evaluations",
@@ -323,6 +334,9 @@ pub struct PlanStats {
     pub goal_error: Option<f64>,
     /// The exact finish of a task-point goal.
     pub exact: ExactGoal,
+    /// The maps did not join start and goal: RRT-Connect found the path
+    /// ([`PlanOptions::sampling`]); its samples and collision checks.
+    pub sampled: Option<(usize, u64)>,
 }
 
 /// A planned motion.
@@ -477,6 +491,25 @@ impl<'a> Planner<'a> {
         options: &PlanOptions,
     ) -> Result<Planned, PlanError> {
         let planned = self.plan_once(start, goal, options);
+        // a configuration goal the maps do not reach: the sampling planner finishes the query
+        if let (Err(PlanError::Unreachable { .. }), Goal::Configuration(q), Some(rrt)) =
+            (&planned, goal, &options.sampling)
+        {
+            let began = Instant::now();
+            let found = crate::rrt::rrt_connect(&self.objective, &self.world, start, q, rrt)?;
+            let mut stats = PlanStats {
+                sampled: Some((found.iterations, found.checks)),
+                length: crate::rrt::path_length(&found.path),
+                ..Default::default()
+            };
+            let trajectory = self.timed(&found.path, options);
+            stats.seconds = began.elapsed().as_secs_f64();
+            return Ok(Planned {
+                trajectory,
+                nodes: Vec::new(),
+                stats,
+            });
+        }
         // a task point with no reachable node within the tolerance but one within twice it:
         // through that node, and NGIK the rest of the way
         if let (

@@ -1,0 +1,241 @@
+//! MotionBenchMaker problem sets (Chamzas et al., 2022): a folder per problem family, each
+//! holding `sceneNNNN.yaml` (a MoveIt planning scene) and `requestNNNN.yaml` (a motion plan
+//! request with a joint goal). [`solve`] answers one problem with RRT-Connect on any robot
+//! model: the active motors are the joints the goal constrains, every other motor stays where
+//! the start state puts it (clamped into its limits).
+
+use std::path::{Path, PathBuf};
+
+use trm_collision::CollisionModel;
+use trm_kinematics::RobotModel;
+use trm_tasks::Objective;
+
+use crate::PlanError;
+use crate::moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
+use crate::rrt::{Checker, RrtOptions, path_length, rrt_connect};
+
+/// One problem of a set.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Problem {
+    /// Family (the folder's name).
+    pub family: String,
+    /// Number (from the file names).
+    pub index: u32,
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The request file.
+    pub request: PathBuf,
+}
+
+/// The problems under `dir` (its folders' `sceneNNNN.yaml` with their `requestNNNN.yaml`),
+/// sorted by family and number. A scene without its request is an error naming it.
+pub fn find_problems(dir: &Path) -> Result<Vec<Problem>, PlanError> {
+    let io = |path: &Path, source| PlanError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut problems = Vec::new();
+    let mut folders: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir())
+        .collect();
+    folders.sort();
+    for folder in folders {
+        let family = folder
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        for entry in std::fs::read_dir(&folder).map_err(|e| io(&folder, e))? {
+            let path = entry.map_err(|e| io(&folder, e))?.path();
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let Some(number) = name
+                .strip_prefix("scene")
+                .and_then(|n| n.strip_suffix(".yaml"))
+            else {
+                continue;
+            };
+            let Ok(index) = number.parse::<u32>() else {
+                continue;
+            };
+            let request = folder.join(format!("request{number}.yaml"));
+            if !request.is_file() {
+                return Err(PlanError::InvalidMoveIt {
+                    path: path.clone(),
+                    line: 0,
+                    problem: format!("no {} beside it", request.display()),
+                    fix: "give every scene its request (MotionBenchMaker writes them in pairs)"
+                        .into(),
+                });
+            }
+            problems.push(Problem {
+                family: family.clone(),
+                index,
+                scene: path,
+                request,
+            });
+        }
+    }
+    problems.sort();
+    if problems.is_empty() {
+        return Err(PlanError::InvalidMoveIt {
+            path: dir.to_path_buf(),
+            line: 0,
+            problem: "no sceneNNNN.yaml in any folder".into(),
+            fix: "give the folder that holds one folder per problem family (MotionBenchMaker's layout)".into(),
+        });
+    }
+    Ok(problems)
+}
+
+/// How one problem went.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Outcome {
+    /// Start and goal are collision-free and within limits (a problem that is not valid is
+    /// left out of the solved rate, as VAMP's and OMPL's reports do).
+    pub valid: bool,
+    /// A path was found.
+    pub solved: bool,
+    /// Planning time (checks, search, shortcutting; not reading the files), s.
+    pub seconds: f64,
+    /// Path length, rad.
+    pub length: f64,
+    /// Waypoints of the path.
+    pub waypoints: usize,
+    /// Configurations checked for collision.
+    pub checks: u64,
+    /// Why it is invalid or unsolved.
+    pub note: String,
+    /// The path (start to goal, active motors).
+    pub path: Vec<Vec<f64>>,
+}
+
+/// Solves one problem for `robot` with `collision` (built once per set), by RRT-Connect;
+/// `options.max_seconds` falls back to the request's `allowed_planning_time` when absent.
+pub fn solve(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    scene: &PlanningScene,
+    request: &MotionPlanRequest,
+    options: &RrtOptions,
+) -> Result<Outcome, PlanError> {
+    let world = scene.to_world()?;
+    let (objective, active, start) = problem_objective(robot, collision, &world, request)?;
+    let goal = request.goal.positions.clone();
+    let within = |q: &[f64]| {
+        active
+            .iter()
+            .zip(q)
+            .all(|(&i, v)| robot.motors()[i].limits.check(*v).is_ok())
+    };
+    let mut outcome = Outcome::default();
+    let mut checker = Checker::new(&objective, &world);
+    let (start_ok, goal_ok) = (within(&start), within(&goal));
+    let start_free = start_ok && checker.free(&start);
+    let goal_free = goal_ok && checker.free(&goal);
+    outcome.valid = start_free && goal_free;
+    if !outcome.valid {
+        outcome.note = match (start_ok, start_free, goal_ok) {
+            (false, _, _) => "the start is outside the joint limits",
+            (_, false, _) => "the start collides",
+            (_, _, false) => "the goal is outside the joint limits",
+            _ => "the goal collides",
+        }
+        .into();
+        return Ok(outcome);
+    }
+    let options = RrtOptions {
+        max_seconds: options.max_seconds.or(request.planning_time),
+        ..options.clone()
+    };
+    match rrt_connect(&objective, &world, &start, &goal, &options) {
+        Ok(found) => {
+            outcome.solved = true;
+            outcome.seconds = found.seconds;
+            outcome.length = path_length(&found.path);
+            outcome.waypoints = found.path.len();
+            outcome.checks = found.checks;
+            outcome.path = found.path;
+        }
+        Err(e) => outcome.note = e.to_string(),
+    }
+    Ok(outcome)
+}
+
+/// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
+/// configuration at a time from one end to the other (an independent check of a planner's
+/// raked, batched edge checks).
+pub fn path_is_free(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    scene: &PlanningScene,
+    request: &MotionPlanRequest,
+    path: &[Vec<f64>],
+    resolution: f64,
+) -> Result<bool, PlanError> {
+    let world = scene.to_world()?;
+    let (objective, _, _) = problem_objective(robot, collision, &world, request)?;
+    let mut scratch = objective.scratch();
+    for w in path.windows(2) {
+        let steps = (crate::rrt::distance(&w[0], &w[1]) / resolution)
+            .ceil()
+            .max(1.0) as usize;
+        for s in 0..=steps {
+            let t = s as f64 / steps as f64;
+            let q: Vec<f64> = w[0]
+                .iter()
+                .zip(&w[1])
+                .map(|(a, b)| a + t * (b - a))
+                .collect();
+            if !objective.is_collision_free_in(&q, &world, &mut scratch) {
+                return Ok(false);
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// The objective of a request in `world`: the goal's joints active, every other motor where
+/// the start state puts it (clamped into its limits); with the active motors' indices and the
+/// start's active values.
+fn problem_objective(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    world: &trm_collision::World,
+    request: &MotionPlanRequest,
+) -> Result<(Objective, Vec<usize>, Vec<f64>), PlanError> {
+    let base: Vec<f64> = robot
+        .motors()
+        .iter()
+        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+        .collect();
+    let (start_motors, _) = motors_from_state(robot, &request.start, &base);
+    let locked: Vec<f64> = robot
+        .motors()
+        .iter()
+        .zip(&start_motors)
+        .map(|(m, v)| v.clamp(m.limits.lower, m.limits.upper))
+        .collect();
+    let mut active = Vec::new();
+    for name in &request.goal.names {
+        let i = robot
+            .motor_index(name)
+            .map_err(|e| PlanError::InvalidMoveIt {
+                path: request.origin.clone(),
+                line: 0,
+                problem: format!("the goal constrains `{name}`: {e}"),
+                fix: "give a request for this robot model".into(),
+            })?;
+        active.push(i);
+    }
+    let start: Vec<f64> = active.iter().map(|&i| start_motors[i]).collect();
+    let active_set = trm_kinematics::ActiveSet::new(robot.clone(), active.clone(), &locked)?;
+    Ok((
+        Objective::new(active_set, collision.clone(), world.clone()),
+        active,
+        start,
+    ))
+}

@@ -1,0 +1,473 @@
+//! RRT-Connect (Kuffner and LaValle, 2000) in an objective's active configuration space, for the
+//! queries maps do not answer: two trees, one from the start and one from the goal, grown
+//! towards random samples and towards each other until they meet; the path then shortcut.
+//! Edges are checked raked, as VAMP checks them: the interpolation points of an edge spread over
+//! the lanes of one batched check, so a collision anywhere on it is usually found in the first
+//! batch. Seeded, so a query is reproducible; bounded by iterations and, optionally, time.
+
+use std::time::Instant;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use trm_collision::World;
+use trm_kinematics::LANES;
+use trm_tasks::{Objective, Scratch};
+
+use crate::PlanError;
+
+/// RRT-Connect settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RrtOptions {
+    /// Seed of the sampler.
+    pub seed: u64,
+    /// Longest step a tree grows by, rad (Euclidean in configuration space).
+    pub range: f64,
+    /// Largest gap between checked points of an edge, rad.
+    pub resolution: f64,
+    /// Most samples drawn before giving up.
+    pub max_iterations: usize,
+    /// Time budget, s (`None`: only the iteration budget; reproducible).
+    pub max_seconds: Option<f64>,
+    /// Random shortcut attempts on the found path after the greedy pass (0 by default: on
+    /// MotionBenchMaker's Panda set 100 attempts shortened paths by 7 % but tripled the median
+    /// time, and their corner-cutting edges graze obstacles between checked points).
+    pub shortcuts: usize,
+}
+
+impl Default for RrtOptions {
+    fn default() -> Self {
+        RrtOptions {
+            seed: 0,
+            range: 1.0,
+            resolution: 1.0 / 32.0,
+            max_iterations: 100_000,
+            max_seconds: None,
+            shortcuts: 0,
+        }
+    }
+}
+
+impl RrtOptions {
+    /// Checks the settings' ranges.
+    pub fn check(&self) -> Result<(), PlanError> {
+        let bad = |what: &str, problem: String| PlanError::InvalidOptions {
+            what: what.into(),
+            problem,
+        };
+        if !(self.range.is_finite() && self.range > 0.0) {
+            return Err(bad(
+                "range",
+                format!("{} is not a positive finite step", self.range),
+            ));
+        }
+        if !(self.resolution.is_finite() && self.resolution >= 1e-6) {
+            return Err(bad(
+                "resolution",
+                format!(
+                    "{} is not a finite step of at least 1e-6 rad",
+                    self.resolution
+                ),
+            ));
+        }
+        if let Some(s) = self.max_seconds {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(bad(
+                    "max_seconds",
+                    format!("{s} is not a positive finite time"),
+                ));
+            }
+        }
+        if self.max_iterations == 0 {
+            return Err(bad("max_iterations", "0 draws no sample".into()));
+        }
+        Ok(())
+    }
+}
+
+/// What a search found and what it cost.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RrtPath {
+    /// Waypoints from the start to the goal (shortcut).
+    pub path: Vec<Vec<f64>>,
+    /// Waypoints before shortcutting.
+    pub raw_waypoints: usize,
+    /// Samples drawn.
+    pub iterations: usize,
+    /// Nodes of both trees.
+    pub nodes: usize,
+    /// Configurations checked for collision.
+    pub checks: u64,
+    /// Wall time, s.
+    pub seconds: f64,
+    /// Searches run again at a finer resolution because the path grazed an obstacle.
+    pub refinements: u32,
+}
+
+/// Collision checks of configurations and edges in one world, counted.
+pub struct Checker<'a> {
+    objective: &'a Objective,
+    world: &'a World,
+    scratch: Scratch,
+    batch: Vec<f64>,
+    /// Configurations checked so far.
+    pub checks: u64,
+}
+
+impl<'a> Checker<'a> {
+    /// A checker for `objective`'s robot in `world`.
+    pub fn new(objective: &'a Objective, world: &'a World) -> Self {
+        Checker {
+            objective,
+            world,
+            scratch: objective.scratch(),
+            batch: Vec::new(),
+            checks: 0,
+        }
+    }
+
+    /// Whether `q` is collision-free.
+    pub fn free(&mut self, q: &[f64]) -> bool {
+        self.checks += 1;
+        self.objective
+            .is_collision_free_in(q, self.world, &mut self.scratch)
+    }
+
+    /// Whether the straight edge a → b is free at every `resolution` (the end points not
+    /// checked again), its points visited raked: batch k holds points k, k + m, k + 2m, … of
+    /// the edge's n points (m = ⌈n / LANES⌉).
+    pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let d = a.len();
+        let length = distance(a, b);
+        let steps = (length / resolution).ceil().max(1.0) as usize;
+        // interior points 1..steps (0 and steps are the checked ends)
+        let n = steps.saturating_sub(1);
+        if n == 0 {
+            return true;
+        }
+        let stride = n.div_ceil(LANES);
+        self.batch.resize(LANES * d, 0.0);
+        for k in 0..stride {
+            let mut lanes = 0;
+            for l in 0..LANES {
+                let i = k + l * stride;
+                if i >= n {
+                    break;
+                }
+                let s = (i + 1) as f64 / steps as f64;
+                for (j, q) in self.batch[lanes * d..(lanes + 1) * d]
+                    .iter_mut()
+                    .enumerate()
+                {
+                    *q = a[j] + s * (b[j] - a[j]);
+                }
+                lanes += 1;
+            }
+            self.checks += lanes as u64;
+            if !self.objective.all_collision_free_in(
+                &self.batch[..lanes * d],
+                self.world,
+                &mut self.scratch,
+            ) {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// Euclidean distance between configurations.
+pub fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt()
+}
+
+struct Tree {
+    nodes: Vec<Vec<f64>>,
+    parents: Vec<usize>,
+}
+
+impl Tree {
+    fn new(root: &[f64]) -> Self {
+        Tree {
+            nodes: vec![root.to_vec()],
+            parents: vec![usize::MAX],
+        }
+    }
+
+    fn nearest(&self, q: &[f64]) -> usize {
+        let mut best = (f64::INFINITY, 0);
+        for (i, n) in self.nodes.iter().enumerate() {
+            let d: f64 = n.iter().zip(q).map(|(x, y)| (x - y) * (x - y)).sum();
+            if d < best.0 {
+                best = (d, i);
+            }
+        }
+        best.1
+    }
+
+    /// Root → node `i`.
+    fn path_to(&self, mut i: usize) -> Vec<Vec<f64>> {
+        let mut out = Vec::new();
+        while i != usize::MAX {
+            out.push(self.nodes[i].clone());
+            i = self.parents[i];
+        }
+        out.reverse();
+        out
+    }
+}
+
+enum Extend {
+    Reached(usize),
+    Advanced(usize),
+    Trapped,
+}
+
+/// One step of `tree` from its node nearest to `target` towards it (at most `range`).
+fn extend(tree: &mut Tree, target: &[f64], options: &RrtOptions, checker: &mut Checker) -> Extend {
+    let near = tree.nearest(target);
+    let from = &tree.nodes[near];
+    let d = distance(from, target);
+    let (to, reached) = if d <= options.range {
+        (target.to_vec(), true)
+    } else {
+        let s = options.range / d;
+        (
+            from.iter()
+                .zip(target)
+                .map(|(a, b)| a + s * (b - a))
+                .collect(),
+            false,
+        )
+    };
+    if !checker.free(&to) || !checker.edge_free(&tree.nodes[near].clone(), &to, options.resolution)
+    {
+        return Extend::Trapped;
+    }
+    tree.nodes.push(to);
+    tree.parents.push(near);
+    let i = tree.nodes.len() - 1;
+    if reached {
+        Extend::Reached(i)
+    } else {
+        Extend::Advanced(i)
+    }
+}
+
+/// A collision-free path from `start` to `goal` in `world` (both checked first), by RRT-Connect
+/// in the box of the active motors' limits, then shortcut.
+///
+/// The shortcut path is checked again at half the resolution (raked, as every edge); where an
+/// edge grazes an obstacle between the points first checked, the search runs again at that
+/// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
+/// it was checked. [`RrtPath::refinements`] counts the reruns.
+pub fn rrt_connect(
+    objective: &Objective,
+    world: &World,
+    start: &[f64],
+    goal: &[f64],
+    options: &RrtOptions,
+) -> Result<RrtPath, PlanError> {
+    options.check()?;
+    let began = Instant::now();
+    let mut checks = 0;
+    let mut iterations = 0;
+    for refinement in 0..3 {
+        let resolution = options.resolution / f64::from(1u32 << refinement);
+        let attempt = RrtOptions {
+            resolution,
+            ..options.clone()
+        };
+        let mut found = search(objective, world, start, goal, &attempt, began)?;
+        let mut checker = Checker::new(objective, world);
+        let free = found
+            .path
+            .windows(2)
+            .all(|w| checker.edge_free(&w[0], &w[1], resolution / 2.0));
+        checks += found.checks + checker.checks;
+        iterations += found.iterations;
+        if free {
+            found.checks = checks;
+            found.iterations = iterations;
+            found.refinements = refinement;
+            found.seconds = began.elapsed().as_secs_f64();
+            return Ok(found);
+        }
+    }
+    Err(PlanError::Unreachable {
+        reason: format!(
+            "every path RRT-Connect found grazed an obstacle between its checked points, down to a resolution of {} rad",
+            options.resolution / 4.0
+        ),
+        closest_node: None,
+        closest_distance: f64::INFINITY,
+    })
+}
+
+/// One RRT-Connect search at `options.resolution`, its time counted from `began`.
+fn search(
+    objective: &Objective,
+    world: &World,
+    start: &[f64],
+    goal: &[f64],
+    options: &RrtOptions,
+    began: Instant,
+) -> Result<RrtPath, PlanError> {
+    let dim = objective.dim();
+    for (what, q) in [("start", start), ("goal", goal)] {
+        if q.len() != dim || q.iter().any(|v| !v.is_finite()) {
+            return Err(PlanError::InvalidGoal {
+                problem: format!(
+                    "the {what} has {} values (or a non-finite one) for {dim} active motors",
+                    q.len()
+                ),
+                fix: format!("give {dim} finite values"),
+            });
+        }
+    }
+    let mut checker = Checker::new(objective, world);
+    if !checker.free(start) {
+        return Err(PlanError::InvalidStart("it collides in the world".into()));
+    }
+    if !checker.free(goal) {
+        return Err(PlanError::Unreachable {
+            reason: "the goal configuration collides in the world".into(),
+            closest_node: None,
+            closest_distance: f64::INFINITY,
+        });
+    }
+    let (lower, upper) = objective.active().bounds();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut result = RrtPath::default();
+    // the straight line first: many queries need nothing else
+    let mut raw = if checker.edge_free(start, goal, options.resolution) {
+        Some(vec![start.to_vec(), goal.to_vec()])
+    } else {
+        None
+    };
+    let (mut a, mut b) = (Tree::new(start), Tree::new(goal));
+    let mut a_is_start = true;
+    let mut sample = vec![0.0; dim];
+    while raw.is_none() && result.iterations < options.max_iterations {
+        if options
+            .max_seconds
+            .is_some_and(|s| began.elapsed().as_secs_f64() > s)
+        {
+            break;
+        }
+        result.iterations += 1;
+        for (k, v) in sample.iter_mut().enumerate() {
+            *v = rng.random_range(lower[k]..=upper[k]);
+        }
+        let new = match extend(&mut a, &sample, options, &mut checker) {
+            Extend::Trapped => None,
+            Extend::Reached(i) | Extend::Advanced(i) => Some(i),
+        };
+        if let Some(i) = new {
+            let target = a.nodes[i].clone();
+            loop {
+                match extend(&mut b, &target, options, &mut checker) {
+                    Extend::Advanced(_) => continue,
+                    Extend::Trapped => break,
+                    Extend::Reached(j) => {
+                        let (from_a, from_b) = (a.path_to(i), b.path_to(j));
+                        let (mut first, second) = if a_is_start {
+                            (from_a, from_b)
+                        } else {
+                            (from_b, from_a)
+                        };
+                        // the meeting point is in both halves
+                        first.pop();
+                        first.extend(second.into_iter().rev());
+                        raw = Some(first);
+                        break;
+                    }
+                }
+            }
+        }
+        std::mem::swap(&mut a, &mut b);
+        a_is_start = !a_is_start;
+    }
+    result.nodes = a.nodes.len() + b.nodes.len();
+    let Some(mut path) = raw else {
+        result.checks = checker.checks;
+        return Err(PlanError::Unreachable {
+            reason: format!(
+                "RRT-Connect found no path in {} samples ({} nodes, {:.3} s)",
+                result.iterations,
+                result.nodes,
+                began.elapsed().as_secs_f64()
+            ),
+            closest_node: None,
+            closest_distance: f64::INFINITY,
+        });
+    };
+    result.raw_waypoints = path.len();
+    shortcut(&mut path, options, &mut checker, &mut rng);
+    result.path = path;
+    result.checks = checker.checks;
+    result.seconds = began.elapsed().as_secs_f64();
+    Ok(result)
+}
+
+/// Shortens `path`: first every waypoint skipped whose neighbours see each other (greedy, from
+/// the start), then random pairs of points on the path joined where the straight edge is free.
+pub fn shortcut(
+    path: &mut Vec<Vec<f64>>,
+    options: &RrtOptions,
+    checker: &mut Checker,
+    rng: &mut impl RngExt,
+) {
+    // greedy: from each kept point, the farthest later waypoint it sees
+    let mut kept = vec![path[0].clone()];
+    let mut i = 0;
+    while i + 1 < path.len() {
+        let mut j = path.len() - 1;
+        while j > i + 1 && !checker.edge_free(&path[i], &path[j], options.resolution) {
+            j -= 1;
+        }
+        kept.push(path[j].clone());
+        i = j;
+    }
+    *path = kept;
+    for _ in 0..options.shortcuts {
+        if path.len() < 3 {
+            break;
+        }
+        let n = path.len();
+        let (i, j) = (rng.random_range(0..n - 2), rng.random_range(0..n));
+        let j = j.max(i + 2).min(n - 1);
+        if j <= i + 1 {
+            continue;
+        }
+        // points a fraction along the edges leaving i and entering j
+        let (s, t) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        let lerp = |a: &[f64], b: &[f64], s: f64| -> Vec<f64> {
+            a.iter().zip(b).map(|(x, y)| x + s * (y - x)).collect()
+        };
+        let p = lerp(&path[i], &path[i + 1], s);
+        let q = lerp(&path[j - 1], &path[j], t);
+        let before = distance(&p, &path[i + 1])
+            + path[i + 1..j]
+                .windows(2)
+                .map(|w| distance(&w[0], &w[1]))
+                .sum::<f64>()
+            + distance(&path[j - 1], &q);
+        if distance(&p, &q) < before - 1e-9 && checker.edge_free(&p, &q, options.resolution) {
+            let mut next: Vec<Vec<f64>> = path[..=i].to_vec();
+            next.push(p);
+            next.push(q);
+            next.extend_from_slice(&path[j..]);
+            next.dedup();
+            *path = next;
+        }
+    }
+}
+
+/// Length of a path, rad.
+pub fn path_length(path: &[Vec<f64>]) -> f64 {
+    path.windows(2).map(|w| distance(&w[0], &w[1])).sum()
+}

@@ -1,0 +1,163 @@
+//! MoveIt scenes and requests (MotionBenchMaker's Panda sample in tests/fixtures/mbm): every
+//! file reads, scenes round-trip through the writer, malformed files are located errors, and
+//! RRT-Connect solves every sample problem on MotionBenchMaker's own Panda with paths that an
+//! independent check at half the resolution finds collision-free.
+
+use std::path::{Path, PathBuf};
+
+use trm_plan::PlanError;
+use trm_plan::mbm::{find_problems, path_is_free, solve};
+use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+use trm_plan::rrt::RrtOptions;
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mbm")
+}
+
+#[test]
+fn every_sample_scene_and_request_reads_and_scenes_round_trip() {
+    let problems = find_problems(&fixtures()).unwrap();
+    assert_eq!(problems.len(), 14);
+    for p in &problems {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        assert_eq!(request.goal.names.len(), 7, "{}", p.request.display());
+        assert_eq!(request.group, "panda_arm");
+        assert_eq!(request.planning_time, Some(60.0));
+        assert_eq!(scene.robot_model_name, "panda");
+        let world = scene.to_world().unwrap();
+        let primitives: usize = scene.objects.iter().map(|o| o.primitives.len()).sum();
+        assert!(primitives > 0 && world.objects().len() == primitives);
+        let acm = scene.allowed_collisions.as_ref().unwrap();
+        assert!(
+            acm.allowed_pairs()
+                .any(|(a, b)| a == "panda_hand" && b == "panda_leftfinger")
+        );
+        // the writer's output reads back to the same scene (poses to rounding)
+        let again = PlanningScene::parse(&scene.to_yaml(), &p.scene).unwrap();
+        assert_eq!(again.objects.len(), scene.objects.len());
+        assert_eq!(again.allowed_collisions, scene.allowed_collisions);
+        assert_eq!(again.robot_state, scene.robot_state);
+        for (a, b) in again.objects.iter().zip(&scene.objects) {
+            assert_eq!(a.id, b.id);
+            for (x, y) in a.primitives.iter().zip(&b.primitives) {
+                assert_eq!(x.shape, y.shape);
+                assert!((x.pose.translation.vector - y.pose.translation.vector).norm() < 1e-12);
+                assert!(x.pose.rotation.angle_to(&y.pose.rotation) < 1e-9);
+            }
+        }
+    }
+}
+
+fn scene_error(text: &str) -> String {
+    match PlanningScene::parse(text, Path::new("s.yaml")).and_then(|s| s.to_world().map(|_| ())) {
+        Err(e @ PlanError::InvalidMoveIt { .. }) => e.to_string(),
+        other => panic!("{text:?}: {other:?}"),
+    }
+}
+
+#[test]
+fn malformed_scenes_and_requests_are_located_errors() {
+    let object = |body: &str| format!("world:\n  collision_objects:\n    - id: a\n{body}");
+    let prim = "      primitives:\n        - type: box\n          dimensions: [1, 1, 1]\n      primitive_poses:\n        - position: [0, 0, 0]\n          orientation: [0, 0, 0, 1]\n";
+    for (text, expected) in [
+        ("world: [1, 2\n".to_string(), "s.yaml:2: not readable YAML"),
+        ("- 1\n".into(), "s.yaml:1: the document is a sequence"),
+        (object(&prim.replace("box", "cone")), "s.yaml:5: object `a`.primitives[0] is a `cone`"),
+        (object(&prim.replace("[1, 1, 1]", "[1, -1, 1]")), "s.yaml:5: object `a`.primitives[0]: a box with dimensions"),
+        (object(&prim.replace("[1, 1, 1]", "[1, 1]")), "s.yaml:5"),
+        (object(&prim.replace("[0, 0, 0, 1]", "[0, 0, 0, 3]")), "orientation has norm 3.0000"),
+        (object(&prim.replace("position: [0, 0, 0]", "position: [0, .nan, 0]")), "s.yaml:8: object `a`.primitive_poses[0].position[1] is `.nan`"),
+        (object(&prim.replace("        - position: [0, 0, 0]\n          orientation: [0, 0, 0, 1]\n", "")), "s.yaml:8: object `a`.primitive_poses is a scalar, not a list"),
+        (object(&format!("{prim}      meshes: [{{}}]\n")), "s.yaml:3: object `a` has meshes"),
+        (format!("{}    - id: a\n{prim}", object(prim)), "s.yaml:10: object `a` is given twice (first at line 3)"),
+        (object(prim).replace("id: a", "id: \"\""), "s.yaml:3: world.collision_objects[0] has an empty id"),
+        ("allowed_collision_matrix:\n  entry_names: [a, b]\n  entry_values:\n    - [false, true]\n    - [false, false]\n".into(), "(b, a) is false one way and true the other"),
+        ("allowed_collision_matrix:\n  entry_names: [a, b]\n  entry_values:\n    - [false, maybe]\n    - [true, false]\n".into(), "s.yaml:4: allowed_collision_matrix.entry_values[0]: `maybe`"),
+        ("robot_state:\n  joint_state:\n    name: [j1, j2]\n    position: [0]\n".into(), "s.yaml:3: robot_state.joint_state names 2 joints and gives 1 positions"),
+        ("a: 1\na: 2\n".into(), "s.yaml:2: not readable YAML: `a` is given twice"),
+        (format!("world:\n  collision_objects:\n{}", "  ".repeat(1) + &"- ".repeat(100_000)), "nested more than 64 deep"),
+    ] {
+        let e = scene_error(&text);
+        assert!(e.contains(expected) && e.contains("fix:"), "{text:?}:\n{e}\nexpected {expected:?}");
+    }
+    let request = std::fs::read_to_string(fixtures().join("box_panda/request0001.yaml")).unwrap();
+    for (from, to, expected) in [
+        (
+            "position: 1.",
+            "position: x1.",
+            "r.yaml:17: goal_constraints[0].joint_constraints[1].position is `x1.",
+        ),
+        (
+            "joint_name: panda_joint2",
+            "joint_name: panda_joint1",
+            "joint `panda_joint1` is constrained twice",
+        ),
+        (
+            "allowed_planning_time: 60",
+            "allowed_planning_time: -1",
+            "allowed_planning_time is -1",
+        ),
+        (
+            "goal_constraints:",
+            "goals:",
+            "the request has no `goal_constraints`",
+        ),
+    ] {
+        assert!(request.contains(from), "{from}");
+        let bad = request.replacen(from, to, 1);
+        let e = MotionPlanRequest::parse(&bad, Path::new("r.yaml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("r.yaml:") && e.contains(expected),
+            "{from} → {to}:\n{e}"
+        );
+    }
+}
+
+#[test]
+fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolution() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let options = RrtOptions::default();
+    for p in find_problems(&fixtures()).unwrap() {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        let outcome = solve(&robot, &collision, &scene, &request, &options).unwrap();
+        assert!(
+            outcome.valid && outcome.solved,
+            "{} {}: {}",
+            p.family,
+            p.index,
+            outcome.note
+        );
+        let path = &outcome.path;
+        assert!(path.len() >= 2);
+        assert!(
+            path[0]
+                .iter()
+                .zip(&request.start.positions)
+                .all(|(a, b)| (a - b).abs() < 1e-12)
+        );
+        assert_eq!(path.last().unwrap(), &request.goal.positions);
+        assert!(
+            path_is_free(
+                &robot,
+                &collision,
+                &scene,
+                &request,
+                path,
+                options.resolution / 2.0
+            )
+            .unwrap(),
+            "{} {}",
+            p.family,
+            p.index
+        );
+        // the same seed finds the same path
+        let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
+        assert_eq!(again.path, outcome.path);
+    }
+}

@@ -1,0 +1,315 @@
+//! `cargo xtask benchmark-mbm DIR --model MODEL [--package-path DIR] [--per-family N]`: a
+//! MotionBenchMaker set (a folder per family of `sceneNNNN.yaml` + `requestNNNN.yaml`, e.g.
+//! VAMP's `resources/panda/problems.tar.bz2` unpacked) solved problem by problem
+//! (`trm_plan::mbm::solve`, RRT-Connect); per family: valid, solved, median and p95 time, path
+//! length, collision checks; `results.csv`, `results.md` and `times.svg` in `--out-dir`.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use trm_plan::mbm::{Outcome, find_problems, path_is_free, solve};
+use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+use trm_plan::rrt::RrtOptions;
+
+/// Arguments of `benchmark-mbm`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The problem set: a folder holding one folder per family, or a .tar.bz2 of one (as VAMP
+    /// ships them).
+    dir: PathBuf,
+    /// The robot (.urdf or .ron model description).
+    #[arg(long)]
+    model: PathBuf,
+    #[command(flatten)]
+    meshes: crate::MeshArgs,
+    /// Problems per family (the first N by number; all when absent).
+    #[arg(long, value_parser = crate::parse::count(1, 1_000_000))]
+    per_family: Option<usize>,
+    /// Only these families (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    families: Vec<String>,
+    /// Seed of every problem's sampler.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Time budget per problem, s (default: each request's allowed_planning_time).
+    #[arg(long, value_parser = crate::parse::positive)]
+    max_seconds: Option<f64>,
+    /// Sample budget per problem.
+    #[arg(long, default_value_t = 100_000, value_parser = crate::parse::count(1, 100_000_000))]
+    max_iterations: usize,
+    /// Largest gap between checked points of an edge, rad.
+    #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]
+    resolution: f64,
+    /// Random shortcut attempts per path (after the greedy pass).
+    #[arg(long, default_value_t = 0, value_parser = crate::parse::count(0, 1_000_000))]
+    shortcuts: usize,
+    /// Re-check every returned path one configuration at a time at half the planner's
+    /// resolution (an independent check of the raked edge checks).
+    #[arg(long)]
+    verify: bool,
+    /// Where results.csv, results.md and times.svg go.
+    #[arg(long, default_value = "target/benchmark-mbm")]
+    pub out_dir: PathBuf,
+}
+
+/// One row of the results.
+struct Row {
+    family: String,
+    index: u32,
+    outcome: Outcome,
+    verified: Option<bool>,
+}
+
+/// The `q`-quantile (0..=1) of sorted values (nearest rank).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let k = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
+    sorted[k - 1]
+}
+
+/// A `.tar.bz2` (or `.tar`) of a problem set unpacked into a fresh temporary folder (at most
+/// 1 GiB; entries that would land outside it are refused by `tar`), removed when dropped.
+struct Unpacked(PathBuf);
+
+impl Drop for Unpacked {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn unpack(archive: &std::path::Path) -> Result<Unpacked> {
+    use anyhow::Context as _;
+    let dir = std::env::temp_dir().join(format!("trm-mbm-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir)?;
+    let unpacked = Unpacked(dir.clone());
+    let file =
+        std::fs::File::open(archive).with_context(|| format!("reading {}", archive.display()))?;
+    let name = archive.to_string_lossy();
+    let reader: Box<dyn std::io::Read> = if name.ends_with(".bz2") || name.ends_with(".tbz2") {
+        Box::new(bzip2::read::BzDecoder::new(file))
+    } else {
+        Box::new(file)
+    };
+    let mut tar = tar::Archive::new(reader);
+    let mut total = 0u64;
+    for entry in tar
+        .entries()
+        .with_context(|| format!("{}: not a tar archive", archive.display()))?
+    {
+        let mut entry =
+            entry.with_context(|| format!("{}: a damaged tar entry", archive.display()))?;
+        total += entry.size();
+        if total > trm_kinematics::MAX_INPUT_BYTES {
+            anyhow::bail!(
+                "{}: unpacks to more than {} bytes\n  fix: give a MotionBenchMaker set (VAMP's are a few MB)",
+                archive.display(),
+                trm_kinematics::MAX_INPUT_BYTES
+            );
+        }
+        entry
+            .unpack_in(&dir)
+            .with_context(|| format!("{}: unpacking an entry", archive.display()))?;
+    }
+    Ok(unpacked)
+}
+
+/// The folder holding the family folders: `dir`, or its one subfolder when it holds nothing
+/// else (VAMP's archives hold `problems/<family>/…`).
+fn set_root(dir: &std::path::Path) -> PathBuf {
+    let entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    match entries.as_slice() {
+        [only] if only.is_dir() && !only.join("scene0001.yaml").exists() => only.clone(),
+        _ => dir.to_path_buf(),
+    }
+}
+
+/// Runs the set, prints the per-family table, writes the files.
+pub fn run(args: &Args) -> Result<()> {
+    let robot = crate::load_model(Some(&args.model))?;
+    let collision = args.meshes.collision_model(&robot)?;
+    let unpacked = if args.dir.is_file() {
+        Some(unpack(&args.dir)?)
+    } else {
+        None
+    };
+    let root = set_root(unpacked.as_ref().map_or(&args.dir, |u| &u.0));
+    let mut problems = find_problems(&root)?;
+    if !args.families.is_empty() {
+        for f in &args.families {
+            if !problems.iter().any(|p| &p.family == f) {
+                let known: std::collections::BTreeSet<&str> =
+                    problems.iter().map(|p| p.family.as_str()).collect();
+                anyhow::bail!(
+                    "--families: no family `{f}` in {}\n  fix: give some of {}",
+                    args.dir.display(),
+                    known.into_iter().collect::<Vec<_>>().join(", ")
+                );
+            }
+        }
+        problems.retain(|p| args.families.contains(&p.family));
+    }
+    if let Some(n) = args.per_family {
+        let mut kept = Vec::new();
+        for p in problems {
+            if kept
+                .iter()
+                .filter(|k: &&trm_plan::mbm::Problem| k.family == p.family)
+                .count()
+                < n
+            {
+                kept.push(p);
+            }
+        }
+        problems = kept;
+    }
+    let options = RrtOptions {
+        seed: args.seed,
+        max_iterations: args.max_iterations,
+        max_seconds: args.max_seconds,
+        resolution: args.resolution,
+        shortcuts: args.shortcuts,
+        ..Default::default()
+    };
+    let mut rows = Vec::new();
+    let mut progress = crate::progress::Progress::new("problems", problems.len() as u64);
+    for (k, p) in problems.iter().enumerate() {
+        let scene = PlanningScene::load(&p.scene)?;
+        let request = MotionPlanRequest::load(&p.request)?;
+        let outcome = solve(&robot, &collision, &scene, &request, &options)?;
+        let verified = (args.verify && outcome.solved)
+            .then(|| {
+                path_is_free(
+                    &robot,
+                    &collision,
+                    &scene,
+                    &request,
+                    &outcome.path,
+                    options.resolution / 2.0,
+                )
+            })
+            .transpose()?;
+        rows.push(Row {
+            family: p.family.clone(),
+            index: p.index,
+            outcome,
+            verified,
+        });
+        progress.set(k as u64 + 1, problems.len() as u64, &p.family);
+    }
+    progress.finish();
+    let mut csv =
+        String::from("family,problem,valid,solved,seconds,length,waypoints,checks,verified,note\n");
+    for r in &rows {
+        let o = &r.outcome;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},\"{}\"",
+            r.family,
+            r.index,
+            o.valid,
+            o.solved,
+            o.seconds,
+            o.length,
+            o.waypoints,
+            o.checks,
+            r.verified.map_or(String::new(), |v| v.to_string()),
+            o.note.replace('"', "'")
+        );
+    }
+    let mut md = format!(
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, {} samples at most{})\n\n",
+        args.dir.display(),
+        args.model.display(),
+        args.seed,
+        args.max_iterations,
+        args.max_seconds
+            .map_or(String::new(), |s| format!(", {s} s at most"))
+    );
+    md.push_str("| family | valid | solved | median ms | p95 ms | median length (rad) | median checks |\n|---|---|---|---|---|---|---|\n");
+    let mut families: Vec<&str> = rows.iter().map(|r| r.family.as_str()).collect();
+    families.dedup();
+    let mut all_times = Vec::new();
+    let mut series = Vec::new();
+    let summary = |name: &str, rows: &[&Row]| -> (String, Vec<f64>) {
+        let valid: Vec<&&Row> = rows.iter().filter(|r| r.outcome.valid).collect();
+        let solved: Vec<&&Row> = valid.iter().copied().filter(|r| r.outcome.solved).collect();
+        let mut times: Vec<f64> = solved.iter().map(|r| r.outcome.seconds * 1e3).collect();
+        times.sort_by(f64::total_cmp);
+        let mut lengths: Vec<f64> = solved.iter().map(|r| r.outcome.length).collect();
+        lengths.sort_by(f64::total_cmp);
+        let mut checks: Vec<f64> = solved.iter().map(|r| r.outcome.checks as f64).collect();
+        checks.sort_by(f64::total_cmp);
+        let line = format!(
+            "| {name} | {}/{} | {}/{} ({:.1} %) | {:.2} | {:.2} | {:.2} | {:.0} |\n",
+            valid.len(),
+            rows.len(),
+            solved.len(),
+            valid.len(),
+            100.0 * solved.len() as f64 / valid.len().max(1) as f64,
+            quantile(&times, 0.5),
+            quantile(&times, 0.95),
+            quantile(&lengths, 0.5),
+            quantile(&checks, 0.5)
+        );
+        (line, times)
+    };
+    for f in &families {
+        let of: Vec<&Row> = rows.iter().filter(|r| r.family == *f).collect();
+        let (line, times) = summary(f, &of);
+        md.push_str(&line);
+        series.push(crate::plot::Series {
+            label: f.to_string(),
+            points: times
+                .iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    (
+                        (i + 1) as f64 / times.len() as f64 * 100.0,
+                        t.max(1e-3).log10(),
+                    )
+                })
+                .collect(),
+            color: None,
+        });
+        all_times.extend(times);
+    }
+    let everything: Vec<&Row> = rows.iter().collect();
+    let (line, _) = summary("all", &everything);
+    md.push_str(&line);
+    if args.verify {
+        let checked = rows.iter().filter(|r| r.verified.is_some()).count();
+        let failed = rows.iter().filter(|r| r.verified == Some(false)).count();
+        let _ = writeln!(
+            md,
+            "\nEvery returned path re-checked one configuration at a time at half the resolution: {failed} of {checked} collide."
+        );
+    }
+    print!("{md}");
+    all_times.sort_by(f64::total_cmp);
+    let svg = crate::plot::panels(
+        (800, 420),
+        &[crate::plot::Panel {
+            title: "Planning time per solved problem, sorted".into(),
+            axes: ("problems solved (%)".into(), "time (log10 ms)".into()),
+            x: 0.0..100.0,
+            y: (all_times.first().copied().unwrap_or(0.01).max(1e-3).log10() - 0.1)
+                ..(all_times.last().copied().unwrap_or(1.0).max(1e-3).log10() + 0.1),
+            series,
+        }],
+    )?;
+    std::fs::create_dir_all(&args.out_dir)?;
+    crate::write_atomic(&args.out_dir.join("results.csv"), csv.as_bytes())?;
+    crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
+    crate::write_atomic(&args.out_dir.join("times.svg"), svg.as_bytes())?;
+    println!(
+        "wrote {}/{{results.csv, results.md, times.svg}}",
+        args.out_dir.display()
+    );
+    Ok(())
+}
