@@ -868,6 +868,55 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &["0", "-1", "x"],
     ));
     cases.extend(flag_cases(&run_scenario, "--threads", &["0", "x"]));
+    // MotionBenchMaker sets: missing, empty, not an archive, an unknown family, a broken scene
+    let mbm = at("crates/trm-plan/tests/fixtures/mbm")
+        .to_string_lossy()
+        .to_string();
+    let panda = at("models/panda-mbm/panda.ron")
+        .to_string_lossy()
+        .to_string();
+    let bench = |set: &str| -> Vec<String> {
+        [
+            "benchmark-mbm",
+            set,
+            "--model",
+            panda.as_str(),
+            "--out-dir",
+            "mbm-out",
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    std::fs::create_dir_all(dir.join("empty_set/family")).unwrap();
+    std::fs::create_dir_all(dir.join("broken_set/box")).unwrap();
+    std::fs::write(dir.join("broken_set/box/scene0001.yaml"), "world:\n  collision_objects:\n    - id: a\n      primitives: [{type: cone, dimensions: [1, 1]}]\n      primitive_poses: [{position: [0, 0, 0]}]\n").unwrap();
+    std::fs::copy(
+        at("crates/trm-plan/tests/fixtures/mbm/box_panda/request0001.yaml"),
+        dir.join("broken_set/box/request0001.yaml"),
+    )
+    .unwrap();
+    std::fs::create_dir_all(dir.join("lonely_set/box")).unwrap();
+    std::fs::write(dir.join("lonely_set/box/scene0001.yaml"), "{}\n").unwrap();
+    for (set, names) in [
+        ("no_such_set", "no_such_set"),
+        ("empty_set", "empty_set"),
+        ("map.json", "map.json"),
+        ("broken_set", "scene0001.yaml:4"),
+        ("lonely_set", "request0001.yaml"),
+    ] {
+        cases.push(Case {
+            what: format!("benchmark-mbm {set}"),
+            args: bench(set),
+            names: names.into(),
+        });
+    }
+    let mut families = bench(&mbm);
+    families.extend(["--families".into(), "box_pand".into()]);
+    cases.push(Case {
+        what: "benchmark-mbm with an unknown family".into(),
+        args: families,
+        names: "box_panda".into(),
+    });
     // one budget or the other, not both
     let both: Vec<&str> = run_scenario
         .iter()

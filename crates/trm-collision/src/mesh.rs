@@ -90,9 +90,13 @@ pub fn convex_hull_of_mesh_bytes(
             format!("{}: materials are not read", p.display()),
         ))
     };
-    let scene = mesh_loader::Loader::default()
-        .load_from_slice_with_reader(bytes, path, no_materials)
-        .map_err(|e| e.to_string())?;
+    // mesh-loader panics on some malformed files (found by fuzzing: a COLLADA accessor
+    // longer than its array): an error, not a crash
+    let scene = trm_kinematics::quietly(|| {
+        mesh_loader::Loader::default().load_from_slice_with_reader(bytes, path, no_materials)
+    })
+    .map_err(|_| "the mesh reader failed on this file (malformed mesh)".to_string())?
+    .map_err(|e| e.to_string())?;
     let points: Vec<Point3<f64>> = scene
         .meshes
         .iter()
@@ -161,6 +165,20 @@ mod tests {
         assert_eq!(hull.len(), 4);
         let far = convex_hull_of_mesh_bytes(good.as_bytes(), Path::new("t.stl"), [1e4; 3]);
         assert!(far.unwrap_err().contains("more than 1000 m"));
+        // found by fuzzing: an accessor of 5 points over an array of 4 made mesh-loader panic
+        let dae = format!(
+            "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n<library_geometries><geometry id=\"g\"><mesh>\n<source id=\"p\"><float_array id=\"pa\" count=\"12\">0 0 0 1 0 0 0 1 0 0 0 1</float_array>\n<technique_common><accessor source=\"#pa\" count=\"{}\" stride=\"3\"><param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n<triangles count=\"4\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p></triangles>\n</mesh></geometry></library_geometries>\n<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#g\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n</COLLADA>\n",
+            "{}"
+        );
+        let ok = dae.replacen("{}", "4", 1);
+        assert_eq!(
+            convex_hull_of_mesh_bytes(ok.as_bytes(), Path::new("t.dae"), [1.0; 3])
+                .unwrap()
+                .len(),
+            4
+        );
+        let bad = dae.replacen("{}", "5", 1);
+        assert!(convex_hull_of_mesh_bytes(bad.as_bytes(), Path::new("t.dae"), [1.0; 3]).is_err());
     }
 
     #[test]

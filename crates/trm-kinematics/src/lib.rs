@@ -64,7 +64,7 @@ pub use files::{
     write_file_bytes,
 };
 pub use fk::{FrameId, PoseBuffer};
-pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel};
+pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel, quietly};
 pub use nalgebra;
 pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
 pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_field, locate_ron_path};

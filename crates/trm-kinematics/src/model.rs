@@ -121,8 +121,9 @@ fn parse_urdf(text: &str, origin: &str) -> Result<urdf_rs::Robot> {
 }
 
 /// Runs `f`, catching a panic without the panic hook printing it (on this thread; panics
-/// elsewhere are reported as before).
-fn quietly<R>(f: impl FnOnce() -> R + std::panic::UnwindSafe) -> std::thread::Result<R> {
+/// elsewhere are reported as before): for third-party parsers that panic on some malformed
+/// input (urdf-rs's XML layer, mesh-loader's COLLADA reader), so that trm reports an error.
+pub fn quietly<R>(f: impl FnOnce() -> R + std::panic::UnwindSafe) -> std::thread::Result<R> {
     use std::cell::Cell;
     thread_local!(static QUIET: Cell<bool> = const { Cell::new(false) });
     static HOOK: std::sync::Once = std::sync::Once::new();

@@ -613,8 +613,9 @@ impl PlanningScene {
             let names: Vec<String> = acm.names.iter().map(|n| quote(n)).collect();
             let _ = writeln!(
                 out,
-                "allowed_collision_matrix:\n  entry_names: [{}]\n  entry_values:",
-                names.join(", ")
+                "allowed_collision_matrix:\n  entry_names: [{}]\n  entry_values:{}",
+                names.join(", "),
+                if acm.allowed.is_empty() { " []" } else { "" }
             );
             for row in &acm.allowed {
                 let _ = writeln!(

@@ -496,7 +496,7 @@ impl<'a> Planner<'a> {
             (&planned, goal, &options.sampling)
         {
             let began = Instant::now();
-            let found = crate::rrt::rrt_connect(&self.objective, &self.world, start, q, rrt)?;
+            let found = crate::rrt::rrt_connect(self.objective, &self.world, start, q, rrt)?;
             let mut stats = PlanStats {
                 sampled: Some((found.iterations, found.checks)),
                 length: crate::rrt::path_length(&found.path),

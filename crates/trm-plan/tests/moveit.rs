@@ -76,7 +76,7 @@ fn malformed_scenes_and_requests_are_located_errors() {
         ("allowed_collision_matrix:\n  entry_names: [a, b]\n  entry_values:\n    - [false, maybe]\n    - [true, false]\n".into(), "s.yaml:4: allowed_collision_matrix.entry_values[0]: `maybe`"),
         ("robot_state:\n  joint_state:\n    name: [j1, j2]\n    position: [0]\n".into(), "s.yaml:3: robot_state.joint_state names 2 joints and gives 1 positions"),
         ("a: 1\na: 2\n".into(), "s.yaml:2: not readable YAML: `a` is given twice"),
-        (format!("world:\n  collision_objects:\n{}", "  ".repeat(1) + &"- ".repeat(100_000)), "nested more than 64 deep"),
+        (format!("world:\n  collision_objects:\n{}", "  ".to_string() + &"- ".repeat(100_000)), "nested more than 64 deep"),
     ] {
         let e = scene_error(&text);
         assert!(e.contains(expected) && e.contains("fix:"), "{text:?}:\n{e}\nexpected {expected:?}");
