@@ -569,3 +569,46 @@ fn trajectories_export_as_ros_joint_trajectories() {
         "{e}"
     );
 }
+
+#[test]
+fn a_configuration_goal_the_maps_do_not_reach_is_finished_by_rrt_connect() {
+    use rand::SeedableRng;
+    let p = problem();
+    let mut planner = Planner::new(&p.objective, &[map()]).unwrap();
+    let maps_only = PlanOptions {
+        sampling: None,
+        attach_neighbours: 1,
+        ..Default::default()
+    };
+    let with_sampling = PlanOptions {
+        attach_neighbours: 1,
+        ..Default::default()
+    };
+    // seeded random goals: the first free one the map alone cannot reach
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let mut found = 0;
+    for _ in 0..300 {
+        let q = p.objective.active().random(&mut rng);
+        if !planner.is_free(&q) {
+            continue;
+        }
+        let goal = Goal::Configuration(q.clone());
+        if !matches!(
+            planner.plan(&p.start, &goal, &maps_only),
+            Err(PlanError::Unreachable { .. })
+        ) {
+            continue;
+        }
+        let planned = planner.plan(&p.start, &goal, &with_sampling).unwrap();
+        let (samples, checks) = planned.stats.sampled.expect("RRT-Connect answered");
+        assert!(samples > 0 && checks > 0);
+        let last = planned.trajectory.positions.last().unwrap();
+        assert_eq!(&p.objective.active().from_motors(last), &q);
+        check(&mut planner, &p.start, &planned, &with_sampling);
+        found += 1;
+        if found == 3 {
+            break;
+        }
+    }
+    assert_eq!(found, 3, "too few goals the map alone cannot reach");
+}
