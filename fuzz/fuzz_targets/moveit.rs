@@ -10,7 +10,7 @@ use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
 fuzz_target!(|text: &str| {
     if let Ok(scene) = PlanningScene::parse(text, Path::new("fuzz.yaml")) {
         let _ = scene.to_world();
-        let again = PlanningScene::parse(&scene.to_yaml(), Path::new("again.yaml"));
+        let again = PlanningScene::parse(&scene.to_yaml().expect("a scene that reads is written"), Path::new("again.yaml"));
         let again = again.expect("what the writer writes, the reader reads");
         assert_eq!(again.objects.len(), scene.objects.len());
         assert_eq!(again.allowed_collisions, scene.allowed_collisions);

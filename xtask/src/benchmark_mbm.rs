@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use trm_plan::mbm::{Outcome, find_problems, path_is_free, solve};
+use trm_plan::mbm::{Outcome, ProblemSet, Summary, path_is_free, solve};
 use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
@@ -61,85 +61,12 @@ struct Row {
     verified: Option<bool>,
 }
 
-/// The `q`-quantile (0..=1) of sorted values (nearest rank).
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let k = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
-    sorted[k - 1]
-}
-
-/// A `.tar.bz2` (or `.tar`) of a problem set unpacked into a fresh temporary folder (at most
-/// 1 GiB; entries that would land outside it are refused by `tar`), removed when dropped.
-struct Unpacked(PathBuf);
-
-impl Drop for Unpacked {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn unpack(archive: &std::path::Path) -> Result<Unpacked> {
-    use anyhow::Context as _;
-    let dir = std::env::temp_dir().join(format!("trm-mbm-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir)?;
-    let unpacked = Unpacked(dir.clone());
-    let file =
-        std::fs::File::open(archive).with_context(|| format!("reading {}", archive.display()))?;
-    let name = archive.to_string_lossy();
-    let reader: Box<dyn std::io::Read> = if name.ends_with(".bz2") || name.ends_with(".tbz2") {
-        Box::new(bzip2::read::BzDecoder::new(file))
-    } else {
-        Box::new(file)
-    };
-    let mut tar = tar::Archive::new(reader);
-    let mut total = 0u64;
-    for entry in tar
-        .entries()
-        .with_context(|| format!("{}: not a tar archive", archive.display()))?
-    {
-        let mut entry =
-            entry.with_context(|| format!("{}: a damaged tar entry", archive.display()))?;
-        total += entry.size();
-        if total > trm_kinematics::MAX_INPUT_BYTES {
-            anyhow::bail!(
-                "{}: unpacks to more than {} bytes\n  fix: give a MotionBenchMaker set (VAMP's are a few MB)",
-                archive.display(),
-                trm_kinematics::MAX_INPUT_BYTES
-            );
-        }
-        entry
-            .unpack_in(&dir)
-            .with_context(|| format!("{}: unpacking an entry", archive.display()))?;
-    }
-    Ok(unpacked)
-}
-
-/// The folder holding the family folders: `dir`, or its one subfolder when it holds nothing
-/// else (VAMP's archives hold `problems/<family>/…`).
-fn set_root(dir: &std::path::Path) -> PathBuf {
-    let entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|r| r.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    match entries.as_slice() {
-        [only] if only.is_dir() && !only.join("scene0001.yaml").exists() => only.clone(),
-        _ => dir.to_path_buf(),
-    }
-}
-
 /// Runs the set, prints the per-family table, writes the files.
 pub fn run(args: &Args) -> Result<()> {
     let robot = crate::load_model(Some(&args.model))?;
     let collision = args.meshes.collision_model(&robot)?;
-    let unpacked = if args.dir.is_file() {
-        Some(unpack(&args.dir)?)
-    } else {
-        None
-    };
-    let root = set_root(unpacked.as_ref().map_or(&args.dir, |u| &u.0));
-    let mut problems = find_problems(&root)?;
+    let set = ProblemSet::open(&args.dir)?;
+    let mut problems = set.problems.clone();
     if !args.families.is_empty() {
         for f in &args.families {
             if !problems.iter().any(|p| &p.family == f) {
@@ -236,33 +163,34 @@ pub fn run(args: &Args) -> Result<()> {
     families.dedup();
     let mut all_times = Vec::new();
     let mut series = Vec::new();
-    let summary = |name: &str, rows: &[&Row]| -> (String, Vec<f64>) {
-        let valid: Vec<&&Row> = rows.iter().filter(|r| r.outcome.valid).collect();
-        let solved: Vec<&&Row> = valid.iter().copied().filter(|r| r.outcome.solved).collect();
-        let mut times: Vec<f64> = solved.iter().map(|r| r.outcome.seconds * 1e3).collect();
-        times.sort_by(f64::total_cmp);
-        let mut lengths: Vec<f64> = solved.iter().map(|r| r.outcome.length).collect();
-        lengths.sort_by(f64::total_cmp);
-        let mut checks: Vec<f64> = solved.iter().map(|r| r.outcome.checks as f64).collect();
-        checks.sort_by(f64::total_cmp);
-        let line = format!(
-            "| {name} | {}/{} | {}/{} ({:.1} %) | {:.2} | {:.2} | {:.2} | {:.0} |\n",
-            valid.len(),
-            rows.len(),
-            solved.len(),
-            valid.len(),
-            100.0 * solved.len() as f64 / valid.len().max(1) as f64,
-            quantile(&times, 0.5),
-            quantile(&times, 0.95),
-            quantile(&lengths, 0.5),
-            quantile(&checks, 0.5)
-        );
-        (line, times)
+    let ms = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2}", v * 1e3));
+    let line = |name: &str, s: &Summary| {
+        format!(
+            "| {name} | {}/{} | {}/{} ({:.1} %) | {} | {} | {} | {} |\n",
+            s.valid,
+            s.problems,
+            s.solved,
+            s.valid,
+            100.0 * s.solved as f64 / s.valid.max(1) as f64,
+            ms(s.time.map(|t| t.0)),
+            ms(s.time.map(|t| t.1)),
+            s.length.map_or("—".into(), |l| format!("{l:.2}")),
+            s.checks.map_or("—".into(), |c| format!("{c:.0}"))
+        )
     };
     for f in &families {
-        let of: Vec<&Row> = rows.iter().filter(|r| r.family == *f).collect();
-        let (line, times) = summary(f, &of);
-        md.push_str(&line);
+        let of: Vec<&Outcome> = rows
+            .iter()
+            .filter(|r| r.family == *f)
+            .map(|r| &r.outcome)
+            .collect();
+        md.push_str(&line(f, &Summary::of(of.iter().copied())));
+        let mut times: Vec<f64> = of
+            .iter()
+            .filter(|o| o.valid && o.solved)
+            .map(|o| o.seconds * 1e3)
+            .collect();
+        times.sort_by(f64::total_cmp);
         series.push(crate::plot::Series {
             label: f.to_string(),
             points: times
@@ -279,9 +207,7 @@ pub fn run(args: &Args) -> Result<()> {
         });
         all_times.extend(times);
     }
-    let everything: Vec<&Row> = rows.iter().collect();
-    let (line, _) = summary("all", &everything);
-    md.push_str(&line);
+    md.push_str(&line("all", &Summary::of(rows.iter().map(|r| &r.outcome))));
     if args.verify {
         let checked = rows.iter().filter(|r| r.verified.is_some()).count();
         let failed = rows.iter().filter(|r| r.verified == Some(false)).count();

@@ -910,6 +910,39 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             names: names.into(),
         });
     }
+    for (flag, values) in [
+        ("--per-family", &["0", "-1", "x"][..]),
+        ("--max-seconds", &["0", "-1", "NaN", "inf"][..]),
+        ("--resolution", &["0", "-0.1", "NaN", "1e-300"][..]),
+        ("--max-iterations", &["0", "1e12"][..]),
+        ("--seed", &["-1", "1.5"][..]),
+    ] {
+        let names = if flag == "--resolution" {
+            "resolution"
+        } else {
+            flag
+        };
+        for v in values {
+            let mut args = bench(&mbm);
+            args.extend([flag.to_string(), v.to_string()]);
+            cases.push(Case {
+                what: format!("benchmark-mbm {flag} {v}"),
+                args,
+                names: names.into(),
+            });
+        }
+    }
+    for out in ["map.json", "link_to_dir"] {
+        let mut args = bench(&mbm);
+        args.truncate(4);
+        args.extend(["--out-dir".into(), out.into()]);
+        cases.push(Case {
+            what: format!("benchmark-mbm --out-dir {out}"),
+            args,
+            names: out.into(),
+        });
+    }
+    let _ = std::os::unix::fs::symlink(dir.join("map.json"), dir.join("link_to_dir"));
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);
     cases.push(Case {

@@ -27,6 +27,154 @@ pub struct Problem {
     pub request: PathBuf,
 }
 
+/// A problem set opened from a folder or a `.tar.bz2`/`.tar` of one (unpacked into a fresh
+/// temporary folder, at most [`trm_kinematics::MAX_INPUT_BYTES`] in all, removed when the set
+/// is dropped; `tar` refuses entries that would land outside it).
+pub struct ProblemSet {
+    /// The problems, sorted by family and number.
+    pub problems: Vec<Problem>,
+    unpacked: Option<PathBuf>,
+}
+
+impl Drop for ProblemSet {
+    fn drop(&mut self) {
+        if let Some(dir) = &self.unpacked {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
+impl ProblemSet {
+    /// Opens `path`: a folder of family folders (or holding one folder of them, as VAMP's
+    /// archives do), or an archive of one.
+    pub fn open(path: &Path) -> Result<Self, PlanError> {
+        let unpacked = if path.is_file() {
+            Some(unpack(path)?)
+        } else {
+            None
+        };
+        let mut set = ProblemSet {
+            problems: Vec::new(),
+            unpacked,
+        };
+        let root = set_root(set.unpacked.as_deref().unwrap_or(path));
+        set.problems = find_problems(&root)?;
+        Ok(set)
+    }
+}
+
+fn unpack(archive: &Path) -> Result<PathBuf, PlanError> {
+    let bad = |problem: String| PlanError::InvalidMoveIt {
+        path: archive.to_path_buf(),
+        line: 0,
+        problem,
+        fix: "give a MotionBenchMaker set: a folder, or a .tar.bz2 of one as VAMP ships them"
+            .into(),
+    };
+    let dir = std::env::temp_dir().join(format!(
+        "trm-mbm-{}-{}",
+        std::process::id(),
+        UNPACKED.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    let io = |path: &Path, source| PlanError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+    let result = (|| {
+        let file = std::fs::File::open(archive).map_err(|e| io(archive, e))?;
+        let name = archive.to_string_lossy();
+        let reader: Box<dyn std::io::Read> = if name.ends_with(".bz2") || name.ends_with(".tbz2") {
+            Box::new(bzip2::read::BzDecoder::new(file))
+        } else {
+            Box::new(file)
+        };
+        let mut tar = tar::Archive::new(reader);
+        let mut total = 0u64;
+        for entry in tar
+            .entries()
+            .map_err(|e| bad(format!("not a tar archive ({e})")))?
+        {
+            let mut entry = entry.map_err(|e| bad(format!("a damaged archive entry ({e})")))?;
+            total += entry.size();
+            if total > trm_kinematics::MAX_INPUT_BYTES {
+                return Err(bad(format!(
+                    "unpacks to more than {} bytes",
+                    trm_kinematics::MAX_INPUT_BYTES
+                )));
+            }
+            entry
+                .unpack_in(&dir)
+                .map_err(|e| bad(format!("an entry could not be unpacked ({e})")))?;
+        }
+        Ok(())
+    })();
+    match result {
+        Ok(()) => Ok(dir),
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&dir);
+            Err(e)
+        }
+    }
+}
+
+static UNPACKED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// `dir`, or its one subfolder when it holds nothing else and no scene.
+fn set_root(dir: &Path) -> PathBuf {
+    let entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| r.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    match entries.as_slice() {
+        [only] if only.is_dir() && !only.join("scene0001.yaml").exists() => only.clone(),
+        _ => dir.to_path_buf(),
+    }
+}
+
+/// What a family (or a whole set) came to, as the field reports planners.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Problems.
+    pub problems: usize,
+    /// Valid problems (start and goal free and within limits).
+    pub valid: usize,
+    /// Valid problems solved.
+    pub solved: usize,
+    /// Median and 95th percentile of the solved problems' times, s (`None` when none solved).
+    pub time: Option<(f64, f64)>,
+    /// Median path length of the solved problems, rad.
+    pub length: Option<f64>,
+    /// Median collision checks of the solved problems.
+    pub checks: Option<f64>,
+}
+
+/// The `q`-quantile (0..=1, nearest rank) of `values`; `None` for none.
+pub fn quantile(values: &[f64], q: f64) -> Option<f64> {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let k = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len().max(1));
+    sorted.get(k - 1).copied()
+}
+
+impl Summary {
+    /// The summary of `outcomes`.
+    pub fn of<'a>(outcomes: impl IntoIterator<Item = &'a Outcome>) -> Self {
+        let outcomes: Vec<&Outcome> = outcomes.into_iter().collect();
+        let solved: Vec<&&Outcome> = outcomes.iter().filter(|o| o.valid && o.solved).collect();
+        let of = |f: &dyn Fn(&Outcome) -> f64| solved.iter().map(|o| f(o)).collect::<Vec<f64>>();
+        let times = of(&|o| o.seconds);
+        Summary {
+            problems: outcomes.len(),
+            valid: outcomes.iter().filter(|o| o.valid).count(),
+            solved: solved.len(),
+            time: quantile(&times, 0.5).zip(quantile(&times, 0.95)),
+            length: quantile(&of(&|o| o.length), 0.5),
+            checks: quantile(&of(&|o| o.checks as f64), 0.5),
+        }
+    }
+}
+
 /// The problems under `dir` (its folders' `sceneNNNN.yaml` with their `requestNNNN.yaml`),
 /// sorted by family and number. A scene without its request is an error naming it.
 pub fn find_problems(dir: &Path) -> Result<Vec<Problem>, PlanError> {
@@ -122,6 +270,7 @@ pub fn solve(
     request: &MotionPlanRequest,
     options: &RrtOptions,
 ) -> Result<Outcome, PlanError> {
+    options.check()?;
     let world = scene.to_world()?;
     let (objective, active, start) = problem_objective(robot, collision, &world, request)?;
     let goal = request.goal.positions.clone();

@@ -556,11 +556,7 @@ impl PlanningScene {
     /// Reads a scene file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&text, path)
+        Self::parse(&read(path)?, path)
     }
 
     /// The world of the scene: one object per primitive (`id`, or `id/k` for an object of
@@ -589,8 +585,56 @@ impl PlanningScene {
     }
 
     /// The scene as YAML in the layout [`PlanningScene::parse`] reads (a round trip keeps every
-    /// field it reads; numbers are written in their shortest exact form).
-    pub fn to_yaml(&self) -> String {
+    /// field it reads; numbers are written in their shortest exact form). Refuses what the
+    /// reader refuses: shapes other than boxes, spheres and cylinders, invalid dimensions or
+    /// poses, repeated ids, a robot state with non-finite values or one value short, a
+    /// non-square allowed-collision matrix.
+    pub fn to_yaml(&self) -> Result<String, PlanError> {
+        let refuse = |problem: String, fix: &str| PlanError::InvalidMoveIt {
+            path: self.origin.clone(),
+            line: 0,
+            problem: format!("not written: {problem}"),
+            fix: fix.into(),
+        };
+        self.to_world()?;
+        for o in &self.objects {
+            if o.primitives.is_empty() {
+                return Err(refuse(
+                    format!("object `{}` has no primitive", o.id),
+                    "give it one",
+                ));
+            }
+            if let Some(p) = o.primitives.iter().find(|p| {
+                !matches!(
+                    p.shape,
+                    Shape::Box { .. } | Shape::Sphere { .. } | Shape::Cylinder { .. }
+                )
+            }) {
+                return Err(refuse(
+                    format!("object `{}` holds a {:?}", o.id, p.shape),
+                    "MoveIt scenes hold boxes, spheres and cylinders",
+                ));
+            }
+        }
+        if let Some(state) = &self.robot_state {
+            if state.names.len() != state.positions.len()
+                || state.positions.iter().any(|v| !v.is_finite())
+            {
+                return Err(refuse(
+                    "the robot state's positions are not one finite value per name".into(),
+                    "give one finite position per joint name",
+                ));
+            }
+        }
+        if let Some(acm) = &self.allowed_collisions {
+            let n = acm.names.len();
+            if acm.allowed.len() != n || acm.allowed.iter().any(|r| r.len() != n) {
+                return Err(refuse(
+                    "the allowed-collision matrix is not square over its names".into(),
+                    "give one row of one value per name for every name",
+                ));
+            }
+        }
         let mut out = String::new();
         let list = |v: &[f64]| {
             v.iter()
@@ -640,7 +684,7 @@ impl PlanningScene {
                     Shape::Box { size } => ("box", size.to_vec()),
                     Shape::Sphere { radius } => ("sphere", vec![*radius]),
                     Shape::Cylinder { radius, length } => ("cylinder", vec![*length, *radius]),
-                    other => unreachable!("a scene holds only what it reads, not {other:?}"),
+                    _ => unreachable!("checked above"),
                 };
                 let _ = writeln!(
                     out,
@@ -660,8 +704,16 @@ impl PlanningScene {
                 );
             }
         }
-        out
+        Ok(out)
     }
+}
+
+/// A file's text, as every trm reader reads input (regular files, size-limited).
+fn read(path: &Path) -> Result<String, PlanError> {
+    trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// A YAML double-quoted string.
@@ -790,14 +842,10 @@ impl MotionPlanRequest {
         Ok(request)
     }
 
-    /// Reads a request file.
+    /// Reads a request file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&text, path)
+        Self::parse(&read(path)?, path)
     }
 }
 

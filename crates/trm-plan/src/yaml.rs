@@ -85,7 +85,12 @@ pub fn parse(text: &str) -> Result<Node, YamlProblem> {
                 let (value, start) = match stack.pop() {
                     Some(Open::Seq(items, start)) => (Value::Seq(items), start),
                     Some(Open::Map(entries, _, start)) => (Value::Map(entries), start),
-                    None => unreachable!("the parser closes only what it opened"),
+                    None => {
+                        return Err(YamlProblem {
+                            line,
+                            problem: "a collection closes that never opened".into(),
+                        });
+                    }
                 };
                 attach(&mut stack, &mut root, value, start)?;
                 false

@@ -34,7 +34,7 @@ fn every_sample_scene_and_request_reads_and_scenes_round_trip() {
                 .any(|(a, b)| a == "panda_hand" && b == "panda_leftfinger")
         );
         // the writer's output reads back to the same scene (poses to rounding)
-        let again = PlanningScene::parse(&scene.to_yaml(), &p.scene).unwrap();
+        let again = PlanningScene::parse(&scene.to_yaml().unwrap(), &p.scene).unwrap();
         assert_eq!(again.objects.len(), scene.objects.len());
         assert_eq!(again.allowed_collisions, scene.allowed_collisions);
         assert_eq!(again.robot_state, scene.robot_state);
@@ -160,4 +160,78 @@ fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolutio
         let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
         assert_eq!(again.path, outcome.path);
     }
+}
+
+#[test]
+fn the_writer_refuses_what_the_reader_refuses() {
+    let scene = PlanningScene::load(fixtures().join("box_panda/scene0001.yaml")).unwrap();
+    let refused = |mutate: &dyn Fn(&mut PlanningScene)| {
+        let mut s = scene.clone();
+        mutate(&mut s);
+        s.to_yaml().unwrap_err().to_string()
+    };
+    let e = refused(&|s| {
+        s.objects[0].primitives[0].shape = trm_collision::Shape::Capsule {
+            radius: 0.1,
+            length: 0.2,
+        }
+    });
+    assert!(e.contains("not written") && e.contains("Capsule"), "{e}");
+    let e = refused(&|s| s.objects[0].primitives[0].pose.translation.vector.x = f64::NAN);
+    assert!(e.contains("not finite"), "{e}");
+    let e = refused(&|s| s.robot_state.as_mut().unwrap().positions[0] = f64::INFINITY);
+    assert!(e.contains("one finite position per joint name"), "{e}");
+    let e = refused(&|s| {
+        s.allowed_collisions
+            .as_mut()
+            .unwrap()
+            .allowed
+            .pop()
+            .map(drop)
+            .unwrap()
+    });
+    assert!(e.contains("not square"), "{e}");
+    let e = refused(&|s| {
+        let twin = s.objects[0].clone();
+        s.objects.push(twin)
+    });
+    assert!(
+        e.contains("names an earlier object") || e.contains("already"),
+        "{e}"
+    );
+}
+
+#[test]
+fn problem_sets_open_from_folders_and_archives_and_summarise() {
+    use trm_plan::mbm::{Outcome, ProblemSet, Summary, quantile};
+    assert_eq!(ProblemSet::open(&fixtures()).unwrap().problems.len(), 14);
+    let archive =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/mbm/panda_problems.tar.bz2");
+    let set = ProblemSet::open(&archive).unwrap();
+    assert_eq!(set.problems.len(), 700);
+    let first = set.problems[0].scene.clone();
+    assert!(first.is_file());
+    drop(set);
+    assert!(!first.exists(), "the unpacked set is removed with it");
+    let not_tar = fixtures().join("NOTICE.md");
+    let e = ProblemSet::open(&not_tar).err().unwrap().to_string();
+    assert!(
+        e.starts_with(&not_tar.display().to_string()) && e.contains("fix:"),
+        "{e}"
+    );
+    let e = ProblemSet::open(Path::new("no/such/set"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("no/such/set"), "{e}");
+    // the field's report: quantiles by nearest rank, nothing where nothing was solved
+    assert_eq!(quantile(&[3.0, 1.0, 2.0, 4.0], 0.5), Some(2.0));
+    assert_eq!(quantile(&[3.0, 1.0, 2.0, 4.0], 0.95), Some(4.0));
+    assert_eq!(quantile(&[], 0.5), None);
+    let unsolved = Outcome {
+        valid: true,
+        ..Default::default()
+    };
+    let s = Summary::of([&unsolved]);
+    assert_eq!((s.problems, s.valid, s.solved, s.time), (1, 1, 0, None));
 }
