@@ -48,6 +48,12 @@ pub struct Args {
     /// resolution (an independent check of the raked edge checks).
     #[arg(long)]
     verify: bool,
+    /// Also run OMPL's RRTConnect on the same problems (benches/python/mbm_ompl.py: the same
+    /// robot files, coal through Pinocchio, the same edge step, `--per-family` and seed; needs
+    /// `python3 -m pip install ompl pin pyyaml numpy`) and print its table after trm's; the
+    /// value is OMPL's time limit per problem, s.
+    #[arg(long, value_parser = crate::parse::positive, conflicts_with = "families")]
+    ompl: Option<f64>,
     /// Where results.csv, results.md and times.svg go.
     #[arg(long, default_value = "target/benchmark-mbm")]
     pub out_dir: PathBuf,
@@ -233,6 +239,30 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&args.out_dir.join("results.csv"), csv.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("times.svg"), svg.as_bytes())?;
+    if let Some(limit) = args.ompl {
+        let script =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../benches/python/mbm_ompl.py");
+        let python = std::env::var("TRM_PYTHON").unwrap_or_else(|_| "python3".into());
+        let mut command = std::process::Command::new(python);
+        command.arg(&script).arg(set.root()).args([
+            "--time-limit",
+            &limit.to_string(),
+            "--seed",
+            &args.seed.to_string(),
+        ]);
+        if let Some(n) = args.per_family {
+            command.args(["--per-family", &n.to_string()]);
+        }
+        println!();
+        let status = command
+            .status()
+            .map_err(|e| anyhow::anyhow!("--ompl: starting {}: {e}", script.display()))?;
+        anyhow::ensure!(
+            status.success(),
+            "--ompl: {} failed ({status})\n  fix: python3 -m pip install ompl pin pyyaml numpy",
+            script.display()
+        );
+    }
     println!(
         "wrote {}/{{results.csv, results.md, times.svg}}",
         args.out_dir.display()

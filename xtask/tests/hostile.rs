@@ -916,6 +916,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         ("--resolution", &["0", "-0.1", "NaN", "1e-300"][..]),
         ("--max-iterations", &["0", "1e12"][..]),
         ("--seed", &["-1", "1.5"][..]),
+        ("--ompl", &["0", "-1", "NaN"][..]),
     ] {
         let names = if flag == "--resolution" {
             "resolution"
@@ -943,6 +944,16 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         });
     }
     let _ = std::os::unix::fs::symlink(dir.join("map.json"), dir.join("link_to_dir"));
+    let mut both = bench(&mbm);
+    both.extend(["--families".into(), "box_panda".into()]);
+    cases.push(Case {
+        what: "benchmark-mbm --ompl with --families".into(),
+        args: both
+            .into_iter()
+            .chain(["--ompl".into(), "1".into()])
+            .collect(),
+        names: "--ompl".into(),
+    });
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);
     cases.push(Case {

@@ -34,6 +34,7 @@ pub struct ProblemSet {
     /// The problems, sorted by family and number.
     pub problems: Vec<Problem>,
     unpacked: Option<PathBuf>,
+    root: PathBuf,
 }
 
 impl Drop for ProblemSet {
@@ -55,11 +56,17 @@ impl ProblemSet {
         };
         let mut set = ProblemSet {
             problems: Vec::new(),
+            root: PathBuf::new(),
             unpacked,
         };
-        let root = set_root(set.unpacked.as_deref().unwrap_or(path));
-        set.problems = find_problems(&root)?;
+        set.root = set_root(set.unpacked.as_deref().unwrap_or(path));
+        set.problems = find_problems(&set.root)?;
         Ok(set)
+    }
+
+    /// The folder holding the family folders (inside the unpacked archive, for an archive).
+    pub fn root(&self) -> &Path {
+        &self.root
     }
 }
 
