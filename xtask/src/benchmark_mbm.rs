@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Result;
-use trm_plan::mbm::{Outcome, ProblemSet, Summary, path_is_free, solve};
+use trm_plan::mbm::{Outcome, ProblemSet, path_is_free, solve};
 use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
@@ -54,6 +54,11 @@ pub struct Args {
     /// value is OMPL's time limit per problem, s.
     #[arg(long, value_parser = crate::parse::positive, conflicts_with = "families")]
     ompl: Option<f64>,
+    /// Also run VAMP's RRT-Connect + simplifier on the same problems and print its table and a
+    /// side-by-side one after trm's: the program benches/peers/vamp/build.sh builds
+    /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5).
+    #[arg(long, conflicts_with = "families")]
+    vamp: Option<PathBuf>,
     /// Where results.csv, results.md and times.svg go.
     #[arg(long, default_value = "target/benchmark-mbm")]
     pub out_dir: PathBuf,
@@ -164,37 +169,20 @@ pub fn run(args: &Args) -> Result<()> {
         args.max_seconds
             .map_or(String::new(), |s| format!(", {s} s at most"))
     );
-    md.push_str("| family | valid | solved | median ms | p95 ms | median length (rad) | median checks |\n|---|---|---|---|---|---|---|\n");
+    let outcomes: Vec<(&str, &Outcome)> = rows
+        .iter()
+        .map(|r| (r.family.as_str(), &r.outcome))
+        .collect();
+    md.push_str(&trm_plan::mbm::markdown_table(outcomes.iter().copied()));
     let mut families: Vec<&str> = rows.iter().map(|r| r.family.as_str()).collect();
     families.dedup();
     let mut all_times = Vec::new();
     let mut series = Vec::new();
-    let ms = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2}", v * 1e3));
-    let line = |name: &str, s: &Summary| {
-        format!(
-            "| {name} | {}/{} | {}/{} ({:.1} %) | {} | {} | {} | {} |\n",
-            s.valid,
-            s.problems,
-            s.solved,
-            s.valid,
-            100.0 * s.solved as f64 / s.valid.max(1) as f64,
-            ms(s.time.map(|t| t.0)),
-            ms(s.time.map(|t| t.1)),
-            s.length.map_or("—".into(), |l| format!("{l:.2}")),
-            s.checks.map_or("—".into(), |c| format!("{c:.0}"))
-        )
-    };
     for f in &families {
-        let of: Vec<&Outcome> = rows
+        let mut times: Vec<f64> = rows
             .iter()
-            .filter(|r| r.family == *f)
-            .map(|r| &r.outcome)
-            .collect();
-        md.push_str(&line(f, &Summary::of(of.iter().copied())));
-        let mut times: Vec<f64> = of
-            .iter()
-            .filter(|o| o.valid && o.solved)
-            .map(|o| o.seconds * 1e3)
+            .filter(|r| r.family == *f && r.outcome.valid && r.outcome.solved)
+            .map(|r| r.outcome.seconds * 1e3)
             .collect();
         times.sort_by(f64::total_cmp);
         series.push(crate::plot::Series {
@@ -213,7 +201,6 @@ pub fn run(args: &Args) -> Result<()> {
         });
         all_times.extend(times);
     }
-    md.push_str(&line("all", &Summary::of(rows.iter().map(|r| &r.outcome))));
     if args.verify {
         let checked = rows.iter().filter(|r| r.verified.is_some()).count();
         let failed = rows.iter().filter(|r| r.verified == Some(false)).count();
@@ -239,6 +226,34 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&args.out_dir.join("results.csv"), csv.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("times.svg"), svg.as_bytes())?;
+    if let Some(binary) = &args.vamp {
+        let peer = run_vamp(args, binary, &robot, &collision, &set, &problems)?;
+        let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
+        let mut text = format!(
+            "\nVAMP's RRT-Connect + simplifier on the same problems ({}, its spherized Panda, Halton sampler, range 1.0; time = planning + simplification as VAMP reports them):\n\n{}",
+            binary.display(),
+            trm_plan::mbm::markdown_table(theirs.iter().copied())
+        );
+        if args.verify {
+            let failed = peer
+                .iter()
+                .filter(|(_, o)| o.note == VAMP_PATH_COLLIDES)
+                .count();
+            let checked = peer.iter().filter(|(_, o)| o.solved).count();
+            let _ = writeln!(
+                text,
+                "\nVAMP's paths re-checked against trm's model at half trm's resolution: {failed} of {checked} collide there."
+            );
+        }
+        let _ = write!(
+            text,
+            "\nSide by side, on the problems both call valid (ratio = trm / VAMP):\n\n{}",
+            trm_plan::mbm::side_by_side((&outcomes, "trm"), (&theirs, "VAMP"))
+        );
+        print!("{text}");
+        md.push_str(&text);
+        crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
+    }
     if let Some(limit) = args.ompl {
         let script =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../benches/python/mbm_ompl.py");
@@ -268,4 +283,77 @@ pub fn run(args: &Args) -> Result<()> {
         args.out_dir.display()
     );
     Ok(())
+}
+
+/// The note of a VAMP path that collides in trm's model (`--verify`).
+const VAMP_PATH_COLLIDES: &str = "VAMP's path collides in trm's model";
+
+/// Runs VAMP's program on `problems` (exported with `trm_plan::mbm::peer_problems`); its
+/// outcomes in the order of `problems`, with `--verify` its paths re-checked in trm's model.
+fn run_vamp(
+    args: &Args,
+    binary: &std::path::Path,
+    robot: &trm_kinematics::RobotModel,
+    collision: &trm_collision::CollisionModel,
+    set: &ProblemSet,
+    problems: &[trm_plan::mbm::Problem],
+) -> Result<Vec<(String, Outcome)>> {
+    use std::io::Write as _;
+    let fix = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR PDQSORT_DIR (benches/peers/vamp/README.md)";
+    anyhow::ensure!(
+        binary.is_file(),
+        "--vamp: no program at {}\n  {fix}",
+        binary.display()
+    );
+    let input = trm_plan::mbm::peer_problems(robot.name(), problems)?;
+    let exported = args.out_dir.join("peer-problems.txt");
+    crate::write_atomic(&exported, input.as_bytes())?;
+    println!(
+        "\nrunning VAMP on {} problems of {}",
+        problems.len(),
+        set.root().display()
+    );
+    let mut child = std::process::Command::new(binary)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| anyhow::anyhow!("--vamp: starting {}: {e}\n  {fix}", binary.display()))?;
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let output = child.wait_with_output()?;
+    let _ = writer.join();
+    anyhow::ensure!(
+        output.status.success(),
+        "--vamp: {} failed ({}): {}",
+        binary.display(),
+        output.status,
+        String::from_utf8_lossy(&output.stderr).trim()
+    );
+    let results = trm_plan::mbm::parse_peer_results(&String::from_utf8_lossy(&output.stdout))
+        .map_err(|e| anyhow::anyhow!("--vamp: {}'s output, {e}", binary.display()))?;
+    let mut ordered = Vec::new();
+    for p in problems {
+        let found = results
+            .iter()
+            .find(|(f, i, _)| *f == p.family && *i == p.index)
+            .ok_or_else(|| anyhow::anyhow!("--vamp: no result for {} {}", p.family, p.index))?;
+        let mut outcome = found.2.clone();
+        if args.verify && outcome.solved {
+            let scene = PlanningScene::load(&p.scene)?;
+            let request = MotionPlanRequest::load(&p.request)?;
+            if !path_is_free(
+                robot,
+                collision,
+                &scene,
+                &request,
+                &outcome.path,
+                args.resolution / 2.0,
+            )? {
+                outcome.note = VAMP_PATH_COLLIDES.into();
+            }
+        }
+        ordered.push((p.family.clone(), outcome));
+    }
+    Ok(ordered)
 }

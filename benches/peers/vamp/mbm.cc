@@ -1,0 +1,230 @@
+// VAMP's RRT-Connect and simplifier on MotionBenchMaker problems exported by trm
+// (`cargo xtask benchmark-mbm SET --model M --vamp target/peers/vamp-mbm`), for the side-by-side
+// table. Reads the problems on stdin (the format `trm_plan::mbm::peer_problems` writes), prints
+// one line per problem on stdout:
+//   result FAMILY INDEX VALID SOLVED PLAN_NS SIMPLIFY_NS COST SIMPLIFIED_COST ITERATIONS WAYPOINTS
+//   path q1 … qd   (one line per waypoint of the simplified path)
+// Settings as VAMP's own evaluate_mbm.py: Halton sampler reset per problem, dynamic-domain
+// RRT-Connect with the robot's range, default simplification, rake = the CPU's float lanes.
+// Built by benches/peers/vamp/build.sh; see README.md there.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <vamp/collision/factory.hh>
+#include <vamp/planning/rrtc.hh>
+#include <vamp/planning/simplify.hh>
+#include <vamp/planning/validate.hh>
+#include <vamp/random/halton.hh>
+#include <vamp/robots/fetch.hh>
+#include <vamp/robots/panda.hh>
+#include <vamp/robots/ur5.hh>
+
+namespace
+{
+    constexpr std::size_t rake = vamp::FloatVectorWidth;
+
+    [[noreturn]] void fail(const std::string &what)
+    {
+        std::cerr << "vamp-mbm: " << what << '\n';
+        std::exit(2);
+    }
+
+    auto expect(std::istream &in, const std::string &word) -> void
+    {
+        std::string got;
+        if (!(in >> got) || got != word)
+        {
+            fail("expected `" + word + "`, read `" + got + "`");
+        }
+    }
+
+    template <typename T>
+    auto read(std::istream &in, const char *what) -> T
+    {
+        T value{};
+        if (!(in >> value))
+        {
+            fail(std::string("could not read ") + what);
+        }
+        return value;
+    }
+
+    // three numbers in order (a constructor's arguments may be evaluated in any order)
+    auto read_vector(std::istream &in) -> Eigen::Vector3f
+    {
+        Eigen::Vector3f v;
+        for (int i = 0; i < 3; ++i)
+        {
+            v[i] = read<float>(in, "a coordinate");
+        }
+        return v;
+    }
+
+    auto read_environment(std::istream &in) -> vamp::collision::Environment<float>
+    {
+        vamp::collision::Environment<float> environment;
+        expect(in, "objects");
+        const auto n = read<std::size_t>(in, "the object count");
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            const auto kind = read<std::string>(in, "an object kind");
+            const auto p = read_vector(in);
+            if (kind == "sphere")
+            {
+                environment.spheres.emplace_back(
+                    vamp::collision::factory::sphere::array({p[0], p[1], p[2]}, read<float>(in, "radius")));
+                continue;
+            }
+            const auto w = read<float>(in, "qw");
+            const auto x = read<float>(in, "qx");
+            const auto y = read<float>(in, "qy");
+            const auto z = read<float>(in, "qz");
+            // VAMP's factories take Euler angles applied as Rz(phi) Ry(theta) Rx(rho) (the
+            // "sxyz" angles its Python loader computes); its eigen_rot helpers take
+            // eulerAngles(0, 1, 2), the X-Y-Z product, which differs for general rotations.
+            const auto zyx = Eigen::Quaternionf(w, x, y, z).normalized().toRotationMatrix().eulerAngles(2, 1, 0);
+            const Eigen::Vector3f euler(zyx[2], zyx[1], zyx[0]);
+            if (kind == "box")
+            {
+                const auto h = read_vector(in);
+                environment.cuboids.emplace_back(vamp::collision::factory::cuboid::eigen(p, euler, h));
+            }
+            else if (kind == "cylinder")
+            {
+                const auto radius = read<float>(in, "radius");
+                const auto length = read<float>(in, "length");
+                environment.cylinders.emplace_back(
+                    vamp::collision::factory::cylinder::center::eigen(p, euler, radius, length));
+            }
+            else
+            {
+                fail("unknown object kind `" + kind + "`");
+            }
+        }
+        environment.sort();
+        return environment;
+    }
+
+    template <typename Robot>
+    auto run(std::istream &in, float range) -> void
+    {
+        using Configuration = typename Robot::Configuration;
+        using Environment = vamp::collision::Environment<vamp::FloatVector<rake>>;
+        using RRTC = vamp::planning::RRTC<Robot, rake, Robot::resolution>;
+
+        expect(in, "joints");
+        if (read<std::size_t>(in, "the joint count") != Robot::dimension)
+        {
+            fail(std::string("joint count differs from VAMP's ") + Robot::name);
+        }
+        for (std::size_t j = 0; j < Robot::dimension; ++j)
+        {
+            const auto name = read<std::string>(in, "a joint name");
+            if (name != Robot::joint_names[j])
+            {
+                fail("joint " + std::to_string(j) + " is `" + name + "`, VAMP's is `" +
+                     std::string(Robot::joint_names[j]) + "`");
+            }
+        }
+        expect(in, "problems");
+        const auto count = read<std::size_t>(in, "the problem count");
+
+        vamp::planning::RRTCSettings settings;
+        settings.range = range;
+        settings.max_iterations = 1000000;
+        settings.max_samples = 1000000;
+        const vamp::planning::SimplifySettings simplify_settings;
+        auto rng = std::make_shared<vamp::rng::Halton<Robot>>();
+
+        const auto configuration = [&in](const char *what)
+        {
+            expect(in, what);
+            typename Robot::ConfigurationArray q;
+            for (auto &v : q)
+            {
+                v = read<float>(in, what);
+            }
+            return Configuration(q);
+        };
+
+        for (std::size_t k = 0; k < count; ++k)
+        {
+            expect(in, "problem");
+            const auto family = read<std::string>(in, "a family");
+            const auto index = read<std::size_t>(in, "an index");
+            const auto start = configuration("start");
+            const auto goal = configuration("goal");
+            const Environment environment(read_environment(in));
+
+            const bool valid = vamp::planning::validate_motion<Robot, rake, 1>(start, start, environment) and
+                               vamp::planning::validate_motion<Robot, rake, 1>(goal, goal, environment);
+            std::printf("result %s %zu %d", family.c_str(), index, valid ? 1 : 0);
+            if (not valid)
+            {
+                std::printf(" 0 0 0 0 0 0 0\n");
+                continue;
+            }
+            rng->reset();
+            const auto result = RRTC::solve(start, goal, environment, settings, rng);
+            if (result.path.empty())
+            {
+                std::printf(" 0 %zu 0 0 0 %zu 0\n", result.nanoseconds, result.iterations);
+                continue;
+            }
+            const auto simple = vamp::planning::simplify<Robot, rake, Robot::resolution>(
+                result.path, environment, simplify_settings, rng);
+            std::printf(
+                " 1 %zu %zu %.6f %.6f %zu %zu\n",
+                result.nanoseconds,
+                simple.nanoseconds,
+                result.path.cost(),
+                simple.path.cost(),
+                result.iterations,
+                simple.path.size());
+            for (const auto &q : simple.path)
+            {
+                const auto a = q.to_array();
+                std::printf("path");
+                for (std::size_t j = 0; j < Robot::dimension; ++j)
+                {
+                    std::printf(" %.9g", a[j]);
+                }
+                std::printf("\n");
+            }
+        }
+    }
+}  // namespace
+
+auto main() -> int
+{
+    std::ios::sync_with_stdio(false);
+    expect(std::cin, "trm-mbm-problems");
+    if (read<int>(std::cin, "the format version") != 1)
+    {
+        fail("format version is not 1");
+    }
+    expect(std::cin, "robot");
+    const auto robot = read<std::string>(std::cin, "the robot name");
+    // RRT-Connect ranges of VAMP's evaluate_mbm.py (vamp/constants.py)
+    if (robot == "panda")
+    {
+        run<vamp::robots::Panda>(std::cin, 1.0F);
+    }
+    else if (robot == "fetch")
+    {
+        run<vamp::robots::Fetch>(std::cin, 1.0F);
+    }
+    else if (robot == "ur5")
+    {
+        run<vamp::robots::UR5>(std::cin, 1.5F);
+    }
+    else
+    {
+        fail("VAMP has no robot `" + robot + "` here (panda, fetch, ur5)");
+    }
+    return 0;
+}
