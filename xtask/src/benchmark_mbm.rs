@@ -54,6 +54,11 @@ pub struct Args {
     /// value is OMPL's time limit per problem, s.
     #[arg(long, value_parser = crate::parse::positive, conflicts_with = "families")]
     ompl: Option<f64>,
+    /// Also solve the set with experience kept, twice (`trm_plan::mbm::solve_with_experience`:
+    /// one planner per family keeps every path RRT-Connect finds; pass 1 plans each problem
+    /// through the family's earlier paths, pass 2 runs the set again), a table per pass.
+    #[arg(long)]
+    experience: bool,
     /// Also run VAMP's RRT-Connect + simplifier on the same problems and print its table and a
     /// side-by-side one after trm's: the program benches/peers/vamp/build.sh builds
     /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5).
@@ -74,6 +79,13 @@ struct Row {
 
 /// Runs the set, prints the per-family table, writes the files.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(binary) = &args.vamp {
+        anyhow::ensure!(
+            binary.is_file(),
+            "--vamp: no program at {}\n  {VAMP_FIX}",
+            binary.display()
+        );
+    }
     let robot = crate::load_model(Some(&args.model))?;
     let collision = args.meshes.collision_model(&robot)?;
     let set = ProblemSet::open(&args.dir)?;
@@ -226,12 +238,84 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&args.out_dir.join("results.csv"), csv.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
     crate::write_atomic(&args.out_dir.join("times.svg"), svg.as_bytes())?;
+    let mut experience = Vec::new();
+    if args.experience {
+        let total = 2 * problems.len() as u64;
+        let mut progress = crate::progress::Progress::new("problems with experience", total);
+        let mut count = 0;
+        experience = trm_plan::mbm::solve_with_experience(
+            &robot,
+            &collision,
+            &problems,
+            &options,
+            2,
+            |_, k| {
+                count += 1;
+                progress.set(count, total, &problems[k].family);
+            },
+        )?;
+        progress.finish();
+        let mut text = String::new();
+        for (pass, outcomes) in experience.iter_mut().enumerate() {
+            let mut failed = 0;
+            if args.verify {
+                for (o, p) in outcomes.iter_mut().zip(&problems) {
+                    if o.solved {
+                        let scene = PlanningScene::load(&p.scene)?;
+                        let request = MotionPlanRequest::load(&p.request)?;
+                        if !path_is_free(
+                            &robot,
+                            &collision,
+                            &scene,
+                            &request,
+                            &o.path,
+                            options.resolution / 2.0,
+                        )? {
+                            failed += 1;
+                        }
+                    }
+                }
+            }
+            let pairs: Vec<(&str, &Outcome)> = problems
+                .iter()
+                .map(|p| p.family.as_str())
+                .zip(outcomes.iter())
+                .collect();
+            let from_experience = outcomes
+                .iter()
+                .filter(|o| o.solved && o.note == "experience")
+                .count();
+            let _ = write!(
+                text,
+                "\nWith experience kept, pass {} ({}; {from_experience} of {} solved problems answered by the experience alone):\n\n{}",
+                pass + 1,
+                if pass == 0 {
+                    "one planner per family: each problem planned through the paths of the family's earlier problems, checked lazily in its scene, RRT-Connect where they do not reach"
+                } else {
+                    "the set again, every path of pass 1 kept, the problem's own included"
+                },
+                outcomes.iter().filter(|o| o.solved).count(),
+                trm_plan::mbm::markdown_table(pairs)
+            );
+            if args.verify {
+                let _ = writeln!(
+                    text,
+                    "\nEvery path re-checked one configuration at a time at half the resolution: {failed} of {} collide.",
+                    outcomes.iter().filter(|o| o.solved).count()
+                );
+            }
+        }
+        print!("{text}");
+        md.push_str(&text);
+        crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
+    }
     if let Some(binary) = &args.vamp {
         let peer = run_vamp(args, binary, &robot, &collision, &set, &problems)?;
         let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
         let mut text = format!(
-            "\nVAMP's RRT-Connect + simplifier on the same problems ({}, its spherized Panda, Halton sampler, range 1.0; time = planning + simplification as VAMP reports them):\n\n{}",
+            "\nVAMP's RRT-Connect + simplifier on the same problems ({}, VAMP's sphere model of {}, Halton sampler, its range for the robot; time = planning + simplification as VAMP reports them):\n\n{}",
             binary.display(),
+            robot.name(),
             trm_plan::mbm::markdown_table(theirs.iter().copied())
         );
         if args.verify {
@@ -250,6 +334,18 @@ pub fn run(args: &Args) -> Result<()> {
             "\nSide by side, on the problems both call valid (ratio = trm / VAMP):\n\n{}",
             trm_plan::mbm::side_by_side((&outcomes, "trm"), (&theirs, "VAMP"))
         );
+        if let Some(second) = experience.get(1) {
+            let ours: Vec<(&str, &Outcome)> = problems
+                .iter()
+                .map(|p| p.family.as_str())
+                .zip(second.iter())
+                .collect();
+            let _ = write!(
+                text,
+                "\ntrm with experience (pass 2) beside VAMP:\n\n{}",
+                trm_plan::mbm::side_by_side((&ours, "trm"), (&theirs, "VAMP"))
+            );
+        }
         print!("{text}");
         md.push_str(&text);
         crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
@@ -285,6 +381,9 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
+/// How to get VAMP's program.
+const VAMP_FIX: &str = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR PDQSORT_DIR (benches/peers/vamp/README.md)";
+
 /// The note of a VAMP path that collides in trm's model (`--verify`).
 const VAMP_PATH_COLLIDES: &str = "VAMP's path collides in trm's model";
 
@@ -299,12 +398,6 @@ fn run_vamp(
     problems: &[trm_plan::mbm::Problem],
 ) -> Result<Vec<(String, Outcome)>> {
     use std::io::Write as _;
-    let fix = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR PDQSORT_DIR (benches/peers/vamp/README.md)";
-    anyhow::ensure!(
-        binary.is_file(),
-        "--vamp: no program at {}\n  {fix}",
-        binary.display()
-    );
     let input = trm_plan::mbm::peer_problems(robot.name(), problems)?;
     let exported = args.out_dir.join("peer-problems.txt");
     crate::write_atomic(&exported, input.as_bytes())?;
@@ -318,7 +411,7 @@ fn run_vamp(
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
-        .map_err(|e| anyhow::anyhow!("--vamp: starting {}: {e}\n  {fix}", binary.display()))?;
+        .map_err(|e| anyhow::anyhow!("--vamp: starting {}: {e}\n  {VAMP_FIX}", binary.display()))?;
     let mut stdin = child.stdin.take().expect("stdin is piped");
     let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
     let output = child.wait_with_output()?;

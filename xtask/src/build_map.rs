@@ -236,7 +236,7 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
 /// Prints what `world` blocks in `map`: through the index (built once, then timed over
 /// repeated queries) and by checking every node and edge, with both times.
 fn blocking_report(map: &Roadmap, problem: &Problem, world: &Path) -> Result<()> {
-    let world = trm_collision::World::load(world)?;
+    let world = trm_plan::moveit::load_world(world)?;
     let objective = &problem.objective;
     let started = std::time::Instant::now();
     let index = trm_roadmap::BlockIndex::new(map, objective)?;
@@ -279,7 +279,7 @@ fn blocking_report(map: &Roadmap, problem: &Problem, world: &Path) -> Result<()>
 pub struct InfoArgs {
     /// A map file written by build-map.
     map: PathBuf,
-    /// Also report what this world (RON) blocks in the map — nodes and edges, found through
+    /// Also report what this world (RON, or a MoveIt scene .yaml) blocks in the map — nodes and edges, found through
     /// the map's bounding-box index — with the time that takes against checking everything.
     #[arg(long, value_name = "WORLD.ron")]
     world: Option<PathBuf>,

@@ -14,7 +14,7 @@ pub struct Args {
     model: Option<PathBuf>,
     #[command(flatten)]
     configs: crate::fk::ConfigsArgs,
-    /// World objects (RON; format: crates/trm-collision/docs/world.md), checked as well.
+    /// World objects (RON: crates/trm-collision/docs/world.md; or a MoveIt planning scene .yaml), checked as well.
     #[arg(long)]
     world: Option<PathBuf>,
     #[command(flatten)]
@@ -29,7 +29,7 @@ pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(args.model.as_deref())?;
     let collision = args.meshes.collision_model(&model)?;
     let world = match &args.world {
-        Some(path) => World::load(path)?,
+        Some(path) => trm_plan::moveit::load_world(path)?,
         None => World::new(),
     };
     let (_, all) = args.configs.read(&model)?;

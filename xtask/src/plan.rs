@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use trm_collision::World;
 use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
 use trm_roadmap::{RepairOptions, Roadmap};
 use trm_tasks::Problem;
@@ -15,7 +14,7 @@ pub struct Args {
     /// Map files (repeatable); they must share the first map's active motors.
     #[arg(long = "map", required = true)]
     maps: Vec<PathBuf>,
-    /// The current world (RON), replacing the one the maps were built in.
+    /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps were built in.
     #[arg(long)]
     world: Option<PathBuf>,
     /// Repair the maps for --world before planning: park what it blocks, bring back parked
@@ -85,7 +84,11 @@ pub fn run(args: &Args) -> Result<()> {
         .iter()
         .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
         .collect::<Result<_>>()?;
-    let world = args.world.as_ref().map(World::load).transpose()?;
+    let world = args
+        .world
+        .as_ref()
+        .map(trm_plan::moveit::load_world)
+        .transpose()?;
     if let (true, Some(world)) = (args.repair, &world) {
         for (map, path) in maps.iter_mut().zip(&args.maps) {
             let problem = map

@@ -24,7 +24,7 @@ pub struct Args {
     /// Where the object stands in the robot's root frame: "x,y,z" or "x,y,z,yaw".
     #[arg(long, default_value = "-0.3,0.2,0.05", allow_hyphen_values = true)]
     at: String,
-    /// Obstacles (RON world, root frame), e.g. specs/worlds/table.ron; none by default.
+    /// Obstacles (RON world or MoveIt planning scene .yaml, root frame), e.g. specs/worlds/table.ron; none by default.
     #[arg(long)]
     world: Option<PathBuf>,
     /// Reach the single grasp nearest the object's centre instead of anywhere on the map.
@@ -53,7 +53,7 @@ pub fn run(args: &Args) -> Result<()> {
         Vector3::z() * v.get(3).copied().unwrap_or(0.0),
     );
     let world = match &args.world {
-        Some(w) => World::load(w)?,
+        Some(w) => trm_plan::moveit::load_world(w)?,
         None => World::new(),
     };
     let active = e

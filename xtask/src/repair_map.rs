@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use trm_collision::World;
 use trm_roadmap::{BuildOptions, RepairOptions, RepairReport, Roadmap, build};
 
 /// Arguments of `repair-map`.
@@ -13,7 +12,7 @@ use trm_roadmap::{BuildOptions, RepairOptions, RepairReport, Roadmap, build};
 pub struct Args {
     /// The map (built by build-map, or repaired before).
     map: PathBuf,
-    /// The world the map must be valid in (RON).
+    /// The world the map must be valid in (RON, or a MoveIt planning scene .yaml).
     #[arg(long, value_name = "WORLD.ron")]
     world: PathBuf,
     /// Output map (default: the map's name with .repaired.map.json).
@@ -49,7 +48,7 @@ pub fn run(args: &Args) -> Result<()> {
     let problem = map
         .problem()
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
-    let world = World::load(&args.world)?;
+    let world = trm_plan::moveit::load_world(&args.world)?;
     let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
     let started = Instant::now();

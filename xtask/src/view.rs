@@ -32,7 +32,7 @@ pub struct Args {
     /// `stand-up` write), or `plan`'s JSON (with its task-space path).
     #[arg(long)]
     traj: Option<PathBuf>,
-    /// World objects (RON), replacing the spec's.
+    /// World objects (RON, or a MoveIt planning scene .yaml), replacing the spec's.
     #[arg(long)]
     world: Option<PathBuf>,
     /// The page; the JSON scene is written beside it.
@@ -230,7 +230,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let mut s = subject(args, map.as_ref())?;
     if let Some(w) = &args.world {
-        s.world = World::load(w)?;
+        s.world = trm_plan::moveit::load_world(w)?;
     }
     let collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
     let mut scene = Scene::new(&s.title, &collision);

@@ -954,6 +954,23 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .collect(),
         names: "--ompl".into(),
     });
+    // VAMP beside trm: a program that is not there, not a program, or prints nonsense
+    let fake = dir.join("fake_vamp.sh");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\ncat > /dev/null\necho 'result box_panda 1 1 1 NaN 0 0 0 0 0'\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    for program in ["no/such/program", "map.json", "fake_vamp.sh"] {
+        let mut args = bench(&mbm);
+        args.extend(["--per-family", "1", "--vamp", program].map(String::from));
+        cases.push(Case {
+            what: format!("benchmark-mbm --vamp {program}"),
+            args,
+            names: "--vamp".into(),
+        });
+    }
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);
     cases.push(Case {

@@ -12,7 +12,7 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
-use crate::rrt::{Checker, RrtOptions, path_length, rrt_connect};
+use crate::rrt::{Checker, RrtOptions, path_length, rrt_connect, shortcut};
 
 /// One problem of a set.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -246,6 +246,12 @@ pub fn find_problems(dir: &Path) -> Result<Vec<Problem>, PlanError> {
     Ok(problems)
 }
 
+/// How far outside its joint limits a start or goal value may lie and still be taken, clamped
+/// onto the limit. URDFs round ±π to ±3.14159, so MotionBenchMaker's Fetch states at ±π lie
+/// 2.7·10⁻⁶ rad outside; MoveIt moves such starts inside (its FixStartStateBounds adapter, up
+/// to 0.05 rad) and samples joint goals within the bounds.
+pub const LIMIT_SLACK: f64 = 1e-4;
+
 /// How one problem went.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Outcome {
@@ -279,30 +285,15 @@ pub fn solve(
 ) -> Result<Outcome, PlanError> {
     options.check()?;
     let world = scene.to_world()?;
-    let (objective, active, start) = problem_objective(robot, collision, &world, request)?;
-    let goal = request.goal.positions.clone();
-    let within = |q: &[f64]| {
-        active
-            .iter()
-            .zip(q)
-            .all(|(&i, v)| robot.motors()[i].limits.check(*v).is_ok())
-    };
-    let mut outcome = Outcome::default();
+    let (objective, active, mut start) = problem_objective(robot, collision, &world, request)?;
+    let mut goal = request.goal.positions.clone();
     let mut checker = Checker::new(&objective, &world);
-    let (start_ok, goal_ok) = (within(&start), within(&goal));
-    let start_free = start_ok && checker.free(&start);
-    let goal_free = goal_ok && checker.free(&goal);
-    outcome.valid = start_free && goal_free;
-    if !outcome.valid {
-        outcome.note = match (start_ok, start_free, goal_ok) {
-            (false, _, _) => "the start is outside the joint limits",
-            (_, false, _) => "the start collides",
-            (_, _, false) => "the goal is outside the joint limits",
-            _ => "the goal collides",
-        }
-        .into();
+    let mut outcome = Outcome::default();
+    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| checker.free(q)) {
+        outcome.note = why.into();
         return Ok(outcome);
     }
+    outcome.valid = true;
     let options = RrtOptions {
         max_seconds: options.max_seconds.or(request.planning_time),
         ..options.clone()
@@ -319,6 +310,180 @@ pub fn solve(
         Err(e) => outcome.note = e.to_string(),
     }
     Ok(outcome)
+}
+
+/// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
+/// and `free`). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
+fn invalid(
+    robot: &RobotModel,
+    active: &[usize],
+    start: &mut [f64],
+    goal: &mut [f64],
+    mut free: impl FnMut(&[f64]) -> bool,
+) -> Option<&'static str> {
+    let within = |q: &mut [f64]| {
+        active.iter().zip(q).all(|(&i, v)| {
+            let limits = &robot.motors()[i].limits;
+            let inside = (limits.lower - LIMIT_SLACK..=limits.upper + LIMIT_SLACK).contains(v);
+            *v = v.clamp(limits.lower, limits.upper);
+            inside
+        })
+    };
+    if !within(start) {
+        Some("the start is outside the joint limits")
+    } else if !free(start) {
+        Some("the start collides")
+    } else if !within(goal) {
+        Some("the goal is outside the joint limits")
+    } else if !free(goal) {
+        Some("the goal collides")
+    } else {
+        None
+    }
+}
+
+/// Solves `problems` with experience, as a robot that keeps what it learns: one planner per
+/// family (`crate::Planner` over no map), each problem planned through what the family's
+/// earlier problems left behind (checked lazily in the new scene) and, where that does not
+/// join start and goal, by RRT-Connect, whose path is then kept ([`crate::Planner::add_path`]).
+/// An outcome's note says how it was answered: `experience`, `straight` (the straight edge
+/// from start to goal is free) or `RRT-Connect (path kept)`. The set is run `passes` times with the experience kept; `outcomes[pass][k]` answers
+/// `problems[k]`; `done(pass, k)` is called after each. The problems of a family must share
+/// the goal's joints and the start's other motors (an error names the first that does not).
+pub fn solve_with_experience(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    problems: &[Problem],
+    options: &RrtOptions,
+    passes: usize,
+    mut done: impl FnMut(usize, usize),
+) -> Result<Vec<Vec<Outcome>>, PlanError> {
+    options.check()?;
+    let mut outcomes = vec![vec![Outcome::default(); problems.len()]; passes];
+    let mut families: Vec<&str> = problems.iter().map(|p| p.family.as_str()).collect();
+    families.dedup();
+    families.sort_unstable();
+    families.dedup();
+    for family in families {
+        let members: Vec<usize> = (0..problems.len())
+            .filter(|&k| problems[k].family == family)
+            .collect();
+        let first = MotionPlanRequest::load(&problems[members[0]].request)?;
+        let (objective, active, _) =
+            problem_objective(robot, collision, &trm_collision::World::new(), &first)?;
+        let mut planner = crate::Planner::new(&objective, &[])?;
+        for (pass, results) in outcomes.iter_mut().enumerate() {
+            for &k in &members {
+                let p = &problems[k];
+                let scene = PlanningScene::load(&p.scene)?;
+                let request = MotionPlanRequest::load(&p.request)?;
+                let (other, other_active, mut start) =
+                    problem_objective(robot, collision, &trm_collision::World::new(), &request)?;
+                if other_active != active
+                    || other.active().to_motors(&start) != objective.active().to_motors(&start)
+                {
+                    return Err(PlanError::InvalidMoveIt {
+                        path: request.origin.clone(),
+                        line: 0,
+                        problem: format!(
+                            "its goal's joints or its start's other motors differ from {}'s",
+                            problems[members[0]].request.display()
+                        ),
+                        fix: "give a family whose problems share the robot's planning group and its other joints' values".into(),
+                    });
+                }
+                planner.set_world(scene.to_world()?);
+                let mut goal = request.goal.positions.clone();
+                let outcome = &mut results[k];
+                if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| {
+                    planner.is_free(q)
+                }) {
+                    outcome.note = why.into();
+                    done(pass, k);
+                    continue;
+                }
+                outcome.valid = true;
+                let began = std::time::Instant::now();
+                let rrt = RrtOptions {
+                    max_seconds: options.max_seconds.or(request.planning_time),
+                    ..options.clone()
+                };
+                let plan_options = crate::PlanOptions {
+                    resolution: options.resolution,
+                    shortcuts: 0,
+                    seed: options.seed,
+                    exact_goal: false,
+                    sampling: Some(rrt.clone()),
+                    ..Default::default()
+                };
+                let found = match planner.plan(
+                    &start,
+                    &crate::Goal::Configuration(goal.clone()),
+                    &plan_options,
+                ) {
+                    Ok(planned) if planned.stats.sampled.is_some() => Ok((
+                        planned.waypoints,
+                        planned.stats.sampled.map_or(0, |s| s.1),
+                        None,
+                    )),
+                    Ok(planned) => {
+                        // through experience: shortcut greedily, and checked at half the
+                        // resolution as RRT-Connect's paths are; RRT-Connect where that fails
+                        let world = planner.world().clone();
+                        let mut checker = Checker::new(&objective, &world);
+                        let mut path = planned.waypoints;
+                        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(
+                            options.seed,
+                        );
+                        shortcut(
+                            &mut path,
+                            &RrtOptions {
+                                shortcuts: 0,
+                                ..options.clone()
+                            },
+                            &mut checker,
+                            &mut rng,
+                        );
+                        let how = if planned.nodes.is_empty() {
+                            "straight"
+                        } else {
+                            "experience"
+                        };
+                        if path
+                            .windows(2)
+                            .all(|w| checker.edge_free(&w[0], &w[1], options.resolution / 2.0))
+                        {
+                            Ok((path, checker.checks, Some(how)))
+                        } else {
+                            rrt_connect(&objective, &world, &start, &goal, &rrt)
+                                .map(|f| (f.path, checker.checks + f.checks, None))
+                        }
+                    }
+                    Err(e) => Err(e),
+                };
+                match found {
+                    Ok((path, checks, answered)) => {
+                        outcome.solved = true;
+                        outcome.seconds = began.elapsed().as_secs_f64();
+                        outcome.length = path_length(&path);
+                        outcome.waypoints = path.len();
+                        outcome.checks = checks;
+                        outcome.note = match answered {
+                            Some(how) => how.into(),
+                            None => {
+                                planner.add_path(&path)?;
+                                "RRT-Connect (path kept)".into()
+                            }
+                        };
+                        outcome.path = path;
+                    }
+                    Err(e) => outcome.note = e.to_string(),
+                }
+                done(pass, k);
+            }
+        }
+    }
+    Ok(outcomes)
 }
 
 /// Whether every edge of `path` is free at `resolution` in the problem's world, checked one

@@ -50,6 +50,21 @@ impl JointState {
     }
 }
 
+/// The top-level fields of a MoveIt PlanningScene message (a document naming none of them is
+/// not a scene).
+const SCENE_FIELDS: [&str; 10] = [
+    "name",
+    "robot_state",
+    "robot_model_name",
+    "fixed_frame_transforms",
+    "allowed_collision_matrix",
+    "link_padding",
+    "link_scale",
+    "object_colors",
+    "world",
+    "is_diff",
+];
+
 /// One primitive of a collision object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Primitive {
@@ -499,6 +514,25 @@ impl PlanningScene {
     pub fn parse(text: &str, origin: &Path) -> Result<Self, PlanError> {
         let r = Reader { origin };
         let doc = r.parse(text)?;
+        if let crate::yaml::Value::Map(entries) = &doc.value {
+            if !entries.is_empty()
+                && !entries
+                    .iter()
+                    .any(|(k, _)| SCENE_FIELDS.contains(&k.as_str()))
+            {
+                let request =
+                    doc.get("goal_constraints").is_some() || doc.get("start_state").is_some();
+                return Err(r.err(
+                    doc.line,
+                    if request {
+                        "this is a motion plan request, not a planning scene".to_string()
+                    } else {
+                        format!("no planning-scene field ({})", SCENE_FIELDS.join(", "))
+                    },
+                    "give a MoveIt PlanningScene (MotionBenchMaker's sceneNNNN.yaml)",
+                ));
+            }
+        }
         let mut scene = PlanningScene {
             origin: origin.to_path_buf(),
             ..Default::default()
@@ -846,6 +880,16 @@ impl MotionPlanRequest {
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();
         Self::parse(&read(path)?, path)
+    }
+}
+
+/// A world from a file: a MoveIt planning scene (`.yaml`/`.yml`, its collision objects) or
+/// trm's RON world (anything else).
+pub fn load_world(path: impl AsRef<Path>) -> Result<World, PlanError> {
+    let path = path.as_ref();
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("yaml" | "yml") => PlanningScene::load(path)?.to_world(),
+        _ => Ok(World::load(path)?),
     }
 }
 

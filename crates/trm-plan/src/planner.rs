@@ -20,6 +20,9 @@ pub enum PlanError {
     /// From the kinematics (an unknown motor name, a wrong vector length).
     #[error(transparent)]
     Kinematics(#[from] trm_kinematics::KinematicsError),
+    /// From the collision crate (a world file that cannot be read, an invalid object).
+    #[error(transparent)]
+    Collision(#[from] trm_collision::CollisionError),
     /// A file could not be read or written.
     #[error("{}: {source}", path.display())]
     Io {
@@ -346,6 +349,8 @@ pub struct Planned {
     pub trajectory: Trajectory,
     /// Map nodes visited (global indices over all maps).
     pub nodes: Vec<usize>,
+    /// The path's waypoints in active values (the trajectory's positions are all motors').
+    pub waypoints: Vec<Vec<f64>>,
     /// Statistics.
     pub stats: PlanStats,
 }
@@ -446,6 +451,57 @@ impl<'a> Planner<'a> {
         self.edge_state.fill(State::Unknown);
     }
 
+    /// Keeps a path (active values, free in the current world, e.g. one RRT-Connect found) as
+    /// experience: its waypoints join the graph as nodes (a waypoint within 1e-9 rad of a node
+    /// is that node), its segments as edges known free in the current world, and each new node
+    /// is joined to its 3 nearest older nodes by edges checked when a search first wants them.
+    /// Later queries, in this world or another (after [`Planner::set_world`]), search through
+    /// it. Returns the number of nodes added.
+    pub fn add_path(&mut self, path: &[Vec<f64>]) -> Result<usize, PlanError> {
+        let d = self.active.len();
+        if let Some(bad) = path
+            .iter()
+            .find(|q| q.len() != d || q.iter().any(|v| !v.is_finite()))
+        {
+            return Err(PlanError::InvalidOptions {
+                what: "experience path".into(),
+                problem: format!("a waypoint has {} values, not {d} finite ones", bad.len()),
+            });
+        }
+        let old = self.nodes.len();
+        let mut ids = Vec::with_capacity(path.len());
+        for q in path {
+            let same = (0..self.nodes.len()).find(|&i| distance(&self.nodes[i].0, q) <= 1e-9);
+            let id = match same {
+                Some(i) => i,
+                None => {
+                    let t = self.task_of(q);
+                    self.nodes.push((q.clone(), t));
+                    self.node_state.push(State::Valid);
+                    let me = self.nodes.len() - 1;
+                    let mut near: Vec<(f64, usize)> = (0..old)
+                        .map(|j| (distance(q, &self.nodes[j].0), j))
+                        .collect();
+                    near.sort_by(|x, y| x.0.total_cmp(&y.0));
+                    for &(l, j) in near.iter().take(3) {
+                        self.edges.push((me, j, l));
+                        self.edge_state.push(State::Unknown);
+                    }
+                    me
+                }
+            };
+            ids.push(id);
+        }
+        for w in ids.windows(2) {
+            if w[0] != w[1] {
+                let l = distance(&self.nodes[w[0]].0, &self.nodes[w[1]].0);
+                self.edges.push((w[0], w[1], l));
+                self.edge_state.push(State::Valid);
+            }
+        }
+        Ok(self.nodes.len() - old)
+    }
+
     /// Number of nodes over all maps.
     pub fn num_nodes(&self) -> usize {
         self.nodes.len()
@@ -507,6 +563,7 @@ impl<'a> Planner<'a> {
             return Ok(Planned {
                 trajectory,
                 nodes: Vec::new(),
+                waypoints: found.path,
                 stats,
             });
         }
@@ -773,6 +830,7 @@ impl<'a> Planner<'a> {
             return Ok(Planned {
                 trajectory,
                 nodes: node_ids,
+                waypoints,
                 stats,
             });
         }

@@ -235,3 +235,211 @@ fn problem_sets_open_from_folders_and_archives_and_summarise() {
     let s = Summary::of([&unsolved]);
     assert_eq!((s.problems, s.valid, s.solved, s.time), (1, 1, 0, None));
 }
+
+/// The second MotionBenchMaker robot, from its files only (URDF, SRDF naming links the URDF
+/// lacks, STL meshes): its sample problems read, their ±π states are taken within
+/// `LIMIT_SLACK`, and RRT-Connect solves them with paths free at half the resolution.
+#[test]
+fn the_fetch_runs_from_its_files_only() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let robot =
+        trm_kinematics::RobotModel::load(root.join("../../models/fetch-mbm/fetch.ron")).unwrap();
+    assert_eq!(robot.motors().len(), 8);
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let options = RrtOptions::default();
+    let problems = find_problems(&root.join("tests/fixtures/mbm-fetch")).unwrap();
+    assert_eq!(problems.len(), 2);
+    for p in problems {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        let outcome = solve(&robot, &collision, &scene, &request, &options).unwrap();
+        assert!(
+            outcome.valid && outcome.solved,
+            "{} {}: {}",
+            p.family,
+            p.index,
+            outcome.note
+        );
+        assert!(
+            path_is_free(
+                &robot,
+                &collision,
+                &scene,
+                &request,
+                &outcome.path,
+                options.resolution / 2.0
+            )
+            .unwrap()
+        );
+    }
+}
+
+/// Problems as peers read them, and their answers read back: every problem and primitive
+/// written, numbers exact; malformed answers are errors naming the line.
+#[test]
+fn peer_problems_are_written_and_peer_results_read() {
+    let problems = find_problems(&fixtures()).unwrap();
+    let text = trm_plan::mbm::peer_problems("panda", &problems).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("trm-mbm-problems 1"));
+    assert_eq!(lines.next(), Some("robot panda"));
+    assert!(lines.next().unwrap().starts_with("joints 7 panda_joint1 "));
+    assert_eq!(lines.next(), Some("problems 14"));
+    for p in &problems {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        assert_eq!(
+            lines.next().unwrap(),
+            format!("problem {} {}", p.family, p.index)
+        );
+        let start: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(' ')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(start, request.start.positions[..7]);
+        let goal: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(' ')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(goal, request.goal.positions);
+        let n: usize = lines
+            .next()
+            .unwrap()
+            .strip_prefix("objects ")
+            .unwrap()
+            .parse()
+            .unwrap();
+        let primitives: Vec<_> = scene.objects.iter().flat_map(|o| &o.primitives).collect();
+        assert_eq!(n, primitives.len());
+        for primitive in primitives {
+            let words: Vec<&str> = lines.next().unwrap().split(' ').collect();
+            let x: f64 = words[1].parse().unwrap();
+            assert_eq!(x, primitive.pose.translation.vector.x);
+        }
+    }
+    assert_eq!(lines.next(), None);
+
+    let answer = "result box_panda 1 1 1 150000 50000 4.5 4.0 12 2\npath 0 0\npath 1 1\n\nresult box_panda 2 0 0 0 0 0 0 0 0\n";
+    let results = trm_plan::mbm::parse_peer_results(answer).unwrap();
+    assert_eq!(results.len(), 2);
+    let (family, index, first) = &results[0];
+    assert_eq!((family.as_str(), *index), ("box_panda", 1));
+    assert!(first.valid && first.solved);
+    assert!((first.seconds - 2e-4).abs() < 1e-15);
+    assert_eq!((first.length, first.waypoints), (4.0, 2));
+    assert_eq!(first.path, vec![vec![0.0, 0.0], vec![1.0, 1.0]]);
+    assert!(!results[1].2.valid && !results[1].2.solved);
+    for (bad, says) in [
+        (
+            "result box_panda 1 1 1 NaN 0 0 0 0 0",
+            "line 1: not a finite number",
+        ),
+        (
+            "result box_panda 1 1 1 0 0 0 0 0",
+            "line 1: a result has 10 fields",
+        ),
+        ("path 0 0", "line 1: a path line before any result"),
+        (
+            "result box_panda x 1 1 0 0 0 0 0 0",
+            "line 1: not a problem number",
+        ),
+        (
+            "result box_panda 1 1 1 0 0 0 0 0 0\nsolved",
+            "line 2: neither",
+        ),
+    ] {
+        let e = trm_plan::mbm::parse_peer_results(bad).unwrap_err();
+        assert!(e.contains(says), "{bad}: {e}");
+    }
+}
+
+/// `--world` files: a MoveIt scene (.yaml) or trm's RON world, one call.
+#[test]
+fn worlds_load_from_moveit_scenes_and_ron() {
+    let scene = fixtures().join("box_panda/scene0001.yaml");
+    let world = trm_plan::moveit::load_world(&scene).unwrap();
+    assert_eq!(
+        world.len(),
+        PlanningScene::load(&scene)
+            .unwrap()
+            .to_world()
+            .unwrap()
+            .len()
+    );
+    let ron = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/worlds/table.ron");
+    assert!(!trm_plan::moveit::load_world(&ron).unwrap().is_empty());
+    let e =
+        trm_plan::moveit::load_world(fixtures().join("box_panda/request0001.yaml")).unwrap_err();
+    assert!(e.to_string().contains("request0001.yaml"), "{e}");
+}
+
+/// Experience: one planner per family keeps what RRT-Connect finds; the second pass over the
+/// sample answers from it, every path free at half the resolution, and the whole run repeats
+/// exactly for its seed.
+#[test]
+fn experience_answers_the_second_pass() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let problems = find_problems(&fixtures()).unwrap();
+    let options = RrtOptions::default();
+    let mut calls = 0;
+    let passes =
+        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {
+            calls += 1
+        })
+        .unwrap();
+    assert_eq!(calls, 2 * problems.len());
+    for (pass, outcomes) in passes.iter().enumerate() {
+        for (p, o) in problems.iter().zip(outcomes) {
+            assert!(
+                o.valid && o.solved,
+                "pass {pass}, {} {}: {}",
+                p.family,
+                p.index,
+                o.note
+            );
+            let scene = PlanningScene::load(&p.scene).unwrap();
+            let request = MotionPlanRequest::load(&p.request).unwrap();
+            assert!(
+                path_is_free(
+                    &robot,
+                    &collision,
+                    &scene,
+                    &request,
+                    &o.path,
+                    options.resolution / 2.0
+                )
+                .unwrap()
+            );
+            assert_eq!(o.path.first().unwrap(), &request.start.positions[..7]);
+            assert_eq!(o.path.last().unwrap(), &request.goal.positions);
+        }
+    }
+    // the first problem of each family has no experience yet
+    assert!(
+        passes[0]
+            .iter()
+            .zip(&problems)
+            .filter(|(_, p)| p.index == 1)
+            .all(|(o, _)| o.note != "experience")
+    );
+    let from_experience = passes[1].iter().filter(|o| o.note == "experience").count();
+    assert!(
+        from_experience * 2 >= problems.len(),
+        "{from_experience} of {} from experience",
+        problems.len()
+    );
+    let again =
+        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {})
+            .unwrap();
+    for (a, b) in passes.iter().flatten().zip(again.iter().flatten()) {
+        assert_eq!(a.path, b.path);
+    }
+}

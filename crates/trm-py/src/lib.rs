@@ -387,11 +387,11 @@ impl PyWorld {
         Self::default()
     }
 
-    /// A world from a RON file (`(objects: [(name: "table", shape: Box(size: (…)), xyz: (…))])`).
+    /// A world from a RON file (`(objects: [(name: "table", shape: Box(size: (…)), xyz: (…))])`) or a MoveIt planning scene (`.yaml`).
     #[staticmethod]
     fn load(path: &str) -> PyResult<Self> {
         Ok(PyWorld {
-            world: World::load(path).map_err(err)?,
+            world: trm_plan::moveit::load_world(path).map_err(err)?,
         })
     }
 
