@@ -234,10 +234,8 @@ pub fn run(args: &Args) -> Result<()> {
             series,
         }],
     )?;
-    std::fs::create_dir_all(&args.out_dir)?;
-    crate::write_atomic(&args.out_dir.join("results.csv"), csv.as_bytes())?;
-    crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
-    crate::write_atomic(&args.out_dir.join("times.svg"), svg.as_bytes())?;
+    // every file is written at the end, once every part has run
+    let mut files = vec![("results.csv", csv.into_bytes()), ("times.svg", svg.into_bytes())];
     let mut experience = Vec::new();
     if args.experience {
         let total = 2 * problems.len() as u64;
@@ -307,10 +305,10 @@ pub fn run(args: &Args) -> Result<()> {
         }
         print!("{text}");
         md.push_str(&text);
-        crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
     }
     if let Some(binary) = &args.vamp {
-        let peer = run_vamp(args, binary, &robot, &collision, &set, &problems)?;
+        let (peer, exported) = run_vamp(args, binary, &robot, &collision, &set, &problems)?;
+        files.push(("peer-problems.txt", exported.into_bytes()));
         let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
         let mut text = format!(
             "\nVAMP's RRT-Connect + simplifier on the same problems ({}, VAMP's sphere model of {}, Halton sampler, its range for the robot; time = planning + simplification as VAMP reports them):\n\n{}",
@@ -348,7 +346,6 @@ pub fn run(args: &Args) -> Result<()> {
         }
         print!("{text}");
         md.push_str(&text);
-        crate::write_atomic(&args.out_dir.join("results.md"), md.as_bytes())?;
     }
     if let Some(limit) = args.ompl {
         let script =
@@ -364,20 +361,28 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(n) = args.per_family {
             command.args(["--per-family", &n.to_string()]);
         }
-        println!();
-        let status = command
-            .status()
+        println!("\nrunning OMPL on the same problems");
+        let output = command
+            .stderr(std::process::Stdio::inherit())
+            .output()
             .map_err(|e| anyhow::anyhow!("--ompl: starting {}: {e}", script.display()))?;
         anyhow::ensure!(
-            status.success(),
-            "--ompl: {} failed ({status})\n  fix: python3 -m pip install ompl pin pyyaml numpy",
-            script.display()
+            output.status.success(),
+            "--ompl: {} failed ({})\n  fix: python3 -m pip install ompl pin pyyaml numpy",
+            script.display(),
+            output.status
         );
+        let text = format!("\n{}", String::from_utf8_lossy(&output.stdout));
+        print!("{text}");
+        md.push_str(&text);
     }
-    println!(
-        "wrote {}/{{results.csv, results.md, times.svg}}",
-        args.out_dir.display()
-    );
+    files.push(("results.md", md.into_bytes()));
+    std::fs::create_dir_all(&args.out_dir)?;
+    for (name, bytes) in &files {
+        crate::write_atomic(&args.out_dir.join(name), bytes)?;
+    }
+    let names: Vec<&str> = files.iter().map(|f| f.0).collect();
+    println!("wrote {}/{{{}}}", args.out_dir.display(), names.join(", "));
     Ok(())
 }
 
@@ -388,7 +393,8 @@ const VAMP_FIX: &str = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR 
 const VAMP_PATH_COLLIDES: &str = "VAMP's path collides in trm's model";
 
 /// Runs VAMP's program on `problems` (exported with `trm_plan::mbm::peer_problems`); its
-/// outcomes in the order of `problems`, with `--verify` its paths re-checked in trm's model.
+/// outcomes in the order of `problems`, with `--verify` its paths re-checked in trm's model,
+/// and the problems as given to it.
 fn run_vamp(
     args: &Args,
     binary: &std::path::Path,
@@ -396,11 +402,10 @@ fn run_vamp(
     collision: &trm_collision::CollisionModel,
     set: &ProblemSet,
     problems: &[trm_plan::mbm::Problem],
-) -> Result<Vec<(String, Outcome)>> {
+) -> Result<(Vec<(String, Outcome)>, String)> {
     use std::io::Write as _;
     let input = trm_plan::mbm::peer_problems(robot.name(), problems)?;
-    let exported = args.out_dir.join("peer-problems.txt");
-    crate::write_atomic(&exported, input.as_bytes())?;
+    let exported = input.clone();
     println!(
         "\nrunning VAMP on {} problems of {}",
         problems.len(),
@@ -448,5 +453,5 @@ fn run_vamp(
         }
         ordered.push((p.family.clone(), outcome));
     }
-    Ok(ordered)
+    Ok((ordered, exported))
 }

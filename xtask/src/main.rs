@@ -10,6 +10,7 @@ mod fit_proxies;
 mod fk;
 mod gen_acm;
 mod gen_icub;
+mod gen_mbm;
 mod map_scaling;
 mod model_info;
 mod optimise;
@@ -62,6 +63,9 @@ enum Command {
     GenAcm(gen_acm::Args),
     /// Regenerate models/icub_upper_body.{urdf,ron} from the official iCub files in models/.
     GenIcub,
+    /// A MotionBenchMaker-like set for a spec's robot: seeded table, shelf and cage scenes with
+    /// reaching goals (NGIK), written as MoveIt scenes and requests.
+    GenMbm(gen_mbm::Args),
     /// Run an optimiser on a test function several times: evaluations to target and a summary.
     Optimise(optimise::Args),
     /// Fig. 2 of the parallel paper: map-building time per thread count, and P's effect.
@@ -133,6 +137,7 @@ impl Command {
             Command::RepairMap(a) => (vec![a.out_path()], vec![]),
             Command::Scenario(a) => (vec![], vec![a.out_dir.clone()]),
             Command::BenchmarkMbm(a) => (vec![], vec![a.out_dir.clone()]),
+            Command::GenMbm(a) => (vec![], vec![a.out.clone()]),
             Command::FitProxies(a) => (file(&a.out), vec![]),
             Command::StandUp(a) => (
                 beside(&Some(a.out.join("trajectory.csv")), &["ros.yaml"]),
@@ -250,6 +255,7 @@ fn dispatch(command: Command) -> Result<()> {
         Command::ExploreTaskMap(args) => explore_task_map::run(&args),
         Command::GenAcm(args) => gen_acm::run(&args),
         Command::GenIcub => gen_icub::run(&models_dir()),
+        Command::GenMbm(args) => gen_mbm::run(&args),
         Command::Optimise(args) => optimise::run(&args),
         Command::Plan(args) => plan::run(&args),
         Command::ReachGrasp(args) => reach_grasp::run(&args),

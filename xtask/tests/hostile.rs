@@ -978,6 +978,55 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         args: families,
         names: "box_panda".into(),
     });
+    // gen-mbm: settings out of range, a spec that does not reach, outputs that are files
+    let gen_spec = at("specs/mbm/icub_reach.ron").to_string_lossy().to_string();
+    let gen_mbm = [
+        "gen-mbm",
+        gen_spec.as_str(),
+        "--out",
+        "gen-out",
+        "--per-family",
+        "1",
+    ];
+    for (flag, values) in [
+        ("--per-family", &["0", "-1"][..]),
+        ("--center", &["1,2", "1,2,NaN"][..]),
+        ("--facing", &["0,0", "1"][..]),
+        ("--tolerance", &["0", "-1", "NaN"][..]),
+        ("--tries", &["0"][..]),
+    ] {
+        cases.extend(flag_cases(&gen_mbm, flag, values));
+    }
+    cases.push(Case {
+        what: "gen-mbm with an unknown family".into(),
+        args: gen_mbm
+            .iter()
+            .map(|s| s.to_string())
+            .chain(["--families".into(), "kitchen".into()])
+            .collect(),
+        names: "kitchen".into(),
+    });
+    cases.push(Case {
+        what: "gen-mbm with scenes out of reach".into(),
+        args: gen_mbm
+            .iter()
+            .map(|s| s.to_string())
+            .chain(["--center=-5,0,0".into(), "--tries".into(), "1".into()])
+            .collect(),
+        names: "center".into(),
+    });
+    cases.extend(file_flag_cases(
+        &["gen-mbm", gen_spec.as_str(), "--per-family", "1"],
+        "--out",
+        &["map.json"],
+    ));
+    cases.push(Case {
+        what: "gen-mbm with a spec that is not there".into(),
+        args: ["gen-mbm", "no_such_spec.ron", "--out", "gen-out"]
+            .map(String::from)
+            .to_vec(),
+        names: "no_such_spec.ron".into(),
+    });
     // one budget or the other, not both
     let both: Vec<&str> = run_scenario
         .iter()

@@ -13,6 +13,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod generate;
 pub mod mbm;
 pub mod moveit;
 mod planner;

@@ -876,6 +876,60 @@ impl MotionPlanRequest {
         Ok(request)
     }
 
+    /// The request as YAML in the layout [`MotionPlanRequest::parse`] reads (start state, one
+    /// goal of joint constraints with their tolerances, group, planning time; numbers in their
+    /// shortest exact form). Refuses a goal or start that is not one finite value per name.
+    pub fn to_yaml(&self) -> Result<String, PlanError> {
+        let refuse = |problem: &str| PlanError::InvalidMoveIt {
+            path: self.origin.clone(),
+            line: 0,
+            problem: format!("not written: {problem}"),
+            fix: "give one finite value (and two tolerances of 0 or more) per joint name".into(),
+        };
+        let (s, g) = (&self.start, &self.goal);
+        if s.names.len() != s.positions.len() || s.positions.iter().any(|v| !v.is_finite()) {
+            return Err(refuse("the start is not one finite value per name"));
+        }
+        if g.names.is_empty()
+            || g.names.len() != g.positions.len()
+            || g.names.len() != g.tolerances.len()
+            || g.positions.iter().any(|v| !v.is_finite())
+            || g.tolerances
+                .iter()
+                .any(|(a, b)| !(a.is_finite() && b.is_finite() && *a >= 0.0 && *b >= 0.0))
+        {
+            return Err(refuse(
+                "the goal is not one finite value and two tolerances per name",
+            ));
+        }
+        let mut out = String::new();
+        if !self.group.is_empty() {
+            let _ = writeln!(out, "group_name: {}", quote(&self.group));
+        }
+        if let Some(t) = self.planning_time {
+            let _ = writeln!(out, "allowed_planning_time: {t:?}");
+        }
+        let names: Vec<String> = s.names.iter().map(|n| quote(n)).collect();
+        let positions: Vec<String> = s.positions.iter().map(|v| format!("{v:?}")).collect();
+        let _ = writeln!(
+            out,
+            "start_state:\n  joint_state:\n    name: [{}]\n    position: [{}]",
+            names.join(", "),
+            positions.join(", ")
+        );
+        out.push_str("goal_constraints:\n  - joint_constraints:\n");
+        for ((name, position), (below, above)) in
+            g.names.iter().zip(&g.positions).zip(&g.tolerances)
+        {
+            let _ = writeln!(
+                out,
+                "      - joint_name: {}\n        position: {position:?}\n        tolerance_below: {below:?}\n        tolerance_above: {above:?}",
+                quote(name)
+            );
+        }
+        Ok(out)
+    }
+
     /// Reads a request file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();

@@ -23,6 +23,9 @@ pub enum PlanError {
     /// From the collision crate (a world file that cannot be read, an invalid object).
     #[error(transparent)]
     Collision(#[from] trm_collision::CollisionError),
+    /// From the task crate (an objective that cannot be built, NGIK that cannot run).
+    #[error(transparent)]
+    Tasks(Box<trm_tasks::TaskError>),
     /// A file could not be read or written.
     #[error("{}: {source}", path.display())]
     Io {
@@ -70,6 +73,16 @@ pub enum PlanError {
         what: String,
         /// What is wrong and what to give.
         problem: String,
+    },
+    /// A problem set could not be generated as asked.
+    #[error("generating {what}: {problem}\n  fix: {fix}")]
+    Generate {
+        /// The problem or setting.
+        what: String,
+        /// What went wrong.
+        problem: String,
+        /// What to change.
+        fix: String,
     },
     /// The start configuration collides in the current world, or has the wrong length.
     #[error("the start configuration is invalid: {0}")]
@@ -172,6 +185,12 @@ impl Goal {
                 }
             }
         }
+    }
+}
+
+impl From<trm_tasks::TaskError> for PlanError {
+    fn from(e: trm_tasks::TaskError) -> Self {
+        PlanError::Tasks(Box::new(e))
     }
 }
 
