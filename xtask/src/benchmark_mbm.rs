@@ -235,7 +235,10 @@ pub fn run(args: &Args) -> Result<()> {
         }],
     )?;
     // every file is written at the end, once every part has run
-    let mut files = vec![("results.csv", csv.into_bytes()), ("times.svg", svg.into_bytes())];
+    let mut files = vec![
+        ("results.csv", csv.into_bytes()),
+        ("times.svg", svg.into_bytes()),
+    ];
     let mut experience = Vec::new();
     if args.experience {
         let total = 2 * problems.len() as u64;

@@ -50,7 +50,11 @@ pub fn run(args: &Args) -> Result<()> {
     anyhow::ensure!(
         args.facing.len() == 2 && args.facing.iter().any(|v| *v != 0.0),
         "--facing: {} given\n  fix: give a horizontal direction x,y, not zero",
-        args.facing.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(",")
+        args.facing
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
     );
     let spec = trm_tasks::spec::Problem::load(&args.spec)?;
     let options = SetOptions {
