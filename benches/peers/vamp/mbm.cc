@@ -64,7 +64,10 @@ namespace
         return v;
     }
 
-    auto read_environment(std::istream &in) -> vamp::collision::Environment<float>
+    // Cylinders as VAMP's own MotionBenchMaker loader (vamp.problem_dict_to_vamp) gives them:
+    // capsules (VAMP's checks never read Environment::cylinders), and in the `box` family,
+    // whose goals grasp a can from above, boxes of half extents (r, r, length / 2).
+    auto read_environment(std::istream &in, bool cylinders_as_boxes) -> vamp::collision::Environment<float>
     {
         vamp::collision::Environment<float> environment;
         expect(in, "objects");
@@ -97,8 +100,16 @@ namespace
             {
                 const auto radius = read<float>(in, "radius");
                 const auto length = read<float>(in, "length");
-                environment.cylinders.emplace_back(
-                    vamp::collision::factory::cylinder::center::eigen(p, euler, radius, length));
+                if (cylinders_as_boxes)
+                {
+                    environment.cuboids.emplace_back(vamp::collision::factory::cuboid::eigen(
+                        p, euler, Eigen::Vector3f(radius, radius, length / 2)));
+                }
+                else
+                {
+                    environment.capsules.emplace_back(
+                        vamp::collision::factory::capsule::center::eigen(p, euler, radius, length));
+                }
             }
             else
             {
@@ -158,7 +169,8 @@ namespace
             const auto index = read<std::size_t>(in, "an index");
             const auto start = configuration("start");
             const auto goal = configuration("goal");
-            const Environment environment(read_environment(in));
+            const bool box_family = family.rfind("box_", 0) == 0 or family == "box";
+            const Environment environment(read_environment(in, box_family));
 
             const bool valid = vamp::planning::validate_motion<Robot, rake, 1>(start, start, environment) and
                                vamp::planning::validate_motion<Robot, rake, 1>(goal, goal, environment);
