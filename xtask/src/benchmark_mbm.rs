@@ -35,8 +35,8 @@ pub struct Args {
     /// Time budget per problem, s (default: each request's allowed_planning_time).
     #[arg(long, value_parser = crate::parse::positive)]
     max_seconds: Option<f64>,
-    /// Sample budget per problem.
-    #[arg(long, default_value_t = 100_000, value_parser = crate::parse::count(1, 100_000_000))]
+    /// Sample budget per problem (VAMP's evaluate_mbm.py gives its RRT-Connect 10⁶).
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::parse::count(1, 100_000_000))]
     max_iterations: usize,
     /// Largest gap between checked points of an edge, rad.
     #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]

@@ -24,7 +24,8 @@ pub struct RrtOptions {
     pub range: f64,
     /// Largest gap between checked points of an edge, rad.
     pub resolution: f64,
-    /// Most samples drawn before giving up.
+    /// Most samples extended from before giving up (samples outside the dynamic domain are not
+    /// counted; see [`MAX_DRAWS_PER_SAMPLE`]).
     pub max_iterations: usize,
     /// Time budget, s (`None`: only the iteration budget; reproducible).
     pub max_seconds: Option<f64>,
@@ -32,7 +33,28 @@ pub struct RrtOptions {
     /// MotionBenchMaker's Panda set 100 attempts shortened paths by 7 % but tripled the median
     /// time, and their corner-cutting edges graze obstacles between checked points).
     pub shortcuts: usize,
+    /// Dynamic domain (Jaillet, Yershova, LaValle and Siméon, IROS 2005), as VAMP grows its
+    /// trees: a node whose extension hit an obstacle takes samples only within a radius of it
+    /// (first [`DOMAIN_RADIUS`], shrinking by [`DOMAIN_ALPHA`] at each failure down to
+    /// [`DOMAIN_MIN_RADIUS`], growing at each success); farther samples are drawn again
+    /// without a collision check.
+    pub dynamic_domain: bool,
+    /// Grow the smaller tree (the trees swap roles only while their sizes are within a factor
+    /// of 2), as VAMP does; otherwise they alternate.
+    pub balance: bool,
 }
+
+/// Draws per counted sample at most: samples outside every dynamic domain are drawn again
+/// without a collision check and not counted in [`RrtOptions::max_iterations`], up to this
+/// many times its value in all.
+pub const MAX_DRAWS_PER_SAMPLE: usize = 100;
+
+/// First radius of a node's dynamic domain after a failed extension, rad (VAMP's default).
+pub const DOMAIN_RADIUS: f64 = 4.0;
+/// Relative change of a domain radius per failed (−) or successful (+) extension.
+pub const DOMAIN_ALPHA: f64 = 1e-4;
+/// Smallest domain radius, rad.
+pub const DOMAIN_MIN_RADIUS: f64 = 1.0;
 
 impl Default for RrtOptions {
     fn default() -> Self {
@@ -43,6 +65,8 @@ impl Default for RrtOptions {
             max_iterations: 100_000,
             max_seconds: None,
             shortcuts: 0,
+            dynamic_domain: true,
+            balance: true,
         }
     }
 }
@@ -187,6 +211,8 @@ pub fn distance(a: &[f64], b: &[f64]) -> f64 {
 struct Tree {
     nodes: Vec<Vec<f64>>,
     parents: Vec<usize>,
+    /// Dynamic-domain radius of each node (infinite until an extension from it fails).
+    radii: Vec<f64>,
 }
 
 impl Tree {
@@ -194,18 +220,20 @@ impl Tree {
         Tree {
             nodes: vec![root.to_vec()],
             parents: vec![usize::MAX],
+            radii: vec![f64::INFINITY],
         }
     }
 
-    fn nearest(&self, q: &[f64]) -> usize {
-        let mut best = (f64::INFINITY, 0);
+    /// The node nearest to `q` and its distance.
+    fn nearest(&self, q: &[f64]) -> (usize, f64) {
+        let mut best = (0, f64::INFINITY);
         for (i, n) in self.nodes.iter().enumerate() {
             let d: f64 = n.iter().zip(q).map(|(x, y)| (x - y) * (x - y)).sum();
-            if d < best.0 {
-                best = (d, i);
+            if d < best.1 {
+                best = (i, d);
             }
         }
-        best.1
+        (best.0, best.1.sqrt())
     }
 
     /// Root → node `i`.
@@ -224,13 +252,24 @@ enum Extend {
     Reached(usize),
     Advanced(usize),
     Trapped,
+    /// Outside the nearest node's dynamic domain: nothing checked.
+    Outside,
 }
 
-/// One step of `tree` from its node nearest to `target` towards it (at most `range`).
-fn extend(tree: &mut Tree, target: &[f64], options: &RrtOptions, checker: &mut Checker) -> Extend {
-    let near = tree.nearest(target);
+/// One step of `tree` from its node nearest to `target` towards it (at most `range`); with
+/// `domain`, the nearest node's dynamic domain bounds where it goes and learns from the step.
+fn extend(
+    tree: &mut Tree,
+    target: &[f64],
+    options: &RrtOptions,
+    checker: &mut Checker,
+    domain: bool,
+) -> Extend {
+    let (near, d) = tree.nearest(target);
+    if domain && d > tree.radii[near] {
+        return Extend::Outside;
+    }
     let from = &tree.nodes[near];
-    let d = distance(from, target);
     let (to, reached) = if d <= options.range {
         (target.to_vec(), true)
     } else {
@@ -245,10 +284,22 @@ fn extend(tree: &mut Tree, target: &[f64], options: &RrtOptions, checker: &mut C
     };
     if !checker.free(&to) || !checker.edge_free(&tree.nodes[near].clone(), &to, options.resolution)
     {
+        if domain {
+            let r = &mut tree.radii[near];
+            *r = if r.is_infinite() {
+                DOMAIN_RADIUS
+            } else {
+                (*r * (1.0 - DOMAIN_ALPHA)).max(DOMAIN_MIN_RADIUS)
+            };
+        }
         return Extend::Trapped;
+    }
+    if domain && tree.radii[near].is_finite() {
+        tree.radii[near] *= 1.0 + DOMAIN_ALPHA;
     }
     tree.nodes.push(to);
     tree.parents.push(near);
+    tree.radii.push(f64::INFINITY);
     let i = tree.nodes.len() - 1;
     if reached {
         Extend::Reached(i)
@@ -351,6 +402,7 @@ fn search(
     let (mut a, mut b) = (Tree::new(start), Tree::new(goal));
     let mut a_is_start = true;
     let mut sample = vec![0.0; dim];
+    let mut draws = 0usize;
     while raw.is_none() && result.iterations < options.max_iterations {
         if options
             .max_seconds
@@ -358,20 +410,32 @@ fn search(
         {
             break;
         }
-        result.iterations += 1;
+        draws += 1;
+        if draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
+            break;
+        }
         for (k, v) in sample.iter_mut().enumerate() {
             *v = rng.random_range(lower[k]..=upper[k]);
         }
-        let new = match extend(&mut a, &sample, options, &mut checker) {
+        let new = match extend(
+            &mut a,
+            &sample,
+            options,
+            &mut checker,
+            options.dynamic_domain,
+        ) {
+            // outside the dynamic domain: drawn again, not counted as a sample
+            Extend::Outside => continue,
             Extend::Trapped => None,
             Extend::Reached(i) | Extend::Advanced(i) => Some(i),
         };
+        result.iterations += 1;
         if let Some(i) = new {
             let target = a.nodes[i].clone();
             loop {
-                match extend(&mut b, &target, options, &mut checker) {
+                match extend(&mut b, &target, options, &mut checker, false) {
                     Extend::Advanced(_) => continue,
-                    Extend::Trapped => break,
+                    Extend::Trapped | Extend::Outside => break,
                     Extend::Reached(j) => {
                         let (from_a, from_b) = (a.path_to(i), b.path_to(j));
                         let (mut first, second) = if a_is_start {
@@ -388,8 +452,12 @@ fn search(
                 }
             }
         }
-        std::mem::swap(&mut a, &mut b);
-        a_is_start = !a_is_start;
+        // balanced: the next sample grows the smaller tree
+        let (na, nb) = (a.nodes.len() as f64, b.nodes.len() as f64);
+        if !options.balance || (na - nb).abs() / na < 1.0 {
+            std::mem::swap(&mut a, &mut b);
+            a_is_start = !a_is_start;
+        }
     }
     result.nodes = a.nodes.len() + b.nodes.len();
     let Some(mut path) = raw else {

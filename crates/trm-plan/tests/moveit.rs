@@ -443,3 +443,36 @@ fn experience_answers_the_second_pass() {
         assert_eq!(a.path, b.path);
     }
 }
+
+/// Plain RRT-Connect (no dynamic domain, alternating trees) solves the sample too; the dynamic
+/// domain skips samples without checking them, so it needs fewer checks on the cage problems.
+#[test]
+fn plain_and_dynamic_domain_rrt_connect_both_solve() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let plain = RrtOptions {
+        dynamic_domain: false,
+        balance: false,
+        ..Default::default()
+    };
+    let (mut checks_plain, mut checks_domain) = (0, 0);
+    for p in find_problems(&fixtures()).unwrap() {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        for (options, checks) in [
+            (&plain, &mut checks_plain),
+            (&RrtOptions::default(), &mut checks_domain),
+        ] {
+            let outcome = solve(&robot, &collision, &scene, &request, options).unwrap();
+            assert!(outcome.solved, "{} {}: {}", p.family, p.index, outcome.note);
+            if p.family.starts_with("cage") {
+                *checks += outcome.checks;
+            }
+        }
+    }
+    assert!(
+        checks_domain < checks_plain,
+        "{checks_domain} checks with the dynamic domain, {checks_plain} without"
+    );
+}

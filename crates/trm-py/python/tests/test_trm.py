@@ -246,3 +246,12 @@ def test_an_optimiser_refuses_values_for_other_candidates():
     world.add_box("a", [1, 1, 1], [0, 0, 0])
     with pytest.raises(trm.TrmError, match="already exists"):
         world.add_box("a", [1, 1, 1], [0, 0, 0])
+
+
+def test_worlds_load_from_moveit_scenes(tmp_path):
+    scene = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/scene0001.yaml"
+    world = trm.World.load(str(scene))
+    assert len(world.names()) == 7
+    request = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/request0001.yaml"
+    with pytest.raises(trm.TrmError, match="request0001.yaml"):
+        trm.World.load(str(request))
