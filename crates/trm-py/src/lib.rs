@@ -1230,6 +1230,7 @@ fn view(
 #[pymodule]
 fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TrmError", m.py().get_type::<TrmError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("ALGORITHMS", trm_optim::ALGORITHMS.to_vec())?;
     m.add_class::<Robot>()?;
     m.add_class::<PyWorld>()?;

@@ -251,7 +251,39 @@ def test_an_optimiser_refuses_values_for_other_candidates():
 def test_worlds_load_from_moveit_scenes(tmp_path):
     scene = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/scene0001.yaml"
     world = trm.World.load(str(scene))
-    assert len(world.names()) == 7
+    assert len(world.names) == 7
     request = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/request0001.yaml"
     with pytest.raises(trm.TrmError, match="request0001.yaml"):
         trm.World.load(str(request))
+
+
+def test_version_is_the_crate_version():
+    cargo = (ROOT / "Cargo.toml").read_text()
+    assert f'version = "{trm.__version__}"' in cargo
+
+
+def test_the_stubs_name_what_the_module_has():
+    """Every class, function and public member in __init__.pyi exists in the module, and every
+    public name of the module and of its classes is in the stubs."""
+    import ast
+
+    stubs = ast.parse((Path(trm.__file__).parent / "__init__.pyi").read_text())
+    declared = {}
+    for node in stubs.body:
+        if isinstance(node, ast.ClassDef):
+            declared[node.name] = {
+                n.name for n in node.body if isinstance(n, ast.FunctionDef) and not n.name.startswith("_")
+            }
+        elif isinstance(node, ast.FunctionDef):
+            declared[node.name] = None
+        elif isinstance(node, ast.AnnAssign):
+            declared[node.target.id] = None
+    public = {n for n in dir(trm) if not n.startswith("_") or n == "__version__"}
+    public -= {"annotations"}
+    for name, members in declared.items():
+        assert hasattr(trm, name), f"the stubs declare trm.{name}, the module lacks it"
+        if members is not None:
+            actual = {m for m in vars(getattr(trm, name)) if not m.startswith("_")}
+            assert members == actual, f"trm.{name}: stubs only {members - actual}, module only {actual - members}"
+    missing = {n for n in public if n not in declared and not isinstance(getattr(trm, n), type(trm))}
+    assert not missing, f"not in the stubs: {missing}"

@@ -21,11 +21,13 @@ from ._trm import (
     Robot,
     TrmError,
     World,
+    __version__,
     minimize_constrained,
     view,
 )
 
 __all__ = [
+    "__version__",
     "ALGORITHMS",
     "CollisionModel",
     "Optimizer",

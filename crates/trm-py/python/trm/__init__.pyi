@@ -8,6 +8,7 @@ import numpy.typing as npt
 ArrayLike = npt.ArrayLike
 Array = npt.NDArray[np.float64]
 
+__version__: str
 ALGORITHMS: list[str]
 
 class TrmError(ValueError): ...
