@@ -1,12 +1,14 @@
 // VAMP's RRT-Connect and simplifier on MotionBenchMaker problems exported by trm
 // (`cargo xtask benchmark-mbm SET --model M --vamp target/peers/vamp-mbm`), for the side-by-side
 // table. Reads the problems on stdin (the format `trm_plan::mbm::peer_problems` writes), prints
-// one line per problem on stdout:
+// one line per problem on stdout (after `robot NAME`, `configurations N` instead of `joints`
+// times FK + self-collision of N configurations instead: see `configurations` below):
 //   result FAMILY INDEX VALID SOLVED PLAN_NS SIMPLIFY_NS COST SIMPLIFIED_COST ITERATIONS WAYPOINTS
 //   path q1 … qd   (one line per waypoint of the simplified path)
 // Settings as VAMP's own evaluate_mbm.py: Halton sampler reset per problem, dynamic-domain
 // RRT-Connect with the robot's range, default simplification, rake = the CPU's float lanes.
 // Built by benches/peers/vamp/build.sh; see README.md there.
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -127,7 +129,6 @@ namespace
         using Environment = vamp::collision::Environment<vamp::FloatVector<rake>>;
         using RRTC = vamp::planning::RRTC<Robot, rake, Robot::resolution>;
 
-        expect(in, "joints");
         if (read<std::size_t>(in, "the joint count") != Robot::dimension)
         {
             fail(std::string("joint count differs from VAMP's ") + Robot::name);
@@ -209,6 +210,89 @@ namespace
             }
         }
     }
+
+    // Configurations mode: FK + self-collision of each configuration in an empty world, timed
+    // over blocks of `rake` configurations (VAMP's fkcc), and each one's verdict alone.
+    template <typename Robot>
+    auto configurations(std::istream &in) -> void
+    {
+        using Block = typename Robot::template ConfigurationBlock<rake>;
+        const vamp::collision::Environment<vamp::FloatVector<rake>> empty{};
+        const auto n = read<std::size_t>(in, "the configuration count");
+        std::vector<std::array<float, Robot::dimension>> qs(n);
+        for (auto &q : qs)
+        {
+            for (auto &v : q)
+            {
+                v = read<float>(in, "a joint value");
+            }
+        }
+        const auto block_of = [&](std::size_t first, bool broadcast)
+        {
+            Block block;
+            for (std::size_t j = 0; j < Robot::dimension; ++j)
+            {
+                std::array<float, rake> lane{};
+                for (std::size_t l = 0; l < rake; ++l)
+                {
+                    const auto k = broadcast ? first : std::min(first + l, n - 1);
+                    lane[l] = qs[k][j];
+                }
+                block[j] = vamp::FloatVector<rake>(lane);
+            }
+            return block;
+        };
+        std::vector<Block> blocks;
+        for (std::size_t first = 0; first < n; first += rake)
+        {
+            blocks.push_back(block_of(first, false));
+        }
+        const auto repeats = read<std::size_t>(in, "the repeat count");
+        for (std::size_t r = 0; r < repeats; ++r)
+        {
+            std::size_t valid = 0;
+            const auto began = std::chrono::steady_clock::now();
+            for (auto &block : blocks)
+            {
+                valid += Robot::template fkcc<rake>(empty, block) ? 1 : 0;
+            }
+            const auto ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - began).count();
+            std::printf("time %.3f %zu\n", ns / static_cast<double>(n), valid);
+            std::fflush(stdout);
+            // wait for the caller's turn (interleaved runs): one word per repeat
+            if (r + 1 < repeats)
+            {
+                expect(in, "next");
+            }
+        }
+        for (std::size_t k = 0; k < n; ++k)
+        {
+            auto block = block_of(k, true);
+            std::printf("valid %d\n", Robot::template fkcc<rake>(empty, block) ? 1 : 0);
+        }
+    }
+}  // namespace
+
+namespace
+{
+    template <typename Robot>
+    auto dispatch(std::istream &in, float range) -> void
+    {
+        std::string mode;
+        in >> mode;
+        if (mode == "joints")
+        {
+            run<Robot>(in, range);
+        }
+        else if (mode == "configurations")
+        {
+            configurations<Robot>(in);
+        }
+        else
+        {
+            fail("expected `joints` or `configurations`, read `" + mode + "`");
+        }
+    }
 }  // namespace
 
 auto main() -> int
@@ -224,15 +308,15 @@ auto main() -> int
     // RRT-Connect ranges of VAMP's evaluate_mbm.py (vamp/constants.py)
     if (robot == "panda")
     {
-        run<vamp::robots::Panda>(std::cin, 1.0F);
+        dispatch<vamp::robots::Panda>(std::cin, 1.0F);
     }
     else if (robot == "fetch")
     {
-        run<vamp::robots::Fetch>(std::cin, 1.0F);
+        dispatch<vamp::robots::Fetch>(std::cin, 1.0F);
     }
     else if (robot == "ur5")
     {
-        run<vamp::robots::UR5>(std::cin, 1.5F);
+        dispatch<vamp::robots::UR5>(std::cin, 1.5F);
     }
     else
     {
