@@ -42,7 +42,9 @@ fn main() {
     }
     let (timed, exact) = (objective(&args[0]), objective(&args[1]));
     let n: usize = args[3].parse().expect("COUNT is a number");
-    let rounds: usize = args.get(4).map_or(7, |r| r.parse().expect("ROUNDS is a number"));
+    let rounds: usize = args
+        .get(4)
+        .map_or(7, |r| r.parse().expect("ROUNDS is a number"));
     let qs = random_configurations(timed.active(), n, 0);
     let world = World::new();
 
@@ -50,7 +52,12 @@ fn main() {
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
-        .unwrap_or_else(|e| panic!("{}: {e} (build it with benches/peers/vamp/build.sh)", args[2]));
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e} (build it with benches/peers/vamp/build.sh)",
+                args[2]
+            )
+        });
     let mut to_vamp = vamp.stdin.take().expect("piped");
     let mut from_vamp = BufReader::new(vamp.stdout.take().expect("piped")).lines();
     let mut input = format!(
@@ -58,7 +65,12 @@ fn main() {
         timed.active().model().name()
     );
     for q in &qs {
-        input.push_str(&q.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(" "));
+        input.push_str(
+            &q.iter()
+                .map(|v| format!("{v}"))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
         input.push('\n');
     }
     input.push_str(&format!("{rounds}\n"));

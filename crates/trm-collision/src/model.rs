@@ -148,14 +148,15 @@ impl CollisionModel {
             .collect()
     }
 
-    /// Bodies from the URDF's `<collision>` elements (meshes found relative to the URDF) and
-    /// the allowed-collision matrix of the model description
-    /// ([`AllowedCollisionMatrix::from_model`]).
+    /// Bodies from the URDF's `<collision>` elements and the allowed-collision matrix of the
+    /// model description ([`AllowedCollisionMatrix::from_model`]); meshes are found relative to
+    /// the URDF, in the description's `package_paths` and in `ROS_PACKAGE_PATH`.
     pub fn new(robot: &RobotModel) -> Result<Self> {
-        Self::with_options(robot, &CollisionOptions::default())
+        Self::with_options(robot, &CollisionOptions::with_ros_package_path(Vec::new()))
     }
 
-    /// As [`CollisionModel::new`], with mesh search paths.
+    /// As [`CollisionModel::new`], with mesh search paths (searched before the description's
+    /// `package_paths`; `ROS_PACKAGE_PATH` only as `options` give it).
     pub fn with_options(robot: &RobotModel, options: &CollisionOptions) -> Result<Self> {
         let bodies = bodies_from_urdf(robot, options)?;
         let has = has_geometry(robot.num_links(), &bodies);
@@ -370,6 +371,12 @@ fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Ve
         .urdf_dir
         .clone()
         .or_else(|| link_dir(robot.origin()));
+    let package_paths: Vec<PathBuf> = options
+        .package_paths
+        .iter()
+        .chain(robot.package_paths())
+        .cloned()
+        .collect();
     let mut bodies = Vec::new();
     for (index, link) in robot.tree().links.iter().enumerate() {
         let several = link.collisions.len() > 1;
@@ -400,7 +407,7 @@ fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Ve
                     else {
                         unreachable!("from_urdf converts every geometry but meshes")
                     };
-                    let path = resolve_mesh(filename, urdf_dir.as_deref(), &options.package_paths)
+                    let path = resolve_mesh(filename, urdf_dir.as_deref(), &package_paths)
                         .map_err(|tried| CollisionError::MeshNotFound {
                             origin: robot.origin().to_string(),
                             line: link.line,

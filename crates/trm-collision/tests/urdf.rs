@@ -214,3 +214,39 @@ fn unknown_links_in_the_collision_lists_are_named_with_suggestions() {
         "{e}"
     );
 }
+
+/// A model description's `package_paths` (relative to the description) reach the mesh loader
+/// of every user of the model, `CollisionModel::new` included; without them the mesh is not
+/// found and the error says where to add it.
+#[test]
+fn package_paths_of_a_description_reach_the_mesh_loader() {
+    let dir = std::env::temp_dir().join(format!("trm-collision-pkg-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("robot")).unwrap();
+    let urdf = arm(r#"<mesh filename="package://demo_pkg/meshes/cube.stl"/>"#);
+    std::fs::write(dir.join("robot/arm.urdf"), &urdf).unwrap();
+    let fixtures = fixtures().display().to_string();
+    std::fs::write(
+        dir.join("robot/arm.ron"),
+        format!("(urdf: \"arm.urdf\", package_paths: [\"{fixtures}\"])"),
+    )
+    .unwrap();
+    let robot = RobotModel::load(dir.join("robot/arm.ron")).unwrap();
+    assert_eq!(robot.package_paths().len(), 1);
+    let collision = CollisionModel::new(&robot).unwrap();
+    assert!(matches!(
+        collision.bodies()[collision.body_index("tool").unwrap()].shape,
+        Shape::Convex { .. }
+    ));
+    // relative to the description
+    std::fs::create_dir_all(dir.join("pkgs")).unwrap();
+    std::fs::write(
+        dir.join("robot/relative.ron"),
+        "(urdf: \"arm.urdf\", package_paths: [\"../pkgs\"])",
+    )
+    .unwrap();
+    let relative = RobotModel::load(dir.join("robot/relative.ron")).unwrap();
+    assert_eq!(relative.package_paths(), &[dir.join("robot/../pkgs")]);
+    let e = CollisionModel::new(&relative).unwrap_err().to_string();
+    assert!(e.contains("package paths"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -23,6 +23,10 @@ use serde::{Deserialize, Serialize};
 pub struct ModelDescription {
     /// The URDF, relative to the description file.
     pub urdf: PathBuf,
+    /// Directories searched for the URDF's `package://NAME/...` meshes, relative to the
+    /// description file, before `ROS_PACKAGE_PATH` (e.g. `["../ros_ws/src"]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub package_paths: Vec<PathBuf>,
     /// Motors that drive coupled joints. A movable joint that no coupling names (and that has no
     /// `<mimic>`) is driven by a motor of its own, with the joint's name and limits.
     #[serde(default)]

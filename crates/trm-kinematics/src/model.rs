@@ -1,6 +1,6 @@
 //! [`RobotModel`]: a URDF tree plus motors, couplings, named frames, groups and postures.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use nalgebra::Isometry3;
@@ -64,6 +64,8 @@ struct ModelData {
     postures: Vec<(String, Vec<f64>)>,
     disabled_collisions: Vec<DisabledCollision>,
     enabled_collisions: Vec<[usize; 2]>,
+    /// Directories searched for `package://` meshes (the description's, resolved).
+    package_paths: Vec<PathBuf>,
     /// FK over joint values.
     joint_plan: Plan,
     /// FK over motor values.
@@ -172,11 +174,12 @@ impl RobotModel {
         let path = path.as_ref();
         let text = crate::files::read_text(path)?;
         let origin = path.display().to_string();
-        let description = ModelDescription::from_ron(&text, &origin)?;
-        let urdf_path = path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&description.urdf);
+        let mut description = ModelDescription::from_ron(&text, &origin)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let urdf_path = dir.join(&description.urdf);
+        for p in &mut description.package_paths {
+            *p = dir.join(&*p);
+        }
         let urdf = crate::files::read_text(&urdf_path)?;
         Self::from_parts(
             &urdf,
@@ -252,6 +255,7 @@ impl RobotModel {
         let (joint_plan, motor_plan) = compile_plans(&tree, &frames, &couplings);
         Ok(RobotModel {
             data: Arc::new(ModelData {
+                package_paths: desc.package_paths.clone(),
                 origin: origin.to_string(),
                 tree,
                 motors,
@@ -277,6 +281,7 @@ impl RobotModel {
         let (joint_plan, motor_plan) = compile_plans(&d.tree, &all, &d.couplings);
         Ok(RobotModel {
             data: Arc::new(ModelData {
+                package_paths: d.package_paths.clone(),
                 origin: d.origin.clone(),
                 tree: d.tree.clone(),
                 motors: d.motors.clone(),
@@ -290,6 +295,12 @@ impl RobotModel {
                 motor_plan,
             }),
         })
+    }
+
+    /// Directories the model description gives for `package://` meshes (resolved against the
+    /// description's directory; empty for a bare URDF).
+    pub fn package_paths(&self) -> &[PathBuf] {
+        &self.data.package_paths
     }
 
     /// Where the model was loaded from (the URDF file name, or `<string>`).
