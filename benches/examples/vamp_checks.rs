@@ -23,11 +23,14 @@ use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
 use trm_tasks::Objective;
 
-fn objective(path: &str) -> Objective {
-    let robot = RobotModel::load(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let collision = CollisionModel::new(&robot).unwrap_or_else(|e| panic!("{path}: {e}"));
-    Objective::new(robot.all_active(), collision, World::new())
+fn objective(path: &str) -> Result<Objective, String> {
+    let robot = RobotModel::load(path).map_err(|e| e.to_string())?;
+    let collision = CollisionModel::new(&robot).map_err(|e| e.to_string())?;
+    Ok(Objective::new(robot.all_active(), collision, World::new()))
 }
+
+/// trm's and VAMP's times per configuration (one per round) and VAMP's verdicts.
+type Exchanged = (Vec<f64>, Vec<f64>, Vec<bool>);
 
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
@@ -35,76 +38,112 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.len() < 4 {
-        eprintln!("usage: vamp_checks TIMED_MODEL EXACT_MODEL VAMP_PROGRAM COUNT [ROUNDS]");
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
         std::process::exit(2);
     }
-    let (timed, exact) = (objective(&args[0]), objective(&args[1]));
-    let n: usize = args[3].parse().expect("COUNT is a number");
-    let rounds: usize = args
-        .get(4)
-        .map_or(7, |r| r.parse().expect("ROUNDS is a number"));
+}
+
+fn run() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() < 4 {
+        return Err(
+            "usage: vamp_checks TIMED_MODEL EXACT_MODEL VAMP_PROGRAM COUNT [ROUNDS]".into(),
+        );
+    }
+    let (timed, exact) = (objective(&args[0])?, objective(&args[1])?);
+    let count = |text: &str, what: &str| match text.parse::<usize>() {
+        Ok(v) if v > 0 => Ok(v),
+        _ => Err(format!("{what}: `{text}` is not a positive whole number")),
+    };
+    let n = count(&args[3], "COUNT")?;
+    let rounds = args.get(4).map_or(Ok(7), |r| count(r, "ROUNDS"))?;
+    if timed.dim() != exact.dim() {
+        return Err(format!(
+            "{} moves {} motors, {} moves {}: give two models of one robot",
+            args[0],
+            timed.dim(),
+            args[1],
+            exact.dim()
+        ));
+    }
     let qs = random_configurations(timed.active(), n, 0);
     let world = World::new();
 
-    let mut vamp = Command::new(&args[2])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}: {e} (build it with benches/peers/vamp/build.sh)",
-                args[2]
-            )
-        });
-    let mut to_vamp = vamp.stdin.take().expect("piped");
-    let mut from_vamp = BufReader::new(vamp.stdout.take().expect("piped")).lines();
     let mut input = format!(
         "trm-mbm-problems 1\nrobot {}\nconfigurations {n}\n",
         timed.active().model().name()
     );
     for q in &qs {
-        input.push_str(
-            &q.iter()
-                .map(|v| format!("{v}"))
-                .collect::<Vec<_>>()
-                .join(" "),
-        );
+        let values: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
+        input.push_str(&values.join(" "));
         input.push('\n');
     }
     input.push_str(&format!("{rounds}\n"));
-    to_vamp.write_all(input.as_bytes()).unwrap();
-    to_vamp.flush().unwrap();
-
+    let mut vamp = Command::new(&args[2])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| {
+            format!(
+                "{}: {e} (build it with benches/peers/vamp/build.sh)",
+                args[2]
+            )
+        })?;
+    let (Some(mut to_vamp), Some(out)) = (vamp.stdin.take(), vamp.stdout.take()) else {
+        let _ = vamp.kill();
+        let _ = vamp.wait();
+        return Err("no pipes to VAMP".into());
+    };
+    let mut from_vamp = BufReader::new(out).lines();
+    let lost = |e: std::io::Error| format!("{}: {e}", args[2]);
     let flat: Vec<f64> = qs.iter().flatten().copied().collect();
     let d = timed.dim();
     let mut scratch = timed.scratch();
-    let (mut ours, mut theirs) = (Vec::new(), Vec::new());
-    for round in 0..rounds {
-        let began = Instant::now();
-        let mut free_blocks = 0;
-        for block in flat.chunks(LANES * d) {
-            free_blocks += usize::from(timed.all_collision_free_in(block, &world, &mut scratch));
+    // trm's pass, then VAMP's, `rounds` times; then VAMP's verdicts
+    let mut exchange = || -> Result<Exchanged, String> {
+        to_vamp.write_all(input.as_bytes()).map_err(lost)?;
+        to_vamp.flush().map_err(lost)?;
+        let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+        for round in 0..rounds {
+            let began = Instant::now();
+            let mut free_blocks = 0;
+            for block in flat.chunks(LANES * d) {
+                free_blocks +=
+                    usize::from(timed.all_collision_free_in(block, &world, &mut scratch));
+            }
+            ours.push(began.elapsed().as_nanos() as f64 / n as f64);
+            std::hint::black_box(free_blocks);
+            let line = from_vamp
+                .next()
+                .ok_or_else(|| format!("{} stopped answering", args[2]))?
+                .map_err(lost)?;
+            let ns: f64 = line
+                .split_whitespace()
+                .nth(1)
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| format!("{} said `{line}`, not `time NS VALID`", args[2]))?;
+            theirs.push(ns);
+            if round + 1 < rounds {
+                to_vamp.write_all(b"next\n").map_err(lost)?;
+                to_vamp.flush().map_err(lost)?;
+            }
         }
-        ours.push(began.elapsed().as_nanos() as f64 / n as f64);
-        std::hint::black_box(free_blocks);
-        let line = from_vamp.next().expect("VAMP answers").unwrap();
-        let ns: f64 = line
-            .split_whitespace()
-            .nth(1)
-            .and_then(|v| v.parse().ok())
-            .unwrap_or_else(|| panic!("VAMP said `{line}`"));
-        theirs.push(ns);
-        if round + 1 < rounds {
-            to_vamp.write_all(b"next\n").unwrap();
-            to_vamp.flush().unwrap();
+        let mut free = Vec::with_capacity(n);
+        for _ in 0..n {
+            let line = from_vamp
+                .next()
+                .ok_or_else(|| format!("{} gave too few verdicts", args[2]))?
+                .map_err(lost)?;
+            free.push(line == "valid 1");
         }
-    }
-    let vamp_free: Vec<bool> = (0..n)
-        .map(|_| from_vamp.next().expect("a verdict").unwrap() == "valid 1")
-        .collect();
+        Ok((ours, theirs, free))
+    };
+    let exchanged = exchange();
+    let _ = vamp.kill();
     let _ = vamp.wait();
+    let (mut ours, mut theirs, vamp_free) = exchanged?;
+    let mut scratch = timed.scratch();
 
     let mut exact_scratch = exact.scratch();
     let (mut missed, mut false_positive, mut agree_spheres, mut colliding) = (0, 0, 0, 0);
@@ -128,4 +167,5 @@ fn main() {
         "verdicts against the exact model ({}, {colliding} of {n} colliding): VAMP missed {missed} collisions, refused {false_positive} free configurations; VAMP and trm's copy of its spheres agree on {agree_spheres} of {n}",
         args[1]
     );
+    Ok(())
 }
