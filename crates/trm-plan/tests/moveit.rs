@@ -476,3 +476,28 @@ fn plain_and_dynamic_domain_rrt_connect_both_solve() {
         "{checks_domain} checks with the dynamic domain, {checks_plain} without"
     );
 }
+
+/// Requests round-trip through the writer (every field the reader reads), and the writer
+/// refuses a goal or start that is not one finite value per name.
+#[test]
+fn requests_round_trip_and_bad_ones_are_not_written() {
+    for p in find_problems(&fixtures()).unwrap() {
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        let again = MotionPlanRequest::parse(&request.to_yaml().unwrap(), &p.request).unwrap();
+        assert_eq!(again, request, "{}", p.request.display());
+    }
+    let good = MotionPlanRequest::load(fixtures().join("box_panda/request0001.yaml")).unwrap();
+    let mut nan = good.clone();
+    nan.goal.positions[0] = f64::NAN;
+    let mut short = good.clone();
+    short.start.positions.pop();
+    let mut tolerance = good.clone();
+    tolerance.goal.tolerances[0].1 = -1.0;
+    for bad in [nan, short, tolerance] {
+        let e = bad.to_yaml().unwrap_err().to_string();
+        assert!(
+            e.contains("not written") && e.contains("request0001.yaml"),
+            "{e}"
+        );
+    }
+}
