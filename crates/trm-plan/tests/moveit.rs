@@ -14,6 +14,34 @@ fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mbm")
 }
 
+/// Solves problem `p` for `robot`, asserts it is valid, solved and its path free at half the
+/// resolution (checked one configuration at a time); its request and outcome.
+fn solved_and_free(
+    robot: &trm_kinematics::RobotModel,
+    collision: &trm_collision::CollisionModel,
+    p: &trm_plan::mbm::Problem,
+    options: &RrtOptions,
+) -> (MotionPlanRequest, trm_plan::mbm::Outcome) {
+    let scene = PlanningScene::load(&p.scene).unwrap();
+    let request = MotionPlanRequest::load(&p.request).unwrap();
+    let outcome = solve(robot, collision, &scene, &request, options).unwrap();
+    assert!(
+        outcome.valid && outcome.solved,
+        "{} {}: {}",
+        p.family,
+        p.index,
+        outcome.note
+    );
+    let half = options.resolution / 2.0;
+    assert!(
+        path_is_free(robot, collision, &scene, &request, &outcome.path, half).unwrap(),
+        "{} {}",
+        p.family,
+        p.index
+    );
+    (request, outcome)
+}
+
 #[test]
 fn every_sample_scene_and_request_reads_and_scenes_round_trip() {
     let problems = find_problems(&fixtures()).unwrap();
@@ -123,16 +151,7 @@ fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolutio
     let collision = trm_collision::CollisionModel::new(&robot).unwrap();
     let options = RrtOptions::default();
     for p in find_problems(&fixtures()).unwrap() {
-        let scene = PlanningScene::load(&p.scene).unwrap();
-        let request = MotionPlanRequest::load(&p.request).unwrap();
-        let outcome = solve(&robot, &collision, &scene, &request, &options).unwrap();
-        assert!(
-            outcome.valid && outcome.solved,
-            "{} {}: {}",
-            p.family,
-            p.index,
-            outcome.note
-        );
+        let (request, outcome) = solved_and_free(&robot, &collision, &p, &options);
         let path = &outcome.path;
         assert!(path.len() >= 2);
         assert!(
@@ -142,21 +161,8 @@ fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolutio
                 .all(|(a, b)| (a - b).abs() < 1e-12)
         );
         assert_eq!(path.last().unwrap(), &request.goal.positions);
-        assert!(
-            path_is_free(
-                &robot,
-                &collision,
-                &scene,
-                &request,
-                path,
-                options.resolution / 2.0
-            )
-            .unwrap(),
-            "{} {}",
-            p.family,
-            p.index
-        );
         // the same seed finds the same path
+        let scene = PlanningScene::load(&p.scene).unwrap();
         let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
         assert_eq!(again.path, outcome.path);
     }
@@ -250,27 +256,7 @@ fn the_fetch_runs_from_its_files_only() {
     let problems = find_problems(&root.join("tests/fixtures/mbm-fetch")).unwrap();
     assert_eq!(problems.len(), 2);
     for p in problems {
-        let scene = PlanningScene::load(&p.scene).unwrap();
-        let request = MotionPlanRequest::load(&p.request).unwrap();
-        let outcome = solve(&robot, &collision, &scene, &request, &options).unwrap();
-        assert!(
-            outcome.valid && outcome.solved,
-            "{} {}: {}",
-            p.family,
-            p.index,
-            outcome.note
-        );
-        assert!(
-            path_is_free(
-                &robot,
-                &collision,
-                &scene,
-                &request,
-                &outcome.path,
-                options.resolution / 2.0
-            )
-            .unwrap()
-        );
+        solved_and_free(&robot, &collision, &p, &options);
     }
 }
 
