@@ -597,9 +597,9 @@ pub fn generate(models: &Path) -> Result<Generated> {
 /// Writes models/icub_upper_body.{urdf,ron} (atomically) and checks they load.
 pub fn run(models: &Path) -> Result<()> {
     let g = generate(models)?;
-    crate::write_atomic(&models.join("icub_upper_body.urdf"), g.urdf.as_bytes())?;
-    crate::write_atomic(&models.join("icub_upper_body.ron"), g.ron.as_bytes())?;
-    crate::write_atomic(
+    trm::write_atomic(&models.join("icub_upper_body.urdf"), g.urdf.as_bytes())?;
+    trm::write_atomic(&models.join("icub_upper_body.ron"), g.ron.as_bytes())?;
+    trm::write_atomic(
         &models.join("icub_full_body.urdf"),
         g.full_body_urdf.as_bytes(),
     )?;

@@ -18,10 +18,10 @@ pub struct Args {
     /// The task spec (e.g. specs/reach_1cm.ron).
     spec: PathBuf,
     /// The largest map (points).
-    #[arg(long, default_value_t = 10_000, value_parser = crate::parse::count(1, trm_roadmap::MAX_POINTS))]
+    #[arg(long, default_value_t = 10_000, value_parser = trm::parse::count(1, trm_roadmap::MAX_POINTS))]
     points: usize,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = crate::parse::count(1, 4096))]
+    #[arg(long, value_parser = trm::parse::count(1, 4096))]
     threads: Option<usize>,
     /// Output directory: scaling.md and the final map.
     #[arg(long, default_value = "target/map-scaling")]
@@ -49,10 +49,10 @@ fn marks(points: usize) -> Vec<usize> {
 /// Runs the build and the measurements, prints and writes the table.
 pub fn run(args: &Args) -> Result<()> {
     let problem = Problem::load(&args.spec)?;
-    let pool = crate::thread_pool(args.threads)?;
+    let pool = trm::thread_pool(args.threads)?;
     let marks = marks(args.points);
     let mut reached: Vec<Option<(f64, Option<f64>)>> = vec![None; marks.len()];
-    let mut progress = crate::progress::Progress::new("points", args.points as u64);
+    let mut progress = trm::progress::Progress::new("points", args.points as u64);
     let options = BuildOptions {
         points: Some(args.points),
         ..Default::default()
@@ -154,8 +154,8 @@ pub fn run(args: &Args) -> Result<()> {
         .file_stem()
         .map_or("map".into(), |s| s.to_string_lossy().to_string());
     let map_path = args.out_dir.join(format!("{stem}.map.json"));
-    crate::write_atomic(&map_path, map.to_json(&map_path)?.as_bytes())?;
-    crate::write_atomic(&args.out_dir.join("scaling.md"), md.as_bytes())?;
+    trm::write_atomic(&map_path, map.to_json(&map_path)?.as_bytes())?;
+    trm::write_atomic(&args.out_dir.join("scaling.md"), md.as_bytes())?;
     println!("{md}");
     println!(
         "wrote {}/{{scaling.md, {stem}.map.json}}",

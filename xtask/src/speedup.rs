@@ -18,13 +18,13 @@ pub struct Args {
     /// The task spec.
     spec: PathBuf,
     /// Point counts to time, comma-separated.
-    #[arg(long, default_value = "200,400", value_delimiter = ',', value_parser = crate::parse::count(1, trm_roadmap::MAX_POINTS))]
+    #[arg(long, default_value = "200,400", value_delimiter = ',', value_parser = trm::parse::count(1, trm_roadmap::MAX_POINTS))]
     points: Vec<usize>,
     /// Thread counts, comma-separated.
-    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = crate::parse::count(1, 1024))]
+    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = trm::parse::count(1, 1024))]
     threads: Vec<usize>,
     /// Values of P for the work table and the model (built with the largest thread count).
-    #[arg(long, default_value = "1,2,4,8,16,32", value_delimiter = ',', value_parser = crate::parse::count(1, trm_roadmap::MAX_SEARCHES))]
+    #[arg(long, default_value = "1,2,4,8,16,32", value_delimiter = ',', value_parser = trm::parse::count(1, trm_roadmap::MAX_SEARCHES))]
     searches: Vec<usize>,
     /// Seed.
     #[arg(long, default_value_t = 0)]
@@ -207,25 +207,25 @@ pub fn run(args: &Args) -> Result<()> {
     }
     md.push_str("\nThe paper (Fig. 2, 400 points, 64-core Dell PowerEdge C6145): 2 267 s on 1 core, 186 s on 32 (12.2×, 38 % efficiency).\n");
     std::fs::create_dir_all(&args.out_dir)?;
-    crate::write_atomic(&args.out_dir.join("speedup.md"), md.as_bytes())?;
+    trm::write_atomic(&args.out_dir.join("speedup.md"), md.as_bytes())?;
     let curve = |rows: &[(usize, Vec<f64>)], k: usize| {
         rows.iter()
             .map(|(t, times)| (*t as f64, rows[0].1[k] / times[k]))
             .collect::<Vec<_>>()
     };
-    let mut series = vec![crate::plot::Series {
+    let mut series = vec![trm::plot::Series {
         label: "ideal".into(),
         points: vec![(1.0, 1.0), (32.0, 32.0)],
         color: Some(BLACK.mix(0.5)),
     }];
     for (k, p) in args.points.iter().enumerate() {
-        series.push(crate::plot::Series {
+        series.push(trm::plot::Series {
             label: format!("{p} points, P = threads (measured)"),
             points: curve(&paper, k),
             color: None,
         });
     }
-    series.push(crate::plot::Series {
+    series.push(trm::plot::Series {
         label: format!("{mark} points, model"),
         points: modelled
             .iter()
@@ -234,19 +234,19 @@ pub fn run(args: &Args) -> Result<()> {
             .collect(),
         color: None,
     });
-    series.push(crate::plot::Series {
+    series.push(trm::plot::Series {
         label: "paper, 400 points".into(),
         points: vec![(1.0, 1.0), (32.0, 2267.0 / 186.0)],
         color: None,
     });
-    let svg = crate::plot::lines(
+    let svg = trm::plot::lines(
         "Parallel E-TRM speedup (P searches on P workers)",
         ("workers", "speedup"),
         0.5..33.0,
         0.0..33.0,
         series,
     )?;
-    crate::write_atomic(&args.out_dir.join("speedup.svg"), svg.as_bytes())?;
+    trm::write_atomic(&args.out_dir.join("speedup.svg"), svg.as_bytes())?;
     println!("{md}");
     println!(
         "wrote {}/{{speedup.md, speedup.svg}}",

@@ -14,14 +14,14 @@ use trm_kinematics::nalgebra::Isometry3;
 use trm_plan::{Trajectory, time_parametrise};
 use trm_taskmap::{Motion, MotionGoal};
 
-use crate::explore_task_map::{Explored, explore_spec};
-use crate::reach_grasp::reach_problem;
+use trm::explore_task_map::{Explored, explore_spec};
+use trm::reach_grasp::reach_problem;
 
 /// Arguments of `task-map-studies`.
 #[derive(clap::Args)]
 pub struct Args {
     /// iRprop− iterations per optimisation.
-    #[arg(long, default_value_t = 30, value_parser = crate::parse::count(1, 100_000))]
+    #[arg(long, default_value_t = 30, value_parser = trm::parse::count(1, 100_000))]
     iterations: usize,
     /// Output directory (table.md, joint_limits.svg, paths.svg, one CSV and world per run).
     #[arg(long, default_value = "target/taskmap-studies")]
@@ -116,10 +116,10 @@ fn reach(
             .collect(),
         task_path: Vec::new(),
     };
-    crate::write_atomic(&csv, trajectory.to_csv(&csv)?.as_bytes())?;
+    trm::write_atomic(&csv, trajectory.to_csv(&csv)?.as_bytes())?;
     let world = scene(obstacles, e, &at)?;
     let ron = ron::ser::to_string_pretty(&world.to_spec(), Default::default())?;
-    crate::write_atomic(&out_dir.join(format!("{name}.world.ron")), ron.as_bytes())?;
+    trm::write_atomic(&out_dir.join(format!("{name}.world.ron")), ron.as_bytes())?;
     Ok(Run {
         name: name.into(),
         motion,
@@ -249,7 +249,7 @@ pub fn run(args: &Args) -> Result<()> {
         basket_runs.push(r);
     }
     let _ = writeln!(md, "\nWall time {:.1} s.", started.elapsed().as_secs_f64());
-    crate::write_atomic(&out.join("table.md"), md.as_bytes())?;
+    trm::write_atomic(&out.join("table.md"), md.as_bytes())?;
     write_plots(args, &runs, &basket_runs)?;
     println!("{md}");
     println!(
@@ -263,9 +263,9 @@ pub fn run(args: &Args) -> Result<()> {
 fn series<'a>(
     runs: impl IntoIterator<Item = &'a Run>,
     points: impl Fn(&Run) -> Vec<(f64, f64)>,
-) -> Vec<crate::plot::Series> {
+) -> Vec<trm::plot::Series> {
     runs.into_iter()
-        .map(|r| crate::plot::Series {
+        .map(|r| trm::plot::Series {
             label: r.name.replace('_', " "),
             points: points(r),
             color: None,
@@ -281,7 +281,7 @@ fn write_plots(args: &Args, cylinder: &[Run], basket: &[Run]) -> Result<()> {
         .flat_map(|r| r.trace.iter().map(|t| t.1))
         .fold(0.0f64, f64::max)
         * 1.1;
-    let svg = crate::plot::lines(
+    let svg = trm::plot::lines(
         "Cylinder: joint-limit cost of the best motion so far",
         (
             "iRprop− iteration",
@@ -297,7 +297,7 @@ fn write_plots(args: &Args, cylinder: &[Run], basket: &[Run]) -> Result<()> {
                 .collect()
         }),
     )?;
-    crate::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
+    trm::write_atomic(&args.out_dir.join("joint_limits.svg"), svg.as_bytes())?;
     let all = || cylinder.iter().chain(basket);
     let range = |i: usize| {
         let (lo, hi) = all()
@@ -313,14 +313,14 @@ fn write_plots(args: &Args, cylinder: &[Run], basket: &[Run]) -> Result<()> {
         })
     };
     let panels = [
-        crate::plot::Panel {
+        trm::plot::Panel {
             title: "Hand path from the side (x back, z up)".into(),
             axes: ("x (m)".into(), "z (m)".into()),
             x: range(0),
             y: range(2),
             series: path(0, 2),
         },
-        crate::plot::Panel {
+        trm::plot::Panel {
             title: "Hand path from above (x back, y right)".into(),
             axes: ("x (m)".into(), "y (m)".into()),
             x: range(0),
@@ -328,8 +328,8 @@ fn write_plots(args: &Args, cylinder: &[Run], basket: &[Run]) -> Result<()> {
             series: path(0, 1),
         },
     ];
-    let svg = crate::plot::panels((640, 420), &panels)?;
-    crate::write_atomic(&args.out_dir.join("paths.svg"), svg.as_bytes())?;
+    let svg = trm::plot::panels((640, 420), &panels)?;
+    trm::write_atomic(&args.out_dir.join("paths.svg"), svg.as_bytes())?;
     Ok(())
 }
 
