@@ -115,6 +115,6 @@ pub(crate) fn unknown<'a>(
     CollisionError::UnknownName {
         kind,
         name: name.to_string(),
-        suggestions: trm_kinematics::closest_names(name, candidates),
+        suggestions: trm_io::closest_names(name, candidates),
     }
 }

@@ -60,17 +60,17 @@ pub fn resolve_mesh(
 /// spans metres, and a vertex a kilometre away is a misread file or a wrong scale.
 pub const MAX_VERTEX_DISTANCE: f64 = 1e3;
 
-/// Loads a mesh file (STL, COLLADA or OBJ; at most [`trm_kinematics::MAX_INPUT_BYTES`]),
+/// Loads a mesh file (STL, COLLADA or OBJ; at most [`trm_io::MAX_INPUT_BYTES`]),
 /// scales it and returns the vertices of its convex hull.
 pub fn convex_hull_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<[f64; 3]>, String> {
-    let bytes = trm_kinematics::read_input_bytes(path).map_err(|e| e.to_string())?;
+    let bytes = trm_io::read_input_bytes(path).map_err(|e| e.to_string())?;
     convex_hull_of_mesh_bytes(&bytes, path, scale)
 }
 
 /// [`convex_hull_of_mesh`] of a file's bytes; `path` gives the format (by extension, else by
 /// content) and names the file in errors. An OBJ file's material library is not read (a
 /// hull needs no materials); COLLADA is refused nested deeper than
-/// [`trm_kinematics::XML_NESTING_LIMIT`] before it is parsed.
+/// [`trm_io::XML_NESTING_LIMIT`] before it is parsed.
 pub fn convex_hull_of_mesh_bytes(
     bytes: &[u8],
     path: &Path,
@@ -81,7 +81,7 @@ pub fn convex_hull_of_mesh_bytes(
         .is_some_and(|e| e.eq_ignore_ascii_case("dae"))
         || bytes.trim_ascii_start().starts_with(b"<");
     if collada {
-        trm_kinematics::check_xml_nesting(bytes, trm_kinematics::XML_NESTING_LIMIT)
+        trm_io::check_xml_nesting(bytes, trm_io::XML_NESTING_LIMIT)
             .map_err(|e| format!("{e}: flatten the COLLADA scene"))?;
     }
     let no_materials = |p: &Path| -> std::io::Result<Vec<u8>> {

@@ -115,7 +115,7 @@ impl World {
         for (i, o) in spec.objects.iter().enumerate() {
             let path = format!("{}[{i}]", located.map_or("objects", |(_, at)| at));
             let line = located
-                .and_then(|(text, _)| trm_kinematics::locate_ron_path(text, &path))
+                .and_then(|(text, _)| trm_io::locate_ron_path(text, &path))
                 .map(|(line, _)| line);
             let element = format!("{path} (\"{}\")", o.name);
             world
@@ -154,7 +154,7 @@ impl World {
     /// Parses a RON world; `origin` names the source in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
         let spec: WorldSpec = ron::from_str(text).map_err(|e| {
-            let p = trm_kinematics::explain_ron_error(&e);
+            let p = trm_io::explain_ron_error(&e);
             CollisionError::MalformedWorld {
                 origin: origin.to_string(),
                 line: p.line,
@@ -168,7 +168,7 @@ impl World {
     /// Reads a RON world file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| CollisionError::Io {
+        let text = trm_io::read_input(path).map_err(|source| CollisionError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -43,7 +43,7 @@ impl fmt::Display for NameKind {
 pub enum KinematicsError {
     /// A versioned JSON file could not be read or written.
     #[error(transparent)]
-    File(#[from] crate::files::FileError),
+    File(#[from] trm_io::FileError),
     /// A file trm reads (a posture file, a configuration file) holds something invalid.
     #[error("{}: {}{problem}\n  fix: {fix}", path.display(), if field.is_empty() { String::new() } else { format!("{field}: ") })]
     InvalidFile {
@@ -172,27 +172,12 @@ fn suggest(suggestions: &[String]) -> String {
 /// Result alias of this crate.
 pub type Result<T, E = KinematicsError> = std::result::Result<T, E>;
 
-/// Up to three names from `candidates` closest to `name` (Jaro-Winkler and substring match).
-pub fn closest_names<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Vec<String> {
-    let lower = name.to_lowercase();
-    let mut scored: Vec<(f64, &str)> = candidates
-        .into_iter()
-        .map(|c| {
-            let cl = c.to_lowercase();
-            let mut score = strsim::jaro_winkler(&lower, &cl);
-            if !lower.is_empty() && (cl.contains(&lower) || lower.contains(&cl)) {
-                score += 0.2;
-            }
-            (score, c)
-        })
-        .filter(|(s, _)| *s > 0.75)
-        .collect();
-    scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(b.1)));
-    scored
-        .into_iter()
-        .take(3)
-        .map(|(_, c)| c.to_string())
-        .collect()
+/// Reads a text file, naming it in the error.
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String> {
+    trm_io::read_input(path).map_err(|source| KinematicsError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// An [`KinematicsError::UnknownName`] with suggestions drawn from `candidates`.
@@ -204,7 +189,7 @@ pub(crate) fn unknown<'a>(
     KinematicsError::UnknownName {
         kind,
         name: name.to_string(),
-        suggestions: closest_names(name, candidates),
+        suggestions: trm_io::closest_names(name, candidates),
     }
 }
 

@@ -37,17 +37,14 @@ mod batch;
 mod derivatives;
 mod description;
 mod error;
-mod files;
 mod fk;
 pub mod ik;
 mod model;
 mod posture;
 mod resolve;
-mod ron_path;
 pub mod ros;
 pub mod srdf;
 mod tree;
-mod xml;
 
 pub use active::ActiveSet;
 pub use batch::{LANES, Lanes, PoseBatch, PoseLanes, lane_pose, sin_cos};
@@ -56,23 +53,26 @@ pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,
     MotorSpec, PostureSpec,
 };
-pub use error::{KinematicsError, NameKind, Result, closest_names};
-pub use files::{
+pub use error::{KinematicsError, NameKind, Result};
+// The file plumbing lives in trm-io; re-exported here for the crates built on this one.
+pub use fk::{FrameId, PoseBuffer};
+pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel, quietly};
+pub use nalgebra;
+pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
+pub use tree::{
+    Inertial, Joint, JointKind, LIMIT_TOLERANCE, Limits, Link, Mimic, Tree, pose_from_xyz_rpy,
+};
+pub use trm_io::{
     FileError, MAX_INPUT_BYTES, StagedFile, binary_bytes, check_output, check_unique_keys,
     json_text, load_versioned, parse_binary_versioned, parse_versioned, read_file, read_file_bytes,
     read_input, read_input_bytes, save_json, unique_names, write_atomic, write_file,
     write_file_bytes,
 };
-pub use fk::{FrameId, PoseBuffer};
-pub use model::{Coupling, DisabledCollision, Motor, NamedFrame, RobotModel, quietly};
-pub use nalgebra;
-pub use posture::{ConfigurationSample, ConfigurationsFile, PostureFile};
-pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_field, locate_ron_path};
-pub use tree::{
-    Inertial, Joint, JointKind, LIMIT_TOLERANCE, Limits, Link, Mimic, Tree, pose_from_xyz_rpy,
+pub use trm_io::{
+    RonProblem, SpecError, TooDeep, XML_NESTING_LIMIT, check_xml_nesting, closest_names,
+    explain_ron_error, locate_ron_field, locate_ron_path,
 };
 pub use urdf_rs;
-pub use xml::{TooDeep, XML_NESTING_LIMIT, check_xml_nesting};
 
 /// The file formats this crate reads and writes.
 pub mod formats {

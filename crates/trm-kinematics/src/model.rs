@@ -161,7 +161,7 @@ impl RobotModel {
     /// Mesh files are never opened.
     pub fn from_urdf_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_urdf_str(&crate::files::read_text(path)?, &path.display().to_string())
+        Self::from_urdf_str(&crate::error::read_text(path)?, &path.display().to_string())
     }
 
     /// Parses URDF text; `origin` names the text in errors (a file name or `<string>`).
@@ -172,7 +172,7 @@ impl RobotModel {
     /// Loads a model description (RON) and the URDF it names (relative to the description).
     pub fn from_description_file(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = crate::files::read_text(path)?;
+        let text = crate::error::read_text(path)?;
         let origin = path.display().to_string();
         let mut description = ModelDescription::from_ron(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
@@ -180,7 +180,7 @@ impl RobotModel {
         for p in &mut description.package_paths {
             *p = dir.join(&*p);
         }
-        let urdf = crate::files::read_text(&urdf_path)?;
+        let urdf = crate::error::read_text(&urdf_path)?;
         Self::from_parts(
             &urdf,
             &urdf_path.display().to_string(),

@@ -26,8 +26,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{KinematicsError, Result};
-use crate::files::FileError;
 use crate::{ActiveSet, RobotModel};
+use trm_io::FileError;
 
 /// A posture file: motor values by name and/or a task's active values, plus metadata.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -76,7 +76,7 @@ impl PostureFile {
     /// Reads a posture file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = crate::files::read_text(path)?;
+        let text = crate::error::read_text(path)?;
         Self::from_json(&text, path)
     }
 
@@ -219,7 +219,7 @@ impl ConfigurationsFile {
     /// Reads a configurations file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_json(&crate::files::read_text(path)?, path)
+        Self::from_json(&crate::error::read_text(path)?, path)
     }
 
     /// The joint names of `robot` the file leaves out (they are 0, or follow their leader when

@@ -26,7 +26,7 @@ impl DescCtx<'_> {
         let path = element.split(" (").next().unwrap_or("");
         let needle = format!("\"{quoted}\"");
         let line = self.text.and_then(|t| {
-            crate::ron_path::locate_ron_field(t, path)
+            trm_io::locate_ron_field(t, path)
                 .map(|(line, _)| line)
                 .or_else(|| {
                     t.lines()
@@ -57,7 +57,7 @@ fn suggestion_fix<'a>(
     candidates: impl IntoIterator<Item = &'a str>,
     otherwise: &str,
 ) -> String {
-    let near = crate::error::closest_names(name, candidates);
+    let near = trm_io::closest_names(name, candidates);
     if near.is_empty() {
         otherwise.to_string()
     } else {

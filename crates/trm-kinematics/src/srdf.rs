@@ -26,8 +26,9 @@ use std::path::Path;
 use crate::description::{
     DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription, PostureSpec,
 };
-use crate::error::{KinematicsError, Result, closest_names};
+use crate::error::{KinematicsError, Result};
 use crate::model::RobotModel;
+use trm_io::closest_names;
 
 /// A group: its members as the SRDF lists them.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -361,7 +362,7 @@ impl Srdf {
     /// Reads an SRDF file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::parse(&crate::files::read_text(path)?, &path.display().to_string())
+        Self::parse(&crate::error::read_text(path)?, &path.display().to_string())
     }
 
     /// `base` (usually the model's own description) with the SRDF's groups, group states, end

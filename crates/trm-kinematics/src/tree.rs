@@ -295,10 +295,8 @@ impl Tree {
             }
             let find = |link: &str, role: &str| {
                 link_index.get(link).copied().ok_or_else(|| {
-                    let near = crate::error::closest_names(
-                        link,
-                        robot.links.iter().map(|l| l.name.as_str()),
-                    );
+                    let near =
+                        trm_io::closest_names(link, robot.links.iter().map(|l| l.name.as_str()));
                     ctx.invalid(
                         "joint",
                         &joint.name,
@@ -426,7 +424,7 @@ impl Tree {
         for joint in &self.joints {
             let Some(mimic) = &joint.mimic else { continue };
             let Some(leader) = self.joints.iter().find(|j| j.name == mimic.leader) else {
-                let near = crate::error::closest_names(
+                let near = trm_io::closest_names(
                     &mimic.leader,
                     self.joints.iter().map(|j| j.name.as_str()),
                 );

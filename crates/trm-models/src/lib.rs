@@ -57,7 +57,7 @@ pub fn load(name: &str, base: &Path) -> Result<RobotModel, KinematicsError> {
     Err(KinematicsError::UnknownModel {
         name: name.to_string(),
         looked_for: path,
-        suggestions: trm_kinematics::closest_names(name, NAMES.iter().copied()),
+        suggestions: trm_io::closest_names(name, NAMES.iter().copied()),
     })
 }
 

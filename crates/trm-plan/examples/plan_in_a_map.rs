@@ -46,6 +46,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Err(e) => println!("with a box on the old path: {e}"),
     }
     let out = std::path::Path::new("target/plan_in_a_map.csv");
-    trm_kinematics::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
+    trm_io::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
     Ok(())
 }

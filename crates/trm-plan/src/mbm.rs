@@ -28,7 +28,7 @@ pub struct Problem {
 }
 
 /// A problem set opened from a folder or a `.tar.bz2`/`.tar` of one (unpacked into a fresh
-/// temporary folder, at most [`trm_kinematics::MAX_INPUT_BYTES`] in all, removed when the set
+/// temporary folder, at most [`trm_io::MAX_INPUT_BYTES`] in all, removed when the set
 /// is dropped; `tar` refuses entries that would land outside it).
 pub struct ProblemSet {
     /// The problems, sorted by family and number.
@@ -105,10 +105,10 @@ fn unpack(archive: &Path) -> Result<PathBuf, PlanError> {
         {
             let mut entry = entry.map_err(|e| bad(format!("a damaged archive entry ({e})")))?;
             total += entry.size();
-            if total > trm_kinematics::MAX_INPUT_BYTES {
+            if total > trm_io::MAX_INPUT_BYTES {
                 return Err(bad(format!(
                     "unpacks to more than {} bytes",
-                    trm_kinematics::MAX_INPUT_BYTES
+                    trm_io::MAX_INPUT_BYTES
                 )));
             }
             entry

@@ -587,7 +587,7 @@ impl PlanningScene {
         Ok(scene)
     }
 
-    /// Reads a scene file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
+    /// Reads a scene file (at most [`trm_io::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();
         Self::parse(&read(path)?, path)
@@ -744,7 +744,7 @@ impl PlanningScene {
 
 /// A file's text, as every trm reader reads input (regular files, size-limited).
 fn read(path: &Path) -> Result<String, PlanError> {
-    trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
+    trm_io::read_input(path).map_err(|source| PlanError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -930,7 +930,7 @@ impl MotionPlanRequest {
         Ok(out)
     }
 
-    /// Reads a request file (at most [`trm_kinematics::MAX_INPUT_BYTES`]).
+    /// Reads a request file (at most [`trm_io::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();
         Self::parse(&read(path)?, path)

@@ -29,7 +29,7 @@ use std::time::Instant;
 
 use serde::Deserialize;
 use trm_collision::{Shape, World};
-use trm_kinematics::SpecError;
+use trm_io::SpecError;
 use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError, segment_is_collision_free};
 use trm_tasks::Problem;
@@ -244,7 +244,7 @@ impl Scenario {
     /// Reads and checks a scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ScenarioError> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| ScenarioError::Io {
+        let text = trm_io::read_input(path).map_err(|source| ScenarioError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -72,7 +72,7 @@ impl Trajectory {
     /// Reads [`Trajectory::to_json`]'s output; `origin` names the text in errors. Checks it as
     /// [`Trajectory::check`] does.
     pub fn from_json(text: &str, origin: &Path) -> Result<Self, PlanError> {
-        let t: Trajectory = trm_kinematics::check_unique_keys(text)
+        let t: Trajectory = trm_io::check_unique_keys(text)
             .and_then(|()| serde_json::from_str(text))
             .map_err(|e| {
                 invalid(
@@ -349,7 +349,7 @@ impl Trajectory {
     /// Reads a trajectory file of `robot`: JSON when the extension is `.json`, else CSV.
     pub fn load(path: impl AsRef<Path>, robot: &RobotModel) -> Result<Self, PlanError> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| PlanError::Io {
+        let text = trm_io::read_input(path).map_err(|source| PlanError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -4,6 +4,8 @@
 //! `(N, n)` one, and results gain the leading `N` axis. Long calls release the GIL; errors
 //! become `trm.TrmError` (a `ValueError`) carrying trm's located messages.
 
+mod cost;
+
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -613,6 +615,21 @@ impl Collision {
 #[pyclass(module = "trm")]
 struct Problem {
     problem: trm_tasks::Problem,
+    /// The error slots of the costs added from Python.
+    python_costs: Vec<std::sync::Arc<std::sync::Mutex<Option<String>>>>,
+}
+
+impl Problem {
+    /// The first error a Python cost raised since the last call, as a `TrmError` (the slots
+    /// are cleared for the next call).
+    fn python_cost_error(&self) -> PyResult<()> {
+        for slot in &self.python_costs {
+            if let Some(e) = slot.lock().ok().and_then(|mut s| s.take()) {
+                return Err(err(e));
+            }
+        }
+        Ok(())
+    }
 }
 
 #[pymethods]
@@ -622,7 +639,48 @@ impl Problem {
     fn load(path: &str) -> PyResult<Self> {
         Ok(Problem {
             problem: trm_tasks::Problem::load(path).map_err(err)?,
+            python_costs: Vec::new(),
         })
+    }
+
+    /// Adds a cost written in Python: `weight · function(q, frames)`, where `q` is a batch of
+    /// candidates' active values `(N, d)` and `frames` a dict of the named frames' world poses
+    /// `(N, 4, 4)`; it returns `(N,)` finite costs ≥ 0. NGIK calls it once per batch of
+    /// candidates, taking the GIL for that call only. An exception, a wrong shape or a bad value
+    /// is raised as a `TrmError` naming the cost when `solve` or `cost` returns.
+    #[pyo3(signature = (function, weight = 1.0, label = None, frames = Vec::new()))]
+    fn add_cost(
+        &mut self,
+        function: Py<PyAny>,
+        weight: f64,
+        label: Option<String>,
+        frames: Vec<String>,
+    ) -> PyResult<()> {
+        let label = label.unwrap_or_else(|| format!("python cost {}", self.python_costs.len()));
+        let frames = frames
+            .into_iter()
+            .map(|name| {
+                let id = self
+                    .problem
+                    .robot
+                    .frame_id(&name)
+                    .map_err(|e| err(format!("add_cost `{label}`: frames: {e}")))?;
+                Ok((name, id))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let error = std::sync::Arc::new(std::sync::Mutex::new(None));
+        let term = cost::PythonCost {
+            function,
+            label,
+            frames,
+            error: error.clone(),
+        };
+        self.problem
+            .objective
+            .add(weight, Box::new(term))
+            .map_err(err)?;
+        self.python_costs.push(error);
+        Ok(())
     }
 
     /// Names of the active motors (the columns of `q`).
@@ -660,6 +718,7 @@ impl Problem {
             .chunks(o.dim().max(1))
             .map(|row| o.eval(row, &mut scratch))
             .collect();
+        self.python_cost_error()?;
         numbers(py, batch, costs)
     }
 
@@ -752,9 +811,9 @@ impl Problem {
         if let Some(m) = max_evals {
             solver.max_evaluations = m;
         }
-        let s = py
-            .detach(|| trm_tasks::solve(o, &from, &solver))
-            .map_err(err)?;
+        let s = py.detach(|| trm_tasks::solve(o, &from, &solver));
+        self.python_cost_error()?;
+        let s = s.map_err(err)?;
         let d = PyDict::new(py);
         d.set_item("q", shaped(py, None, &[s.q.len()], s.q.clone())?)?;
         d.set_item(
@@ -1221,8 +1280,8 @@ fn view(
         None => None,
     };
     let json = out.with_extension("json");
-    trm_kinematics::write_file(&json, &scene.to_json().map_err(err)?).map_err(err)?;
-    trm_kinematics::write_file(&out, &scene.to_html(code.as_deref()).map_err(err)?).map_err(err)?;
+    trm_io::write_file(&json, &scene.to_json().map_err(err)?).map_err(err)?;
+    trm_io::write_file(&out, &scene.to_html(code.as_deref()).map_err(err)?).map_err(err)?;
     Ok(out)
 }
 

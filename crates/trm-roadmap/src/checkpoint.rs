@@ -4,7 +4,7 @@
 //! [`crate::resume`] finishes with exactly the map an uninterrupted build gives.
 //!
 //! File format `trm-checkpoint`, version 1: trm's binary layout
-//! ([`trm_kinematics::binary_bytes`]: postcard, every f64 bit for bit), written atomically.
+//! ([`trm_io::binary_bytes`]: postcard, every f64 bit for bit), written atomically.
 
 use std::path::Path;
 
@@ -126,15 +126,12 @@ impl Checkpoint {
     /// killed while writing leaves the previous checkpoint whole.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        Ok(trm_kinematics::write_file_bytes(
-            path,
-            &self.to_bytes(path)?,
-        )?)
+        Ok(trm_io::write_file_bytes(path, &self.to_bytes(path)?)?)
     }
 
     /// The checkpoint file's bytes (`path` names it in errors).
     pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>> {
-        Ok(trm_kinematics::binary_bytes(
+        Ok(trm_io::binary_bytes(
             path,
             self,
             CHECKPOINT_FORMAT,
@@ -146,18 +143,14 @@ impl Checkpoint {
     /// whose parts do not fit together are clear errors naming the file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_bytes(&trm_kinematics::read_file_bytes(path)?, path)
+        Self::from_bytes(&trm_io::read_file_bytes(path)?, path)
     }
 
     /// Reads a checkpoint from a file's bytes (`path` names it in errors), checked as
     /// [`Checkpoint::load`] checks a file.
     pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self> {
-        let checkpoint: Checkpoint = trm_kinematics::parse_binary_versioned(
-            path,
-            bytes,
-            CHECKPOINT_FORMAT,
-            CHECKPOINT_VERSION,
-        )?;
+        let checkpoint: Checkpoint =
+            trm_io::parse_binary_versioned(path, bytes, CHECKPOINT_FORMAT, CHECKPOINT_VERSION)?;
         checkpoint.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),
             problem: format!("{problem}; start the build again"),

@@ -11,7 +11,7 @@ pub type Result<T, E = RoadmapError> = std::result::Result<T, E>;
 pub enum RoadmapError {
     /// A map file could not be read or written.
     #[error(transparent)]
-    MapFile(#[from] trm_kinematics::FileError),
+    MapFile(#[from] trm_io::FileError),
     /// From the task layer (specs, objective, solver); boxed, it is large.
     #[error(transparent)]
     Tasks(Box<trm_tasks::TaskError>),

@@ -124,7 +124,7 @@ impl Roadmap {
     /// written here reads back.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = path.as_ref();
-        Ok(trm_kinematics::write_file(path, &self.to_json(path)?)?)
+        Ok(trm_io::write_file(path, &self.to_json(path)?)?)
     }
 
     /// The map as JSON, refused as [`Roadmap::save`] refuses it; `path` names the file it is
@@ -134,20 +134,20 @@ impl Roadmap {
             path: path.display().to_string(),
             problem: format!("not written: {problem}"),
         })?;
-        Ok(trm_kinematics::json_text(path, self, FORMAT)?)
+        Ok(trm_io::json_text(path, self, FORMAT)?)
     }
 
     /// Reads a map file; a truncated, foreign or newer file, or one whose points and edges do
     /// not fit together, is a clear error.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        Self::from_json(&trm_kinematics::read_file(path)?, path)
+        Self::from_json(&trm_io::read_file(path)?, path)
     }
 
     /// Reads a map from JSON text (`path` names it in errors), checked as [`Roadmap::load`]
     /// checks a file.
     pub fn from_json(text: &str, path: &Path) -> Result<Self> {
-        let map: Roadmap = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
+        let map: Roadmap = trm_io::parse_versioned(path, text, FORMAT, VERSION)?;
         map.check().map_err(|problem| RoadmapError::File {
             path: path.display().to_string(),
             problem: format!("{problem}; rebuild the map"),

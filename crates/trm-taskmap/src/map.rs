@@ -13,11 +13,11 @@ use thiserror::Error;
 pub enum TaskMapError {
     /// A task-map file could not be read or written.
     #[error(transparent)]
-    MapFile(#[from] trm_kinematics::FileError),
+    MapFile(#[from] trm_io::FileError),
     /// A task-map spec holds something invalid: where (file, line:column, field path), what,
     /// fix (boxed: errors stay small).
     #[error(transparent)]
-    Spec(Box<trm_kinematics::SpecError>),
+    Spec(Box<trm_io::SpecError>),
     /// From the kinematics (model loading, hand motors and links).
     #[error(transparent)]
     Kinematics(#[from] trm_kinematics::KinematicsError),
@@ -285,13 +285,13 @@ impl TaskMap {
             path: path.display().to_string(),
             problem: format!("not written: {problem}"),
         })?;
-        Ok(trm_kinematics::json_text(path, self, FORMAT)?)
+        Ok(trm_io::json_text(path, self, FORMAT)?)
     }
 
     /// Writes the map as JSON (atomically); see [`TaskMap::to_json`].
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TaskMapError> {
         let path = path.as_ref();
-        Ok(trm_kinematics::write_file(path, &self.to_json(path)?)?)
+        Ok(trm_io::write_file(path, &self.to_json(path)?)?)
     }
 
     /// Checks that the map holds something and that its points fit together: finite goal
@@ -326,13 +326,13 @@ impl TaskMap {
     /// Reads a map; truncated, foreign or newer files are clear errors.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, TaskMapError> {
         let path = path.as_ref();
-        Self::from_json(&trm_kinematics::read_file(path)?, path)
+        Self::from_json(&trm_io::read_file(path)?, path)
     }
 
     /// Reads a task map from JSON text (`path` names it in errors), checked as
     /// [`TaskMap::load`] checks a file.
     pub fn from_json(text: &str, path: &Path) -> Result<Self, TaskMapError> {
-        let mut map: TaskMap = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
+        let mut map: TaskMap = trm_io::parse_versioned(path, text, FORMAT, VERSION)?;
         map.metric.check()?;
         map.check().map_err(|problem| TaskMapError::File {
             path: path.display().to_string(),

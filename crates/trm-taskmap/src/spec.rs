@@ -128,8 +128,8 @@ impl TaskMapSpec {
     /// Reads a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<LoadedTaskMapSpec, TaskMapError> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| {
-            TaskMapError::MapFile(trm_kinematics::FileError::Io {
+        let text = trm_io::read_input(path).map_err(|source| {
+            TaskMapError::MapFile(trm_io::FileError::Io {
                 path: path.to_path_buf(),
                 source,
             })
@@ -151,9 +151,8 @@ impl TaskMapSpec {
         origin: &str,
         base: &Path,
     ) -> Result<LoadedTaskMapSpec, TaskMapError> {
-        let spec: TaskMapSpec = ron::from_str(text).map_err(|e| {
-            TaskMapError::Spec(Box::new(trm_kinematics::SpecError::from_ron(&e, origin)))
-        })?;
+        let spec: TaskMapSpec = ron::from_str(text)
+            .map_err(|e| TaskMapError::Spec(Box::new(trm_io::SpecError::from_ron(&e, origin))))?;
         let loaded = LoadedTaskMapSpec {
             spec,
             origin: origin.to_string(),
@@ -167,7 +166,7 @@ impl TaskMapSpec {
 
 impl LoadedTaskMapSpec {
     fn err(&self, field: &str, problem: impl Into<String>, fix: impl Into<String>) -> TaskMapError {
-        TaskMapError::Spec(Box::new(trm_kinematics::SpecError::at(
+        TaskMapError::Spec(Box::new(trm_io::SpecError::at(
             &self.text,
             &self.origin,
             field,

@@ -11,7 +11,7 @@ pub type Result<T, E = TaskError> = std::result::Result<T, E>;
 pub enum TaskError {
     /// A spec file problem, located in the file (boxed: errors stay small).
     #[error(transparent)]
-    Spec(Box<trm_kinematics::SpecError>),
+    Spec(Box<trm_io::SpecError>),
     /// An invalid value given in code.
     #[error("{what}: {problem}")]
     Invalid {

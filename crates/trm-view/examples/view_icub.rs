@@ -15,11 +15,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         q[shoulder] += 0.6 * (i as f64 * 0.3).sin().abs();
         scene.add_frame(0.1 * i as f64, &q)?;
     }
-    trm_kinematics::write_atomic(
+    trm_io::write_atomic(
         "target/icub.scene.json".as_ref(),
         scene.to_json()?.as_bytes(),
     )?;
-    trm_kinematics::write_atomic(
+    trm_io::write_atomic(
         "target/icub.scene.html".as_ref(),
         scene.to_html(None)?.as_bytes(),
     )?;

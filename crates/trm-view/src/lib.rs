@@ -43,7 +43,7 @@ pub const VIEWER_SOURCE: &str = include_str!("../viewer/main.js");
 pub enum ViewError {
     /// A scene file could not be read or written.
     #[error(transparent)]
-    SceneFile(#[from] trm_kinematics::FileError),
+    SceneFile(#[from] trm_io::FileError),
     /// Invalid input.
     #[error("{what}: {problem}")]
     Invalid {
@@ -396,7 +396,7 @@ impl Scene {
     }
 
     /// Reads a scene, checking its format and version (the one versioned-JSON reader of trm,
-    /// [`trm_kinematics::parse_versioned`]) and its content ([`Scene::check`]).
+    /// [`trm_io::parse_versioned`]) and its content ([`Scene::check`]).
     pub fn from_json(text: &str) -> Result<Self> {
         Self::parse(std::path::Path::new("<scene>"), text)
     }
@@ -404,7 +404,7 @@ impl Scene {
     /// Reads a scene file.
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|e| ViewError::Io {
+        let text = trm_io::read_input(path).map_err(|e| ViewError::Io {
             path: path.display().to_string(),
             message: e.to_string(),
         })?;
@@ -412,7 +412,7 @@ impl Scene {
     }
 
     fn parse(path: &std::path::Path, text: &str) -> Result<Self> {
-        let scene: Scene = trm_kinematics::parse_versioned(path, text, FORMAT, VERSION)?;
+        let scene: Scene = trm_io::parse_versioned(path, text, FORMAT, VERSION)?;
         scene.check().map_err(|e| match e {
             ViewError::Invalid { what, problem } => ViewError::Invalid {
                 what: format!("{}: {what}", path.display()),

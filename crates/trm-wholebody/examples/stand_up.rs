@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .solutions
         .last()
         .expect("at least the hand-tuned motion");
-    trm_kinematics::write_atomic(
+    trm_io::write_atomic(
         "target/stand_up.csv".as_ref(),
         best.rollout.to_csv(problem.model())?.as_bytes(),
     )?;

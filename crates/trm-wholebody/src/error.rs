@@ -10,7 +10,7 @@ pub enum WholeBodyError {
     /// A motion spec holds something invalid: where (file, line:column, field path), what,
     /// fix (boxed: errors stay small).
     #[error(transparent)]
-    Spec(Box<trm_kinematics::SpecError>),
+    Spec(Box<trm_io::SpecError>),
     /// A file could not be read.
     #[error("{}: {source}", path.display())]
     Io {
@@ -50,7 +50,7 @@ impl WholeBodyError {
         problem: impl Into<String>,
         fix: impl Into<String>,
     ) -> Self {
-        WholeBodyError::Spec(Box::new(trm_kinematics::SpecError::at(
+        WholeBodyError::Spec(Box::new(trm_io::SpecError::at(
             text, origin, field, problem, fix,
         )))
     }

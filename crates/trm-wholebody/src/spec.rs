@@ -8,7 +8,8 @@ use std::path::Path;
 use crate::WholeBodyError;
 use serde::{Deserialize, Serialize};
 use trm_collision::{Shape, WorldSpec};
-use trm_kinematics::{RobotModel, closest_names};
+use trm_io::closest_names;
+use trm_kinematics::RobotModel;
 
 use crate::Result;
 
@@ -37,7 +38,7 @@ pub struct MotionSpec {
     #[serde(default)]
     pub reach: Option<ReachSpec>,
     /// Start posture, degrees, by motor name (motors left out: 0 clamped into limits).
-    #[serde(deserialize_with = "trm_kinematics::unique_names")]
+    #[serde(deserialize_with = "trm_io::unique_names")]
     pub start: BTreeMap<String, f64>,
     /// The phases, in order; each ends at a keyframe posture.
     pub phases: Vec<PhaseSpec>,
@@ -109,7 +110,7 @@ pub struct PhaseSpec {
     pub locked: Vec<String>,
     /// Keyframe posture reached at the phase's end (posture task), degrees by motor name;
     /// motors left out keep the previous keyframe's value.
-    #[serde(deserialize_with = "trm_kinematics::unique_names")]
+    #[serde(deserialize_with = "trm_io::unique_names")]
     pub keyframe: BTreeMap<String, f64>,
 }
 
@@ -136,10 +137,10 @@ pub struct ControllerSpec {
 pub struct LimitsSpec {
     /// Velocity limits, rad/s, by motor (overriding or completing the model's).
     #[serde(default)]
-    #[serde(deserialize_with = "trm_kinematics::unique_names")]
+    #[serde(deserialize_with = "trm_io::unique_names")]
     pub velocity: BTreeMap<String, f64>,
     /// Static torque limits per joint, N·m, by motor (every motor needs one).
-    #[serde(deserialize_with = "trm_kinematics::unique_names")]
+    #[serde(deserialize_with = "trm_io::unique_names")]
     pub torque: BTreeMap<String, f64>,
     /// Check self-collision along the motion.
     #[serde(default = "yes")]
@@ -201,7 +202,7 @@ impl MotionSpec {
     /// Reads and checks a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| WholeBodyError::Io {
+        let text = trm_io::read_input(path).map_err(|source| WholeBodyError::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -212,9 +213,8 @@ impl MotionSpec {
     /// Parses a spec (numbers and structure; names are checked against the model by
     /// [`MotionSpec::check_names`]).
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
-        let spec: MotionSpec = ron::from_str(text).map_err(|e| {
-            WholeBodyError::Spec(Box::new(trm_kinematics::SpecError::from_ron(&e, origin)))
-        })?;
+        let spec: MotionSpec = ron::from_str(text)
+            .map_err(|e| WholeBodyError::Spec(Box::new(trm_io::SpecError::from_ron(&e, origin))))?;
         let err = |field: &str, problem: String, fix: &str| {
             WholeBodyError::spec(text, origin, field, problem, fix)
         };

@@ -30,6 +30,6 @@ pub fn build_map(job: Job, resumed: Option<Checkpoint>) -> Result<()> {
 #[cfg(not(feature = "mpi"))]
 pub fn build_map(_job: Job, _resumed: Option<Checkpoint>) -> Result<()> {
     anyhow::bail!(
-        "--mpi: this xtask was built without MPI\n  fix: install an MPI library (Debian: libopenmpi-dev openmpi-bin libclang-dev), build with `cargo build --release -p xtask --features mpi` and run `mpirun -n 2 target/release/xtask build-map SPEC --mpi`"
+        "--mpi: this trm was built without MPI\n  fix: install an MPI library (Debian: libopenmpi-dev openmpi-bin libclang-dev), build with `cargo build --release -p trm --features mpi` and run `mpirun -n 2 target/release/trm build-map SPEC --mpi`"
     )
 }

@@ -156,7 +156,7 @@ pub fn run_staged(
     work: impl FnOnce() -> Result<()>,
 ) -> Result<()> {
     for f in files {
-        trm_kinematics::check_output(f).with_context(|| format!("output {}", f.display()))?;
+        trm_io::check_output(f).with_context(|| format!("output {}", f.display()))?;
     }
     for d in dirs {
         if d.exists() && !d.is_dir() {
@@ -166,8 +166,7 @@ pub fn run_staged(
             );
         }
         if !d.exists() {
-            trm_kinematics::check_output(d)
-                .with_context(|| format!("output directory {}", d.display()))?;
+            trm_io::check_output(d).with_context(|| format!("output directory {}", d.display()))?;
         }
     }
     *staged() = Some(Vec::new());
@@ -184,9 +183,8 @@ pub fn run_staged(
 
 /// Output files written by this run but not yet in place (`None`: write directly, as tests
 /// calling a command's `run` do).
-fn staged() -> std::sync::MutexGuard<'static, Option<Vec<trm_kinematics::StagedFile>>> {
-    static STAGED: std::sync::Mutex<Option<Vec<trm_kinematics::StagedFile>>> =
-        std::sync::Mutex::new(None);
+fn staged() -> std::sync::MutexGuard<'static, Option<Vec<trm_io::StagedFile>>> {
+    static STAGED: std::sync::Mutex<Option<Vec<trm_io::StagedFile>>> = std::sync::Mutex::new(None);
     STAGED.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -485,12 +483,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let context = || format!("writing {}", path.display());
     match staged().as_mut() {
         Some(files) => {
-            let file = trm_kinematics::StagedFile::new(path, bytes).with_context(context)?;
+            let file = trm_io::StagedFile::new(path, bytes).with_context(context)?;
             files.retain(|f| f.path() != path);
             files.push(file);
             Ok(())
         }
-        None => trm_kinematics::write_atomic(path, bytes).with_context(context),
+        None => trm_io::write_atomic(path, bytes).with_context(context),
     }
 }
 

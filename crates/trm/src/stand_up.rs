@@ -54,7 +54,7 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(r) = args.rollouts {
             spec.optimiser.rollouts = r;
         }
-        let text = trm_kinematics::read_input(&spec_path)
+        let text = trm_io::read_input(&spec_path)
             .with_context(|| format!("reading {}", spec_path.display()))?;
         problem = WholeBody::new(
             spec,

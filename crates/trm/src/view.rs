@@ -67,8 +67,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
         (Some(path), _) => {
             let title = path.display().to_string();
             let text = if path.extension().is_some_and(|e| e == "ron") {
-                trm_kinematics::read_input(path)
-                    .with_context(|| format!("reading {}", path.display()))?
+                trm_io::read_input(path).with_context(|| format!("reading {}", path.display()))?
             } else {
                 String::new()
             };

@@ -105,6 +105,80 @@ def test_ngik_solves_the_reach_spec_reproducibly():
     assert a["motors"].shape == (41,) and a["q"].shape == (len(problem.active_names),)
 
 
+HOME_TERM = '        (weight: 0.5, cost: HomePosture(weights: {"torso": 3.0})),\n'
+
+
+def reach_point_specs(tmp_path):
+    """specs/reach_point.ron with its home-posture term moved last (Rust) and removed (for the
+    Python twin, which is added last): the terms are summed in the same order."""
+    text = (ROOT / "specs" / "reach_point.ron").read_text()
+    assert HOME_TERM in text
+    without = text.replace(HOME_TERM, "")
+    last = without.replace("    ],\n    task:", HOME_TERM + "    ],\n    task:")
+    rust, python = tmp_path / "rust.ron", tmp_path / "python.ron"
+    rust.write_text(last)
+    python.write_text(without)
+    return str(rust), str(python)
+
+
+def test_a_python_cost_inside_ngik_matches_its_rust_twin(tmp_path):
+    rust_spec, python_spec = reach_point_specs(tmp_path)
+    rust = trm.Problem.load(rust_spec)
+    twin = trm.Problem.load(python_spec)
+    home = twin.start.copy()
+    w = np.array([3.0 if n.startswith("torso") else 1.0 for n in twin.active_names])
+    calls = []
+
+    def home_posture(q, frames):
+        # HomePosture's formula, summed in its order: sqrt(sum_j (w_j (q_j - home_j))^2)
+        calls.append(len(q))
+        assert q.shape[1] == len(home) and frames == {}
+        s = np.zeros(len(q))
+        for j in range(q.shape[1]):
+            s = s + (w[j] * (q[:, j] - home[j])) ** 2
+        return np.sqrt(s)
+
+    twin.add_cost(home_posture, weight=0.5, label="home posture")
+    q = rust.start + 0.05
+    assert rust.cost(q) == twin.cost(q)
+    a = rust.solve(seed=2, max_evals=2000)
+    b = twin.solve(seed=2, max_evals=2000)
+    np.testing.assert_array_equal(a["q"], b["q"])
+    assert a["cost"] == b["cost"] and a["evaluations"] == b["evaluations"]
+    assert [t[0] for t in b["breakdown"]][-1] == "home posture"
+    assert len(calls) < b["evaluations"]  # called per batch, not per candidate
+
+
+def test_python_costs_see_frames_and_their_errors_are_located():
+    problem = trm.Problem.load(str(ROOT / "specs" / "reach_point.ron"))
+    seen = []
+
+    def low_hand(q, frames):
+        hand = frames["r_hand"]
+        seen.append(hand.shape)
+        return np.maximum(0.0, hand[:, 2, 3] + 0.1) ** 2
+
+    problem.add_cost(low_hand, weight=2.0, label="hand low", frames=["r_hand"])
+    start = problem.cost(problem.start)
+    assert seen and seen[0][1:] == (4, 4)
+    assert problem.solve(seed=1, max_evals=1000)["cost"] < start
+
+    with pytest.raises(trm.TrmError, match="did you mean"):
+        problem.add_cost(low_hand, frames=["r_hnd"])
+    for bad, message in [
+        (lambda q, f: 1 / 0, r"`broken` raised ZeroDivisionError: division by zero \(File .*test_trm.py"),
+        (lambda q, f: "cheap", "`broken` returned str"),
+        (lambda q, f: np.zeros(len(q) + 1), "`broken` returned shape"),
+        (lambda q, f: np.full(len(q), np.nan), "`broken` returned NaN"),
+    ]:
+        p = trm.Problem.load(str(ROOT / "specs" / "reach_point.ron"))
+        p.add_cost(bad, label="broken")
+        with pytest.raises(trm.TrmError, match=message):
+            p.solve(seed=0, max_evals=500)
+        with pytest.raises(trm.TrmError, match=message):
+            p.cost(p.start)
+
+
 @pytest.mark.parametrize("algo", ["xnes", "cmaes"])
 def test_optimisers_ask_tell_on_the_sphere(algo):
     opt = trm.Optimizer(algo, np.full(5, 1.0), 0.5, seed=1, max_evals=20_000)

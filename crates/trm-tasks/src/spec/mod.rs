@@ -46,7 +46,7 @@ pub struct Spec {
     pub start: Option<String>,
     /// Motor values overriding the start posture, by motor name.
     #[serde(default)]
-    #[serde(deserialize_with = "trm_kinematics::unique_names")]
+    #[serde(deserialize_with = "trm_io::unique_names")]
     pub start_values: BTreeMap<String, f64>,
     /// World objects.
     #[serde(default)]
@@ -137,7 +137,7 @@ pub enum CostKind {
         posture: Option<String>,
         /// Weights by motor or group name; 1 for the rest.
         #[serde(default)]
-        #[serde(deserialize_with = "trm_kinematics::unique_names")]
+        #[serde(deserialize_with = "trm_io::unique_names")]
         weights: BTreeMap<String, f64>,
     },
     /// Number of colliding pairs.
@@ -456,5 +456,5 @@ impl MapSpec {
 
 /// A RON error with its position and, for unknown names, the closest valid ones.
 pub fn ron_error(e: &ron::error::SpannedError, origin: &str) -> TaskError {
-    TaskError::Spec(Box::new(trm_kinematics::SpecError::from_ron(e, origin)))
+    TaskError::Spec(Box::new(trm_io::SpecError::from_ron(e, origin)))
 }

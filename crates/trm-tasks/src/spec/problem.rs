@@ -4,7 +4,8 @@
 use std::path::Path;
 
 use trm_collision::{CollisionModel, World};
-use trm_kinematics::{FrameSpec, RobotModel, closest_names};
+use trm_io::closest_names;
+use trm_kinematics::{FrameSpec, RobotModel};
 
 use crate::error::{Result, TaskError};
 use crate::objective::Objective;
@@ -43,7 +44,7 @@ impl Ctx<'_> {
         problem: impl Into<String>,
         fix: impl Into<String>,
     ) -> TaskError {
-        TaskError::Spec(Box::new(trm_kinematics::SpecError::at(
+        TaskError::Spec(Box::new(trm_io::SpecError::at(
             self.text,
             self.origin,
             field,
@@ -71,7 +72,7 @@ impl Problem {
     /// Reads and builds a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = trm_kinematics::read_input(path).map_err(|source| TaskError::Io {
+        let text = trm_io::read_input(path).map_err(|source| TaskError::Io {
             path: path.to_path_buf(),
             source,
         })?;

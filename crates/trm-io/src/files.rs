@@ -3,14 +3,6 @@
 use std::io::Write as _;
 use std::path::Path;
 
-/// Reads a text file, naming it in the error.
-pub(crate) fn read_text(path: &Path) -> crate::Result<String> {
-    read_input(path).map_err(|source| crate::KinematicsError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
 /// The largest input file trm reads (1 GiB): anything bigger is refused rather than exhausting
 /// memory.
 pub const MAX_INPUT_BYTES: u64 = 1 << 30;
@@ -209,7 +201,7 @@ pub fn check_unique_keys(text: &str) -> Result<(), serde_json::Error> {
 
 /// Deserialises a map of names (`{"torso": 3.0, …}` in RON or JSON), refusing a name given twice
 /// (serde would keep the last one silently). Use as
-/// `#[serde(deserialize_with = "trm_kinematics::unique_names")]`.
+/// `#[serde(deserialize_with = "trm_io::unique_names")]`.
 pub fn unique_names<'de, D, V>(d: D) -> Result<std::collections::BTreeMap<String, V>, D::Error>
 where
     D: serde::Deserializer<'de>,

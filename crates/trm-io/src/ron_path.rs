@@ -10,7 +10,7 @@
 /// character. `None` when the text does not hold the path (or is not RON enough to scan).
 ///
 /// ```
-/// use trm_kinematics::locate_ron_path;
+/// use trm_io::locate_ron_path;
 /// let text = "(\n  noise: Some((sigma: 0.1)),\n  solver: (algo: \"xnes\", sigma: -1.0),\n)";
 /// assert_eq!(locate_ron_path(text, "solver.sigma"), Some((3, 26)));
 /// assert_eq!(locate_ron_path(text, "noise.sigma"), Some((2, 16)));
