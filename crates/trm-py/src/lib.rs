@@ -962,15 +962,11 @@ impl Roadmap {
             points,
             seed,
             searches,
+            edge_resolution,
             ..Default::default()
         };
         let map = py
-            .detach(|| {
-                let mut map = trm_roadmap::build(&problem, &options, |_| {})?;
-                let neighbours = map.settings.edge_neighbours;
-                trm_roadmap::connect(&mut map, &problem.objective, neighbours, edge_resolution)?;
-                Ok::<_, trm_roadmap::RoadmapError>(map)
-            })
+            .detach(|| trm_roadmap::build_connected(&problem, &options, |_| {}))
             .map_err(err)?;
         Ok(Roadmap { map })
     }

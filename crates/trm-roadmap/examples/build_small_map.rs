@@ -21,11 +21,11 @@ fn main() -> Result<(), RoadmapError> {
         .nth(1)
         .unwrap_or_else(|| "target/small.map.json".into());
     let problem = trm_tasks::Problem::from_ron(SPEC, "<example>", std::path::Path::new("."))?;
-    let mut map = trm_roadmap::build(&problem, &BuildOptions::default(), |p| {
+    // built, then connected (the spec's 6 neighbours, edges checked every 0.05 rad)
+    let map = trm_roadmap::build_connected(&problem, &BuildOptions::default(), |p| {
         eprint!("\r{} / {} points", p.points, p.target)
     })?;
     eprintln!();
-    trm_roadmap::connect(&mut map, &problem.objective, 6, 0.05)?;
     map.save(&out)?;
     let back = Roadmap::load(&out)?;
     let s = back.summary();

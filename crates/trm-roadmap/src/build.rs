@@ -42,7 +42,12 @@ pub struct BuildOptions {
     pub repel_weight: f64,
     /// Write a [`Checkpoint`] while building (and once at the end), to resume a killed build.
     pub checkpoint: Option<CheckpointOptions>,
+    /// The joint step (rad) at which [`build_connected`] checks edges.
+    pub edge_resolution: f64,
 }
+
+/// The joint step (rad) at which edges are checked unless told otherwise.
+pub const DEFAULT_EDGE_RESOLUTION: f64 = 0.05;
 
 /// Where and how often a build writes its [`Checkpoint`].
 #[derive(Debug, Clone, PartialEq)]
@@ -62,6 +67,7 @@ impl Default for BuildOptions {
             max_generations: 400,
             repel_weight: 1.0,
             checkpoint: None,
+            edge_resolution: DEFAULT_EDGE_RESOLUTION,
         }
     }
 }
@@ -501,6 +507,41 @@ pub fn build_with(
         evaluator,
         progress,
     )
+}
+
+/// A map ready to plan with: built ([`build`]) and connected ([`connect`]: each point to the
+/// spec's `edge_neighbours` nearest, edges checked every `options.edge_resolution`, which is
+/// checked before any building). Save it with [`Roadmap::save`].
+pub fn build_connected(
+    problem: &Problem,
+    options: &BuildOptions,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    build_connected_with(problem, options, None, &mut Threads::default(), progress)
+}
+
+/// [`build_connected`] finishing a killed build from its checkpoint when `resumed` is given
+/// ([`resume_with`]), the candidates evaluated by `evaluator` ([`build_with`]).
+pub fn build_connected_with(
+    problem: &Problem,
+    options: &BuildOptions,
+    resumed: Option<Checkpoint>,
+    evaluator: &mut dyn Evaluator,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    crate::edges::check_edge_resolution(options.edge_resolution)?;
+    let mut map = match resumed {
+        Some(checkpoint) => resume_with(problem, checkpoint, options, evaluator, progress)?,
+        None => build_with(problem, options, evaluator, progress)?,
+    };
+    let neighbours = map.settings.edge_neighbours;
+    crate::edges::connect(
+        &mut map,
+        &problem.objective,
+        neighbours,
+        options.edge_resolution,
+    )?;
+    Ok(map)
 }
 
 /// Finishes a build from its [`Checkpoint`] with exactly the map the uninterrupted build gives

@@ -7,8 +7,8 @@
 //!
 //! ```no_run
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
-//! let mut map = trm_roadmap::build(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
-//! trm_roadmap::connect(&mut map, &problem.objective, 8, 0.05)?;
+//! // built and connected (the pieces: `build`, then `connect`)
+//! let map = trm_roadmap::build_connected(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
 //! map.save("reach.map.json")?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -26,8 +26,9 @@ mod repair;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
-    BuildOptions, CheckpointOptions, Evaluator, MAX_POINTS, MAX_SEARCHES, Progress, Threads, build,
-    build_with, evaluate_on_threads, resume, resume_with,
+    BuildOptions, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, Evaluator, MAX_POINTS, MAX_SEARCHES,
+    Progress, Threads, build, build_connected, build_connected_with, build_with,
+    evaluate_on_threads, resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{

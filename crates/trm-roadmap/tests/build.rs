@@ -393,3 +393,28 @@ fn the_failure_limit_counts_all_failures_or_consecutive_ones() {
     assert!(consecutive.stats.failures >= 3);
     assert!(consecutive.points.len() >= total.points.len());
 }
+
+#[test]
+fn build_connected_is_build_then_connect_and_checks_the_resolution_first() {
+    let problem = reach();
+    let options = BuildOptions {
+        points: Some(12),
+        edge_resolution: 0.07,
+        ..Default::default()
+    };
+    let one = trm_roadmap::build_connected(&problem, &options, |_| {}).unwrap();
+    let mut two = build(&problem, &options, |_| {}).unwrap();
+    let neighbours = two.settings.edge_neighbours;
+    connect(&mut two, &problem.objective, neighbours, 0.07).unwrap();
+    assert_eq!(one.points, two.points);
+    assert_eq!(one.edges, two.edges);
+    assert!(!one.edges.is_empty());
+    let mut built = false;
+    let bad = BuildOptions {
+        edge_resolution: f64::NAN,
+        ..options
+    };
+    let e = trm_roadmap::build_connected(&problem, &bad, |_| built = true).unwrap_err();
+    assert!(e.to_string().contains("edge resolution"), "{e}");
+    assert!(!built, "the resolution is checked before building");
+}

@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Evaluator, Roadmap, Threads, build_with, connect,
-    resume_with,
+    BuildOptions, Checkpoint, CheckpointOptions, Evaluator, Roadmap, Threads, build_connected_with,
 };
 use trm_tasks::Problem;
 
@@ -46,7 +45,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
     /// Interpolation step (rad) for checking edges.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = trm_roadmap::DEFAULT_EDGE_RESOLUTION)]
     edge_resolution: f64,
     /// Also write a 3-D view of the map (`<out stem>.scene.html` and `.scene.json`).
     #[arg(long)]
@@ -106,6 +105,7 @@ pub fn run(args: &Args) -> Result<()> {
         points: args.points,
         searches: args.searches,
         seed: args.seed,
+        edge_resolution: args.edge_resolution,
         ..Default::default()
     };
     let (problem, resumed) = match (&args.spec, &args.resume) {
@@ -187,18 +187,8 @@ impl Job<'_> {
                     ),
                 );
             };
-            let mut map = match resumed {
-                Some(checkpoint) => resume_with(problem, checkpoint, options, evaluator, report)?,
-                None => build_with(problem, options, evaluator, report)?,
-            };
+            let map = build_connected_with(problem, options, resumed, evaluator, report)?;
             progress.finish();
-            let neighbours = map.settings.edge_neighbours;
-            connect(
-                &mut map,
-                &problem.objective,
-                neighbours,
-                args.edge_resolution,
-            )?;
             Ok(map)
         })()?;
         crate::write_atomic(out, map.to_json(out)?.as_bytes())?;

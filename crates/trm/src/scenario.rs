@@ -147,26 +147,20 @@ fn check_rebuilds(map: &Roadmap, run: &ScenarioRun, options: &ScenarioOptions) -
     for k in failed {
         let mut problem = map.problem()?;
         problem.objective.set_world(run.worlds[k].clone());
-        let mut rebuilt = trm_roadmap::build(
+        let rebuilt = trm_roadmap::build_connected(
             &problem,
             &trm_roadmap::BuildOptions {
                 points: Some(map.points.len()),
                 searches: Some(map.searches),
                 seed: Some(map.seed),
+                edge_resolution: if map.edge_resolution > 0.0 {
+                    map.edge_resolution
+                } else {
+                    trm_roadmap::DEFAULT_EDGE_RESOLUTION
+                },
                 ..Default::default()
             },
             |_| {},
-        )?;
-        let resolution = if map.edge_resolution > 0.0 {
-            map.edge_resolution
-        } else {
-            0.05
-        };
-        trm_roadmap::connect(
-            &mut rebuilt,
-            &problem.objective,
-            map.settings.edge_neighbours,
-            resolution,
         )?;
         let active = problem.objective.active();
         let q = active.from_motors(&run.motion.positions[k]);

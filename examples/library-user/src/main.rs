@@ -117,8 +117,7 @@ fn main() -> Result<(), Box<dyn Error>> {
 
     // 1. build a map from our spec
     let problem = Problem::load(&spec)?;
-    let mut map = trm_roadmap::build(&problem, &BuildOptions::default(), |_| {})?;
-    trm_roadmap::connect(&mut map, &problem.objective, 6, 0.05)?;
+    let map = trm_roadmap::build_connected(&problem, &BuildOptions::default(), |_| {})?;
     let map_file = out.join("right_hand.map.json");
     map.save(&map_file)?;
     let summary = map.summary();
