@@ -82,7 +82,14 @@ fn the_python_package_builds_installs_and_passes_its_tests() {
     );
     run(
         Command::new(&venv_python)
-            .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            .args([
+                "-m",
+                "pytest",
+                "-q",
+                "-p",
+                "no:cacheprovider",
+                "--durations=5",
+            ])
             .arg(root.join("crates/trm-py/python/tests"))
             .current_dir(&work),
         "pytest",

@@ -253,7 +253,7 @@ pub fn find_problems(dir: &Path) -> Result<Vec<Problem>, PlanError> {
 pub const LIMIT_SLACK: f64 = 1e-4;
 
 /// How one problem went.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct Outcome {
     /// Start and goal are collision-free and within limits (a problem that is not valid is
     /// left out of the solved rate, as VAMP's and OMPL's reports do).
@@ -700,6 +700,120 @@ pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, Str
         }
     }
     Ok(results)
+}
+
+impl ProblemSet {
+    /// Keeps the problems of `families` (all when empty; a family the set lacks is an error
+    /// naming those it has) and at most `per_family` of each, in order.
+    pub fn select(
+        &mut self,
+        families: &[String],
+        per_family: Option<usize>,
+    ) -> Result<(), PlanError> {
+        for f in families {
+            if !self.problems.iter().any(|p| &p.family == f) {
+                let known: std::collections::BTreeSet<&str> =
+                    self.problems.iter().map(|p| p.family.as_str()).collect();
+                return Err(PlanError::InvalidOptions {
+                    what: format!("family `{f}`"),
+                    problem: format!(
+                        "is not in this set\n  fix: give some of {}",
+                        known.into_iter().collect::<Vec<_>>().join(", ")
+                    ),
+                });
+            }
+        }
+        if !families.is_empty() {
+            self.problems.retain(|p| families.contains(&p.family));
+        }
+        if let Some(n) = per_family {
+            let mut count = std::collections::BTreeMap::<String, usize>::new();
+            self.problems.retain(|p| {
+                let c = count.entry(p.family.clone()).or_default();
+                *c += 1;
+                *c <= n
+            });
+        }
+        Ok(())
+    }
+}
+
+/// One problem of a benchmark run and how it went.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Run {
+    /// Its family.
+    pub family: String,
+    /// Its number in the family.
+    pub index: u32,
+    /// The planner's outcome.
+    pub outcome: Outcome,
+    /// With verification: whether the path is free when re-checked one configuration at a time
+    /// at half the resolution ([`path_is_free`]).
+    pub verified: Option<bool>,
+}
+
+/// Solves each problem by RRT-Connect + shortcutting ([`solve`]), re-checking solved paths
+/// when `verify`; `progress(done, problem)` after each.
+pub fn run_set(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    problems: &[Problem],
+    options: &RrtOptions,
+    verify: bool,
+    mut progress: impl FnMut(usize, &Problem),
+) -> Result<Vec<Run>, PlanError> {
+    let mut runs = Vec::with_capacity(problems.len());
+    for (k, p) in problems.iter().enumerate() {
+        let scene = PlanningScene::load(&p.scene)?;
+        let request = MotionPlanRequest::load(&p.request)?;
+        let outcome = solve(robot, collision, &scene, &request, options)?;
+        let verified = (verify && outcome.solved)
+            .then(|| {
+                path_is_free(
+                    robot,
+                    collision,
+                    &scene,
+                    &request,
+                    &outcome.path,
+                    options.resolution / 2.0,
+                )
+            })
+            .transpose()?;
+        runs.push(Run {
+            family: p.family.clone(),
+            index: p.index,
+            outcome,
+            verified,
+        });
+        progress(k + 1, p);
+    }
+    Ok(runs)
+}
+
+/// The runs as CSV: family, problem, valid, solved, seconds, length, waypoints, checks,
+/// verified, note.
+pub fn runs_csv(runs: &[Run]) -> String {
+    use std::fmt::Write as _;
+    let mut csv =
+        String::from("family,problem,valid,solved,seconds,length,waypoints,checks,verified,note\n");
+    for r in runs {
+        let o = &r.outcome;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{},\"{}\"",
+            r.family,
+            r.index,
+            o.valid,
+            o.solved,
+            o.seconds,
+            o.length,
+            o.waypoints,
+            o.checks,
+            r.verified.map_or(String::new(), |v| v.to_string()),
+            o.note.replace('"', "'")
+        );
+    }
+    csv
 }
 
 /// Formats a time in milliseconds with two decimals ("—" for none).

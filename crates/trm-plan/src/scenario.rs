@@ -343,7 +343,7 @@ impl Default for ScenarioOptions {
 }
 
 /// What the robot did in a step.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub enum Action {
     /// Went on with its motion (the goal unchanged, the rest of the motion clear).
     Kept,
@@ -354,7 +354,7 @@ pub enum Action {
 }
 
 /// One step of a scenario run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct StepReport {
     /// Time, s.
     pub t: f64,

@@ -412,7 +412,7 @@ impl Roadmap {
 }
 
 /// What [`Roadmap::summary`] reports.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MapSummary {
     /// Number of points.
     pub points: usize,

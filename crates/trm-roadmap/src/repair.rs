@@ -54,7 +54,7 @@ impl Default for RepairOptions {
 }
 
 /// What a world change and a repair did.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct RepairReport {
     /// Nodes the new world blocks (parked).
     pub blocked_nodes: usize,

@@ -71,7 +71,7 @@ impl Default for Comparison {
 }
 
 /// One run of a comparison.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ComparisonRun {
     /// Index of the problem.
     pub problem: usize,

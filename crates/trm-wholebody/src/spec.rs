@@ -215,6 +215,14 @@ impl MotionSpec {
     pub fn from_ron(text: &str, origin: &str) -> Result<Self> {
         let spec: MotionSpec = ron::from_str(text)
             .map_err(|e| WholeBodyError::Spec(Box::new(trm_io::SpecError::from_ron(&e, origin))))?;
+        spec.check(text, origin)?;
+        Ok(spec)
+    }
+
+    /// Checks the numbers and structure (what [`MotionSpec::from_ron`] checks), errors located
+    /// in `text`: for a spec changed after parsing, e.g. its budgets replaced.
+    pub fn check(&self, text: &str, origin: &str) -> Result<()> {
+        let spec = self;
         let err = |field: &str, problem: String, fix: &str| {
             WholeBodyError::spec(text, origin, field, problem, fix)
         };
@@ -407,7 +415,7 @@ impl MotionSpec {
                 ));
             }
         }
-        Ok(spec)
+        Ok(())
     }
 
     /// Checks every motor and link name against `model`, with suggestions.

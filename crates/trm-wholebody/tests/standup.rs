@@ -262,3 +262,16 @@ fn a_rollout_exports_as_a_ros_joint_trajectory() {
         );
     }
 }
+
+#[test]
+fn budgets_given_at_load_replace_the_specs_and_are_checked_as_its_own() {
+    let problem = WholeBody::load_with_budgets(SPEC, Some(7), Some(3)).unwrap();
+    assert_eq!(problem.spec().optimiser.rollouts, 7);
+    assert_eq!(problem.spec().optimiser.bootstrap_rollouts, 3);
+    let e = WholeBody::load_with_budgets(SPEC, Some(100_000_000), None).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("optimiser.rollouts") && text.contains("standup.ron"),
+        "{text}"
+    );
+}

@@ -7,8 +7,8 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::Result;
-use trm_plan::mbm::{Outcome, ProblemSet, path_is_free, solve};
+use anyhow::{Context, Result};
+use trm_plan::mbm::{Outcome, ProblemSet, path_is_free};
 use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
@@ -69,14 +69,6 @@ pub struct Args {
     pub out_dir: PathBuf,
 }
 
-/// One row of the results.
-struct Row {
-    family: String,
-    index: u32,
-    outcome: Outcome,
-    verified: Option<bool>,
-}
-
 /// Runs the set, prints the per-family table, writes the files.
 pub fn run(args: &Args) -> Result<()> {
     if let Some(binary) = &args.vamp {
@@ -88,36 +80,10 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let robot = crate::load_model(Some(&args.model))?;
     let collision = args.meshes.collision_model(&robot)?;
-    let set = ProblemSet::open(&args.dir)?;
-    let mut problems = set.problems.clone();
-    if !args.families.is_empty() {
-        for f in &args.families {
-            if !problems.iter().any(|p| &p.family == f) {
-                let known: std::collections::BTreeSet<&str> =
-                    problems.iter().map(|p| p.family.as_str()).collect();
-                anyhow::bail!(
-                    "--families: no family `{f}` in {}\n  fix: give some of {}",
-                    args.dir.display(),
-                    known.into_iter().collect::<Vec<_>>().join(", ")
-                );
-            }
-        }
-        problems.retain(|p| args.families.contains(&p.family));
-    }
-    if let Some(n) = args.per_family {
-        let mut kept = Vec::new();
-        for p in problems {
-            if kept
-                .iter()
-                .filter(|k: &&trm_plan::mbm::Problem| k.family == p.family)
-                .count()
-                < n
-            {
-                kept.push(p);
-            }
-        }
-        problems = kept;
-    }
+    let mut set = ProblemSet::open(&args.dir)?;
+    set.select(&args.families, args.per_family)
+        .with_context(|| format!("--families/--per-family with {}", args.dir.display()))?;
+    let problems = set.problems.clone();
     let options = RrtOptions {
         seed: args.seed,
         max_iterations: args.max_iterations,
@@ -126,52 +92,17 @@ pub fn run(args: &Args) -> Result<()> {
         shortcuts: args.shortcuts,
         ..Default::default()
     };
-    let mut rows = Vec::new();
     let mut progress = crate::progress::Progress::new("problems", problems.len() as u64);
-    for (k, p) in problems.iter().enumerate() {
-        let scene = PlanningScene::load(&p.scene)?;
-        let request = MotionPlanRequest::load(&p.request)?;
-        let outcome = solve(&robot, &collision, &scene, &request, &options)?;
-        let verified = (args.verify && outcome.solved)
-            .then(|| {
-                path_is_free(
-                    &robot,
-                    &collision,
-                    &scene,
-                    &request,
-                    &outcome.path,
-                    options.resolution / 2.0,
-                )
-            })
-            .transpose()?;
-        rows.push(Row {
-            family: p.family.clone(),
-            index: p.index,
-            outcome,
-            verified,
-        });
-        progress.set(k as u64 + 1, problems.len() as u64, &p.family);
-    }
+    let rows = trm_plan::mbm::run_set(
+        &robot,
+        &collision,
+        &problems,
+        &options,
+        args.verify,
+        |k, p| progress.set(k as u64, problems.len() as u64, &p.family),
+    )?;
     progress.finish();
-    let mut csv =
-        String::from("family,problem,valid,solved,seconds,length,waypoints,checks,verified,note\n");
-    for r in &rows {
-        let o = &r.outcome;
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{},{},{},\"{}\"",
-            r.family,
-            r.index,
-            o.valid,
-            o.solved,
-            o.seconds,
-            o.length,
-            o.waypoints,
-            o.checks,
-            r.verified.map_or(String::new(), |v| v.to_string()),
-            o.note.replace('"', "'")
-        );
-    }
+    let csv = trm_plan::mbm::runs_csv(&rows);
     let mut md = format!(
         "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, {} samples at most{})\n\n",
         args.dir.display(),

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use plotters::style::{BLACK, Color, RGBColor};
 use trm_wholebody::{Comparison, StandUpResult, WholeBody};
 
@@ -45,24 +45,7 @@ pub fn run(args: &Args) -> Result<()> {
         .spec
         .clone()
         .unwrap_or_else(|| crate::models_dir().join("../specs/wholebody/standup.ron"));
-    let mut problem = WholeBody::load(&spec_path)?;
-    if args.bootstrap_rollouts.is_some() || args.rollouts.is_some() {
-        let mut spec = problem.spec().clone();
-        if let Some(b) = args.bootstrap_rollouts {
-            spec.optimiser.bootstrap_rollouts = b;
-        }
-        if let Some(r) = args.rollouts {
-            spec.optimiser.rollouts = r;
-        }
-        let text = trm_io::read_input(&spec_path)
-            .with_context(|| format!("reading {}", spec_path.display()))?;
-        problem = WholeBody::new(
-            spec,
-            problem.model().clone(),
-            &spec_path.display().to_string(),
-            &text,
-        )?;
-    }
+    let problem = WholeBody::load_with_budgets(&spec_path, args.rollouts, args.bootstrap_rollouts)?;
     println!(
         "{}: {} motors, {:.1} kg, CoM from ({:.3}, {:.3}) to ({:.3}, {:.3}) m (x forward, z up), {} parameters, {} constraints",
         spec_path.display(),

@@ -331,6 +331,72 @@ def test_worlds_load_from_moveit_scenes(tmp_path):
         trm.World.load(str(request))
 
 
+# ---- every command of the trm tool from Python ----------------------------------------------
+
+
+def test_table_iii_from_python_is_seeded_and_complete():
+    specs = [str(ROOT / "specs" / "table_iii" / "posture1.ron")]
+    kw = dict(algorithms=["xnes", "sir"], runs=2, seed=4, max_evals=1500, no_improvement=1000)
+    a = trm.compare_optimisers(specs, **kw)
+    b = trm.compare_optimisers(specs, **kw)
+    assert [r["cost"] for r in a["runs"]] == [r["cost"] for r in b["runs"]]
+    assert len(a["runs"]) == 4 and {r["algorithm"] for r in a["runs"]} == {"xnes", "sir"}
+    assert "XNES" in a["table"] and a["csv"].count("\n") == 5
+    with pytest.raises(trm.TrmError, match="zigzag"):
+        trm.compare_optimisers(specs, algorithms=["zigzag"], runs=1)
+
+
+def test_motionbenchmaker_from_python_solves_and_verifies():
+    fixtures = ROOT / "crates" / "trm-plan" / "tests" / "fixtures" / "mbm"
+    model = str(ROOT / "models" / "panda-mbm" / "panda.ron")
+    r = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True)
+    assert len(r["runs"]) == 2 and all(run["family"] == "box_panda" for run in r["runs"])
+    for run in r["runs"]:
+        assert run["outcome"]["valid"] and run["outcome"]["solved"] and run["verified"]
+        assert len(run["outcome"]["path"]) >= 2
+    assert "box_panda" in r["table"] and r["csv"].startswith("family,problem")
+    with pytest.raises(trm.TrmError, match="box_panda"):
+        trm.benchmark_mbm(str(fixtures), model, families=["box_pand"])
+
+
+def test_task_maps_explore_save_load_and_cost(tmp_path):
+    explored = trm.TaskMap.explore(str(ROOT / "specs" / "taskmaps" / "stick.ron"))
+    assert len(explored) > 50 and explored.points.shape == (len(explored), 6)
+    assert explored.clusters >= 1 and explored.values.shape == (len(explored),)
+    explored.save(str(tmp_path / "stick.taskmap.json"))
+    back = trm.TaskMap.load(str(tmp_path / "stick.taskmap.json"))
+    np.testing.assert_array_equal(back.points, explored.points)
+    cost, gradient = back.cost(back.points[3])
+    assert cost == 0.0 and gradient.shape == (6,)
+    assert back.cost(back.points[3] + 0.05)[0] > 0.0
+
+
+def test_maps_repair_for_a_new_world_and_run_scenarios():
+    built = trm.Roadmap.build(SPEC, points=40, seed=0)
+    world = trm.World.load(str(ROOT / "specs" / "worlds" / "reach_with_box.ron"))
+    repaired, report = built.repair(world)
+    assert report["blocked_nodes"] >= 0 and "stopped_because" in report
+    problem = trm.Problem.load(SPEC)
+    assert all(problem.is_collision_free(repaired.postures, world))
+    run = trm.run_scenario(str(ROOT / "specs" / "scenarios" / "sliding_box.ron"), built, repair_evaluations=300)
+    again = trm.run_scenario(str(ROOT / "specs" / "scenarios" / "sliding_box.ron"), built, repair_evaluations=300)
+    assert len(run["steps"]) == len(run["times"]) == run["positions"].shape[0] > 10
+    assert run["positions"].shape[1] == 41
+    assert [s["action"] for s in run["steps"]] == [s["action"] for s in again["steps"]]
+    np.testing.assert_array_equal(run["positions"], again["positions"])
+    with pytest.raises(trm.TrmError, match="repair_ms"):
+        trm.run_scenario(str(ROOT / "specs" / "scenarios" / "sliding_box.ron"), built, repair_ms=0.0)
+
+
+def test_whole_body_motion_from_python():
+    result = trm.stand_up(str(ROOT / "specs" / "wholebody" / "standup.ron"), seed=1, rollouts=6, bootstrap_rollouts=6)
+    assert result["rollouts"] >= 6 and isinstance(result["feasible"], bool)
+    assert result["solutions"]
+    # the budgets given replace the spec's and are checked as the spec's own are
+    with pytest.raises(trm.TrmError, match="optimiser.rollouts"):
+        trm.stand_up(str(ROOT / "specs" / "wholebody" / "standup.ron"), rollouts=10**8)
+
+
 def test_version_is_the_crate_version():
     cargo = (ROOT / "Cargo.toml").read_text()
     assert f'version = "{trm.__version__}"' in cargo

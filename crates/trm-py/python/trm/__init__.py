@@ -19,10 +19,15 @@ from ._trm import (
     Problem,
     Roadmap,
     Robot,
+    TaskMap,
     TrmError,
     World,
     __version__,
+    benchmark_mbm,
+    compare_optimisers,
     minimize_constrained,
+    run_scenario,
+    stand_up,
     view,
 )
 
@@ -35,10 +40,15 @@ __all__ = [
     "Problem",
     "Roadmap",
     "Robot",
+    "TaskMap",
     "TrmError",
     "World",
+    "benchmark_mbm",
+    "compare_optimisers",
     "minimize",
     "minimize_constrained",
+    "run_scenario",
+    "stand_up",
     "view",
 ]
 

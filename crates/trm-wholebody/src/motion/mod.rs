@@ -80,9 +80,26 @@ fn deg_map(
 impl WholeBody {
     /// Loads a spec file (the model path is relative to it).
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        Self::load_with_budgets(path, None, None)
+    }
+
+    /// [`WholeBody::load`] with the optimiser's budgets replaced where given (`rollouts`,
+    /// `bootstrap_rollouts`), checked as the spec's own values are.
+    pub fn load_with_budgets(
+        path: impl AsRef<Path>,
+        rollouts: Option<u64>,
+        bootstrap_rollouts: Option<u64>,
+    ) -> Result<Self> {
         let path = path.as_ref();
-        let (spec, text) = MotionSpec::load(path)?;
+        let (mut spec, text) = MotionSpec::load(path)?;
+        if let Some(r) = rollouts {
+            spec.optimiser.rollouts = r;
+        }
+        if let Some(b) = bootstrap_rollouts {
+            spec.optimiser.bootstrap_rollouts = b;
+        }
         let origin = path.display().to_string();
+        spec.check(&text, &origin)?;
         let base = path.parent().unwrap_or(Path::new("."));
         let model = trm_models::load(&spec.model, base)?;
         Self::new(spec, model, &origin, &text)

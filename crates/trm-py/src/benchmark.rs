@@ -1,0 +1,94 @@
+//! The benchmarks from Python: Table III (`trm.compare_optimisers`) and MotionBenchMaker sets
+//! (`trm.benchmark_mbm`), as the `trm` tool's commands of the same names run them.
+
+use crate::*;
+
+/// Table III of the TRM paper on the given task specs, as `trm compare-optimisers`: every
+/// algorithm (`trm.ALGORITHMS` names; default xNES, SIR, SIRD, MH, simplex, CMA-ES,
+/// (1+1)-CMA-ES) `runs` times from seeds `seed`, `seed + 1`, …, each with `max_evals`
+/// evaluations and stopped after `no_improvement` without progress. Returns a dict: `table`
+/// (markdown, the paper's columns), `csv` (every run), `runs` (a dict per run: problem,
+/// algorithm, seed, cost, best_at, evaluations, collision_free, seconds, trace, motors) and
+/// `wall_seconds`.
+#[pyfunction]
+#[pyo3(signature = (specs, algorithms = None, runs = 30, seed = 0, max_evals = 400_000, no_improvement = 30_000))]
+pub(crate) fn compare_optimisers<'py>(
+    py: Python<'py>,
+    specs: Vec<String>,
+    algorithms: Option<Vec<String>>,
+    runs: u64,
+    seed: u64,
+    max_evals: u64,
+    no_improvement: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let defaults = trm_tasks::Comparison::default();
+    let comparison = trm_tasks::Comparison {
+        algorithms: algorithms.unwrap_or(defaults.algorithms),
+        runs,
+        seed,
+        max_evaluations: max_evals,
+        no_improvement,
+    };
+    comparison.check().map_err(err)?;
+    let problems: Vec<trm_tasks::Problem> = specs
+        .iter()
+        .map(|s| trm_tasks::Problem::load(s).map_err(err))
+        .collect::<PyResult<_>>()?;
+    let pairs: Vec<(&str, &trm_tasks::Problem)> =
+        specs.iter().map(String::as_str).zip(&problems).collect();
+    let result = py.detach(|| comparison.run(&pairs)).map_err(err)?;
+    let d = PyDict::new(py);
+    d.set_item("table", result.to_markdown())?;
+    d.set_item("csv", result.to_csv())?;
+    d.set_item("runs", to_python(py, &result.runs)?)?;
+    d.set_item("wall_seconds", result.wall_seconds)?;
+    Ok(d)
+}
+
+/// A MotionBenchMaker set (a folder or `.tar.bz2` of MoveIt scenes and joint-goal requests)
+/// solved by RRT-Connect + shortcutting with `model` (a `.urdf`, a `.ron` description or an
+/// embedded model's name), as `trm benchmark-mbm`: `families` and `per_family` select
+/// problems, `verify` re-checks each path one configuration at a time. Returns a dict: `runs`
+/// (per problem: family, index, outcome {valid, solved, seconds, length, waypoints, checks,
+/// note, path}, verified), `table` (markdown: solved %, median and p95 time per family) and
+/// `csv`.
+#[pyfunction]
+#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn benchmark_mbm<'py>(
+    py: Python<'py>,
+    path: &str,
+    model: &str,
+    families: Vec<String>,
+    per_family: Option<usize>,
+    seed: u64,
+    max_iterations: usize,
+    verify: bool,
+    package_paths: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let robot = trm_models::load(model, std::path::Path::new("")).map_err(err)?;
+    let options = trm_collision::CollisionOptions::with_ros_package_path(
+        package_paths.into_iter().map(Into::into).collect(),
+    );
+    let collision = CollisionModel::with_options(&robot, &options).map_err(err)?;
+    let mut set = trm_plan::mbm::ProblemSet::open(std::path::Path::new(path)).map_err(err)?;
+    set.select(&families, per_family).map_err(err)?;
+    let rrt = trm_plan::rrt::RrtOptions {
+        seed,
+        max_iterations,
+        ..Default::default()
+    };
+    let runs = py
+        .detach(|| {
+            trm_plan::mbm::run_set(&robot, &collision, &set.problems, &rrt, verify, |_, _| {})
+        })
+        .map_err(err)?;
+    let d = PyDict::new(py);
+    d.set_item(
+        "table",
+        trm_plan::mbm::markdown_table(runs.iter().map(|r| (r.family.as_str(), &r.outcome))),
+    )?;
+    d.set_item("csv", trm_plan::mbm::runs_csv(&runs))?;
+    d.set_item("runs", to_python(py, &runs)?)?;
+    Ok(d)
+}

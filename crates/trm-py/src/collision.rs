@@ -1,0 +1,239 @@
+//! `trm.World` and `trm.CollisionModel`: worlds (RON or MoveIt scenes) and collision queries.
+
+use crate::*;
+
+/// Obstacles: boxes, spheres, capsules, cylinders at poses (root frame).
+#[pyclass(name = "World", module = "trm")]
+#[derive(Clone, Default)]
+pub(crate) struct PyWorld {
+    pub(crate) world: World,
+}
+
+#[pymethods]
+impl PyWorld {
+    /// An empty world.
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// A world from a RON file (`(objects: [(name: "table", shape: Box(size: (…)), xyz: (…))])`) or a MoveIt planning scene (`.yaml`).
+    #[staticmethod]
+    fn load(path: &str) -> PyResult<Self> {
+        Ok(PyWorld {
+            world: trm_plan::moveit::load_world(path).map_err(err)?,
+        })
+    }
+
+    /// Adds a box of full side lengths `size` at `xyz`, turned by URDF `rpy`.
+    #[pyo3(signature = (name, size, xyz, rpy = [0.0; 3]))]
+    fn add_box(
+        &mut self,
+        name: &str,
+        size: [f64; 3],
+        xyz: [f64; 3],
+        rpy: [f64; 3],
+    ) -> PyResult<()> {
+        self.add(name, Shape::Box { size }, xyz, rpy)
+    }
+
+    /// Adds a sphere.
+    fn add_sphere(&mut self, name: &str, radius: f64, xyz: [f64; 3]) -> PyResult<()> {
+        self.add(name, Shape::Sphere { radius }, xyz, [0.0; 3])
+    }
+
+    /// Adds a capsule along its z axis (`length` between the cap centres).
+    #[pyo3(signature = (name, radius, length, xyz, rpy = [0.0; 3]))]
+    fn add_capsule(
+        &mut self,
+        name: &str,
+        radius: f64,
+        length: f64,
+        xyz: [f64; 3],
+        rpy: [f64; 3],
+    ) -> PyResult<()> {
+        self.add(name, Shape::Capsule { radius, length }, xyz, rpy)
+    }
+
+    /// Adds a cylinder along its z axis.
+    #[pyo3(signature = (name, radius, length, xyz, rpy = [0.0; 3]))]
+    fn add_cylinder(
+        &mut self,
+        name: &str,
+        radius: f64,
+        length: f64,
+        xyz: [f64; 3],
+        rpy: [f64; 3],
+    ) -> PyResult<()> {
+        self.add(name, Shape::Cylinder { radius, length }, xyz, rpy)
+    }
+
+    /// Moves an object.
+    #[pyo3(signature = (name, xyz, rpy = [0.0; 3]))]
+    fn set_pose(&mut self, name: &str, xyz: [f64; 3], rpy: [f64; 3]) -> PyResult<()> {
+        self.world.set_pose(name, pose(xyz, rpy)).map_err(err)
+    }
+
+    /// Removes an object.
+    fn remove(&mut self, name: &str) -> PyResult<()> {
+        self.world.remove(name).map(drop).map_err(err)
+    }
+
+    /// Object names.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.world
+            .objects()
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect()
+    }
+
+    fn __len__(&self) -> usize {
+        self.world.len()
+    }
+}
+
+impl PyWorld {
+    fn add(&mut self, name: &str, shape: Shape, xyz: [f64; 3], rpy: [f64; 3]) -> PyResult<()> {
+        self.world
+            .add(name, shape, pose(xyz, rpy))
+            .map(drop)
+            .map_err(err)
+    }
+}
+
+/// A robot's collision model (its bodies and allowed-collision matrix): counts, checks, pairs
+/// and distances, against itself and a world.
+#[pyclass(name = "CollisionModel", module = "trm")]
+pub(crate) struct Collision {
+    pub(crate) robot: RobotModel,
+    pub(crate) model: CollisionModel,
+}
+
+impl Collision {
+    /// The configurations in `q` placed one by one (without the GIL), `f` on each against
+    /// `world` (none: empty); the results and `Some(N)` for a batch.
+    fn map<T: Send>(
+        &self,
+        py: Python<'_>,
+        q: &Bound<'_, PyAny>,
+        world: Option<&PyWorld>,
+        f: impl Fn(&trm_collision::PlacedBodies, &World) -> T + Sync,
+    ) -> PyResult<(Vec<T>, Option<usize>)> {
+        let empty = World::new();
+        let w = world.map_or(&empty, |w| &w.world);
+        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
+        let out = py.detach(|| self.each(&values, |p| f(p, w))).map_err(err)?;
+        Ok((out, batch))
+    }
+
+    /// Runs `f` on every configuration placed.
+    fn each<T>(
+        &self,
+        values: &[f64],
+        mut f: impl FnMut(&trm_collision::PlacedBodies) -> T,
+    ) -> Result<Vec<T>, String> {
+        let n = self.robot.motors().len().max(1);
+        let mut poses = self.robot.pose_buffer();
+        let mut placed = self.model.placed_bodies();
+        values
+            .chunks(n)
+            .map(|row| {
+                self.robot
+                    .forward_motors(row, &mut poses)
+                    .map_err(|e| e.to_string())?;
+                self.model.place(&poses, &mut placed);
+                Ok(f(&placed))
+            })
+            .collect()
+    }
+}
+
+#[pymethods]
+impl Collision {
+    /// The collision model of `robot` (its capsules and boxes, or meshes as convex hulls).
+    #[new]
+    fn new(robot: &Robot) -> PyResult<Self> {
+        Ok(Collision {
+            model: CollisionModel::new(&robot.model).map_err(err)?,
+            robot: robot.model.clone(),
+        })
+    }
+
+    /// Body names.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.model.bodies().iter().map(|b| b.name.clone()).collect()
+    }
+
+    /// Colliding link pairs (self plus world): an int, or `(N,)` for a batch.
+    #[pyo3(signature = (q, world = None))]
+    fn count<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        world: Option<&PyWorld>,
+    ) -> PyResult<Py<PyAny>> {
+        let (counts, batch) =
+            self.map(py, q, world, |p, w| self.model.count(p, w).total() as f64)?;
+        match batch {
+            None => Ok((first(&counts)? as usize)
+                .into_pyobject(py)?
+                .into_any()
+                .unbind()),
+            Some(_) => numbers(py, batch, counts),
+        }
+    }
+
+    /// Whether anything collides (early exit): a bool, or a bool list for a batch.
+    #[pyo3(signature = (q, world = None))]
+    fn is_colliding<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        world: Option<&PyWorld>,
+    ) -> PyResult<Py<PyAny>> {
+        let (hits, batch) = self.map(py, q, world, |p, w| self.model.is_colliding(p, w))?;
+        flags(py, batch, hits)
+    }
+
+    /// The colliding pairs of one configuration: `[(body, other, signed distance)]`.
+    #[pyo3(signature = (q, world = None))]
+    fn colliding_pairs(
+        &self,
+        q: &Bound<'_, PyAny>,
+        world: Option<&PyWorld>,
+    ) -> PyResult<Vec<(String, String, f64)>> {
+        let empty = World::new();
+        let w = world.map_or(&empty, |w| &w.world);
+        let (values, batch) = configurations(q, self.robot.motors().len(), "q")?;
+        if batch.is_some() {
+            return Err(err("colliding_pairs takes one configuration (n,)"));
+        }
+        let pairs = self
+            .each(&values, |p| self.model.colliding_pairs(p, w))
+            .map_err(err)?;
+        Ok(pairs
+            .into_iter()
+            .flatten()
+            .map(|p| {
+                let other = match p.other {
+                    trm_collision::Other::Body(b) | trm_collision::Other::Object(b) => b,
+                };
+                (p.body, other, p.distance)
+            })
+            .collect())
+    }
+
+    /// The smallest signed distance between checked body pairs (negative when penetrating): a
+    /// float, or `(N,)` for a batch.
+    fn min_distance<'py>(&self, py: Python<'py>, q: &Bound<'py, PyAny>) -> PyResult<Py<PyAny>> {
+        let (d, batch) = self.map(py, q, None, |p, _| {
+            self.model
+                .min_self_distance(p)
+                .map_or(f64::INFINITY, |d| d.distance)
+        })?;
+        numbers(py, batch, d)
+    }
+}
