@@ -14,8 +14,7 @@ use trm_kinematics::nalgebra::Isometry3;
 use trm_plan::{Trajectory, time_parametrise};
 use trm_taskmap::{Motion, MotionGoal};
 
-use trm::explore_task_map::{Explored, explore_spec};
-use trm::reach_grasp::reach_problem;
+use trm_taskmap::{Explored, TaskMapSpec};
 
 /// Arguments of `task-map-studies`.
 #[derive(clap::Args)]
@@ -98,10 +97,8 @@ fn reach(
     iterations: usize,
     out_dir: &Path,
 ) -> Result<Run> {
-    let active = e
-        .model
-        .active_set(&["torso", "right_arm"], e.model.posture("home")?)?;
-    let problem = reach_problem(e, &active, obstacles, at, goal)?;
+    let active = e.reaching_set()?;
+    let problem = e.reach_problem(&active, obstacles, at, goal)?;
     let started = std::time::Instant::now();
     let (motion, trace) = problem.optimize(iterations);
     let seconds = started.elapsed().as_secs_f64();
@@ -133,7 +130,7 @@ pub fn run(args: &Args) -> Result<()> {
     let specs = crate::models_dir().join("../specs/taskmaps");
     let started = std::time::Instant::now();
     let out = &args.out_dir;
-    let stick = explore_spec(&specs.join("stick.ron"))?;
+    let stick = TaskMapSpec::load(specs.join("stick.ron"))?.explore()?;
     let tabletop = table()?;
     let place = Isometry3::translation(CYLINDER[0], CYLINDER[1], CYLINDER[2]);
     // the exact target: the map's grasp nearest the cylinder's centre
@@ -181,16 +178,8 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     // what the analytic gradient saves: one backward pass against 2 × 60 simulations
-    let active = stick
-        .model
-        .active_set(&["torso", "right_arm"], stick.model.posture("home")?)?;
-    let problem = reach_problem(
-        &stick,
-        &active,
-        &tabletop,
-        place,
-        MotionGoal::Map(&stick.map),
-    )?;
+    let active = stick.reaching_set()?;
+    let problem = stick.reach_problem(&active, &tabletop, place, MotionGoal::Map(&stick.map))?;
     let x0 = problem.initial_attractors();
     let timed = |f: &dyn Fn()| {
         let mut times: Vec<f64> = (0..5)
@@ -211,7 +200,7 @@ pub fn run(args: &Args) -> Result<()> {
         x0.len(),
         numeric / analytic
     );
-    let handle = explore_spec(&specs.join("handle.ron"))?;
+    let handle = TaskMapSpec::load(specs.join("handle.ron"))?.explore()?;
     let _ = write!(
         md,
         "\n## (b) Basket on the table ({} feasible grasps on the handle, {} clusters), three locations\n\n| basket | handle origin (x, y) m | total cost | joint-limit cost | closest approach (m) | end cost | grasp angle on the handle (°; 90 = top, below 90 towards the robot) | time (s) |\n|---|---|---|---|---|---|---|---|\n",

@@ -26,7 +26,7 @@ fn has(python: &str, module: &str) -> bool {
 }
 
 #[test]
-#[ignore = "slow (a release build of the wheel); CI runs it with --ignored"]
+#[ignore = "slow (a build of the wheel); CI runs it with --ignored"]
 fn the_python_package_builds_installs_and_passes_its_tests() {
     let required = std::env::var_os("TRM_PYTHON_TEST").is_some_and(|v| v == "1");
     let python = std::env::var("TRM_PYTHON").unwrap_or_else(|_| "python3".into());

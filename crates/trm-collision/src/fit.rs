@@ -14,7 +14,7 @@ use nalgebra::{
 };
 use parry3d_f64::shape::ConvexPolyhedron;
 
-use crate::Shape;
+use crate::{CollisionError, CollisionModel, Shape};
 
 /// A primitive around a set of points: its shape, its pose in the points' frame, its volume.
 #[derive(Debug, Clone, PartialEq)]
@@ -290,4 +290,127 @@ pub fn worst_outside(fitted: &Fitted, points: &[Point3<f64>]) -> f64 {
             }
         })
         .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// One link's proxy, as [`fit_model`] fits it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkFit {
+    /// The link's name.
+    pub link: String,
+    /// The proxy: the smallest of the link's [`Fits`] ([`Fits::best`]).
+    pub fitted: Fitted,
+    /// Volume of the convex hull of the link's mesh vertices, m³.
+    pub hull: f64,
+    /// Largest distance of a vertex outside the proxy ([`worst_outside`]; ≤ 0: all enclosed).
+    pub worst: f64,
+}
+
+/// Fits a proxy to every link of `collision` that has mesh collisions, in link order. An error
+/// when no link has any (the meshes were not found, or the URDF has none) or a link's vertices
+/// are not finite.
+pub fn fit_model(collision: &CollisionModel) -> Result<Vec<LinkFit>, CollisionError> {
+    let mut fits = Vec::new();
+    for (l, link) in collision.robot().tree().links.iter().enumerate() {
+        let points = collision.link_mesh_points(l);
+        if points.is_empty() {
+            continue;
+        }
+        let all = fit(&points).ok_or_else(|| CollisionError::InvalidValue {
+            what: format!("link `{}`'s meshes", link.name),
+            problem: "have no finite vertices to fit".into(),
+        })?;
+        let fitted = all.best().clone();
+        let worst = worst_outside(&fitted, &points);
+        fits.push(LinkFit {
+            link: link.name.clone(),
+            fitted,
+            hull: all.hull_volume,
+            worst,
+        });
+    }
+    if fits.is_empty() {
+        return Err(CollisionError::InvalidValue {
+            what: collision.robot().name().to_string(),
+            problem: "no link has mesh collisions to fit\n  fix: give a URDF whose <collision> elements are meshes (found through the package paths)".into(),
+        });
+    }
+    Ok(fits)
+}
+
+/// Added to radii and half sizes written with six decimals, so that the rounded primitive
+/// still encloses every vertex (rounding moves the origin by at most 5e-7 m).
+pub const WRITE_MARGIN: f64 = 2e-6;
+
+/// `urdf` (the text of the URDF the model was read from; `origin` names it in errors) with each
+/// fitted link's `<collision>` elements replaced by one holding its proxy, padded by
+/// [`WRITE_MARGIN`]; every other byte is kept.
+pub fn urdf_with_proxies(
+    urdf: &str,
+    origin: &str,
+    fits: &[LinkFit],
+) -> Result<String, CollisionError> {
+    let invalid = |problem: String| CollisionError::InvalidValue {
+        what: origin.to_string(),
+        problem,
+    };
+    trm_io::check_xml_nesting(urdf.as_bytes(), trm_io::XML_NESTING_LIMIT)
+        .map_err(|e| invalid(e.to_string()))?;
+    let doc = roxmltree::Document::parse(urdf).map_err(|e| invalid(e.to_string()))?;
+    // (start, end, replacement) of every collision element of a fitted link
+    let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    for link in doc
+        .root_element()
+        .children()
+        .filter(|n| n.has_tag_name("link"))
+    {
+        let Some(f) = fits
+            .iter()
+            .find(|f| Some(f.link.as_str()) == link.attribute("name"))
+        else {
+            continue;
+        };
+        let collisions = link.children().filter(|n| n.has_tag_name("collision"));
+        for (k, c) in collisions.enumerate() {
+            let replacement = if k == 0 {
+                collision_xml(&f.fitted)
+            } else {
+                String::new()
+            };
+            edits.push((c.range().start, c.range().end, replacement));
+        }
+    }
+    edits.sort_by_key(|e| e.0);
+    let mut out = String::with_capacity(urdf.len());
+    let mut at = 0;
+    for (start, end, replacement) in edits {
+        out.push_str(&urdf[at..start]);
+        out.push_str(&replacement);
+        at = end;
+    }
+    out.push_str(&urdf[at..]);
+    Ok(out)
+}
+
+/// A `<collision>` element for a fitted primitive.
+fn collision_xml(f: &Fitted) -> String {
+    let t = f.pose.translation.vector;
+    let (r, p, y) = f.pose.rotation.euler_angles();
+    let geometry = match &f.shape {
+        Shape::Sphere { radius } => format!("<sphere radius=\"{:.6}\"/>", radius + WRITE_MARGIN),
+        Shape::Capsule { radius, length } => format!(
+            "<capsule radius=\"{:.6}\" length=\"{length:.6}\"/>",
+            radius + WRITE_MARGIN
+        ),
+        Shape::Box { size } => format!(
+            "<box size=\"{:.6} {:.6} {:.6}\"/>",
+            size[0] + 2.0 * WRITE_MARGIN,
+            size[1] + 2.0 * WRITE_MARGIN,
+            size[2] + 2.0 * WRITE_MARGIN
+        ),
+        other => format!("<!-- {} -->", other.kind()),
+    };
+    format!(
+        "<collision>\n      <origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"{r:.6} {p:.6} {y:.6}\"/>\n      <geometry>\n        {geometry}\n      </geometry>\n    </collision>",
+        t.x, t.y, t.z
+    )
 }

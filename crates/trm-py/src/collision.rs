@@ -161,6 +161,47 @@ impl Collision {
         })
     }
 
+    /// The allowed-collision matrix MoveIt's setup assistant would generate for this model, as
+    /// `trm gen-acm`: pairs adjacent in the tree, colliding in the default posture (`posture`,
+    /// else `home`), never colliding or colliding in at least `always_fraction` of `samples`
+    /// seeded random configurations. Returns the disabled link pairs as
+    /// `(link, link, reason)`.
+    #[pyo3(signature = (samples = 1_000_000, seed = 0, always_fraction = 0.95, posture = None))]
+    fn generate_acm(
+        &self,
+        py: Python<'_>,
+        samples: usize,
+        seed: u64,
+        always_fraction: f64,
+        posture: Option<String>,
+    ) -> PyResult<Vec<(String, String, String)>> {
+        let default_posture = match posture {
+            Some(name) => Some(self.robot.posture(&name).map_err(err)?.to_vec()),
+            None => None,
+        };
+        let options = trm_collision::AcmOptions {
+            samples,
+            seed,
+            always_fraction,
+            default_posture,
+        };
+        let report = py
+            .detach(|| trm_collision::generate_acm(&self.model, &options))
+            .map_err(err)?;
+        let links = &self.robot.tree().links;
+        Ok(report
+            .acm
+            .disabled_pairs()
+            .map(|([a, b], reason)| {
+                (
+                    links[a].name.clone(),
+                    links[b].name.clone(),
+                    reason.as_str().to_string(),
+                )
+            })
+            .collect())
+    }
+
     /// Body names.
     #[getter]
     fn body_names(&self) -> Vec<String> {

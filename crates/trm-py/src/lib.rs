@@ -7,6 +7,7 @@
 mod benchmark;
 mod collision;
 mod cost;
+mod models;
 mod optim;
 mod plan;
 mod problem;
@@ -189,5 +190,8 @@ fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(benchmark::compare_optimisers, m)?)?;
     m.add_function(wrap_pyfunction!(benchmark::benchmark_mbm, m)?)?;
     m.add_function(wrap_pyfunction!(wholebody::stand_up, m)?)?;
+    m.add_function(wrap_pyfunction!(taskmap::reach_grasp, m)?)?;
+    m.add_function(wrap_pyfunction!(models::fit_proxies, m)?)?;
+    m.add_function(wrap_pyfunction!(models::generate_mbm, m)?)?;
     Ok(())
 }

@@ -69,3 +69,71 @@ impl TaskMap {
         self.map.points.len()
     }
 }
+
+/// The reaching motion of Gienger et al. (Section III), as `trm reach-grasp`: explores the
+/// task map of `spec`, places its object at `at` (`(x, y, z)` or `(x, y, z, yaw)`) in `world`
+/// (none: empty) and optimises the iCub's torso and right arm from home toward the whole map
+/// (or, with `exact`, its centre grasp) for `iterations` iRprop− steps. Returns a dict: cost,
+/// limits, min_distance, collisions, length, end_speed, end, final_pose `(6,)` (the hand in the
+/// object's frame) and trajectory `(T, motors)`.
+#[pyfunction]
+#[pyo3(signature = (spec, at, world = None, exact = false, iterations = 30))]
+pub(crate) fn reach_grasp<'py>(
+    py: Python<'py>,
+    spec: &str,
+    at: Vec<f64>,
+    world: Option<&PyWorld>,
+    exact: bool,
+    iterations: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !(at.len() == 3 || at.len() == 4) || at.iter().any(|v| !v.is_finite()) {
+        return Err(err(format!(
+            "at {at:?}: give (x, y, z) or (x, y, z, yaw), finite"
+        )));
+    }
+    if iterations == 0 {
+        return Err(err("iterations 0: give at least 1"));
+    }
+    let place = Isometry3::new(
+        trm_kinematics::nalgebra::Vector3::new(at[0], at[1], at[2]),
+        trm_kinematics::nalgebra::Vector3::z() * at.get(3).copied().unwrap_or(0.0),
+    );
+    let loaded = trm_taskmap::TaskMapSpec::load(spec).map_err(err)?;
+    let explored = py.detach(|| loaded.explore()).map_err(err)?;
+    let empty = World::new();
+    let world = world.map_or(&empty, |w| &w.world);
+    let active = explored.reaching_set().map_err(err)?;
+    let centre = explored
+        .map
+        .center_grasp()
+        .ok_or_else(|| err("the task map is empty"))?;
+    let goal = if exact {
+        trm_taskmap::MotionGoal::Target(centre)
+    } else {
+        trm_taskmap::MotionGoal::Map(&explored.map)
+    };
+    let problem = explored
+        .reach_problem(&active, world, place, goal)
+        .map_err(err)?;
+    let (m, _) = py.detach(|| problem.optimize(iterations));
+    let d = PyDict::new(py);
+    for (key, value) in [
+        ("cost", m.cost),
+        ("limits", m.limits),
+        ("min_distance", m.min_distance),
+        ("length", m.length),
+        ("end_speed", m.end_speed),
+        ("end", m.end),
+    ] {
+        d.set_item(key, value)?;
+    }
+    d.set_item("collisions", m.collisions)?;
+    d.set_item("final_pose", shaped(py, None, &[6], m.final_pose.to_vec())?)?;
+    let motors: Vec<Vec<f64>> = m.trajectory.iter().map(|q| active.to_motors(q)).collect();
+    let width = motors.first().map_or(0, Vec::len);
+    d.set_item(
+        "trajectory",
+        shaped(py, None, &[motors.len(), width], motors.concat())?,
+    )?;
+    Ok(d)
+}

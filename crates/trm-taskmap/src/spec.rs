@@ -111,6 +111,45 @@ pub struct Explored {
     pub seconds: f64,
 }
 
+impl Explored {
+    /// The paper's reaching motion (Section III) of the iCub's right hand (torso and right arm
+    /// moving, from the home posture) to grasp this map's object placed at `object` in
+    /// `world`, toward `goal` (this map, or one grasp of it), with the default settings.
+    pub fn reach_problem<'a>(
+        &'a self,
+        active: &'a trm_kinematics::ActiveSet,
+        world: &'a World,
+        object: nalgebra::Isometry3<f64>,
+        goal: crate::MotionGoal<'a>,
+    ) -> Result<crate::ReachProblem<'a>, TaskMapError> {
+        let grasp_axis =
+            crate::grasp_axis(&self.map, &self.object).ok_or_else(|| TaskMapError::Invalid {
+                what: "task map".into(),
+                problem:
+                    "gives no grasp axis: it is empty or its object has no capsule, cylinder or box"
+                        .into(),
+            })?;
+        Ok(crate::ReachProblem {
+            active,
+            collision: &self.collision,
+            world,
+            hand: self.model.frame_id("r_hand")?,
+            grasp_axis,
+            object,
+            start: active.from_motors(self.model.posture("home")?),
+            goal,
+            settings: crate::MotionOptions::default(),
+        })
+    }
+
+    /// The active set the reaching motions move: torso and right arm, the rest at home.
+    pub fn reaching_set(&self) -> Result<trm_kinematics::ActiveSet, TaskMapError> {
+        Ok(self
+            .model
+            .active_set(&["torso", "right_arm"], self.model.posture("home")?)?)
+    }
+}
+
 /// A spec with where it came from (for errors and relative paths).
 #[derive(Debug, Clone)]
 pub struct LoadedTaskMapSpec {

@@ -6,9 +6,9 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
-use trm_collision::fit::{Fitted, fit, worst_outside};
-use trm_collision::{CollisionModel, Shape};
+use anyhow::{Context, Result};
+use trm_collision::CollisionModel;
+use trm_collision::fit::{fit_model, urdf_with_proxies};
 
 /// Arguments of `fit-proxies`.
 #[derive(clap::Args)]
@@ -26,42 +26,11 @@ pub struct Args {
     compare: Option<PathBuf>,
 }
 
-/// One link's fit.
-struct LinkFit {
-    link: String,
-    fitted: Fitted,
-    hull: f64,
-    worst: f64,
-}
-
 /// Fits every link that has meshes, prints the table, writes what was asked.
 pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(Some(&args.model))?;
     let collision = args.meshes.collision_model(&model)?;
-    let links = &model.tree().links;
-    let mut fits = Vec::new();
-    for (l, link) in links.iter().enumerate() {
-        let points = collision.link_mesh_points(l);
-        if points.is_empty() {
-            continue;
-        }
-        let all =
-            fit(&points).with_context(|| format!("link `{}`: no finite vertices", link.name))?;
-        let fitted = all.best().clone();
-        let worst = worst_outside(&fitted, &points);
-        fits.push(LinkFit {
-            link: link.name.clone(),
-            fitted,
-            hull: all.hull_volume,
-            worst,
-        });
-    }
-    if fits.is_empty() {
-        bail!(
-            "{}: no link has mesh collisions to fit\n  fix: give a URDF whose <collision> elements are meshes (found through --package-path)",
-            args.model.display()
-        );
-    }
+    let fits = fit_model(&collision).with_context(|| args.model.display().to_string())?;
     let other = match &args.compare {
         Some(p) => Some(CollisionModel::new(&crate::load_model(Some(p))?)?),
         None => None,
@@ -95,8 +64,13 @@ pub fn run(args: &Args) -> Result<()> {
             ""
         }
     );
-    let (mut hull_sum, mut fit_sum, mut cmp_fit, mut cmp_other, mut tighter) =
-        (0.0, 0.0, 0.0, 0.0, 0);
+    let (mut hull_sum, mut fit_sum, mut cmp_fit, mut cmp_other, mut tighter): (
+        f64,
+        f64,
+        f64,
+        f64,
+        usize,
+    ) = (0.0, 0.0, 0.0, 0.0, 0);
     for f in &fits {
         hull_sum += f.hull;
         fit_sum += f.fitted.volume;
@@ -144,8 +118,7 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(out) = &args.out {
         let text = std::fs::read_to_string(&args.model)
             .with_context(|| format!("reading {}", args.model.display()))?;
-        let urdf = with_proxies(&text, &fits)
-            .with_context(|| format!("rewriting {}", args.model.display()))?;
+        let urdf = urdf_with_proxies(&text, &args.model.display().to_string(), &fits)?;
         crate::write_atomic(out, urdf.as_bytes())?;
         println!(
             "wrote {} ({} links with fitted proxies)",
@@ -154,76 +127,6 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The URDF text with each fitted link's `<collision>` elements replaced by one element with
-/// its fitted primitive.
-fn with_proxies(text: &str, fits: &[LinkFit]) -> Result<String> {
-    let doc = roxmltree::Document::parse(text)?;
-    // (start, end, replacement) of every collision element of a fitted link
-    let mut edits: Vec<(usize, usize, String)> = Vec::new();
-    for link in doc
-        .root_element()
-        .children()
-        .filter(|n| n.has_tag_name("link"))
-    {
-        let Some(f) = fits
-            .iter()
-            .find(|f| Some(f.link.as_str()) == link.attribute("name"))
-        else {
-            continue;
-        };
-        let collisions: Vec<_> = link
-            .children()
-            .filter(|n| n.has_tag_name("collision"))
-            .collect();
-        for (k, c) in collisions.iter().enumerate() {
-            let replacement = if k == 0 {
-                collision_xml(&f.fitted)
-            } else {
-                String::new()
-            };
-            edits.push((c.range().start, c.range().end, replacement));
-        }
-    }
-    edits.sort_by_key(|e| e.0);
-    let mut out = String::with_capacity(text.len());
-    let mut at = 0;
-    for (start, end, replacement) in edits {
-        out.push_str(&text[at..start]);
-        out.push_str(&replacement);
-        at = end;
-    }
-    out.push_str(&text[at..]);
-    Ok(out)
-}
-
-/// Added to radii and half sizes written with six decimals, so that the rounded primitive
-/// still encloses every vertex (rounding moves the origin by at most 5e-7 m).
-const MARGIN: f64 = 2e-6;
-
-/// A `<collision>` element for a fitted primitive.
-fn collision_xml(f: &Fitted) -> String {
-    let t = f.pose.translation.vector;
-    let (r, p, y) = f.pose.rotation.euler_angles();
-    let geometry = match &f.shape {
-        Shape::Sphere { radius } => format!("<sphere radius=\"{:.6}\"/>", radius + MARGIN),
-        Shape::Capsule { radius, length } => format!(
-            "<capsule radius=\"{:.6}\" length=\"{length:.6}\"/>",
-            radius + MARGIN
-        ),
-        Shape::Box { size } => format!(
-            "<box size=\"{:.6} {:.6} {:.6}\"/>",
-            size[0] + 2.0 * MARGIN,
-            size[1] + 2.0 * MARGIN,
-            size[2] + 2.0 * MARGIN
-        ),
-        other => format!("<!-- {} -->", other.kind()),
-    };
-    format!(
-        "<collision>\n      <origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"{r:.6} {p:.6} {y:.6}\"/>\n      <geometry>\n        {geometry}\n      </geometry>\n    </collision>",
-        t.x, t.y, t.z
-    )
 }
 
 #[cfg(test)]

@@ -9,10 +9,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use trm_collision::World;
-use trm_kinematics::ActiveSet;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_plan::{Trajectory, time_parametrise};
-use trm_taskmap::{Explored, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
+use trm_taskmap::MotionGoal;
 
 use crate::explore_task_map::explore_spec;
 
@@ -56,16 +55,14 @@ pub fn run(args: &Args) -> Result<()> {
         Some(w) => trm_plan::moveit::load_world(w)?,
         None => World::new(),
     };
-    let active = e
-        .model
-        .active_set(&["torso", "right_arm"], e.model.posture("home")?)?;
+    let active = e.reaching_set()?;
     let centre = e.map.center_grasp().context("the task map is empty")?;
     let goal = if args.exact {
         MotionGoal::Target(centre)
     } else {
         MotionGoal::Map(&e.map)
     };
-    let problem = reach_problem(&e, &active, &world, at, goal)?;
+    let problem = e.reach_problem(&active, &world, at, goal)?;
     let started = std::time::Instant::now();
     let (m, trace) = problem.optimize(args.iterations);
     println!(
@@ -105,31 +102,6 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The reach of the right hand of an explored task map's robot (torso and right arm, from
-/// home) to its object at `object`, around `world`, with the map's grasp axis.
-pub fn reach_problem<'a>(
-    e: &'a Explored,
-    active: &'a ActiveSet,
-    world: &'a World,
-    object: Isometry3<f64>,
-    goal: MotionGoal<'a>,
-) -> Result<ReachProblem<'a>> {
-    let grasp_axis = grasp_axis(&e.map, &e.object).context(
-        "the task map gives no grasp axis: it is empty or its object has no capsule, cylinder or box",
-    )?;
-    Ok(ReachProblem {
-        active,
-        collision: &e.collision,
-        world,
-        hand: e.model.frame_id("r_hand")?,
-        grasp_axis,
-        object,
-        start: active.from_motors(e.model.posture("home")?),
-        goal,
-        settings: MotionOptions::default(),
-    })
 }
 
 #[cfg(test)]

@@ -359,9 +359,19 @@ def test_motionbenchmaker_from_python_solves_and_verifies():
         trm.benchmark_mbm(str(fixtures), model, families=["box_pand"])
 
 
+def small_stick(tmp_path):
+    """specs/taskmaps/stick.ron with a tenth of its exploration (the wheel under test is a
+    debug build)."""
+    text = (ROOT / "specs" / "taskmaps" / "stick.ron").read_text()
+    assert "iterations: 3000" in text and "restarts: 300" in text
+    small = tmp_path / "stick.ron"
+    small.write_text(text.replace("iterations: 3000", "iterations: 300").replace("restarts: 300", "restarts: 30"))
+    return str(small)
+
+
 def test_task_maps_explore_save_load_and_cost(tmp_path):
-    explored = trm.TaskMap.explore(str(ROOT / "specs" / "taskmaps" / "stick.ron"))
-    assert len(explored) > 50 and explored.points.shape == (len(explored), 6)
+    explored = trm.TaskMap.explore(small_stick(tmp_path))
+    assert len(explored) > 20 and explored.points.shape == (len(explored), 6)
     assert explored.clusters >= 1 and explored.values.shape == (len(explored),)
     explored.save(str(tmp_path / "stick.taskmap.json"))
     back = trm.TaskMap.load(str(tmp_path / "stick.taskmap.json"))
@@ -395,6 +405,58 @@ def test_whole_body_motion_from_python():
     # the budgets given replace the spec's and are checked as the spec's own are
     with pytest.raises(trm.TrmError, match="optimiser.rollouts"):
         trm.stand_up(str(ROOT / "specs" / "wholebody" / "standup.ron"), rollouts=10**8)
+
+
+def test_reaching_motion_toward_a_task_map_from_python(tmp_path):
+    spec = small_stick(tmp_path)
+    world = trm.World.load(str(ROOT / "specs" / "worlds" / "table.ron"))
+    r = trm.reach_grasp(spec, [-0.3, 0.1, -0.05], world=world, iterations=3)
+    assert r["trajectory"].shape[1] == 41 and r["trajectory"].shape[0] > 2
+    assert r["final_pose"].shape == (6,) and r["cost"] > 0
+    with pytest.raises(trm.TrmError, match="x, y, z"):
+        trm.reach_grasp(spec, [0.0, 0.0])
+
+
+def test_proxies_fitted_from_python_are_written_into_the_urdf(tmp_path):
+    fixtures = ROOT / "crates" / "trm-collision" / "tests" / "fixtures" / "meshes"
+    mesh = (
+        '<collision><geometry><mesh filename="package://demo_pkg/meshes/cube.stl" '
+        'scale="0.1 0.2 0.05"/></geometry></collision>'
+    )
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(
+        f'<robot name="arm"><link name="base">{mesh}</link><link name="tip">{mesh}</link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="tip"/>'
+        '<origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    out = tmp_path / "arm.fitted.urdf"
+    fits = trm.fit_proxies(str(urdf), package_paths=[str(fixtures)], out=str(out))
+    assert [f["link"] for f in fits] == ["base", "tip"]
+    assert all(f["primitive"] == "box" and f["worst_outside"] <= 1e-9 for f in fits)
+    fitted = trm.CollisionModel(trm.Robot.load(str(out)))
+    assert len(fitted.body_names) == 2
+    with pytest.raises(trm.TrmError, match="no link has mesh collisions"):
+        trm.fit_proxies(str(out))
+
+
+def test_allowed_collisions_generated_from_python_are_seeded():
+    collision = trm.CollisionModel(trm.Robot.load(str(ROOT / "models" / "panda" / "panda.ron")))
+    a = collision.generate_acm(samples=300, seed=3)
+    assert a == collision.generate_acm(samples=300, seed=3)
+    assert any(reason == "adjacent" for _, _, reason in a)
+    with pytest.raises(trm.TrmError, match="did you mean"):
+        collision.generate_acm(samples=10, posture="defualt")
+
+
+def test_a_benchmark_set_generated_from_python_is_solved_from_python(tmp_path):
+    spec = str(ROOT / "specs" / "mbm" / "icub_reach.ron")
+    n = trm.generate_mbm(spec, str(tmp_path / "set"), families=["table"], per_family=1, facing=(-1.0, 0.0))
+    assert n == 1
+    r = trm.benchmark_mbm(str(tmp_path / "set"), "icub_upper_body", per_family=1)
+    assert len(r["runs"]) == 1 and r["runs"][0]["outcome"]["valid"]
+    with pytest.raises(trm.TrmError, match="facing"):
+        trm.generate_mbm(spec, str(tmp_path / "bad"), per_family=1, facing=(0.0, 0.0))
 
 
 def test_version_is_the_crate_version():
