@@ -145,8 +145,8 @@ impl Problem {
     }
 
     /// Clearance of active values: the smallest signed distance between checked body pairs and
-    /// between bodies and `world`'s objects (the spec's world when absent), capped at `cap`
-    /// metres (pairs farther apart are not measured).
+    /// between bodies and `world`'s objects (the spec's world when absent), as `trm solve`
+    /// reports it (`Objective::clearance_in`); values above `cap` metres are given as `cap`.
     #[pyo3(signature = (q, world = None, cap = 0.5))]
     fn clearance(&self, q: &Bound<'_, PyAny>, world: Option<&PyWorld>, cap: f64) -> PyResult<f64> {
         let o = &self.problem.objective;
@@ -155,14 +155,8 @@ impl Problem {
         if batch.is_some() {
             return Err(err("clearance takes one configuration (d,)"));
         }
-        let mut scratch = o.scratch();
-        let poses = o.poses(&values, &mut scratch);
-        let collision = o.collision();
-        let mut placed = collision.placed_bodies();
-        collision.place(&poses, &mut placed);
-        let mut near = Vec::new();
-        collision.near_pairs(&placed, w, cap, &mut near);
-        Ok(near.iter().map(|p| p.distance).fold(cap, f64::min))
+        let clearance = o.clearance_in(&values, w, &mut o.scratch());
+        Ok(clearance.distance().min(cap))
     }
 
     /// The task vector g(q) of active values (empty without a task function).

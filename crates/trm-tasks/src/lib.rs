@@ -43,7 +43,7 @@ pub use context::{Anchor, BatchContext, Context, Frames, LaneView};
 pub use costs::{Cost, TaskTarget};
 pub use error::{Result, TaskError};
 pub use ngik::{Solution, solve, solve_with, solver_start};
-pub use objective::{Objective, Scratch, TermValue};
+pub use objective::{Clearance, Objective, Scratch, TermValue};
 pub use pool::{Lease, ScratchPool};
 pub use spec::{Problem, Spec};
 pub use tasks::TaskFunction;

@@ -51,6 +51,25 @@ pub struct Objective {
     copies_placed: bool,
 }
 
+/// How close a posture comes to collision ([`Objective::clearance_in`]): signed distances in
+/// metres (negative: penetration) with what they are between.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clearance {
+    /// The closest pair of the robot's own checked bodies: (distance, body, body).
+    pub own: Option<(f64, usize, usize)>,
+    /// The closest body to a world object: (distance, body, object).
+    pub world: Option<(f64, usize, usize)>,
+}
+
+impl Clearance {
+    /// The smaller of the two distances (+∞ when there is nothing to measure).
+    pub fn distance(&self) -> f64 {
+        let own = self.own.map_or(f64::INFINITY, |p| p.0);
+        let world = self.world.map_or(f64::INFINITY, |p| p.0);
+        own.min(world)
+    }
+}
+
 /// Per-thread buffers for evaluating an [`Objective`], one candidate or a batch at a time.
 #[derive(Debug, Clone)]
 pub struct Scratch {
@@ -624,6 +643,25 @@ impl Objective {
     pub fn is_collision_free_in(&self, q: &[f64], world: &World, scratch: &mut Scratch) -> bool {
         self.pose(q, scratch, true);
         !self.collision.is_colliding(&scratch.placed, world)
+    }
+
+    /// How close active values `q` come to collision in `world`: the closest checked pair of
+    /// the robot's own bodies and the closest body to a world object (exact signed distances).
+    pub fn clearance_in(&self, q: &[f64], world: &World, scratch: &mut Scratch) -> Clearance {
+        self.pose(q, scratch, true);
+        let model = self.collision();
+        let placed = &scratch.placed;
+        let own = model
+            .min_self_distance(placed)
+            .map(|p| (p.distance, p.a, p.b));
+        let to_world = (0..model.bodies().len())
+            .flat_map(|b| (0..world.len()).map(move |o| (b, o)))
+            .map(|(b, o)| (model.object_distance(placed, b, world, o), b, o))
+            .min_by(|x, y| x.0.total_cmp(&y.0));
+        Clearance {
+            own,
+            world: to_world,
+        }
     }
 
     /// The task vector g(q) (empty without a task function).

@@ -144,34 +144,26 @@ pub fn run(args: &Args) -> Result<()> {
 /// The posture's clearance: the closest checked body pair and the closest body to a world
 /// object (signed distances; negative = penetration).
 fn clearance(objective: &trm_tasks::Objective, q: &[f64]) -> String {
-    let model = objective.collision();
-    let bodies = model.bodies();
+    let bodies = objective.collision().bodies();
     let world = objective.world();
-    let mut scratch = objective.scratch();
+    let c = objective.clearance_in(q, world, &mut objective.scratch());
     let mut line = String::from("clearance:");
-    objective.all_placed(q, &mut scratch, |placed| {
-        if let Some(p) = model.min_self_distance(placed) {
-            line += &format!(
-                " {:.1} mm between checked bodies ({} – {})",
-                p.distance * 1e3,
-                bodies[p.a].name,
-                bodies[p.b].name
-            );
-        }
-        let closest = (0..bodies.len())
-            .flat_map(|b| (0..world.len()).map(move |o| (b, o)))
-            .map(|(b, o)| (model.object_distance(placed, b, world, o), b, o))
-            .min_by(|x, y| x.0.total_cmp(&y.0));
-        if let Some((d, b, o)) = closest {
-            line += &format!(
-                ", {:.1} mm to the world ({} – {})",
-                d * 1e3,
-                bodies[b].name,
-                world.objects()[o].name()
-            );
-        }
-        false
-    });
+    if let Some((d, a, b)) = c.own {
+        line += &format!(
+            " {:.1} mm between checked bodies ({} – {})",
+            d * 1e3,
+            bodies[a].name,
+            bodies[b].name
+        );
+    }
+    if let Some((d, b, o)) = c.world {
+        line += &format!(
+            ", {:.1} mm to the world ({} – {})",
+            d * 1e3,
+            bodies[b].name,
+            world.objects()[o].name()
+        );
+    }
     line
 }
 

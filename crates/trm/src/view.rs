@@ -54,6 +54,21 @@ struct Subject {
     motion: Option<WholeBody>,
 }
 
+/// The top-level field names of a RON file (none when it does not parse as a struct): a task
+/// spec has `costs`, a motion spec `phases`, a model description `urdf`.
+fn ron_fields(text: &str) -> Vec<String> {
+    match ron::from_str::<ron::Value>(text) {
+        Ok(ron::Value::Map(map)) => map
+            .keys()
+            .filter_map(|k| match k {
+                ron::Value::String(s) => Some(s.clone()),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
 fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
     let from_problem = |p: Problem, title: String| Subject {
         start: p.objective.active().to_motors(&p.start),
@@ -71,9 +86,10 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             } else {
                 String::new()
             };
-            if text.contains("costs") {
+            let fields = ron_fields(&text);
+            if fields.iter().any(|f| f == "costs") {
                 Ok(from_problem(Problem::load(path)?, title))
-            } else if text.contains("phases") && text.contains("feet") {
+            } else if fields.iter().any(|f| f == "phases") {
                 let motion = WholeBody::load(path)?;
                 Ok(Subject {
                     robot: motion.model().clone(),
@@ -265,6 +281,21 @@ pub fn run(args: &Args) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_files_kind_comes_from_its_fields_not_its_comments() {
+        let repo = crate::models_dir().join("..");
+        let fields = |p: &str| super::ron_fields(&std::fs::read_to_string(repo.join(p)).unwrap());
+        assert!(fields("specs/reach.ron").contains(&"costs".to_string()));
+        assert!(fields("specs/wholebody/standup.ron").contains(&"phases".to_string()));
+        let description = fields("models/icub_upper_body.ron");
+        assert!(description.contains(&"urdf".to_string()), "{description:?}");
+        assert!(!description.contains(&"costs".to_string()));
+        // a comment naming a field is not a field
+        let text = "// costs: see the spec\n(urdf: \"x.urdf\")";
+        assert_eq!(super::ron_fields(text), ["urdf"]);
+        assert!(super::ron_fields("not ron at all (").is_empty());
+    }
+
     use std::path::{Path, PathBuf};
     use std::process::Command;
 

@@ -459,6 +459,23 @@ def test_a_benchmark_set_generated_from_python_is_solved_from_python(tmp_path):
         trm.generate_mbm(spec, str(tmp_path / "bad"), per_family=1, facing=(0.0, 0.0))
 
 
+EXAMPLES = sorted((ROOT / "crates" / "trm-py" / "examples").glob("*.py"))
+
+
+@pytest.mark.parametrize("example", EXAMPLES, ids=lambda p: p.name)
+def test_the_examples_run(example):
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, str(example)], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.strip()
+
+
+def test_there_are_examples():
+    assert len(EXAMPLES) >= 3
+
+
 def test_version_is_the_crate_version():
     cargo = (ROOT / "Cargo.toml").read_text()
     assert f'version = "{trm.__version__}"' in cargo
