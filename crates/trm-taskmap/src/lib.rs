@@ -28,6 +28,16 @@ pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
 pub use motion::{CostWeights, Motion, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
 pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};
 
+/// Lets task specs name task maps (`TaskMap(file: …)` costs of trm-tasks, read as [`TaskMap`]
+/// files): call once before loading such a spec. The `trm` tool and the Python package do.
+pub fn register() {
+    trm_tasks::register_pose_maps(|path| {
+        TaskMap::load(path)
+            .map(|m| std::sync::Arc::new(m) as std::sync::Arc<dyn trm_tasks::PoseMap>)
+            .map_err(|e| e.to_string())
+    });
+}
+
 /// The file formats this crate reads and writes.
 pub mod formats {
     #[doc = include_str!("../docs/task-map-spec.md")]

@@ -343,6 +343,14 @@ impl TaskMap {
     }
 }
 
+/// A task map as a cost of trm-tasks' catalogue: the part's pose relative to the object, as a
+/// grasp, against the map ([`TaskMap::cost`]).
+impl trm_tasks::PoseMap for TaskMap {
+    fn cost(&self, relative: &Isometry3<f64>) -> f64 {
+        TaskMap::cost(self, &to_params(relative)).0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,8 +1,11 @@
 //! Cost functions h_i(p, q, w) ≥ 0 (Table I of Stollenga et al., IROS 2013, with the parameters
 //! the paper describes). Implement [`Cost`] to add your own.
 
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+
 use trm_kinematics::FrameId;
-use trm_kinematics::nalgebra::Vector3;
+use trm_kinematics::nalgebra::{Isometry3, Vector3};
 
 use crate::context::{Anchor, BatchContext, Context, Frames};
 use crate::error::{Result, TaskError};
@@ -354,13 +357,38 @@ impl Displacement {
     }
 }
 
+/// A map of a part's feasible poses relative to a world object, seen as a cost: 0 on the map,
+/// growing away from it. Task maps of feasible grasps (trm-taskmap's `TaskMap`, Gienger et al.)
+/// implement it; this crate knows nothing else about them.
+pub trait PoseMap: Send + Sync + std::fmt::Debug {
+    /// The cost of the part's pose relative to the object.
+    fn cost(&self, relative: &Isometry3<f64>) -> f64;
+}
+
+/// Reads the pose map a spec's `TaskMap(file: …)` cost names (`Err`: what is wrong with it).
+pub type PoseMapLoader = fn(&Path) -> std::result::Result<Arc<dyn PoseMap>, String>;
+
+static POSE_MAP_LOADER: OnceLock<PoseMapLoader> = OnceLock::new();
+
+/// Lets specs name pose maps (`TaskMap(file: …)` costs), read by `loader`: called once by the
+/// crate that owns the file format (`trm_taskmap::register()`, which the `trm` tool and the
+/// Python package call). Later calls keep the first loader.
+pub fn register_pose_maps(loader: PoseMapLoader) {
+    let _ = POSE_MAP_LOADER.set(loader);
+}
+
+/// The registered loader of pose maps, if any.
+pub(crate) fn pose_map_loader() -> Option<PoseMapLoader> {
+    POSE_MAP_LOADER.get().copied()
+}
+
 /// The task-map cost (Gienger et al., eq. 18–19): c_map = (x − x_map)ᵀ W (x − x_map) where x is
 /// the part's pose relative to a world object (position, rotation vector) and x_map the nearest
 /// feasible point of a task map — "anywhere on the handle" instead of one target.
 #[derive(Debug, Clone)]
 pub struct TaskMapCost {
     /// The map.
-    pub map: std::sync::Arc<trm_taskmap::TaskMap>,
+    pub map: Arc<dyn PoseMap>,
     /// The part whose pose is compared (e.g. the hand).
     pub part: FrameId,
     /// Its name.
@@ -380,7 +408,7 @@ impl TaskMapCost {
     fn value(&self, f: &impl Frames) -> f64 {
         let object = f.world().objects()[self.object].pose();
         let relative = object.inverse() * f.pose(self.part);
-        self.map.cost(&trm_taskmap::to_params(&relative)).0
+        self.map.cost(&relative)
     }
 }
 

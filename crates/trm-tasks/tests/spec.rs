@@ -257,3 +257,18 @@ fn a_rotation_relative_to_another_part_is_the_axis_in_its_frame() {
     let label = objective.task().unwrap().label();
     assert_eq!(label, "rotation r_hand relative to head");
 }
+
+/// Task maps are another crate's format: without its loader registered (nothing in this test
+/// binary registers one), a spec naming a task map is a located error saying what to call.
+#[test]
+fn a_task_map_cost_without_a_registered_reader_says_what_to_call() {
+    let e = error(
+        "(model: \"icub_upper_body\", active: [\"torso\"],
+          world: (objects: [(name: \"stick\", shape: Sphere(radius: 0.01))]),
+          costs: [(weight: 1.0, cost: TaskMap(file: \"stick.taskmap.json\", part: \"r_hand\", object: \"stick\"))])",
+    );
+    assert!(
+        e.contains("trm_taskmap::register()") && e.contains("costs[0]"),
+        "{e}"
+    );
+}

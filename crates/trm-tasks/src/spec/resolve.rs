@@ -270,15 +270,22 @@ impl Resolver<'_> {
             }),
             CostKind::TaskMap { file, part, object } => {
                 let path = self.base.join(file);
-                let map = trm_taskmap::TaskMap::load(&path).map_err(|e| {
+                let loader = crate::costs::pose_map_loader().ok_or_else(|| {
+                    self.ctx.err(
+                        &format!("{field}.cost"),
+                        "task maps are read by trm-taskmap, which is not registered",
+                        "call trm_taskmap::register() once before loading the spec (the trm tool and Python do)",
+                    )
+                })?;
+                let map = loader(&path).map_err(|e| {
                     self.ctx.err(
                         &format!("{field}.cost.file"),
-                        e.to_string(),
-                        "build it with trm_taskmap::explore (cargo xtask explore-task-map)",
+                        e,
+                        "build it with trm_taskmap::explore (trm explore-task-map)",
                     )
                 })?;
                 Box::new(crate::costs::TaskMapCost {
-                    map: std::sync::Arc::new(map),
+                    map,
                     part: self.frame(part, &format!("{field}.cost.part"))?,
                     part_name: part.clone(),
                     object: self.object(object, &format!("{field}.cost.object"))?,

@@ -8,6 +8,7 @@ use trm_tasks::{Problem, solve};
 
 #[test]
 fn ngik_brings_the_hand_onto_a_task_map() {
+    trm_taskmap::register();
     let robot = trm_models::icub_upper_body();
     let mut poses = robot.pose_buffer();
     robot
