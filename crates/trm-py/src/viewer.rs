@@ -5,11 +5,12 @@ use crate::*;
 /// Writes a self-contained 3-D page of `robot` (the same viewer as `cargo xtask view`): one
 /// frame per posture in `frames` (`(n,)` or `(T, n)` motor values; the home posture, else
 /// neutral, when absent) at `times` (default 0.05 s apart), `world`'s objects, and a task-space
-/// `path` `(K, 3)` drawn as a line. `out` gets the page and `out` with `.json` the scene; the
+/// `path` `(K, 3)` drawn as a line, and a `roadmap`'s points, edges and postures (as `trm view
+/// --map` draws them). `out` gets the page and `out` with `.json` the scene; the
 /// page loads three.js from a CDN unless `bundle` names a built viewer (viewer/dist/viewer.js)
 /// to inline. Returns the page's path.
 #[pyfunction]
-#[pyo3(signature = (robot, out, frames = None, times = None, world = None, path = None, title = "trm", bundle = None))]
+#[pyo3(signature = (robot, out, frames = None, times = None, world = None, path = None, title = "trm", bundle = None, roadmap = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn view(
     robot: &Robot,
@@ -20,6 +21,7 @@ pub(crate) fn view(
     path: Option<&Bound<'_, PyAny>>,
     title: &str,
     bundle: Option<std::path::PathBuf>,
+    roadmap: Option<&Roadmap>,
 ) -> PyResult<std::path::PathBuf> {
     let n = robot.model.motors().len();
     let postures = match frames {
@@ -53,6 +55,12 @@ pub(crate) fn view(
         }
         let v = a.as_slice().map_err(err)?;
         scene.set_path(v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect());
+    }
+    if let Some(r) = roadmap {
+        let problem = r.map.problem().map_err(err)?;
+        scene
+            .add_roadmap(&r.map, problem.objective.active())
+            .map_err(err)?;
     }
     let code = match &bundle {
         Some(b) => {

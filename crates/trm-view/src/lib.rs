@@ -28,6 +28,9 @@ use trm_kinematics::JointKind;
 use trm_kinematics::nalgebra::Isometry3;
 use trm_kinematics::{PoseBuffer, RobotModel};
 
+mod subjects;
+pub use subjects::point3;
+
 /// The scene format's name and version.
 pub const FORMAT: &str = "trm-scene";
 /// The scene format version this crate writes and reads.

@@ -198,8 +198,8 @@ impl Job<'_> {
         println!("wrote {} and {}", out.display(), svg.display());
         if args.view {
             let mut scene =
-                crate::view::problem_scene(problem, &format!("map of {}", problem.origin))?;
-            crate::view::add_map(&mut scene, &map, problem.objective.active())?;
+                trm_view::Scene::of_problem(problem, &format!("map of {}", problem.origin))?;
+            scene.add_roadmap(&map, problem.objective.active())?;
             crate::view::write_scene(&scene, &crate::view::scene_path(out))?;
         }
         Ok(())

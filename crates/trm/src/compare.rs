@@ -120,7 +120,7 @@ pub fn run(args: &Args) -> Result<()> {
                 specs[p].display(),
                 args.algos.join(", ")
             );
-            let mut scene = crate::view::problem_scene(problem, &title)?;
+            let mut scene = trm_view::Scene::of_problem(problem, &title)?;
             scene.frames.clear();
             for (i, algo) in args.algos.iter().enumerate() {
                 if let Some(best) = result.best(p, algo) {

@@ -221,7 +221,7 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if args.view {
-        let mut scene = crate::view::problem_scene(&problem, "planned motion")?;
+        let mut scene = trm_view::Scene::of_problem(&problem, "planned motion")?;
         scene.frames.clear();
         for (t, q) in plan.trajectory.times.iter().zip(&plan.trajectory.positions) {
             scene.add_frame(*t, q)?;
@@ -230,11 +230,11 @@ pub fn run(args: &Args) -> Result<()> {
             plan.trajectory
                 .task_path
                 .iter()
-                .map(|p| crate::view::point3(p))
+                .map(|p| trm_view::point3(p))
                 .collect(),
         );
         scene.set_world(planner.world());
-        crate::view::add_map(&mut scene, first, problem.objective.active())?;
+        scene.add_roadmap(first, problem.objective.active())?;
         let out = args
             .out
             .clone()

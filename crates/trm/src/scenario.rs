@@ -79,56 +79,7 @@ pub fn run(args: &Args) -> Result<()> {
         &ros,
         run.motion.to_ros_yaml(&problem.robot, &ros)?.as_bytes(),
     )?;
-    let mut scene = crate::view::problem_scene(&problem, "scenario")?;
-    scene.frames.clear();
-    for (t, q) in run.motion.times.iter().zip(&run.motion.positions) {
-        scene.add_frame(*t, q)?;
-    }
-    // every object that ever appears, posed per frame
-    let mut all = run
-        .worlds
-        .last()
-        .cloned()
-        .unwrap_or_else(|| problem.objective.world().clone());
-    for w in &run.worlds {
-        for o in w.objects() {
-            if all.object(o.name()).is_err() {
-                all.add(o.name(), o.shape().clone(), *o.pose())?;
-            }
-        }
-    }
-    scene.set_world(&all);
-    crate::view::add_map(&mut scene, &run.map, problem.objective.active())?;
-    for (frame, (step, world)) in scene
-        .frames
-        .iter_mut()
-        .zip(run.steps.iter().zip(&run.worlds))
-    {
-        frame.world = Some(
-            all.objects()
-                .iter()
-                .map(|o| {
-                    world
-                        .object(o.name())
-                        .ok()
-                        .map(|p| trm_view::pose(p.pose()))
-                })
-                .collect(),
-        );
-        frame.map = Some(trm_view::FrameMap {
-            nodes: step.nodes,
-            edges: step.edges,
-            blocked: step.parked_nodes.clone(),
-            blocked_edges: step.parked_edges.clone(),
-        });
-    }
-    scene.set_path(
-        run.motion
-            .task_path
-            .iter()
-            .map(|p| crate::view::point3(p))
-            .collect(),
-    );
+    let scene = trm_view::Scene::of_scenario(&problem, &run)?;
     crate::view::write_scene(&scene, &dir.join("scenario.scene.html"))?;
     println!(
         "wrote steps.md, steps.csv, motion.csv (+ .json, .ros.yaml) in {}",

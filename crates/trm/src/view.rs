@@ -162,38 +162,10 @@ fn trajectory(path: &Path, robot: &RobotModel, start: &[f64]) -> Result<(Frames,
     let frames = t
         .motor_frames(robot, start)
         .with_context(|| format!("{}: names", path.display()))?;
-    Ok((frames, t.task_path.iter().map(|p| point3(p)).collect()))
-}
-
-/// The first three components of a task vector (zeros where it has fewer), for drawing.
-pub fn point3(v: &[f64]) -> [f64; 3] {
-    [
-        v.first().copied().unwrap_or(0.0),
-        v.get(1).copied().unwrap_or(0.0),
-        v.get(2).copied().unwrap_or(0.0),
-    ]
-}
-
-/// Adds a roadmap's points (task vectors, first three components), costs, edges and postures.
-pub fn add_map(scene: &mut Scene, map: &Roadmap, active: &ActiveSet) -> Result<()> {
-    scene.set_map(
-        map.points.iter().map(|p| point3(&p.t)).collect(),
-        map.points.iter().map(|p| p.cost).collect(),
-        &map.points
-            .iter()
-            .map(|p| active.to_motors(&p.q))
-            .collect::<Vec<_>>(),
-        map.edges.iter().map(|&(a, b, _)| [a, b]).collect(),
-    )?;
-    Ok(())
-}
-
-/// A scene of a task spec's robot and world at its start posture (frame 0).
-pub fn problem_scene(problem: &Problem, title: &str) -> Result<Scene> {
-    let mut scene = Scene::new(title, problem.objective.collision());
-    scene.set_world(problem.objective.world());
-    scene.add_frame(0.0, &problem.objective.active().to_motors(&problem.start))?;
-    Ok(scene)
+    Ok((
+        frames,
+        t.task_path.iter().map(|p| trm_view::point3(p)).collect(),
+    ))
 }
 
 /// Where a command's `--view` page goes: beside `out`, named `<stem>.scene.html`.
@@ -274,7 +246,7 @@ pub fn run(args: &Args) -> Result<()> {
             Some(a) if a.len() == map.active.len() => a.clone(),
             _ => s.robot.active_set(&map.active, &s.start)?,
         };
-        add_map(&mut scene, map, &active)?;
+        scene.add_roadmap(map, &active)?;
     }
     write_scene(&scene, &args.out)
 }

@@ -250,6 +250,14 @@ def test_a_map_builds_saves_loads_and_plans(tmp_path):
         planner.plan([goal[0], np.nan, goal[2]])
     with pytest.raises(trm.TrmError, match="the goal configuration has 3 values"):
         planner.plan([0.0, 0.0, 0.0], posture=True)
+    # the plan drawn over its map, as `trm plan --view` draws it
+    import json
+
+    page = trm.view(trm.Robot.icub(), str(tmp_path / "plan.html"),
+                    frames=plan["positions"], times=plan["times"], roadmap=loaded)
+    scene = json.loads((tmp_path / "plan.json").read_text())
+    assert len(scene["map"]["points"]) == len(loaded) and len(scene["map"]["edges"]) == info["edges"]
+    assert str(page).endswith("plan.html")
 
 
 def test_errors_are_located_trm_errors(robot, tmp_path):

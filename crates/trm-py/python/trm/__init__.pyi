@@ -173,4 +173,5 @@ def view(
     path: ArrayLike | None = None,
     title: str = "trm",
     bundle: str | None = None,
+    roadmap: Roadmap | None = None,
 ) -> str: ...
