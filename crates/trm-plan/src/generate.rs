@@ -300,6 +300,7 @@ pub fn generate(
                     },
                     group: String::new(),
                     planning_time: Some(10.0),
+                    pose_goal: Default::default(),
                 },
                 target,
             });

@@ -17,6 +17,7 @@ pub mod generate;
 pub mod mbm;
 pub mod moveit;
 mod planner;
+pub mod pose_goal;
 pub mod rrt;
 pub mod scenario;
 mod trajectory;

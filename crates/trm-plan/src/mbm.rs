@@ -289,6 +289,34 @@ pub fn solve(
     let mut goal = request.goal.positions.clone();
     let mut checker = Checker::new(&objective, &world);
     let mut outcome = Outcome::default();
+    if !request.pose_goal.is_empty() {
+        let root = &robot.tree().links[0].name;
+        if let Some(frame) = request.pose_goal.foreign_frame(root) {
+            return Err(PlanError::InvalidMoveIt {
+                path: request.origin.clone(),
+                line: 0,
+                problem: format!("a goal constraint is given in frame `{frame}`"),
+                fix: format!("give it in the robot's root frame `{root}`"),
+            });
+        }
+        let found = request.pose_goal.solve(
+            objective.active(),
+            &start,
+            options.seed,
+            GOAL_ATTEMPTS,
+            |q| checker.free(q),
+        )?;
+        match found {
+            Some(q) => goal = q,
+            None => {
+                outcome.valid = true;
+                outcome.note = format!(
+                    "no collision-free configuration meets the task-space goal ({GOAL_ATTEMPTS} IK starts)"
+                );
+                return Ok(outcome);
+            }
+        }
+    }
     if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| checker.free(q)) {
         outcome.note = why.into();
         return Ok(outcome);
@@ -311,6 +339,22 @@ pub fn solve(
     }
     Ok(outcome)
 }
+
+/// Refuses a task-space goal where only joint goals are handled (`what`).
+fn joint_goal_only(request: &MotionPlanRequest, what: &str) -> Result<(), PlanError> {
+    if request.pose_goal.is_empty() {
+        return Ok(());
+    }
+    Err(PlanError::InvalidMoveIt {
+        path: request.origin.clone(),
+        line: 0,
+        problem: format!("a task-space goal: {what} take joint goals"),
+        fix: "give joint constraints, or solve task-space goals with mbm::solve (benchmark-mbm without --experience/--vamp)".into(),
+    })
+}
+
+/// IK starts tried for a task-space goal (the start, then seeded random configurations).
+pub const GOAL_ATTEMPTS: usize = 50;
 
 /// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
 /// and `free`). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
@@ -377,6 +421,7 @@ pub fn solve_with_experience(
                 let p = &problems[k];
                 let scene = PlanningScene::load(&p.scene)?;
                 let request = MotionPlanRequest::load(&p.request)?;
+                joint_goal_only(&request, "experience runs")?;
                 let (other, other_active, mut start) =
                     problem_objective(robot, collision, &trm_collision::World::new(), &request)?;
                 if other_active != active
@@ -541,6 +586,26 @@ fn problem_objective(
         .map(|(m, v)| v.clamp(m.limits.lower, m.limits.upper))
         .collect();
     let mut active = Vec::new();
+    if request.goal.names.is_empty() {
+        // a task-space goal moves the request's group
+        if request.group.is_empty() {
+            return Err(PlanError::InvalidMoveIt {
+                path: request.origin.clone(),
+                line: 0,
+                problem: "a task-space goal without group_name".into(),
+                fix: "give group_name: the group whose joints move".into(),
+            });
+        }
+        active = robot
+            .group(&request.group)
+            .map_err(|e| PlanError::InvalidMoveIt {
+                path: request.origin.clone(),
+                line: 0,
+                problem: format!("group_name: {e}"),
+                fix: "give a group of this robot model (its description's groups)".into(),
+            })?
+            .to_vec();
+    }
     for name in &request.goal.names {
         let i = robot
             .motor_index(name)
@@ -573,6 +638,7 @@ pub fn peer_problems(robot: &str, problems: &[Problem]) -> Result<String, PlanEr
     for p in problems {
         let scene = PlanningScene::load(&p.scene)?;
         let request = MotionPlanRequest::load(&p.request)?;
+        joint_goal_only(&request, "peer planners")?;
         let order = joints.get_or_insert_with(|| request.goal.names.clone());
         let mismatch = |what: &str| PlanError::InvalidMoveIt {
             path: request.origin.clone(),

@@ -143,8 +143,11 @@ pub struct MotionPlanRequest {
     pub origin: PathBuf,
     /// `start_state.joint_state`.
     pub start: JointState,
-    /// `goal_constraints[0].joint_constraints`.
+    /// `goal_constraints[0].joint_constraints` (may be empty when `pose_goal` is not).
     pub goal: JointGoal,
+    /// `goal_constraints[0].position_constraints` and `orientation_constraints`: a task-space
+    /// goal.
+    pub pose_goal: crate::pose_goal::PoseGoal,
     /// `group_name`.
     pub group: String,
     /// `allowed_planning_time`, s (`None` when absent or 0).
@@ -262,23 +265,29 @@ impl Reader<'_> {
             Some(p) => self.vector(p, &format!("{what}.position"), &["x", "y", "z"])?,
             None => vec![0.0; 3],
         };
-        let q = match node.get("orientation") {
-            Some(o) => self.vector(o, &format!("{what}.orientation"), &["x", "y", "z", "w"])?,
-            None => vec![0.0, 0.0, 0.0, 1.0],
+        let rotation = match node.get("orientation") {
+            Some(o) => self.quaternion(o, &format!("{what}.orientation"))?,
+            None => UnitQuaternion::identity(),
         };
+        Ok(Isometry3::from_parts(
+            Translation3::new(p[0], p[1], p[2]),
+            rotation,
+        ))
+    }
+
+    /// A `geometry_msgs/Quaternion` (x, y, z, w), of norm 1 within 10 %.
+    fn quaternion(&self, node: &Node, what: &str) -> Result<UnitQuaternion<f64>, PlanError> {
+        let q = self.vector(node, what, &["x", "y", "z", "w"])?;
         let quaternion = Quaternion::new(q[3], q[0], q[1], q[2]);
         let norm = quaternion.norm();
         if !(0.9..=1.1).contains(&norm) {
             return Err(self.err(
                 node.line,
-                format!("{what}.orientation has norm {norm:.4}"),
+                format!("{what} has norm {norm:.4}"),
                 "give a unit quaternion [x, y, z, w]",
             ));
         }
-        Ok(Isometry3::from_parts(
-            Translation3::new(p[0], p[1], p[2]),
-            UnitQuaternion::new_normalize(quaternion),
-        ))
+        Ok(UnitQuaternion::new_normalize(quaternion))
     }
 
     fn joint_state(&self, node: &Node, what: &str) -> Result<JointState, PlanError> {
@@ -317,6 +326,154 @@ impl Reader<'_> {
             ));
         }
         Ok(JointState { names, positions })
+    }
+
+    /// A goal's position and orientation constraints.
+    fn pose_goal(&self, goal: &Node) -> Result<crate::pose_goal::PoseGoal, PlanError> {
+        use crate::pose_goal::{OrientationConstraint, PositionConstraint};
+        let mut out = crate::pose_goal::PoseGoal::default();
+        let frame = |c: &Node, here: &str| -> Result<String, PlanError> {
+            match c.get("header").and_then(|h| h.get("frame_id")) {
+                Some(f) => self.text(f, &format!("{here}.header.frame_id")),
+                None => Ok(String::new()),
+            }
+        };
+        let link = |c: &Node, here: &str| -> Result<String, PlanError> {
+            let name = self.text(
+                self.field(c, "link_name", here)?,
+                &format!("{here}.link_name"),
+            )?;
+            if name.trim().is_empty() {
+                return Err(self.err(c.line, format!("{here} names no link"), "give link_name"));
+            }
+            Ok(name)
+        };
+        if let Some(list) = goal.get("position_constraints") {
+            for (i, c) in self.seq(list, "position_constraints")?.iter().enumerate() {
+                let here = format!("goal_constraints[0].position_constraints[{i}]");
+                let offset = match c.get("target_point_offset") {
+                    Some(o) => {
+                        self.vector(o, &format!("{here}.target_point_offset"), &["x", "y", "z"])?
+                    }
+                    None => vec![0.0; 3],
+                };
+                let region = self.field(c, "constraint_region", &here)?;
+                let shapes = match region.get("primitives") {
+                    Some(p) => self.seq(p, &format!("{here}.constraint_region.primitives"))?,
+                    None => &[],
+                };
+                let poses = match region.get("primitive_poses") {
+                    Some(p) => self.seq(p, &format!("{here}.constraint_region.primitive_poses"))?,
+                    None => &[],
+                };
+                if shapes.is_empty() || shapes.len() != poses.len() {
+                    return Err(self.err(
+                        region.line,
+                        format!(
+                            "{here}.constraint_region has {} primitives and {} poses",
+                            shapes.len(),
+                            poses.len()
+                        ),
+                        "give at least one primitive and one pose per primitive (meshes are not read)",
+                    ));
+                }
+                let mut regions = Vec::new();
+                for (k, (s, p)) in shapes.iter().zip(poses).enumerate() {
+                    let shape =
+                        self.primitive(s, &format!("{here}.constraint_region.primitives[{k}]"))?;
+                    let pose =
+                        self.pose(p, &format!("{here}.constraint_region.primitive_poses[{k}]"))?;
+                    regions.push((shape, pose));
+                }
+                out.positions.push(PositionConstraint {
+                    link: link(c, &here)?,
+                    frame: frame(c, &here)?,
+                    offset: trm_kinematics::nalgebra::Vector3::new(offset[0], offset[1], offset[2]),
+                    regions,
+                });
+            }
+        }
+        if let Some(list) = goal.get("orientation_constraints") {
+            for (i, c) in self
+                .seq(list, "orientation_constraints")?
+                .iter()
+                .enumerate()
+            {
+                let here = format!("goal_constraints[0].orientation_constraints[{i}]");
+                let orientation = self.quaternion(
+                    self.field(c, "orientation", &here)?,
+                    &format!("{here}.orientation"),
+                )?;
+                let mut tolerance = [0.0; 3];
+                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                    let key = format!("absolute_{axis}_axis_tolerance");
+                    let v = self.number(self.field(c, &key, &here)?, &format!("{here}.{key}"))?;
+                    if v < 0.0 {
+                        return Err(self.err(
+                            c.line,
+                            format!("{here}.{key} is {v}"),
+                            "give a tolerance of 0 or more",
+                        ));
+                    }
+                    tolerance[k] = v;
+                }
+                out.orientations.push(OrientationConstraint {
+                    link: link(c, &here)?,
+                    frame: frame(c, &here)?,
+                    orientation,
+                    tolerance,
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// A `shape_msgs/SolidPrimitive` (box, sphere, cylinder; by name or number).
+    fn primitive(&self, s: &Node, here: &str) -> Result<Shape, PlanError> {
+        let kind = self.text(self.field(s, "type", here)?, &format!("{here}.type"))?;
+        let d = self.numbers(
+            self.field(s, "dimensions", here)?,
+            &format!("{here}.dimensions"),
+        )?;
+        let need = |n: usize, names: &str| -> Result<(), PlanError> {
+            if d.len() == n && d.iter().all(|v| *v > 0.0) {
+                Ok(())
+            } else {
+                Err(self.err(
+                    s.line,
+                    format!("{here}: a {kind} with dimensions {d:?}"),
+                    format!("give {n} positive dimensions ({names})"),
+                ))
+            }
+        };
+        // shape_msgs/SolidPrimitive: BOX = 1, SPHERE = 2, CYLINDER = 3, CONE = 4
+        let shape = match kind.to_ascii_lowercase().as_str() {
+            "box" | "1" => {
+                need(3, "x, y, z")?;
+                Shape::Box {
+                    size: [d[0], d[1], d[2]],
+                }
+            }
+            "sphere" | "2" => {
+                need(1, "radius")?;
+                Shape::Sphere { radius: d[0] }
+            }
+            "cylinder" | "3" => {
+                need(2, "height, radius")?;
+                Shape::Cylinder {
+                    radius: d[1],
+                    length: d[0],
+                }
+            }
+            _ => {
+                return Err(self.err(
+                    s.line,
+                    format!("{here} is a `{kind}`"),
+                    "use box, sphere or cylinder (cones and other primitives are not supported)",
+                ));
+            }
+        };
+        Ok(shape)
     }
 
     fn object(&self, node: &Node, k: usize) -> Result<CollisionObject, PlanError> {
@@ -378,49 +535,7 @@ impl Reader<'_> {
         let mut primitives = Vec::new();
         for (i, (s, p)) in shapes.iter().zip(poses).enumerate() {
             let here = format!("{what}.primitives[{i}]");
-            let kind = self.text(self.field(s, "type", &here)?, &format!("{here}.type"))?;
-            let d = self.numbers(
-                self.field(s, "dimensions", &here)?,
-                &format!("{here}.dimensions"),
-            )?;
-            let need = |n: usize, names: &str| -> Result<(), PlanError> {
-                if d.len() == n && d.iter().all(|v| *v > 0.0) {
-                    Ok(())
-                } else {
-                    Err(self.err(
-                        s.line,
-                        format!("{here}: a {kind} with dimensions {d:?}"),
-                        format!("give {n} positive dimensions ({names})"),
-                    ))
-                }
-            };
-            // shape_msgs/SolidPrimitive: BOX = 1, SPHERE = 2, CYLINDER = 3, CONE = 4
-            let shape = match kind.to_ascii_lowercase().as_str() {
-                "box" | "1" => {
-                    need(3, "x, y, z")?;
-                    Shape::Box {
-                        size: [d[0], d[1], d[2]],
-                    }
-                }
-                "sphere" | "2" => {
-                    need(1, "radius")?;
-                    Shape::Sphere { radius: d[0] }
-                }
-                "cylinder" | "3" => {
-                    need(2, "height, radius")?;
-                    Shape::Cylinder {
-                        radius: d[1],
-                        length: d[0],
-                    }
-                }
-                _ => {
-                    return Err(self.err(
-                        s.line,
-                        format!("{here} is a `{kind}`"),
-                        "use box, sphere or cylinder (cones and other primitives are not supported)",
-                    ));
-                }
-            };
+            let shape = self.primitive(s, &here)?;
             let pose = object_pose * self.pose(p, &format!("{what}.primitive_poses[{i}]"))?;
             primitives.push(Primitive { shape, pose });
         }
@@ -742,6 +857,83 @@ impl PlanningScene {
     }
 }
 
+/// Writes a task-space goal as one goal constraint's position and orientation constraints.
+fn write_pose_goal(out: &mut String, goal: &crate::pose_goal::PoseGoal) -> Result<(), String> {
+    let pose = |p: &Isometry3<f64>| {
+        let t = p.translation.vector;
+        let q = p.rotation.quaternion();
+        format!(
+            "{{position: {{x: {:?}, y: {:?}, z: {:?}}}, orientation: {{x: {:?}, y: {:?}, z: {:?}, w: {:?}}}}}",
+            t.x, t.y, t.z, q.i, q.j, q.k, q.w
+        )
+    };
+    let header = |frame: &str| {
+        if frame.is_empty() {
+            String::new()
+        } else {
+            format!("\n        header: {{frame_id: {}}}", quote(frame))
+        }
+    };
+    let mut first = true;
+    let mut item = |out: &mut String| {
+        out.push_str(if first { "  - " } else { "    " });
+        first = false;
+    };
+    if !goal.positions.is_empty() {
+        item(out);
+        out.push_str("position_constraints:\n");
+        for c in &goal.positions {
+            let mut primitives = Vec::new();
+            for (shape, _) in &c.regions {
+                primitives.push(match shape {
+                    Shape::Box { size } => format!(
+                        "{{type: 1, dimensions: [{:?}, {:?}, {:?}]}}",
+                        size[0], size[1], size[2]
+                    ),
+                    Shape::Sphere { radius } => format!("{{type: 2, dimensions: [{radius:?}]}}"),
+                    Shape::Cylinder { radius, length } => {
+                        format!("{{type: 3, dimensions: [{length:?}, {radius:?}]}}")
+                    }
+                    other => return Err(format!("a {} region", other.kind())),
+                });
+            }
+            let poses: Vec<String> = c.regions.iter().map(|(_, p)| pose(p)).collect();
+            let _ = writeln!(
+                out,
+                "      - link_name: {}{}\n        target_point_offset: {{x: {:?}, y: {:?}, z: {:?}}}\n        constraint_region:\n          primitives: [{}]\n          primitive_poses: [{}]\n        weight: 1.0",
+                quote(&c.link),
+                header(&c.frame),
+                c.offset.x,
+                c.offset.y,
+                c.offset.z,
+                primitives.join(", "),
+                poses.join(", ")
+            );
+        }
+    }
+    if !goal.orientations.is_empty() {
+        item(out);
+        out.push_str("orientation_constraints:\n");
+        for c in &goal.orientations {
+            let q = c.orientation.quaternion();
+            let _ = writeln!(
+                out,
+                "      - link_name: {}{}\n        orientation: {{x: {:?}, y: {:?}, z: {:?}, w: {:?}}}\n        absolute_x_axis_tolerance: {:?}\n        absolute_y_axis_tolerance: {:?}\n        absolute_z_axis_tolerance: {:?}\n        parameterization: 1\n        weight: 1.0",
+                quote(&c.link),
+                header(&c.frame),
+                q.i,
+                q.j,
+                q.k,
+                q.w,
+                c.tolerance[0],
+                c.tolerance[1],
+                c.tolerance[2]
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A file's text, as every trm reader reads input (regular files, size-limited).
 fn read(path: &Path) -> Result<String, PlanError> {
     trm_io::read_input(path).map_err(|source| PlanError::Io {
@@ -794,32 +986,34 @@ impl MotionPlanRequest {
                 "give one goal constraint with joint constraints",
             ));
         };
-        for unsupported in [
-            "position_constraints",
-            "orientation_constraints",
-            "visibility_constraints",
-        ] {
-            if goal
-                .get(unsupported)
-                .and_then(Node::items)
-                .is_some_and(|l| !l.is_empty())
-            {
-                return Err(r.err(
-                    goal.line,
-                    format!("the goal has {unsupported}"),
-                    "give the goal as joint constraints (task-space goals are not read yet)",
-                ));
-            }
-        }
-        let joints = r.seq(
-            r.field(goal, "joint_constraints", "the goal")?,
-            "goal_constraints[0].joint_constraints",
-        )?;
-        if joints.is_empty() {
+        if goal
+            .get("visibility_constraints")
+            .and_then(Node::items)
+            .is_some_and(|l| !l.is_empty())
+        {
             return Err(r.err(
                 goal.line,
-                "the goal has no joint constraints",
-                "give a joint constraint per joint of the group",
+                "the goal has visibility_constraints",
+                "give the goal as joint constraints or position and orientation constraints",
+            ));
+        }
+        request.pose_goal = r.pose_goal(goal)?;
+        let joints = match goal.get("joint_constraints") {
+            Some(j) => r.seq(j, "goal_constraints[0].joint_constraints")?,
+            None => &[],
+        };
+        if !joints.is_empty() && !request.pose_goal.is_empty() {
+            return Err(r.err(
+                goal.line,
+                "the goal has joint constraints and position or orientation constraints",
+                "give either joint constraints or a task-space goal (both at once are not read)",
+            ));
+        }
+        if joints.is_empty() && request.pose_goal.is_empty() {
+            return Err(r.err(
+                goal.line,
+                "the goal has no joint, position or orientation constraints",
+                "give a joint constraint per joint of the group, or a task-space goal",
             ));
         }
         for (i, c) in joints.iter().enumerate() {
@@ -890,7 +1084,8 @@ impl MotionPlanRequest {
         if s.names.len() != s.positions.len() || s.positions.iter().any(|v| !v.is_finite()) {
             return Err(refuse("the start is not one finite value per name"));
         }
-        if g.names.is_empty()
+        let task_space = !self.pose_goal.is_empty();
+        if (g.names.is_empty() && !task_space)
             || g.names.len() != g.positions.len()
             || g.names.len() != g.tolerances.len()
             || g.positions.iter().any(|v| !v.is_finite())
@@ -917,6 +1112,11 @@ impl MotionPlanRequest {
             names.join(", "),
             positions.join(", ")
         );
+        if task_space {
+            out.push_str("goal_constraints:\n");
+            write_pose_goal(&mut out, &self.pose_goal).map_err(|p| refuse(&p))?;
+            return Ok(out);
+        }
         out.push_str("goal_constraints:\n  - joint_constraints:\n");
         for ((name, position), (below, above)) in
             g.names.iter().zip(&g.positions).zip(&g.tolerances)

@@ -487,3 +487,102 @@ fn requests_round_trip_and_bad_ones_are_not_written() {
         );
     }
 }
+
+/// A task-space goal: the Panda's hand where the sample problem's joint goal puts it (a 1 cm
+/// box, orientation within 0.05 rad), written as MoveIt constraints, read back, solved (IK for
+/// a collision-free goal, then RRT-Connect) and checked at the end of the path.
+#[test]
+fn task_space_goals_are_read_written_and_solved() {
+    use trm_collision::Shape;
+    use trm_kinematics::nalgebra::{Isometry3, Translation3};
+    use trm_plan::pose_goal::{OrientationConstraint, PoseGoal, PositionConstraint};
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let dir = fixtures().join("box_panda");
+    let scene = PlanningScene::load(dir.join("scene0001.yaml")).unwrap();
+    let joints = MotionPlanRequest::load(dir.join("request0001.yaml")).unwrap();
+    // the hand's pose at the joint goal
+    let base: Vec<f64> = robot.neutral_motors();
+    let (start, _) = trm_plan::moveit::motors_from_state(&robot, &joints.start, &base);
+    let mut goal_motors = start.clone();
+    for (name, v) in joints.goal.names.iter().zip(&joints.goal.positions) {
+        goal_motors[robot.motor_index(name).unwrap()] = *v;
+    }
+    let mut poses = robot.pose_buffer();
+    robot.forward_motors(&goal_motors, &mut poses).unwrap();
+    let hand = *poses.pose(robot.frame_id("panda_hand").unwrap());
+    let goal = PoseGoal {
+        positions: vec![PositionConstraint {
+            link: "panda_hand".into(),
+            frame: "panda_link0".into(),
+            offset: Default::default(),
+            regions: vec![(
+                Shape::Box {
+                    size: [0.01, 0.01, 0.01],
+                },
+                Isometry3::from_parts(
+                    Translation3::from(hand.translation.vector),
+                    Default::default(),
+                ),
+            )],
+        }],
+        orientations: vec![OrientationConstraint {
+            link: "panda_hand".into(),
+            frame: String::new(),
+            orientation: hand.rotation,
+            tolerance: [0.05; 3],
+        }],
+    };
+    let mut request = joints.clone();
+    request.goal = Default::default();
+    request.pose_goal = goal.clone();
+    let text = request.to_yaml().unwrap();
+    let back = MotionPlanRequest::parse(&text, Path::new("pose.yaml")).unwrap();
+    // read back as written (the quaternion renormalised on reading: equal to 1e-12 rad)
+    assert_eq!(back.pose_goal.positions, goal.positions, "{text}");
+    let (a, b) = (&back.pose_goal.orientations[0], &goal.orientations[0]);
+    assert!(a.orientation.angle_to(&b.orientation) < 1e-12 && a.tolerance == b.tolerance);
+    assert!(back.goal.names.is_empty() && back.group == "panda_arm");
+    let outcome = solve(&robot, &collision, &scene, &back, &RrtOptions::default()).unwrap();
+    assert!(outcome.valid && outcome.solved, "{}", outcome.note);
+    // the path ends where the goal holds, and is free
+    let active = robot.group("panda_arm").unwrap();
+    let mut end = start.clone();
+    for (&i, v) in active.iter().zip(outcome.path.last().unwrap()) {
+        end[i] = *v;
+    }
+    robot.forward_motors(&end, &mut poses).unwrap();
+    assert!(goal.met(&robot, &poses).unwrap());
+    assert!(path_is_free(&robot, &collision, &scene, &back, &outcome.path, 0.01).unwrap());
+
+    // bad task-space goals: another frame, no group, joints and a pose at once
+    let mut foreign = back.clone();
+    foreign.pose_goal.positions[0].frame = "world".into();
+    let e = solve(&robot, &collision, &scene, &foreign, &RrtOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`world`") && e.contains("panda_link0"), "{e}");
+    let no_group = text.replace("group_name: \"panda_arm\"\n", "");
+    let e = solve(
+        &robot,
+        &collision,
+        &scene,
+        &MotionPlanRequest::parse(&no_group, Path::new("g.yaml")).unwrap(),
+        &RrtOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("group_name"), "{e}");
+    let both = text.replace(
+        "goal_constraints:\n",
+        "goal_constraints:\n  - joint_constraints:\n      - {joint_name: panda_joint1, position: 0.0}\n    ",
+    );
+    let e = MotionPlanRequest::parse(&both, Path::new("b.yaml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("either joint constraints or a task-space goal"),
+        "{e}\n{both}"
+    );
+}
