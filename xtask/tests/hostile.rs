@@ -971,6 +971,27 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             names: "--vamp".into(),
         });
     }
+    // task-space goals: an unknown link, tolerances without --task-space, with experience
+    for (extra, names) in [
+        (vec!["--task-space", "panda_hnd"], "panda_hand"),
+        (vec!["--position-tolerance", "0.02"], "--task-space"),
+        (
+            vec!["--task-space", "panda_hand", "--experience"],
+            "--experience",
+        ),
+        (
+            vec!["--task-space", "panda_hand", "--orientation-tolerance", "0"],
+            "--orientation-tolerance",
+        ),
+    ] {
+        let mut args = bench(&mbm);
+        args.extend(extra.iter().map(|s| s.to_string()));
+        cases.push(Case {
+            what: format!("benchmark-mbm {}", extra.join(" ")),
+            args,
+            names: names.into(),
+        });
+    }
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);
     cases.push(Case {

@@ -289,6 +289,8 @@ pub fn solve(
     let mut goal = request.goal.positions.clone();
     let mut checker = Checker::new(&objective, &world);
     let mut outcome = Outcome::default();
+    // time spent finding a goal configuration for a task-space goal (part of the answer)
+    let mut goal_seconds = 0.0;
     if !request.pose_goal.is_empty() {
         let root = &robot.tree().links[0].name;
         if let Some(frame) = request.pose_goal.foreign_frame(root) {
@@ -299,6 +301,7 @@ pub fn solve(
                 fix: format!("give it in the robot's root frame `{root}`"),
             });
         }
+        let started = std::time::Instant::now();
         let found = request.pose_goal.solve(
             objective.active(),
             &start,
@@ -306,6 +309,7 @@ pub fn solve(
             GOAL_ATTEMPTS,
             |q| checker.free(q),
         )?;
+        goal_seconds = started.elapsed().as_secs_f64();
         match found {
             Some(q) => goal = q,
             None => {
@@ -329,7 +333,7 @@ pub fn solve(
     match rrt_connect(&objective, &world, &start, &goal, &options) {
         Ok(found) => {
             outcome.solved = true;
-            outcome.seconds = found.seconds;
+            outcome.seconds = goal_seconds + found.seconds;
             outcome.length = path_length(&found.path);
             outcome.waypoints = found.path.len();
             outcome.checks = found.checks;
@@ -354,7 +358,7 @@ fn joint_goal_only(request: &MotionPlanRequest, what: &str) -> Result<(), PlanEr
 }
 
 /// IK starts tried for a task-space goal (the start, then seeded random configurations).
-pub const GOAL_ATTEMPTS: usize = 50;
+pub const GOAL_ATTEMPTS: usize = 500;
 
 /// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
 /// and `free`). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
@@ -818,20 +822,41 @@ pub struct Run {
     pub verified: Option<bool>,
 }
 
+/// A set's joint goals posed as task-space goals ([`MotionPlanRequest::to_task_space`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskSpaceGoals {
+    /// The link whose pose is the goal (e.g. the hand).
+    pub link: String,
+    /// Side of the cube the link's origin must reach, m.
+    pub position_tolerance: f64,
+    /// Tolerance about each axis, rad.
+    pub orientation_tolerance: f64,
+}
+
 /// Solves each problem by RRT-Connect + shortcutting ([`solve`]), re-checking solved paths
-/// when `verify`; `progress(done, problem)` after each.
+/// when `verify`; with `task_space`, each joint goal is first turned into the task-space goal
+/// it implies. `progress(done, problem)` after each.
 pub fn run_set(
     robot: &RobotModel,
     collision: &CollisionModel,
     problems: &[Problem],
     options: &RrtOptions,
     verify: bool,
+    task_space: Option<&TaskSpaceGoals>,
     mut progress: impl FnMut(usize, &Problem),
 ) -> Result<Vec<Run>, PlanError> {
     let mut runs = Vec::with_capacity(problems.len());
     for (k, p) in problems.iter().enumerate() {
         let scene = PlanningScene::load(&p.scene)?;
-        let request = MotionPlanRequest::load(&p.request)?;
+        let mut request = MotionPlanRequest::load(&p.request)?;
+        if let Some(t) = task_space {
+            request = request.to_task_space(
+                robot,
+                &t.link,
+                t.position_tolerance,
+                t.orientation_tolerance,
+            )?;
+        }
         let outcome = solve(robot, collision, &scene, &request, options)?;
         let verified = (verify && outcome.solved)
             .then(|| {

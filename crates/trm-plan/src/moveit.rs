@@ -1130,6 +1130,72 @@ impl MotionPlanRequest {
         Ok(out)
     }
 
+    /// This request with its joint goal replaced by the task-space goal it implies: `link`'s pose
+    /// at the goal configuration (the start's values for the other motors), as a cube of side
+    /// `position_tolerance` (m) around its origin and `orientation_tolerance` (rad) about each
+    /// axis, in the robot's root frame.
+    pub fn to_task_space(
+        &self,
+        robot: &trm_kinematics::RobotModel,
+        link: &str,
+        position_tolerance: f64,
+        orientation_tolerance: f64,
+    ) -> Result<Self, PlanError> {
+        for (what, v) in [
+            ("position tolerance", position_tolerance),
+            ("orientation tolerance", orientation_tolerance),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(PlanError::InvalidOptions {
+                    what: what.into(),
+                    problem: format!("{v}: give a finite value above 0"),
+                });
+            }
+        }
+        if !self.pose_goal.is_empty() || self.goal.names.is_empty() {
+            return Err(PlanError::InvalidMoveIt {
+                path: self.origin.clone(),
+                line: 0,
+                problem: "the goal is not joint constraints".into(),
+                fix: "give a request with a joint goal to turn into a task-space goal".into(),
+            });
+        }
+        let frame = robot.frame_id(link)?;
+        let (mut motors, _) = motors_from_state(robot, &self.start, &robot.neutral_motors());
+        for (name, v) in self.goal.names.iter().zip(&self.goal.positions) {
+            motors[robot.motor_index(name)?] = *v;
+        }
+        let mut poses = robot.pose_buffer();
+        robot.forward_motors(&motors, &mut poses)?;
+        let pose = *poses.pose(frame);
+        let root = robot.tree().links[0].name.clone();
+        let mut out = self.clone();
+        out.goal = JointGoal::default();
+        out.pose_goal = crate::pose_goal::PoseGoal {
+            positions: vec![crate::pose_goal::PositionConstraint {
+                link: link.to_string(),
+                frame: root.clone(),
+                offset: Default::default(),
+                regions: vec![(
+                    Shape::Box {
+                        size: [position_tolerance; 3],
+                    },
+                    Isometry3::from_parts(
+                        Translation3::from(pose.translation.vector),
+                        UnitQuaternion::identity(),
+                    ),
+                )],
+            }],
+            orientations: vec![crate::pose_goal::OrientationConstraint {
+                link: link.to_string(),
+                frame: root,
+                orientation: pose.rotation,
+                tolerance: [orientation_tolerance; 3],
+            }],
+        };
+        Ok(out)
+    }
+
     /// Reads a request file (at most [`trm_io::MAX_INPUT_BYTES`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PlanError> {
         let path = path.as_ref();

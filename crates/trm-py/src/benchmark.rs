@@ -48,12 +48,14 @@ pub(crate) fn compare_optimisers<'py>(
 /// A MotionBenchMaker set (a folder or `.tar.bz2` of MoveIt scenes and joint-goal requests)
 /// solved by RRT-Connect + shortcutting with `model` (a `.urdf`, a `.ron` description or an
 /// embedded model's name), as `trm benchmark-mbm`: `families` and `per_family` select
-/// problems, `verify` re-checks each path one configuration at a time. Returns a dict: `runs`
+/// problems, `verify` re-checks each path one configuration at a time, `task_space` (a link)
+/// poses each joint goal as the task-space goal it implies for that link (a cube of side
+/// `position_tolerance`, `orientation_tolerance` about each axis). Returns a dict: `runs`
 /// (per problem: family, index, outcome {valid, solved, seconds, length, waypoints, checks,
 /// note, path}, verified), `table` (markdown: solved %, median and p95 time per family) and
 /// `csv`.
 #[pyfunction]
-#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new()))]
+#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn benchmark_mbm<'py>(
     py: Python<'py>,
@@ -65,7 +67,15 @@ pub(crate) fn benchmark_mbm<'py>(
     max_iterations: usize,
     verify: bool,
     package_paths: Vec<String>,
+    task_space: Option<String>,
+    position_tolerance: f64,
+    orientation_tolerance: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let task_space = task_space.map(|link| trm_plan::mbm::TaskSpaceGoals {
+        link,
+        position_tolerance,
+        orientation_tolerance,
+    });
     let robot = trm_models::load(model, std::path::Path::new("")).map_err(err)?;
     let options = trm_collision::CollisionOptions::with_ros_package_path(
         package_paths.into_iter().map(Into::into).collect(),
@@ -80,7 +90,15 @@ pub(crate) fn benchmark_mbm<'py>(
     };
     let runs = py
         .detach(|| {
-            trm_plan::mbm::run_set(&robot, &collision, &set.problems, &rrt, verify, |_, _| {})
+            trm_plan::mbm::run_set(
+                &robot,
+                &collision,
+                &set.problems,
+                &rrt,
+                verify,
+                task_space.as_ref(),
+                |_, _| {},
+            )
         })
         .map_err(err)?;
     let d = PyDict::new(py);

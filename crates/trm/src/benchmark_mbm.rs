@@ -48,6 +48,17 @@ pub struct Args {
     /// resolution (an independent check of the raked edge checks).
     #[arg(long)]
     verify: bool,
+    /// Pose every joint goal as the task-space goal it implies for this link (its pose at the
+    /// goal: a cube of side --position-tolerance, --orientation-tolerance about each axis) and
+    /// solve that: IK for a collision-free goal of the request's group, then RRT-Connect.
+    #[arg(long, value_name = "LINK", conflicts_with_all = ["experience", "vamp", "ompl"])]
+    task_space: Option<String>,
+    /// With --task-space: side of the cube the link's origin must reach, m.
+    #[arg(long, default_value_t = 0.01, value_parser = crate::parse::positive, requires = "task_space")]
+    position_tolerance: f64,
+    /// With --task-space: tolerance about each axis, rad.
+    #[arg(long, default_value_t = 0.05, value_parser = crate::parse::positive, requires = "task_space")]
+    orientation_tolerance: f64,
     /// Also run OMPL's RRTConnect on the same problems (benches/python/mbm_ompl.py: the same
     /// robot files, coal through Pinocchio, the same edge step, `--per-family` and seed; needs
     /// `python3 -m pip install ompl pin pyyaml numpy`) and print its table after trm's; the
@@ -99,6 +110,14 @@ pub fn run(args: &Args) -> Result<()> {
         &problems,
         &options,
         args.verify,
+        args.task_space
+            .as_ref()
+            .map(|link| trm_plan::mbm::TaskSpaceGoals {
+                link: link.clone(),
+                position_tolerance: args.position_tolerance,
+                orientation_tolerance: args.orientation_tolerance,
+            })
+            .as_ref(),
         |k, p| progress.set(k as u64, problems.len() as u64, &p.family),
     )?;
     progress.finish();

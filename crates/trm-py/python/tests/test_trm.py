@@ -363,6 +363,9 @@ def test_motionbenchmaker_from_python_solves_and_verifies():
         assert run["outcome"]["valid"] and run["outcome"]["solved"] and run["verified"]
         assert len(run["outcome"]["path"]) >= 2
     assert "box_panda" in r["table"] and r["csv"].startswith("family,problem")
+    # the same goals as the hand's pose: IK, then RRT-Connect
+    t = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True, task_space="panda_hand")
+    assert all(run["outcome"]["solved"] and run["verified"] for run in t["runs"])
     with pytest.raises(trm.TrmError, match="box_panda"):
         trm.benchmark_mbm(str(fixtures), model, families=["box_pand"])
 
