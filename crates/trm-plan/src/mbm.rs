@@ -285,10 +285,14 @@ pub fn solve(
 ) -> Result<Outcome, PlanError> {
     options.check()?;
     let world = scene.to_world()?;
-    let (objective, active, mut start) = problem_objective(robot, collision, &world, request)?;
+    let (collision, notes) = scene_collision(collision, scene)?;
+    let (objective, active, mut start) = problem_objective(robot, &collision, &world, request)?;
     let mut goal = request.goal.positions.clone();
     let mut checker = Checker::new(&objective, &world);
-    let mut outcome = Outcome::default();
+    let mut outcome = Outcome {
+        note: notes.join("; "),
+        ..Default::default()
+    };
     // time spent finding a goal configuration for a task-space goal (part of the answer)
     let mut goal_seconds = 0.0;
     if !request.pose_goal.is_empty() {
@@ -342,6 +346,25 @@ pub fn solve(
         Err(e) => outcome.note = e.to_string(),
     }
     Ok(outcome)
+}
+
+/// `collision` with the scene's allowed-collision matrix applied
+/// ([`crate::moveit::AllowedCollisions::apply`]), and notes on the entries it skipped.
+fn scene_collision<'a>(
+    collision: &'a CollisionModel,
+    scene: &PlanningScene,
+) -> Result<(std::borrow::Cow<'a, CollisionModel>, Vec<String>), PlanError> {
+    let Some(acm) = &scene.allowed_collisions else {
+        return Ok((std::borrow::Cow::Borrowed(collision), Vec::new()));
+    };
+    let (applied, notes) = acm.apply(collision)?;
+    Ok((
+        applied.map_or(
+            std::borrow::Cow::Borrowed(collision),
+            std::borrow::Cow::Owned,
+        ),
+        notes,
+    ))
 }
 
 /// Refuses a task-space goal where only joint goals are handled (`what`).
@@ -547,7 +570,8 @@ pub fn path_is_free(
     resolution: f64,
 ) -> Result<bool, PlanError> {
     let world = scene.to_world()?;
-    let (objective, _, _) = problem_objective(robot, collision, &world, request)?;
+    let (collision, _) = scene_collision(collision, scene)?;
+    let (objective, _, _) = problem_objective(robot, &collision, &world, request)?;
     let mut scratch = objective.scratch();
     for w in path.windows(2) {
         let steps = (crate::rrt::distance(&w[0], &w[1]) / resolution)

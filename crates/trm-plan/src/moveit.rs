@@ -108,6 +108,50 @@ impl AllowedCollisions {
     }
 }
 
+impl AllowedCollisions {
+    /// `collision` with this matrix applied to the robot's link pairs, as MoveIt applies a
+    /// planning scene's matrix over the SRDF's: a pair it allows is not checked, a pair it
+    /// does not allow is checked. Entries that are not links of the robot (world objects: trm
+    /// checks every body against every object) are skipped and named in the returned notes.
+    /// `None` when nothing changes.
+    pub fn apply(
+        &self,
+        collision: &trm_collision::CollisionModel,
+    ) -> Result<(Option<trm_collision::CollisionModel>, Vec<String>), PlanError> {
+        let tree = collision.robot().tree();
+        let ids: Vec<Option<usize>> = self.names.iter().map(|n| tree.link_index(n)).collect();
+        let notes: Vec<String> = self
+            .names
+            .iter()
+            .zip(&ids)
+            .filter(|(_, id)| id.is_none())
+            .map(|(n, _)| {
+                format!("allowed_collision_matrix: `{n}` is not a link of the robot (skipped)")
+            })
+            .collect();
+        let mut acm = collision.acm().clone();
+        let mut changed = false;
+        for (i, row) in self.allowed.iter().enumerate() {
+            for (j, &allowed) in row.iter().enumerate().skip(i + 1) {
+                let (Some(a), Some(b)) = (ids[i], ids[j]) else {
+                    continue;
+                };
+                if a == b || allowed != acm.is_checked(a, b) {
+                    continue;
+                }
+                changed = true;
+                if allowed {
+                    acm.disable(a, b, trm_kinematics::DisableReason::User);
+                } else {
+                    acm.enable(a, b);
+                }
+            }
+        }
+        let applied = changed.then(|| collision.with_acm(acm)).transpose()?;
+        Ok((applied, notes))
+    }
+}
+
 /// A MoveIt `PlanningScene`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlanningScene {

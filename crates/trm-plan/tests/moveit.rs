@@ -586,3 +586,60 @@ fn task_space_goals_are_read_written_and_solved() {
         "{e}\n{both}"
     );
 }
+
+/// The scene's allowed-collision matrix overrides the model's on the robot's link pairs, as
+/// MoveIt's planning-scene matrix overrides the SRDF's; entries that are not links are noted.
+#[test]
+fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let scene = PlanningScene::load(fixtures().join("box_panda/scene0001.yaml")).unwrap();
+    let acm = scene.allowed_collisions.clone().unwrap();
+    let tree = robot.tree();
+    let id = |n: &str| tree.link_index(n).unwrap();
+    // pick a pair the model checks and allow it, and one the model skips and forbid it
+    let mut m = acm.clone();
+    let (a, b) = (
+        m.names.iter().position(|n| n == "panda_hand").unwrap(),
+        m.names.iter().position(|n| n == "panda_link2").unwrap(),
+    );
+    m.allowed[a][b] = true;
+    m.allowed[b][a] = true;
+    m.names.push("table".into());
+    for row in &mut m.allowed {
+        row.push(true);
+    }
+    m.allowed.push(vec![true; m.names.len()]);
+    assert!(
+        collision
+            .acm()
+            .is_checked(id("panda_hand"), id("panda_link2"))
+    );
+    let (applied, notes) = m.apply(&collision).unwrap();
+    let applied = applied.expect("the matrix changes the model's");
+    assert!(
+        !applied
+            .acm()
+            .is_checked(id("panda_hand"), id("panda_link2"))
+    );
+    assert_eq!(notes.len(), 1);
+    assert!(notes[0].contains("`table`"), "{notes:?}");
+    // every pair the scene lists ends as the scene says
+    for (i, row) in m.allowed.iter().enumerate() {
+        for (j, &allowed) in row.iter().enumerate() {
+            if let (Some(x), Some(y)) = (tree.link_index(&m.names[i]), tree.link_index(&m.names[j]))
+            {
+                if x != y {
+                    assert_eq!(
+                        applied.acm().is_checked(x, y),
+                        !allowed,
+                        "{} {}",
+                        m.names[i],
+                        m.names[j]
+                    );
+                }
+            }
+        }
+    }
+}
