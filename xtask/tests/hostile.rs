@@ -1186,6 +1186,25 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             .to_vec(),
         names: "icub_upper_body.urdf".into(),
     });
+    for (extra, names) in [
+        (vec!["--spheres", "0"], "--spheres"),
+        (vec!["--sphere-step", "0.01"], "--spheres"),
+        (
+            vec!["--spheres", "4", "--sphere-step", "-1"],
+            "--sphere-step",
+        ),
+        (vec!["--spheres", "4"], "icub_upper_body.urdf"),
+    ] {
+        cases.push(Case {
+            what: format!("fit-proxies {}", extra.join(" ")),
+            args: ["fit-proxies", "icub_upper_body.urdf"]
+                .into_iter()
+                .chain(extra.iter().copied())
+                .map(String::from)
+                .collect(),
+            names: names.into(),
+        });
+    }
     for bad in ["no_such.urdf", ".", "map.json", "world.ron"] {
         cases.push(Case {
             what: format!("fit-proxies {bad}"),

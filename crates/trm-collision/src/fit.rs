@@ -83,6 +83,27 @@ pub fn fit(points: &[Point3<f64>]) -> Option<Fits> {
     })
 }
 
+/// The direction along which the points spread most (the covariance's largest eigenvector).
+fn principal_axis(points: &[Point3<f64>]) -> Vector3<f64> {
+    let n = points.len() as f64;
+    let mean = points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let mut cov = Matrix3::zeros();
+    for p in points {
+        let d = p.coords - mean;
+        cov += d * d.transpose();
+    }
+    let eigen = cov.symmetric_eigen();
+    let k = (0..3)
+        .max_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]))
+        .unwrap_or(0);
+    let axis = eigen.eigenvectors.column(k).into_owned();
+    if axis.iter().all(|v| v.is_finite()) {
+        axis
+    } else {
+        Vector3::x()
+    }
+}
+
 /// The points' principal axes (eigenvectors of their covariance) and the identity.
 fn candidate_frames(points: &[Point3<f64>]) -> Vec<Rotation3<f64>> {
     let n = points.len() as f64;
@@ -292,6 +313,89 @@ pub fn worst_outside(fitted: &Fitted, points: &[Point3<f64>]) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// Points on the surface of the convex hull of `points`: each hull triangle sampled on a
+/// barycentric grid whose steps are at most `step` long (its vertices included). Every point of
+/// the hull's surface is within `step` of a sample.
+pub fn hull_surface_points(points: &[Point3<f64>], step: f64) -> Vec<Point3<f64>> {
+    if points.len() < 4 {
+        return points.to_vec();
+    }
+    let (vertices, triangles) = parry3d_f64::transformation::convex_hull(points);
+    let mut out = vertices.clone();
+    for t in &triangles {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+        let n = ((longest / step).ceil() as usize).clamp(1, 10_000);
+        for i in 0..=n {
+            for j in 0..=n - i {
+                if (i == 0 && j == 0) || (i == n) || (j == n) {
+                    continue; // the triangle's vertices are already in
+                }
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                out.push(a + (b - a) * u + (c - a) * v);
+            }
+        }
+    }
+    out
+}
+
+/// At most `count` spheres (centre, radius) that together enclose every point within `margin`
+/// of `points` (give points sampled on a surface every `step` and `margin = step` to enclose the
+/// whole surface): greedy splits from one bounding sphere, the largest sphere's points split at
+/// the median across their principal axis, until `count` spheres or no cluster can be split.
+/// `None` without finite points.
+pub fn fit_sphere_set(
+    points: &[Point3<f64>],
+    count: usize,
+    margin: f64,
+) -> Option<Vec<(Point3<f64>, f64)>> {
+    if points.is_empty()
+        || count == 0
+        || points
+            .iter()
+            .any(|p| !p.coords.iter().all(|v| v.is_finite()))
+    {
+        return None;
+    }
+    let sphere = |cluster: &[Point3<f64>]| {
+        let f = fit_sphere(cluster);
+        let radius = match f.shape {
+            Shape::Sphere { radius } => radius,
+            _ => unreachable!("fit_sphere fits spheres"),
+        };
+        (Point3::from(f.pose.translation.vector), radius)
+    };
+    // each cluster of points with its bounding sphere (centre, radius)
+    type Cluster = (Vec<Point3<f64>>, (Point3<f64>, f64));
+    let mut clusters: Vec<Cluster> = vec![(points.to_vec(), sphere(points))];
+    while clusters.len() < count {
+        let Some(k) = (0..clusters.len())
+            .filter(|&k| clusters[k].0.len() > 1)
+            .max_by(|&a, &b| clusters[a].1.1.total_cmp(&clusters[b].1.1))
+        else {
+            break;
+        };
+        let (cluster, _) = clusters.swap_remove(k);
+        let axis = principal_axis(&cluster);
+        let mut keyed: Vec<(f64, Point3<f64>)> =
+            cluster.iter().map(|p| (p.coords.dot(&axis), *p)).collect();
+        keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let half = keyed.len() / 2;
+        let low: Vec<Point3<f64>> = keyed[..half].iter().map(|k| k.1).collect();
+        let high: Vec<Point3<f64>> = keyed[half..].iter().map(|k| k.1).collect();
+        for part in [low, high] {
+            let s = sphere(&part);
+            clusters.push((part, s));
+        }
+    }
+    Some(
+        clusters
+            .into_iter()
+            .map(|(_, (c, r))| (c, r + margin))
+            .collect(),
+    )
+}
+
 /// One link's proxy, as [`fit_model`] fits it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinkFit {
@@ -349,6 +453,50 @@ pub fn urdf_with_proxies(
     origin: &str,
     fits: &[LinkFit],
 ) -> Result<String, CollisionError> {
+    let replacements: Vec<(&str, String)> = fits
+        .iter()
+        .map(|f| (f.link.as_str(), collision_xml(&f.fitted)))
+        .collect();
+    replace_collisions(urdf, origin, &replacements)
+}
+
+/// `urdf` with each link of `sets` given its spheres as `<collision>` elements (radii padded by
+/// [`WRITE_MARGIN`]) in place of its own; every other byte is kept.
+pub fn urdf_with_spheres(
+    urdf: &str,
+    origin: &str,
+    sets: &[LinkSpheres],
+) -> Result<String, CollisionError> {
+    let replacements: Vec<(&str, String)> = sets
+        .iter()
+        .map(|set| {
+            let xml: Vec<String> = set
+                .spheres
+                .iter()
+                .map(|(c, r)| {
+                    collision_xml(&Fitted {
+                        shape: Shape::Sphere { radius: *r },
+                        pose: Isometry3::from_parts(
+                            Translation3::from(c.coords),
+                            UnitQuaternion::identity(),
+                        ),
+                        volume: 0.0,
+                    })
+                })
+                .collect();
+            (set.link.as_str(), xml.join("\n    "))
+        })
+        .collect();
+    replace_collisions(urdf, origin, &replacements)
+}
+
+/// `urdf` with the `<collision>` elements of each named link replaced by the given text (the
+/// first element's place; the others removed).
+fn replace_collisions(
+    urdf: &str,
+    origin: &str,
+    replacements: &[(&str, String)],
+) -> Result<String, CollisionError> {
     let invalid = |problem: String| CollisionError::InvalidValue {
         what: origin.to_string(),
         problem,
@@ -356,27 +504,27 @@ pub fn urdf_with_proxies(
     trm_io::check_xml_nesting(urdf.as_bytes(), trm_io::XML_NESTING_LIMIT)
         .map_err(|e| invalid(e.to_string()))?;
     let doc = roxmltree::Document::parse(urdf).map_err(|e| invalid(e.to_string()))?;
-    // (start, end, replacement) of every collision element of a fitted link
+    // (start, end, replacement) of every collision element of a replaced link
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
     for link in doc
         .root_element()
         .children()
         .filter(|n| n.has_tag_name("link"))
     {
-        let Some(f) = fits
+        let Some((_, replacement)) = replacements
             .iter()
-            .find(|f| Some(f.link.as_str()) == link.attribute("name"))
+            .find(|(name, _)| Some(*name) == link.attribute("name"))
         else {
             continue;
         };
         let collisions = link.children().filter(|n| n.has_tag_name("collision"));
         for (k, c) in collisions.enumerate() {
-            let replacement = if k == 0 {
-                collision_xml(&f.fitted)
+            let text = if k == 0 {
+                replacement.clone()
             } else {
                 String::new()
             };
-            edits.push((c.range().start, c.range().end, replacement));
+            edits.push((c.range().start, c.range().end, text));
         }
     }
     edits.sort_by_key(|e| e.0);
@@ -389,6 +537,80 @@ pub fn urdf_with_proxies(
     }
     out.push_str(&urdf[at..]);
     Ok(out)
+}
+
+/// One link's spheres, as [`fit_model_spheres`] fits them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkSpheres {
+    /// The link's name.
+    pub link: String,
+    /// The spheres: centre (link frame) and radius.
+    pub spheres: Vec<(Point3<f64>, f64)>,
+    /// Total volume of the link's convex bodies, m³.
+    pub hull: f64,
+    /// Sum of the spheres' volumes (overlaps counted twice), m³.
+    pub volume: f64,
+}
+
+/// At most `count` spheres for every link of `collision` with mesh collisions, enclosing the
+/// surface of each of the link's convex bodies: sampled every `step` m
+/// ([`hull_surface_points`]) and each radius padded by `step` ([`fit_sphere_set`]). An error
+/// when no link has meshes.
+pub fn fit_model_spheres(
+    collision: &CollisionModel,
+    count: usize,
+    step: f64,
+) -> Result<Vec<LinkSpheres>, CollisionError> {
+    if count == 0 || !(step.is_finite() && step > 0.0) {
+        return Err(CollisionError::InvalidValue {
+            what: format!("{count} spheres per link every {step} m"),
+            problem: "give at least 1 sphere and a finite step above 0".into(),
+        });
+    }
+    let mut sets = Vec::new();
+    for (l, link) in collision.robot().tree().links.iter().enumerate() {
+        let mut surface = Vec::new();
+        let mut hull = 0.0;
+        for body in collision.bodies().iter().filter(|b| b.link == l) {
+            let Shape::Convex { points } = &body.shape else {
+                continue;
+            };
+            let local: Vec<Point3<f64>> = points
+                .iter()
+                .map(|v| body.local * Point3::new(v[0], v[1], v[2]))
+                .collect();
+            hull += ConvexPolyhedron::from_convex_hull(&local).map_or(0.0, |h| {
+                use parry3d_f64::shape::Shape as _;
+                h.mass_properties(1.0).mass()
+            });
+            surface.extend(hull_surface_points(&local, step));
+        }
+        if surface.is_empty() {
+            continue;
+        }
+        let spheres =
+            fit_sphere_set(&surface, count, step).ok_or_else(|| CollisionError::InvalidValue {
+                what: format!("link `{}`'s meshes", link.name),
+                problem: "have no finite vertices to fit".into(),
+            })?;
+        let volume = spheres
+            .iter()
+            .map(|(_, r)| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+            .sum();
+        sets.push(LinkSpheres {
+            link: link.name.clone(),
+            spheres,
+            hull,
+            volume,
+        });
+    }
+    if sets.is_empty() {
+        return Err(CollisionError::InvalidValue {
+            what: collision.robot().name().to_string(),
+            problem: "no link has mesh collisions to fit\n  fix: give a URDF whose <collision> elements are meshes (found through the package paths)".into(),
+        });
+    }
+    Ok(sets)
 }
 
 /// A `<collision>` element for a fitted primitive.

@@ -89,3 +89,31 @@ proptest! {
         }
     }
 }
+
+/// Sphere sets: a hull's surface sampled every `step` lies within `step` of a sample, and the
+/// spheres (radii padded by `step`) enclose every point of the surface: checked on points drawn
+/// on the hull's triangles, far denser than the samples. More spheres are tighter.
+#[test]
+fn sphere_sets_enclose_the_whole_hull_surface_and_tighten_with_more_spheres() {
+    use trm_collision::fit::{fit_sphere_set, hull_surface_points};
+    for kind in 0..3 {
+        let points = cloud(kind, 7, 300);
+        let step = 0.004;
+        let surface = hull_surface_points(&points, step);
+        assert!(surface.len() > points.len() / 4, "{}", surface.len());
+        let dense = hull_surface_points(&points, step / 8.0);
+        let mut largest = Vec::new();
+        for count in [1, 4, 12] {
+            let spheres = fit_sphere_set(&surface, count, step).unwrap();
+            assert!(spheres.len() <= count && !spheres.is_empty());
+            for p in &dense {
+                let inside = spheres.iter().any(|(c, r)| (p - c).norm() <= r + 1e-12);
+                assert!(inside, "kind {kind}, {count} spheres: {p} outside");
+            }
+            largest.push(spheres.iter().map(|s| s.1).fold(0.0, f64::max));
+        }
+        assert!(largest[2] < largest[0], "{largest:?}");
+    }
+    assert!(fit_sphere_set(&[], 3, 0.01).is_none());
+    assert!(fit_sphere_set(&[Point3::new(f64::NAN, 0.0, 0.0)], 3, 0.01).is_none());
+}

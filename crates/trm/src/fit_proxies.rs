@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use trm_collision::CollisionModel;
-use trm_collision::fit::{fit_model, urdf_with_proxies};
+use trm_collision::fit::{fit_model, fit_model_spheres, urdf_with_proxies, urdf_with_spheres};
 
 /// Arguments of `fit-proxies`.
 #[derive(clap::Args)]
@@ -22,14 +22,64 @@ pub struct Args {
     pub out: Option<PathBuf>,
     /// Another model of the same robot (e.g. hand-made proxies) whose primitives' volumes are
     /// compared link by link.
-    #[arg(long, value_name = "MODEL")]
+    #[arg(long, value_name = "MODEL", conflicts_with = "spheres")]
     compare: Option<PathBuf>,
+    /// Fit up to N spheres per link instead of one primitive (a sphere model, as VAMP's
+    /// spherized URDFs): every point of each convex body's surface enclosed.
+    #[arg(long, value_name = "N", value_parser = crate::parse::count(1, 1000))]
+    spheres: Option<usize>,
+    /// With --spheres: the surface is sampled every STEP m and each radius padded by STEP.
+    #[arg(long, value_name = "STEP", default_value_t = 0.005, value_parser = crate::parse::positive, requires = "spheres")]
+    sphere_step: f64,
+}
+
+/// Fits sphere sets, prints the table, writes the URDF when asked.
+fn run_spheres(args: &Args, collision: &CollisionModel, count: usize) -> Result<()> {
+    let sets = fit_model_spheres(collision, count, args.sphere_step)
+        .with_context(|| args.model.display().to_string())?;
+    println!(
+        "{:<24} {:>9} {:>8} {:>12} {:>10}",
+        "link", "hull cm³", "spheres", "spheres cm³", "ratio"
+    );
+    let (mut hull, mut volume, mut total) = (0.0, 0.0, 0);
+    for s in &sets {
+        hull += s.hull;
+        volume += s.volume;
+        total += s.spheres.len();
+        println!(
+            "{:<24} {:>9.1} {:>8} {:>12.1} {:>10.2}",
+            s.link,
+            s.hull * 1e6,
+            s.spheres.len(),
+            s.volume * 1e6,
+            s.volume / s.hull.max(1e-12)
+        );
+    }
+    println!(
+        "{} links, {total} spheres: {:.1} cm³ of spheres (overlaps counted twice) against hulls {:.1} cm³ ({:.2}×); every hull surface point within a sphere (sampled every {} m, radii padded by it)",
+        sets.len(),
+        volume * 1e6,
+        hull * 1e6,
+        volume / hull.max(1e-12),
+        args.sphere_step
+    );
+    if let Some(out) = &args.out {
+        let text = std::fs::read_to_string(&args.model)
+            .with_context(|| format!("reading {}", args.model.display()))?;
+        let urdf = urdf_with_spheres(&text, &args.model.display().to_string(), &sets)?;
+        crate::write_atomic(out, urdf.as_bytes())?;
+        println!("wrote {} ({total} spheres)", out.display());
+    }
+    Ok(())
 }
 
 /// Fits every link that has meshes, prints the table, writes what was asked.
 pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(Some(&args.model))?;
     let collision = args.meshes.collision_model(&model)?;
+    if let Some(count) = args.spheres {
+        return run_spheres(args, &collision, count);
+    }
     let fits = fit_model(&collision).with_context(|| args.model.display().to_string())?;
     let other = match &args.compare {
         Some(p) => Some(CollisionModel::new(&crate::load_model(Some(p))?)?),
@@ -167,6 +217,8 @@ mod tests {
             },
             out: Some(out.clone()),
             compare: None,
+            spheres: None,
+            sphere_step: 0.005,
         };
         super::run(&args).unwrap();
         let options = CollisionOptions::with_ros_package_path(vec![fixtures]);
@@ -213,6 +265,8 @@ mod committed {
             },
             out: Some(fitted.clone()),
             compare: None,
+            spheres: None,
+            sphere_step: 0.005,
         })
         .unwrap();
         let read = |p: &std::path::Path| std::fs::read_to_string(p).unwrap();
