@@ -7,9 +7,10 @@
 #                                           skips with a message where nightly is missing
 #   fuzz/run.sh --list                      the targets
 #
-# Each target's corpus (fuzz/corpus/TARGET, not committed) is seeded from the files in specs/
-# and models/ and from fuzz/seeds/TARGET; crashes land in fuzz/artifacts/TARGET. Targets run
-# under AddressSanitizer; SANITIZER=none runs them about twice as fast (long runs).
+# Each target's corpus (fuzz/corpus/TARGET, not committed) is seeded from the files seeds.txt
+# names (specs/, models/…) and from fuzz/seeds/TARGET; crashes land in fuzz/artifacts/TARGET.
+# What each target checks is a function of fuzz/checks, which the quick test suite also runs on
+# the seeds and mutations of them (stable). Targets run under AddressSanitizer; SANITIZER=none runs them about twice as fast (long runs).
 set -euo pipefail
 cd "$(dirname "$0")"
 root=..
@@ -17,19 +18,13 @@ root=..
 targets=(urdf model_description task_spec world motion_spec taskmap_spec map checkpoint taskmap scene
          configurations posture trajectory_csv trajectory_json srdf mesh moveit)
 
-# The seed files of a target, one per line.
+# The seed files of a target, one per line: its globs in seeds.txt and the files in seeds/TARGET.
 seeds() {
-  case "$1" in
-    urdf) ls "$root"/models/planar_arm.urdf "$root"/models/branched_tree.urdf ;; # + seeds/urdf; the iCub URDFs are slow seeds
-    model_description) ls "$root"/models/*.ron ;;
-    task_spec) ls "$root"/specs/*.ron "$root"/specs/fig6/*.ron "$root"/specs/table_iii/*.ron ;;
-    world) ls "$root"/specs/worlds/*.ron ;;
-    motion_spec) ls "$root"/specs/wholebody/*.ron ;;
-    taskmap_spec) ls "$root"/specs/taskmaps/*.ron ;;
-    configurations) ls "$root"/specs/configs/*.json ;;
-    srdf) ls "$root"/models/*/example-robot-data/robots/*/srdf/*.srdf "$root"/models/*/*.srdf ;;
-    moveit) ls "$root"/crates/trm-plan/tests/fixtures/mbm/box_panda/*.yaml ;;
-  esac
+  local glob
+  awk -v t="$1" '$1 == t { print $2 }' seeds.txt | while read -r glob; do
+    # shellcheck disable=SC2086
+    ls "$root"/$glob
+  done
   if [ -d "seeds/$1" ]; then ls "seeds/$1"/*; fi
 }
 

@@ -7,11 +7,14 @@ use std::path::Path;
 use std::process::Command;
 
 #[test]
-#[ignore = "slow (~3 min: builds the libraries again in the example's own workspace); CI runs it with --ignored"]
+#[ignore = "slow (builds the library crates again for the example's own profile); CI runs it with --ignored"]
 fn a_crate_outside_the_workspace_uses_the_library_end_to_end() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let manifest = root.join("examples/library-user/Cargo.toml");
-    let target = root.join("target/library-user");
+    // the workspace's target directory: the example's lock file and profile for dependencies are
+    // the workspace's, so the dependencies built for the tests serve it (only trm's crates build)
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), Into::into);
     let out = std::env::temp_dir().join(format!("trm-library-user-{}", std::process::id()));
     let run = Command::new(env!("CARGO"))
         .args(["run", "--quiet", "--locked", "--manifest-path"])

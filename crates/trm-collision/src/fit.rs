@@ -413,24 +413,33 @@ pub struct LinkFit {
 /// when no link has any (the meshes were not found, or the URDF has none) or a link's vertices
 /// are not finite.
 pub fn fit_model(collision: &CollisionModel) -> Result<Vec<LinkFit>, CollisionError> {
-    let mut fits = Vec::new();
-    for (l, link) in collision.robot().tree().links.iter().enumerate() {
+    fit_mesh_links(collision, |l, name| {
         let points = collision.link_mesh_points(l);
         if points.is_empty() {
-            continue;
+            return Ok(None);
         }
-        let all = fit(&points).ok_or_else(|| CollisionError::InvalidValue {
-            what: format!("link `{}`'s meshes", link.name),
-            problem: "have no finite vertices to fit".into(),
-        })?;
+        let all = fit(&points).ok_or_else(|| no_finite_vertices(name))?;
         let fitted = all.best().clone();
         let worst = worst_outside(&fitted, &points);
-        fits.push(LinkFit {
-            link: link.name.clone(),
+        Ok(Some(LinkFit {
+            link: name.to_string(),
             fitted,
             hull: all.hull_volume,
             worst,
-        });
+        }))
+    })
+}
+
+/// `fit_link(index, name)` for every link of `collision`, in link order: the fits of the links
+/// it fits (`Some`), an error when it fits none (the meshes were not found, or the URDF has
+/// none).
+fn fit_mesh_links<T>(
+    collision: &CollisionModel,
+    mut fit_link: impl FnMut(usize, &str) -> Result<Option<T>, CollisionError>,
+) -> Result<Vec<T>, CollisionError> {
+    let mut fits = Vec::new();
+    for (l, link) in collision.robot().tree().links.iter().enumerate() {
+        fits.extend(fit_link(l, &link.name)?);
     }
     if fits.is_empty() {
         return Err(CollisionError::InvalidValue {
@@ -439,6 +448,14 @@ pub fn fit_model(collision: &CollisionModel) -> Result<Vec<LinkFit>, CollisionEr
         });
     }
     Ok(fits)
+}
+
+/// The error for a link whose mesh vertices are none of them finite.
+fn no_finite_vertices(link: &str) -> CollisionError {
+    CollisionError::InvalidValue {
+        what: format!("link `{link}`'s meshes"),
+        problem: "have no finite vertices to fit".into(),
+    }
 }
 
 /// Added to radii and half sizes written with six decimals, so that the rounded primitive
@@ -567,8 +584,7 @@ pub fn fit_model_spheres(
             problem: "give at least 1 sphere and a finite step above 0".into(),
         });
     }
-    let mut sets = Vec::new();
-    for (l, link) in collision.robot().tree().links.iter().enumerate() {
+    fit_mesh_links(collision, |l, name| {
         let mut surface = Vec::new();
         let mut hull = 0.0;
         for body in collision.bodies().iter().filter(|b| b.link == l) {
@@ -586,31 +602,21 @@ pub fn fit_model_spheres(
             surface.extend(hull_surface_points(&local, step));
         }
         if surface.is_empty() {
-            continue;
+            return Ok(None);
         }
         let spheres =
-            fit_sphere_set(&surface, count, step).ok_or_else(|| CollisionError::InvalidValue {
-                what: format!("link `{}`'s meshes", link.name),
-                problem: "have no finite vertices to fit".into(),
-            })?;
+            fit_sphere_set(&surface, count, step).ok_or_else(|| no_finite_vertices(name))?;
         let volume = spheres
             .iter()
             .map(|(_, r)| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
             .sum();
-        sets.push(LinkSpheres {
-            link: link.name.clone(),
+        Ok(Some(LinkSpheres {
+            link: name.to_string(),
             spheres,
             hull,
             volume,
-        });
-    }
-    if sets.is_empty() {
-        return Err(CollisionError::InvalidValue {
-            what: collision.robot().name().to_string(),
-            problem: "no link has mesh collisions to fit\n  fix: give a URDF whose <collision> elements are meshes (found through the package paths)".into(),
-        });
-    }
-    Ok(sets)
+        }))
+    })
 }
 
 /// A `<collision>` element for a fitted primitive.

@@ -5,75 +5,29 @@ NumPy arrays in and out, batch-first: a configuration is an ``(n,)`` array, a ba
 ``Roadmap.build``, ``Planner.plan``, batched kinematics and collision) release the GIL. Errors
 are :class:`TrmError` (a ``ValueError``) with trm's located messages: file, place, fix.
 
+One submodule per concept, as the Rust crates are split (``trm.kinematics``,
+``trm.collision``, ``trm.tasks``, ``trm.optim``, ``trm.roadmap``, ``trm.plan``,
+``trm.taskmap``, ``trm.wholebody``, ``trm.viewer``); every name is also here, at the top.
+
 >>> import trm
 >>> robot = trm.Robot.icub()
 >>> robot.fk(robot.posture("home")).shape[1:]
 (4, 4)
 """
 
-from ._trm import (
-    ALGORITHMS,
-    CollisionModel,
-    Optimizer,
-    Planner,
-    Problem,
-    Roadmap,
-    Robot,
-    TaskMap,
-    TrmError,
-    World,
-    __version__,
-    benchmark_mbm,
-    compare_optimisers,
-    fit_proxies,
-    generate_mbm,
-    minimize_constrained,
-    reach_grasp,
-    run_scenario,
-    stand_up,
-    view,
-)
+from . import collision, kinematics, optim, plan, roadmap, taskmap, tasks, viewer, wholebody
+from ._trm import TrmError, __version__
+from .collision import CollisionModel, World, fit_proxies
+from .kinematics import Robot
+from .optim import ALGORITHMS, Optimizer, compare_optimisers, minimize, minimize_constrained
+from .plan import Planner, benchmark_mbm, generate_mbm
+from .roadmap import Roadmap, run_scenario
+from .taskmap import TaskMap, reach_grasp
+from .tasks import Problem
+from .viewer import view
+from .wholebody import stand_up
 
-__all__ = [
-    "__version__",
-    "ALGORITHMS",
-    "CollisionModel",
-    "Optimizer",
-    "Planner",
-    "Problem",
-    "Roadmap",
-    "Robot",
-    "TaskMap",
-    "TrmError",
-    "World",
-    "benchmark_mbm",
-    "compare_optimisers",
-    "fit_proxies",
-    "generate_mbm",
-    "minimize",
-    "minimize_constrained",
-    "reach_grasp",
-    "run_scenario",
-    "stand_up",
-    "view",
-]
+#: the submodules, one per concept
+SUBMODULES = (kinematics, collision, tasks, optim, roadmap, plan, taskmap, wholebody, viewer)
 
-
-def minimize(fun, x0, sigma, algo="xnes", seed=0, max_evals=10_000, batch=False):
-    """Minimises ``fun`` from ``x0`` (step ``sigma``) with a trm-optim algorithm.
-
-    ``fun`` takes one point ``(d,)`` and returns a float or, with ``batch=True``, takes the
-    whole population ``(λ, d)`` and returns ``(λ,)`` values. Returns ``(best_x, best_f,
-    evaluations)``.
-    """
-    import numpy as np
-
-    opt = Optimizer(algo, x0, sigma, seed=seed, max_evals=max_evals)
-    while not opt.done:
-        xs = opt.ask()
-        if batch:
-            values = np.asarray(fun(xs), dtype=float)
-        else:
-            values = np.array([fun(x) for x in xs], dtype=float)
-        opt.tell(values)
-    return opt.best_x, opt.best_f, opt.evaluations
+__all__ = ["__version__", "TrmError"] + [name for m in SUBMODULES for name in m.__all__]

@@ -1,4 +1,5 @@
-"""Type stubs of trm's Python API (see the docstrings for details)."""
+"""Type stubs of trm's native module (see the docstrings for details); the package `trm`
+and its submodules re-export these names."""
 
 from typing import Callable, Sequence
 
@@ -144,16 +145,6 @@ def run_scenario(scenario: str, roadmap: Roadmap, repair_evaluations: int | None
 def compare_optimisers(specs: Sequence[str], algorithms: Sequence[str] | None = None, runs: int = 30, seed: int = 0, max_evals: int = 400_000, no_improvement: int = 30_000) -> dict: ...
 def benchmark_mbm(path: str, model: str, families: Sequence[str] = (), per_family: int | None = None, seed: int = 0, max_iterations: int = 1_000_000, verify: bool = False, package_paths: Sequence[str] = (), task_space: str | None = None, position_tolerance: float = 0.01, orientation_tolerance: float = 0.05) -> dict: ...
 def stand_up(spec: str, seed: int = 0, rollouts: int | None = None, bootstrap_rollouts: int | None = None) -> dict: ...
-
-def minimize(
-    fun: Callable[[Array], float] | Callable[[Array], ArrayLike],
-    x0: ArrayLike,
-    sigma: float,
-    algo: str = "xnes",
-    seed: int = 0,
-    max_evals: int = 10_000,
-    batch: bool = False,
-) -> tuple[Array, float, int]: ...
 
 def minimize_constrained(
     fun: Callable[[Array], float],
