@@ -19,6 +19,7 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use trm_benches::random_configurations;
+use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
 use trm_tasks::Objective;
@@ -29,8 +30,9 @@ fn objective(path: &str) -> Result<Objective, String> {
     Ok(Objective::new(robot.all_active(), collision, World::new()))
 }
 
-/// trm's and VAMP's times per configuration (one per round) and VAMP's verdicts.
-type Exchanged = (Vec<f64>, Vec<f64>, Vec<bool>);
+/// trm's `f64` batch, trm's single-precision screen (when the timed model is a sphere model)
+/// and VAMP's times per configuration (one per round) and VAMP's verdicts.
+type Exchanged = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<bool>);
 
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
@@ -100,11 +102,13 @@ fn run() -> Result<(), String> {
     let flat: Vec<f64> = qs.iter().flatten().copied().collect();
     let d = timed.dim();
     let mut scratch = timed.scratch();
-    // trm's pass, then VAMP's, `rounds` times; then VAMP's verdicts
+    let mut fast = FastChecker::new(timed.collision(), timed.active().clone()).ok();
+    let fast_world = fast.as_ref().map(|f| f.model().world(&world));
+    // trm's passes, then VAMP's, `rounds` times; then VAMP's verdicts
     let mut exchange = || -> Result<Exchanged, String> {
         to_vamp.write_all(input.as_bytes()).map_err(lost)?;
         to_vamp.flush().map_err(lost)?;
-        let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+        let (mut ours, mut screened, mut theirs) = (Vec::new(), Vec::new(), Vec::new());
         for round in 0..rounds {
             let began = Instant::now();
             let mut free_blocks = 0;
@@ -113,6 +117,13 @@ fn run() -> Result<(), String> {
                     usize::from(timed.all_collision_free_in(block, &world, &mut scratch));
             }
             ours.push(began.elapsed().as_nanos() as f64 / n as f64);
+            if let (Some(fast), Some(fast_world)) = (&mut fast, &fast_world) {
+                let began = Instant::now();
+                for block in flat.chunks(FAST_LANES * d) {
+                    free_blocks += usize::from(fast.all_free(block, &world, fast_world));
+                }
+                screened.push(began.elapsed().as_nanos() as f64 / n as f64);
+            }
             std::hint::black_box(free_blocks);
             let line = from_vamp
                 .next()
@@ -137,12 +148,12 @@ fn run() -> Result<(), String> {
                 .map_err(lost)?;
             free.push(line == "valid 1");
         }
-        Ok((ours, theirs, free))
+        Ok((ours, screened, theirs, free))
     };
     let exchanged = exchange();
     let _ = vamp.kill();
     let _ = vamp.wait();
-    let (mut ours, mut theirs, vamp_free) = exchanged?;
+    let (mut ours, mut screened, mut theirs, vamp_free) = exchanged?;
     let mut scratch = timed.scratch();
 
     let mut exact_scratch = exact.scratch();
@@ -160,9 +171,19 @@ fn run() -> Result<(), String> {
         "{n} configurations of {} (seed 0), FK + self-collision in blocks, median of {rounds} interleaved rounds:",
         timed.active().model().name()
     );
-    println!("  trm  ({}): {a:.1} ns per configuration", args[0]);
+    println!(
+        "  trm, f64 batches of {LANES} ({}): {a:.1} ns per configuration ({:.2}× VAMP)",
+        args[0],
+        a / b
+    );
+    if !screened.is_empty() {
+        let c = median(&mut screened);
+        println!(
+            "  trm, f32 sphere screen, blocks of {FAST_LANES} (exact answers): {c:.1} ns per configuration ({:.2}× VAMP)",
+            c / b
+        );
+    }
     println!("  VAMP ({}): {b:.1} ns per configuration", args[2]);
-    println!("  trm / VAMP: {:.2}×", a / b);
     println!(
         "verdicts against the exact model ({}, {colliding} of {n} colliding): VAMP missed {missed} collisions, refused {false_positive} free configurations; VAMP and trm's copy of its spheres agree on {agree_spheres} of {n}",
         args[1]

@@ -30,11 +30,17 @@
 //! boxes add their slabs. [`Shape::enclosing_spheres`] gives a sphere model of any shape (a few
 //! spheres that enclose it, tighter than one).
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
+//!
+//! For sphere models (VAMP's spherized URDFs, or [`fit::urdf_with_spheres`]),
+//! [`fast::FastChecker`] checks eight configurations at once in single precision, deferring the
+//! few within rounding distance of contact to the exact check, so its answers are the exact
+//! model's (the planner uses it whenever the robot is a sphere model).
 
 mod acm;
 mod batch;
 mod cull;
 mod error;
+pub mod fast;
 pub mod fit;
 mod generate;
 pub mod mesh;

@@ -226,4 +226,28 @@ impl ActiveSet {
     pub fn forward_batch_unchecked(&self, q: &[f64], batch: &mut PoseBatch) {
         self.plan.run_batch(q, self.active.len(), batch);
     }
+
+    /// Single-precision forward kinematics of [`BLOCK_LANES`](crate::BLOCK_LANES) active-value
+    /// vectors at once, one after the other in `q` (`BLOCK_LANES × len` values), into `block`
+    /// (made by [`RobotModel::pose_block`]): the [`ActiveSet::forward`] poses rounded to `f32`
+    /// along the chain (a few units of 2⁻²⁴ of relative error per joint).
+    pub fn forward_block(&self, q: &[f64], block: &mut crate::PoseBlock) -> Result<()> {
+        crate::model::check_lanes(
+            "active motor values",
+            q,
+            self.active.len(),
+            crate::BLOCK_LANES,
+            |i| &self.model.motors()[self.active[i]].name,
+        )?;
+        self.model.check_block_buffer(block)?;
+        self.forward_block_unchecked(q, block);
+        Ok(())
+    }
+
+    /// [`ActiveSet::forward_block`] without checks, for the hot path. Panics on a wrong-sized
+    /// `q` or block.
+    #[inline]
+    pub fn forward_block_unchecked(&self, q: &[f64], block: &mut crate::PoseBlock) {
+        self.plan.run_block(q, self.active.len(), block);
+    }
 }

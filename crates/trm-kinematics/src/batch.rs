@@ -140,28 +140,79 @@ fn run_batch(plan: &Plan, inputs: &[f64], stride: usize, batch: &mut PoseBatch) 
             [[0.0; LANES], [1.0; LANES], v]
         };
     }
-    let slots = &batch.slots;
-    let poses = &mut batch.poses;
-    poses[0] = IDENTITY;
+    run_steps(plan, &batch.slots, &mut batch.poses);
+}
+
+/// The float types batched forward kinematics runs in: `f64` ([`PoseBatch`]) and `f32`
+/// ([`PoseBlock`]).
+pub(crate) trait Real:
+    Copy + std::ops::Add<Output = Self> + std::ops::Sub<Output = Self> + std::ops::Mul<Output = Self>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    const TWO: Self;
+    /// `x` rounded to this type.
+    fn of(x: f64) -> Self;
+}
+
+impl Real for f64 {
+    const ZERO: f64 = 0.0;
+    const ONE: f64 = 1.0;
+    const TWO: f64 = 2.0;
+    #[inline(always)]
+    fn of(x: f64) -> f64 {
+        x
+    }
+}
+
+impl Real for f32 {
+    const ZERO: f32 = 0.0;
+    const ONE: f32 = 1.0;
+    const TWO: f32 = 2.0;
+    #[inline(always)]
+    fn of(x: f64) -> f32 {
+        x as f32
+    }
+}
+
+/// The steps of `plan` over slot values `[sin, cos, displacement]` per lane: the world pose
+/// (quaternion `w, i, j, k`, translation `x, y, z`) of every link and frame in every lane.
+#[inline(always)]
+fn run_steps<T: Real, const L: usize>(
+    plan: &Plan,
+    slots: &[[[T; L]; 3]],
+    poses: &mut [[[T; L]; 7]],
+) {
+    let identity = {
+        let mut p = [[T::ZERO; L]; 7];
+        p[0] = [T::ONE; L];
+        p
+    };
+    poses[0] = identity;
     for step in &plan.steps {
         let parent = poses[step.parent as usize];
         let [s, c, d] = slots[step.slot as usize];
         let (r, b) = (&step.rotation, &step.axis_quat);
-        let mut child = IDENTITY;
-        for l in 0..LANES {
+        let (rw, ri, rj, rk) = (T::of(r.w), T::of(r.i), T::of(r.j), T::of(r.k));
+        let (bw, bi, bj, bk) = (T::of(b.w), T::of(b.i), T::of(b.j), T::of(b.k));
+        let (t, a) = (&step.translation, &step.axis_in_parent);
+        let (tx0, ty0, tz0) = (T::of(t.x), T::of(t.y), T::of(t.z));
+        let (ax, ay, az) = (T::of(a.x), T::of(a.y), T::of(a.z));
+        let mut child = identity;
+        for l in 0..L {
             // local rotation c·r + s·b, local translation t + d·axis
-            let lw = c[l] * r.w + s[l] * b.w;
-            let li = c[l] * r.i + s[l] * b.i;
-            let lj = c[l] * r.j + s[l] * b.j;
-            let lk = c[l] * r.k + s[l] * b.k;
-            let tx = step.translation.x + step.axis_in_parent.x * d[l];
-            let ty = step.translation.y + step.axis_in_parent.y * d[l];
-            let tz = step.translation.z + step.axis_in_parent.z * d[l];
+            let lw = c[l] * rw + s[l] * bw;
+            let li = c[l] * ri + s[l] * bi;
+            let lj = c[l] * rj + s[l] * bj;
+            let lk = c[l] * rk + s[l] * bk;
+            let tx = tx0 + ax * d[l];
+            let ty = ty0 + ay * d[l];
+            let tz = tz0 + az * d[l];
             let (w, x, y, z) = (parent[0][l], parent[1][l], parent[2][l], parent[3][l]);
             // parent rotation applied to the local translation: v + w·u + q×u, u = 2 q×v
-            let ux = 2.0 * (y * tz - z * ty);
-            let uy = 2.0 * (z * tx - x * tz);
-            let uz = 2.0 * (x * ty - y * tx);
+            let ux = T::TWO * (y * tz - z * ty);
+            let uy = T::TWO * (z * tx - x * tz);
+            let uz = T::TWO * (x * ty - y * tx);
             child[4][l] = parent[4][l] + tx + w * ux + (y * uz - z * uy);
             child[5][l] = parent[5][l] + ty + w * uy + (z * ux - x * uz);
             child[6][l] = parent[6][l] + tz + w * uz + (x * uy - y * ux);
@@ -172,6 +223,95 @@ fn run_batch(plan: &Plan, inputs: &[f64], stride: usize, batch: &mut PoseBatch) 
         }
         poses[step.child as usize] = child;
     }
+}
+
+/// Configurations per single-precision block.
+pub const BLOCK_LANES: usize = 2 * LANES;
+
+/// A pose in every lane of a block, in `f32`: quaternion `w, i, j, k` then translation
+/// `x, y, z`.
+pub type PoseLanes32 = [[f32; BLOCK_LANES]; 7];
+
+/// Caller-owned scratch for single-precision forward kinematics of [`BLOCK_LANES`]
+/// configurations at once (made by [`RobotModel::pose_block`](crate::RobotModel::pose_block)):
+/// for consumers that do not need double precision, such as collision screens with a stated
+/// rounding margin. Joint values, sines and cosines are computed in `f64` and rounded; the chain
+/// is composed in `f32` (each step adds a few units of 2⁻²⁴ of relative error).
+#[derive(Debug, Clone)]
+pub struct PoseBlock {
+    slots: Vec<[[f32; BLOCK_LANES]; 3]>,
+    poses: Vec<PoseLanes32>,
+}
+
+impl PoseBlock {
+    pub(crate) fn new(num_joints: usize, num_frames: usize) -> Self {
+        PoseBlock {
+            slots: vec![
+                [[0.0; BLOCK_LANES], [1.0; BLOCK_LANES], [0.0; BLOCK_LANES]];
+                num_joints + 1
+            ],
+            poses: vec![[[0.0; BLOCK_LANES]; 7]; num_frames],
+        }
+    }
+
+    /// Whether the block was made for a model with these many joints and frames.
+    pub fn fits(&self, num_joints: usize, num_frames: usize) -> bool {
+        self.poses.len() == num_frames && self.slots.len() == num_joints + 1
+    }
+
+    /// Every pose (links, then named frames, as [`PoseBuffer::poses`] orders them) in every
+    /// lane.
+    #[inline]
+    pub fn lanes(&self) -> &[PoseLanes32] {
+        &self.poses
+    }
+}
+
+impl Plan {
+    /// Runs the pass in `f32` on [`BLOCK_LANES`] inputs: lane `l`'s input is
+    /// `inputs[l * stride..][..stride]`. Lengths must have been checked.
+    #[inline]
+    pub(crate) fn run_block(&self, inputs: &[f64], stride: usize, block: &mut PoseBlock) {
+        run_block(self, inputs, stride, block);
+    }
+}
+
+/// [`Plan::run_block`], compiled for several instruction sets with the best one chosen at run
+/// time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) {
+    let slots = &mut block.slots[..plan.rows.len()];
+    for ((out, &(constant, start, end)), &revolute) in
+        slots.iter_mut().zip(&plan.rows).zip(&plan.revolute)
+    {
+        let terms = &plan.terms[start as usize..end as usize];
+        let mut v = [0.0; BLOCK_LANES];
+        for (l, v) in v.iter_mut().enumerate() {
+            *v = affine(constant, terms, &inputs[l * stride..(l + 1) * stride]);
+        }
+        if revolute {
+            for half in 0..2 {
+                let mut x = [0.0; LANES];
+                for l in 0..LANES {
+                    x[l] = 0.5 * v[half * LANES + l];
+                }
+                let (s, c) = sin_cos(x);
+                for l in 0..LANES {
+                    out[0][half * LANES + l] = s[l] as f32;
+                    out[1][half * LANES + l] = c[l] as f32;
+                    out[2][half * LANES + l] = 0.0;
+                }
+            }
+        } else {
+            for l in 0..BLOCK_LANES {
+                out[0][l] = 0.0;
+                out[1][l] = 1.0;
+                out[2][l] = v[l] as f32;
+            }
+        }
+    }
+    run_steps(plan, &block.slots, &mut block.poses);
 }
 
 // π/2 in three parts (the first two with trailing zero bits, so k·part is exact for the

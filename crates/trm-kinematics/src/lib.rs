@@ -47,7 +47,9 @@ pub mod srdf;
 mod tree;
 
 pub use active::ActiveSet;
-pub use batch::{LANES, Lanes, PoseBatch, PoseLanes, lane_pose, sin_cos};
+pub use batch::{
+    BLOCK_LANES, LANES, Lanes, PoseBatch, PoseBlock, PoseLanes, PoseLanes32, lane_pose, sin_cos,
+};
 pub use derivatives::GRAVITY;
 pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,

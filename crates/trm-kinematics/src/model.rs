@@ -553,6 +553,23 @@ impl RobotModel {
         PoseBatch::new(self.num_joints(), self.num_frames())
     }
 
+    /// A single-precision pose block sized for this model
+    /// ([`BLOCK_LANES`](crate::BLOCK_LANES) configurations at once).
+    pub fn pose_block(&self) -> crate::PoseBlock {
+        crate::PoseBlock::new(self.num_joints(), self.num_frames())
+    }
+
+    pub(crate) fn check_block_buffer(&self, block: &crate::PoseBlock) -> Result<()> {
+        if !block.fits(self.num_joints(), self.num_frames()) {
+            return Err(KinematicsError::WrongLength {
+                what: "pose block (make it with RobotModel::pose_block)",
+                expected: self.num_frames(),
+                got: block.lanes().len(),
+            });
+        }
+        Ok(())
+    }
+
     /// Forward kinematics of [`LANES`](crate::LANES) joint vectors at once, given one after the
     /// other in `joints` (`LANES × num_joints` values), into `batch`. Each lane's poses equal
     /// [`RobotModel::forward_joints`]'s to ≤ 1e-12.
@@ -608,10 +625,21 @@ pub(crate) fn check_batch<'a>(
     n: usize,
     name: impl Fn(usize) -> &'a str,
 ) -> Result<()> {
-    if values.len() != crate::LANES * n {
+    check_lanes(what, values, n, crate::LANES, name)
+}
+
+/// Checks `lanes` vectors of `n` finite values, one after the other in `values`.
+pub(crate) fn check_lanes<'a>(
+    what: &'static str,
+    values: &[f64],
+    n: usize,
+    lanes: usize,
+    name: impl Fn(usize) -> &'a str,
+) -> Result<()> {
+    if values.len() != lanes * n {
         return Err(KinematicsError::WrongLength {
             what,
-            expected: crate::LANES * n,
+            expected: lanes * n,
             got: values.len(),
         });
     }

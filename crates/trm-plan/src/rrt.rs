@@ -10,6 +10,7 @@ use std::time::Instant;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use trm_collision::World;
+use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
 use trm_kinematics::LANES;
 use trm_tasks::{Objective, Scratch};
 
@@ -127,11 +128,14 @@ pub struct RrtPath {
     pub refinements: u32,
 }
 
-/// Collision checks of configurations and edges in one world, counted.
+/// Collision checks of configurations and edges in one world, counted. A sphere model is
+/// checked by the single-precision screen ([`FastChecker`], [`FAST_LANES`] configurations at
+/// a time, exact answers); any other model by the objective's batched `f64` checks.
 pub struct Checker<'a> {
     objective: &'a Objective,
     world: &'a World,
     scratch: Scratch,
+    fast: Option<(FastChecker, FastWorld)>,
     batch: Vec<f64>,
     /// Configurations checked so far.
     pub checks: u64,
@@ -140,25 +144,51 @@ pub struct Checker<'a> {
 impl<'a> Checker<'a> {
     /// A checker for `objective`'s robot in `world`.
     pub fn new(objective: &'a Objective, world: &'a World) -> Self {
+        let fast = FastChecker::new(objective.collision(), objective.active().clone())
+            .ok()
+            .map(|checker| {
+                let fast_world = checker.model().world(world);
+                (checker, fast_world)
+            });
         Checker {
             objective,
             world,
             scratch: objective.scratch(),
+            fast,
             batch: Vec::new(),
             checks: 0,
         }
     }
 
+    /// Whether the single-precision screen checks this robot (a sphere model).
+    pub fn is_fast(&self) -> bool {
+        self.fast.is_some()
+    }
+
     /// Whether `q` is collision-free.
     pub fn free(&mut self, q: &[f64]) -> bool {
         self.checks += 1;
-        self.objective
-            .is_collision_free_in(q, self.world, &mut self.scratch)
+        self.all_free(q)
+    }
+
+    /// Whether every configuration of `qs` (at most a block's worth) is collision-free.
+    fn all_free(&mut self, qs: &[f64]) -> bool {
+        match &mut self.fast {
+            Some((checker, fast_world)) => checker.all_free(qs, self.world, fast_world),
+            None if qs.len() == self.objective.dim() => {
+                self.objective
+                    .is_collision_free_in(qs, self.world, &mut self.scratch)
+            }
+            None => self
+                .objective
+                .all_collision_free_in(qs, self.world, &mut self.scratch),
+        }
     }
 
     /// Whether the straight edge a → b is free at every `resolution` (the end points not
-    /// checked again), its points visited raked: batch k holds points k, k + m, k + 2m, … of
-    /// the edge's n points (m = ⌈n / LANES⌉).
+    /// checked again), its points visited raked: block k holds points k, k + m, k + 2m, … of
+    /// the edge's n points (m = ⌈n / lanes⌉, lanes = [`FAST_LANES`] on the screen, else
+    /// [`LANES`]).
     pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let d = a.len();
         let length = distance(a, b);
@@ -168,34 +198,36 @@ impl<'a> Checker<'a> {
         if n == 0 {
             return true;
         }
-        let stride = n.div_ceil(LANES);
-        self.batch.resize(LANES * d, 0.0);
+        let width = if self.fast.is_some() {
+            FAST_LANES
+        } else {
+            LANES
+        };
+        let stride = n.div_ceil(width);
+        let mut batch = std::mem::take(&mut self.batch);
+        batch.resize(width * d, 0.0);
+        let mut free = true;
         for k in 0..stride {
             let mut lanes = 0;
-            for l in 0..LANES {
+            for l in 0..width {
                 let i = k + l * stride;
                 if i >= n {
                     break;
                 }
                 let s = (i + 1) as f64 / steps as f64;
-                for (j, q) in self.batch[lanes * d..(lanes + 1) * d]
-                    .iter_mut()
-                    .enumerate()
-                {
+                for (j, q) in batch[lanes * d..(lanes + 1) * d].iter_mut().enumerate() {
                     *q = a[j] + s * (b[j] - a[j]);
                 }
                 lanes += 1;
             }
             self.checks += lanes as u64;
-            if !self.objective.all_collision_free_in(
-                &self.batch[..lanes * d],
-                self.world,
-                &mut self.scratch,
-            ) {
-                return false;
+            if !self.all_free(&batch[..lanes * d]) {
+                free = false;
+                break;
             }
         }
-        true
+        self.batch = batch;
+        free
     }
 }
 

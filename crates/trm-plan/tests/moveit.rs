@@ -144,27 +144,44 @@ fn malformed_scenes_and_requests_are_located_errors() {
     }
 }
 
+/// Both Panda models: mesh hulls (the `f64` checks) and VAMP's spheres (the single-precision
+/// screen, whose every path is then re-checked by the exact `f64` model).
 #[test]
 fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolution() {
-    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
-    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
-    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
-    let options = RrtOptions::default();
-    for p in find_problems(&fixtures()).unwrap() {
-        let (request, outcome) = solved_and_free(&robot, &collision, &p, &options);
-        let path = &outcome.path;
-        assert!(path.len() >= 2);
-        assert!(
-            path[0]
-                .iter()
-                .zip(&request.start.positions)
-                .all(|(a, b)| (a - b).abs() < 1e-12)
+    for (file, fast) in [("panda.ron", false), ("panda_spherized.ron", true)] {
+        let model = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../models/panda-mbm")
+            .join(file);
+        let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+        let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+        let objective = trm_tasks::Objective::new(
+            robot.all_active(),
+            collision.clone(),
+            trm_collision::World::new(),
         );
-        assert_eq!(path.last().unwrap(), &request.goal.positions);
-        // the same seed finds the same path
-        let scene = PlanningScene::load(&p.scene).unwrap();
-        let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
-        assert_eq!(again.path, outcome.path);
+        let world = trm_collision::World::new();
+        assert_eq!(
+            trm_plan::rrt::Checker::new(&objective, &world).is_fast(),
+            fast,
+            "{file}"
+        );
+        let options = RrtOptions::default();
+        for p in find_problems(&fixtures()).unwrap() {
+            let (request, outcome) = solved_and_free(&robot, &collision, &p, &options);
+            let path = &outcome.path;
+            assert!(path.len() >= 2);
+            assert!(
+                path[0]
+                    .iter()
+                    .zip(&request.start.positions)
+                    .all(|(a, b)| (a - b).abs() < 1e-12)
+            );
+            assert_eq!(path.last().unwrap(), &request.goal.positions);
+            // the same seed finds the same path
+            let scene = PlanningScene::load(&p.scene).unwrap();
+            let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
+            assert_eq!(again.path, outcome.path);
+        }
     }
 }
 

@@ -1,0 +1,895 @@
+//! Single-precision collision checks of sphere models, [`FAST_LANES`] configurations at once.
+//!
+//! VAMP's way (Thomason, Kingston and Kavraki, ICRA 2024): the robot as spheres, and every
+//! number of a block of eight configurations one `f32` lane, so that each arithmetic step is one
+//! 8-wide vector instruction (AVX2, chosen at run time; two 4-wide ones with SSE or NEON).
+//! Spheres are screened link by link: a link's bounding sphere first, its own spheres only when
+//! some lane's bounding spheres come close.
+//!
+//! **Exact verdicts, not approximate ones.** Single precision moves a sphere's centre by far less
+//! than the [`FastWorld::margin`]; a pair whose distance exceeds the sum of its radii by more than
+//! the margin is *clear*, one that falls short of it by more than the margin is *colliding*, and
+//! anything between is *uncertain*. A lane with an uncertain pair and no certain collision is
+//! handed back ([`Verdict::uncertain`]) for the exact `f64` check, so a caller that checks those
+//! lanes exactly answers as the `f64` path does, configuration by configuration (tested on
+//! random configurations of the Panda against [`CollisionModel::is_colliding`]).
+//!
+//! Robot bodies must be spheres (a spherized URDF, or one written by
+//! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)). World objects of every shape are
+//! taken: spheres, capsules and boxes are checked in single precision, cylinders and convex hulls
+//! through their bounding spheres (a lane near one is uncertain).
+
+// Lane loops index several arrays at once, the form the vectoriser turns into one instruction;
+// `!(x > limit)` is the NaN-inclusive test on purpose.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Point3, Vector3};
+use trm_kinematics::{ActiveSet, BLOCK_LANES, JointKind, PoseBlock, PoseBuffer, PoseLanes32};
+
+use crate::error::{CollisionError, Result};
+use crate::model::{CollisionModel, PlacedBodies};
+use crate::shape::Shape;
+use crate::world::World;
+
+/// Configurations per block ([`BLOCK_LANES`] of single-precision forward kinematics).
+pub const FAST_LANES: usize = BLOCK_LANES;
+
+/// One `f32` per configuration of a block, aligned for one 8-wide register. Its operations are
+/// element-wise loops, which the compiler turns into single vector instructions.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[repr(C, align(32))]
+struct F([f32; FAST_LANES]);
+
+macro_rules! lane_wise {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl std::ops::$trait for F {
+            type Output = F;
+            #[inline(always)]
+            fn $method(self, other: F) -> F {
+                let mut out = [0.0; FAST_LANES];
+                for l in 0..FAST_LANES {
+                    out[l] = self.0[l] $op other.0[l];
+                }
+                F(out)
+            }
+        }
+    };
+}
+lane_wise!(Add, add, +);
+lane_wise!(Sub, sub, -);
+lane_wise!(Mul, mul, *);
+
+impl F {
+    /// `x` in every lane.
+    #[inline(always)]
+    fn splat(x: f32) -> F {
+        F([x; FAST_LANES])
+    }
+
+    /// `f` of every lane.
+    #[inline(always)]
+    fn map(self, f: impl Fn(f32) -> f32) -> F {
+        let mut out = self.0;
+        for v in &mut out {
+            *v = f(*v);
+        }
+        F(out)
+    }
+
+    /// The lanes ≤ `limit` or NaN (NaN is never certainly clear).
+    #[inline(always)]
+    fn within(self, limit: f32) -> Flags {
+        let mut flags = [0; FAST_LANES];
+        for l in 0..FAST_LANES {
+            flags[l] = u32::from(!(self.0[l] > limit));
+        }
+        Flags(flags)
+    }
+
+    /// Whether any lane is ≤ `limit` or NaN ([`F::within`] not all clear), as a count: a vector
+    /// compare and a horizontal sum.
+    #[inline(always)]
+    fn any_within(self, limit: f32) -> bool {
+        let mut count = 0u32;
+        for l in 0..FAST_LANES {
+            count += u32::from(!(self.0[l] > limit));
+        }
+        count != 0
+    }
+
+    /// The lanes < `limit`.
+    #[inline(always)]
+    fn below(self, limit: f32) -> Flags {
+        let mut flags = [0; FAST_LANES];
+        for l in 0..FAST_LANES {
+            flags[l] = u32::from(self.0[l] < limit);
+        }
+        Flags(flags)
+    }
+}
+
+/// One flag (0 or 1) per lane, or-ed together without branches and turned into a
+/// [`LaneMask`] once per group of pairs.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[repr(C, align(32))]
+struct Flags([u32; FAST_LANES]);
+
+impl std::ops::BitOr for Flags {
+    type Output = Flags;
+    #[inline(always)]
+    fn bitor(self, other: Flags) -> Flags {
+        let mut out = [0; FAST_LANES];
+        for l in 0..FAST_LANES {
+            out[l] = self.0[l] | other.0[l];
+        }
+        Flags(out)
+    }
+}
+
+impl Flags {
+    /// The lanes flagged.
+    #[inline(always)]
+    fn mask(self) -> LaneMask {
+        let mut mask = 0;
+        for l in 0..FAST_LANES {
+            mask |= (self.0[l] as LaneMask) << l;
+        }
+        mask
+    }
+}
+
+/// One bit per configuration of a block (bit `l`: configuration `l`).
+pub type LaneMask = u8;
+
+/// Every configuration of a block.
+pub const ALL_LANES: LaneMask = u8::MAX;
+
+/// Rounding budget of the margin, m per metre of the largest coordinate per joint of the
+/// deepest chain (see [`FastWorld::margin`]).
+const MARGIN_PER_METRE_JOINT: f64 = 1e-6;
+
+/// A sphere in the frame of its link.
+#[derive(Debug, Clone, Copy)]
+struct Ball {
+    center: [f32; 3],
+    radius: f32,
+}
+
+/// A link's spheres and the sphere bounding them (in the link frame).
+#[derive(Debug, Clone)]
+struct Group {
+    /// Index of the link pose in the pose batches.
+    frame: usize,
+    bound: Ball,
+    /// The link's spheres: indices into [`FastModel::balls`].
+    balls: std::ops::Range<usize>,
+}
+
+/// Two balls (indices into [`FastModel::balls`]) and the sum of their radii.
+type BallPair = (u32, u32, f32);
+
+/// Two links whose spheres are tested against each other.
+#[derive(Debug, Clone)]
+struct GroupPair {
+    a: usize,
+    b: usize,
+    /// Per ball of link `a`: the ball and its pairs with link `b`'s balls, a range of
+    /// [`FastModel::pairs`].
+    runs: Vec<(u32, std::ops::Range<usize>)>,
+}
+
+/// A sphere model compiled for single-precision checks of [`FAST_LANES`] configurations at
+/// once (made by [`FastModel::new`] from a [`CollisionModel`] whose bodies are all spheres).
+#[derive(Debug, Clone)]
+pub struct FastModel {
+    balls: Vec<Ball>,
+    /// For each ball, the index of the body it came from.
+    bodies: Vec<usize>,
+    groups: Vec<Group>,
+    group_pairs: Vec<GroupPair>,
+    /// Ball pairs and the sums of their radii.
+    pairs: Vec<BallPair>,
+    /// Largest distance of any point of the robot from the world origin, in any configuration
+    /// (a bound from the joint offsets).
+    reach: f64,
+    /// Most movable joints between the root and a link.
+    depth: usize,
+}
+
+/// A world object as the single-precision checks see it.
+#[derive(Debug, Clone, Copy)]
+enum Object {
+    /// A sphere, or a capsule's segment (`a` = `b` for a sphere).
+    Round {
+        a: [f32; 3],
+        b: [f32; 3],
+        radius: f32,
+    },
+    /// A box: centre, the rows of the transposed rotation (world → box frame) and half sizes.
+    Box {
+        center: [f32; 3],
+        axes: [[f32; 3]; 3],
+        half: [f32; 3],
+    },
+    /// A cylinder along its z axis: centre, the rows of the transposed rotation, radius and
+    /// half length.
+    Cylinder {
+        center: [f32; 3],
+        axes: [[f32; 3]; 3],
+        radius: f32,
+        half: f32,
+    },
+    /// Anything else, through its bounding sphere: near it is uncertain, never colliding.
+    Bounded { center: [f32; 3], radius: f32 },
+}
+
+/// A world compiled for a [`FastModel`] (made by [`FastModel::world`]; compile it again when
+/// the world changes).
+#[derive(Debug, Clone)]
+pub struct FastWorld {
+    objects: Vec<Object>,
+    margin: f32,
+}
+
+impl FastWorld {
+    /// The band, m, around contact within which a verdict is uncertain: 1 µm per metre of the
+    /// largest coordinate involved (the robot's reach and the farthest object, plus one metre)
+    /// per joint of the deepest chain (plus two, for placing the spheres and measuring their
+    /// distance). Single precision errs by a few units of 2⁻²⁴ (6e-8) of relative error per
+    /// step — under 0.5 µm per metre per joint — so the band is at least twice the worst
+    /// rounding of both spheres of a pair (25 µm on the Panda; measured FK rounding: 0.7 µm on
+    /// the 75-joint iCub).
+    pub fn margin(&self) -> f64 {
+        f64::from(self.margin)
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether the world has no object.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+}
+
+/// What a block's check found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Verdict {
+    /// Lanes certainly colliding. The check stops at the first it finds, so this holds at
+    /// least one lane when any lane collides, not necessarily all of them.
+    pub colliding: LaneMask,
+    /// Lanes neither certainly colliding nor certainly free (a pair within the margin of
+    /// contact): check them exactly. Meaningful only when `colliding` is 0.
+    pub uncertain: LaneMask,
+}
+
+/// Caller-owned scratch of [`FastModel::check`] (made by [`FastModel::scratch`]): world
+/// centres of every sphere and bounding sphere in every lane. Checks do not allocate.
+#[derive(Debug, Clone)]
+pub struct FastScratch {
+    balls: Vec<[F; 3]>,
+    bounds: Vec<[F; 3]>,
+}
+
+impl FastModel {
+    /// Compiles `model`, whose bodies must all be spheres; an error names the first body that
+    /// is not one.
+    pub fn new(model: &CollisionModel) -> Result<Self> {
+        let bodies = model.bodies();
+        let tree = model.robot().tree();
+        if let Some(body) = bodies
+            .iter()
+            .find(|b| !matches!(b.shape, Shape::Sphere { .. }))
+        {
+            return Err(CollisionError::InvalidValue {
+                what: format!("body `{}`", body.name),
+                problem: format!(
+                    "is a {}: single-precision checks take sphere models only\n  fix: load a spherized URDF, or fit one with `trm fit-proxies URDF --spheres N --out OUT`",
+                    body.shape.kind()
+                ),
+            });
+        }
+        // balls grouped by link, in link order
+        let mut by_link: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for (i, b) in bodies.iter().enumerate() {
+            by_link.entry(b.link).or_default().push(i);
+        }
+        let (mut balls, mut ball_bodies, mut groups) = (Vec::new(), Vec::new(), Vec::new());
+        let mut group_of_body = vec![usize::MAX; bodies.len()];
+        let mut ball_of_body = vec![usize::MAX; bodies.len()];
+        for (&link, members) in &by_link {
+            let start = balls.len();
+            let spheres: Vec<(Point3<f64>, f64)> = members
+                .iter()
+                .map(|&i| {
+                    let Shape::Sphere { radius } = bodies[i].shape else {
+                        unreachable!("checked above")
+                    };
+                    (Point3::from(bodies[i].local.translation.vector), radius)
+                })
+                .collect();
+            for (&i, &(c, r)) in members.iter().zip(&spheres) {
+                group_of_body[i] = groups.len();
+                ball_of_body[i] = balls.len();
+                balls.push(Ball {
+                    center: to_f32(c.coords),
+                    radius: r as f32,
+                });
+                ball_bodies.push(i);
+            }
+            groups.push(Group {
+                frame: link,
+                bound: bounding_ball(&spheres),
+                balls: start..balls.len(),
+            });
+        }
+        // the model's checked body pairs, grouped by link pair
+        let mut by_pair: BTreeMap<(usize, usize), Vec<BallPair>> = BTreeMap::new();
+        for p in model.pairs() {
+            let (a, b) = (p.a as usize, p.b as usize);
+            let (ga, gb) = (group_of_body[a], group_of_body[b]);
+            let (ba, bb) = (ball_of_body[a], ball_of_body[b]);
+            by_pair.entry((ga, gb)).or_default().push((
+                ba as u32,
+                bb as u32,
+                balls[ba].radius + balls[bb].radius,
+            ));
+        }
+        let (mut pairs, mut group_pairs) = (Vec::new(), Vec::new());
+        for ((a, b), mut list) in by_pair {
+            list.sort_by_key(|&(x, y, _)| (x, y));
+            let mut runs: Vec<(u32, std::ops::Range<usize>)> = Vec::new();
+            for pair in list {
+                match runs.last_mut() {
+                    Some((x, range)) if *x == pair.0 => range.end += 1,
+                    _ => runs.push((pair.0, pairs.len()..pairs.len() + 1)),
+                }
+                pairs.push(pair);
+            }
+            group_pairs.push(GroupPair { a, b, runs });
+        }
+        // reach: every joint offset and prismatic travel end to end, then the farthest sphere
+        let chain: f64 = tree
+            .joints
+            .iter()
+            .map(|j| {
+                let travel = if j.kind == JointKind::Prismatic {
+                    j.limits.lower.abs().max(j.limits.upper.abs())
+                } else {
+                    0.0
+                };
+                j.local_origin.translation.vector.norm() + travel
+            })
+            .sum();
+        let farthest = balls
+            .iter()
+            .map(|b| norm(b.center) + f64::from(b.radius))
+            .fold(0.0, f64::max);
+        // joints are in tree order: a parent link's depth is known before its children's
+        let mut depth_of = vec![0usize; tree.links.len()];
+        for j in &tree.joints {
+            depth_of[j.child] = depth_of[j.parent] + usize::from(j.kind != JointKind::Fixed);
+        }
+        Ok(FastModel {
+            depth: depth_of.into_iter().max().unwrap_or(0),
+            balls,
+            bodies: ball_bodies,
+            groups,
+            group_pairs,
+            pairs,
+            reach: chain + farthest,
+        })
+    }
+
+    /// Number of spheres.
+    pub fn num_spheres(&self) -> usize {
+        self.balls.len()
+    }
+
+    /// Number of sphere pairs self-collision checks may test.
+    pub fn num_pairs(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// A scratch buffer for [`FastModel::check`].
+    pub fn scratch(&self) -> FastScratch {
+        FastScratch {
+            balls: vec![[F::default(); 3]; self.balls.len()],
+            bounds: vec![[F::default(); 3]; self.groups.len()],
+        }
+    }
+
+    /// `world` compiled for [`FastModel::check`], with its margin (see [`FastWorld::margin`]).
+    pub fn world(&self, world: &World) -> FastWorld {
+        let mut farthest: f64 = 0.0;
+        let objects = world
+            .objects()
+            .iter()
+            .map(|o| {
+                let pose = o.pose();
+                let bounds = o.bounding_box();
+                let (mins, maxs) = (bounds.mins, bounds.maxs);
+                farthest = farthest.max(mins.coords.amax()).max(maxs.coords.amax());
+                let t = pose.translation.vector;
+                match o.shape() {
+                    Shape::Sphere { radius } => Object::Round {
+                        a: to_f32(t),
+                        b: to_f32(t),
+                        radius: *radius as f32,
+                    },
+                    Shape::Capsule { radius, length } => {
+                        let half = pose.rotation * Vector3::new(0.0, 0.0, 0.5 * length);
+                        Object::Round {
+                            a: to_f32(t - half),
+                            b: to_f32(t + half),
+                            radius: *radius as f32,
+                        }
+                    }
+                    Shape::Box { size } => Object::Box {
+                        center: to_f32(t),
+                        axes: inverse_axes(pose),
+                        half: size.map(|s| (0.5 * s) as f32),
+                    },
+                    Shape::Cylinder { radius, length } => Object::Cylinder {
+                        center: to_f32(t),
+                        axes: inverse_axes(pose),
+                        radius: *radius as f32,
+                        half: (0.5 * length) as f32,
+                    },
+                    Shape::Convex { .. } => {
+                        let c = bounds.center();
+                        Object::Bounded {
+                            center: to_f32(c.coords),
+                            radius: (0.5 * (maxs - mins).norm()) as f32,
+                        }
+                    }
+                }
+            })
+            .collect();
+        let largest = self.reach.max(farthest);
+        FastWorld {
+            objects,
+            margin: (MARGIN_PER_METRE_JOINT * (1.0 + largest) * (2 + self.depth) as f64) as f32,
+        }
+    }
+
+    /// The body of the collision model a sphere came from (spheres are ordered by link).
+    pub fn body_of_sphere(&self, sphere: usize) -> usize {
+        self.bodies[sphere]
+    }
+
+    /// Checks the configurations of a block against themselves and `world`: `poses` holds their
+    /// link poses ([`PoseBlock::lanes`] of the collision model's robot), `live` the lanes in
+    /// use. Stops at the first certain collision.
+    ///
+    /// # Panics
+    /// If the poses or the scratch belong to another model.
+    pub fn check(
+        &self,
+        poses: &[PoseLanes32],
+        live: LaneMask,
+        world: &FastWorld,
+        scratch: &mut FastScratch,
+    ) -> Verdict {
+        check(self, poses, live, world, scratch)
+    }
+}
+
+/// Exact collision checks of a sphere model's configurations, [`FAST_LANES`] at a time: forward
+/// kinematics of a block in `f64`, the [`FastModel`] screen in `f32`, and the exact `f64` check
+/// ([`CollisionModel::is_colliding`]) of the lanes it leaves uncertain. Its answers are the exact
+/// model's; only the work differs. Caller-owned: make one per thread.
+#[derive(Debug, Clone)]
+pub struct FastChecker {
+    fast: FastModel,
+    collision: CollisionModel,
+    active: ActiveSet,
+    /// `FAST_LANES × dim` inputs (unused lanes repeat the first configuration).
+    inputs: Vec<f64>,
+    block: PoseBlock,
+    scratch: FastScratch,
+    pose: PoseBuffer,
+    placed: PlacedBodies,
+    /// Configurations the `f32` screen left uncertain so far (each then checked exactly).
+    pub uncertain: u64,
+}
+
+impl FastChecker {
+    /// A checker of `collision`'s robot (its bodies all spheres) moved by `active`'s
+    /// coordinates; an error for a model with other shapes or an active set of another robot.
+    pub fn new(collision: &CollisionModel, active: ActiveSet) -> Result<Self> {
+        let fast = FastModel::new(collision)?;
+        let robot = collision.robot();
+        if active.model().num_frames() != robot.num_frames()
+            || active.model().name() != robot.name()
+        {
+            return Err(CollisionError::InvalidValue {
+                what: format!("active set of `{}`", active.model().name()),
+                problem: format!("belongs to another robot than `{}`", robot.name()),
+            });
+        }
+        Ok(FastChecker {
+            scratch: fast.scratch(),
+            inputs: vec![0.0; FAST_LANES * active.len()],
+            block: robot.pose_block(),
+            pose: robot.pose_buffer(),
+            placed: collision.placed_bodies(),
+            fast,
+            collision: collision.clone(),
+            active,
+            uncertain: 0,
+        })
+    }
+
+    /// The compiled sphere model.
+    pub fn model(&self) -> &FastModel {
+        &self.fast
+    }
+
+    /// Coordinates per configuration.
+    pub fn dim(&self) -> usize {
+        self.active.len()
+    }
+
+    /// Whether every configuration of `qs` (at most [`FAST_LANES`] of them, one after the
+    /// other) is free of self-collisions and of `world` (`fast_world` is `world` compiled by
+    /// [`FastModel::world`]): the exact model's answer. False for NaN.
+    ///
+    /// # Panics
+    /// If `qs` does not hold 1 to [`FAST_LANES`] whole configurations.
+    pub fn all_free(&mut self, qs: &[f64], world: &World, fast_world: &FastWorld) -> bool {
+        let d = self.active.len();
+        let n = qs.len() / d.max(1);
+        assert!(
+            d > 0 && n > 0 && n <= FAST_LANES && qs.len() == n * d,
+            "1 to {FAST_LANES} whole configurations"
+        );
+        if qs.iter().any(|v| v.is_nan()) {
+            return false;
+        }
+        self.inputs[..n * d].copy_from_slice(qs);
+        for l in n..FAST_LANES {
+            self.inputs.copy_within(..d, l * d);
+        }
+        self.active
+            .forward_block_unchecked(&self.inputs, &mut self.block);
+        let live = if n == FAST_LANES {
+            ALL_LANES
+        } else {
+            (1 << n) - 1
+        };
+        let verdict = self
+            .fast
+            .check(self.block.lanes(), live, fast_world, &mut self.scratch);
+        if verdict.colliding != 0 {
+            return false;
+        }
+        (0..n)
+            .filter(|l| verdict.uncertain & (1 << l) != 0)
+            .all(|l| {
+                self.uncertain += 1;
+                self.active
+                    .forward_unchecked(&qs[l * d..(l + 1) * d], &mut self.pose);
+                self.collision.place(&self.pose, &mut self.placed);
+                !self.collision.is_colliding(&self.placed, world)
+            })
+    }
+}
+
+/// [`FastModel::check`], compiled for several instruction sets with the best one chosen at run
+/// time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn check(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+) -> Verdict {
+    place(model, poses, scratch);
+    let m = world.margin;
+    let mut verdict = Verdict::default();
+    let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+    // self: link bounding spheres, then the pairs of spheres of the links that come close. The
+    // pairs of a link pair are tested lane-wise without a branch (flags or-ed together), and
+    // the flags turned into lane masks once per link pair.
+    for gp in &model.group_pairs {
+        let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
+        let reach = ga.bound.radius + gb.bound.radius + m;
+        let near = live
+            & distance2(&bounds[gp.a], &bounds[gp.b])
+                .within(reach * reach)
+                .mask();
+        if near == 0 {
+            continue;
+        }
+        // each sphere of link a against link b's bounding sphere, then b's spheres
+        let mut contact = Contact::default();
+        for (a, run) in &gp.runs {
+            let ball = &balls[*a as usize];
+            let reach = model.balls[*a as usize].radius + gb.bound.radius + m;
+            if !distance2(ball, &bounds[gp.b]).any_within(reach * reach) {
+                continue;
+            }
+            for &(_, b, r) in &model.pairs[run.clone()] {
+                contact.add(distance2(ball, &balls[b as usize]), r, m);
+            }
+        }
+        if verdict.add(near, contact) {
+            return verdict;
+        }
+    }
+    // world: each object against each link's bounding sphere, then its spheres
+    for object in &world.objects {
+        for (g, group) in model.groups.iter().enumerate() {
+            let near = live & object.near(&bounds[g], group.bound.radius + m);
+            if near == 0 {
+                continue;
+            }
+            let mut contact = Contact::default();
+            for i in group.balls.clone() {
+                object.test(&mut contact, &balls[i], model.balls[i].radius, m);
+            }
+            if verdict.add(near, contact) {
+                return verdict;
+            }
+        }
+    }
+    verdict
+}
+
+/// Lane flags of a group of pairs: certainly colliding, or within the margin of contact (or
+/// NaN).
+#[derive(Debug, Clone, Copy, Default)]
+struct Contact {
+    hit: Flags,
+    close: Flags,
+}
+
+impl Contact {
+    /// Adds a pair at squared distance `d2` whose radii sum to `r`.
+    #[inline(always)]
+    fn add(&mut self, d2: F, r: f32, m: f32) {
+        let inner = (r - m).max(0.0);
+        let outer = r + m;
+        self.hit = self.hit | d2.below(inner * inner);
+        self.close = self.close | d2.within(outer * outer);
+    }
+
+    /// Flags certainly uncertain in every lane (a shape seen through its bounding sphere).
+    #[inline(always)]
+    fn add_uncertain(&mut self, d2: F, reach: f32) {
+        self.close = self.close | d2.within(reach * reach);
+    }
+}
+
+impl Verdict {
+    /// Adds the contacts of a group of pairs in the lanes of `lanes`; true when a lane certainly
+    /// collides.
+    #[inline(always)]
+    fn add(&mut self, lanes: LaneMask, contact: Contact) -> bool {
+        let hit = lanes & contact.hit.mask();
+        if hit != 0 {
+            self.colliding |= hit;
+            return true;
+        }
+        self.uncertain |= lanes & contact.close.mask();
+        false
+    }
+}
+
+impl Object {
+    /// Lanes whose sphere at `c` of radius `r` may come within reach of the object (its
+    /// bounding sphere for [`Object::Bounded`]).
+    #[inline(always)]
+    fn near(&self, c: &[F; 3], r: f32) -> LaneMask {
+        match *self {
+            Object::Round { a, b, radius } => {
+                let reach = r + radius;
+                segment_distance2(c, a, b).within(reach * reach).mask()
+            }
+            Object::Box { center, axes, half } => {
+                box_distance2(c, center, &axes, half).within(r * r).mask()
+            }
+            Object::Cylinder {
+                center,
+                axes,
+                radius,
+                half,
+            } => cylinder_distance2(c, center, &axes, radius, half)
+                .within(r * r)
+                .mask(),
+            Object::Bounded { center, radius } => {
+                let reach = r + radius;
+                distance2(c, &splat(center)).within(reach * reach).mask()
+            }
+        }
+    }
+
+    /// Adds the sphere at `c` of radius `r` against the object.
+    #[inline(always)]
+    fn test(&self, contact: &mut Contact, c: &[F; 3], r: f32, m: f32) {
+        match *self {
+            Object::Round { a, b, radius } => {
+                contact.add(segment_distance2(c, a, b), r + radius, m);
+            }
+            Object::Box { center, axes, half } => {
+                contact.add(box_distance2(c, center, &axes, half), r, m);
+            }
+            Object::Cylinder {
+                center,
+                axes,
+                radius,
+                half,
+            } => contact.add(cylinder_distance2(c, center, &axes, radius, half), r, m),
+            Object::Bounded { center, radius } => {
+                contact.add_uncertain(distance2(c, &splat(center)), r + radius + m);
+            }
+        }
+    }
+}
+
+/// World centres of every bounding sphere and sphere, in every lane.
+#[inline(always)]
+fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
+    for (g, group) in model.groups.iter().enumerate() {
+        let (rot, t) = link_frame(poses, group.frame);
+        scratch.bounds[g] = transform(&rot, &t, group.bound.center);
+        for i in group.balls.clone() {
+            scratch.balls[i] = transform(&rot, &t, model.balls[i].center);
+        }
+    }
+}
+
+/// Rotation matrix (row-major) and translation of link `frame` in every lane, in `f32`.
+#[inline(always)]
+fn link_frame(poses: &[PoseLanes32], frame: usize) -> ([F; 9], [F; 3]) {
+    let p = &poses[frame];
+    let q = [
+        F(p[0]),
+        F(p[1]),
+        F(p[2]),
+        F(p[3]),
+        F(p[4]),
+        F(p[5]),
+        F(p[6]),
+    ];
+    let [w, x, y, z, tx, ty, tz] = q;
+    let two = F::splat(2.0);
+    let one = F::splat(1.0);
+    let (xx, yy, zz) = (x * x, y * y, z * z);
+    let (xy, xz, yz) = (x * y, x * z, y * z);
+    let (wx, wy, wz) = (w * x, w * y, w * z);
+    let r = [
+        one - two * (yy + zz),
+        two * (xy - wz),
+        two * (xz + wy),
+        two * (xy + wz),
+        one - two * (xx + zz),
+        two * (yz - wx),
+        two * (xz - wy),
+        two * (yz + wx),
+        one - two * (xx + yy),
+    ];
+    (r, [tx, ty, tz])
+}
+
+/// `rot · p + t` in every lane.
+#[inline(always)]
+fn transform(rot: &[F; 9], t: &[F; 3], p: [f32; 3]) -> [F; 3] {
+    // no array::from_fn or array::map in the hot path: their closures may stay calls, compiled
+    // without the vector instruction set this function is compiled for
+    let (x, y, z) = (F::splat(p[0]), F::splat(p[1]), F::splat(p[2]));
+    [
+        rot[0] * x + rot[1] * y + rot[2] * z + t[0],
+        rot[3] * x + rot[4] * y + rot[5] * z + t[1],
+        rot[6] * x + rot[7] * y + rot[8] * z + t[2],
+    ]
+}
+
+/// Squared distance between two points in every lane.
+#[inline(always)]
+fn distance2(a: &[F; 3], b: &[F; 3]) -> F {
+    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    dx * dx + dy * dy + dz * dz
+}
+
+/// The point in every lane relative to `origin`, in the frame whose axes are the rows of `axes`.
+#[inline(always)]
+fn local(c: &[F; 3], origin: [f32; 3], axes: &[[f32; 3]; 3]) -> [F; 3] {
+    let p = [
+        c[0] - F::splat(origin[0]),
+        c[1] - F::splat(origin[1]),
+        c[2] - F::splat(origin[2]),
+    ];
+    let along =
+        |a: &[f32; 3]| p[0] * F::splat(a[0]) + p[1] * F::splat(a[1]) + p[2] * F::splat(a[2]);
+    [along(&axes[0]), along(&axes[1]), along(&axes[2])]
+}
+
+/// Squared distance from the point in every lane to the segment a–b.
+#[inline(always)]
+fn segment_distance2(c: &[F; 3], a: [f32; 3], b: [f32; 3]) -> F {
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let inv = F::splat(if len2 > 0.0 { 1.0 / len2 } else { 0.0 });
+    let p = [
+        c[0] - F::splat(a[0]),
+        c[1] - F::splat(a[1]),
+        c[2] - F::splat(a[2]),
+    ];
+    let ab = [F::splat(ab[0]), F::splat(ab[1]), F::splat(ab[2])];
+    let s = ((p[0] * ab[0] + p[1] * ab[1] + p[2] * ab[2]) * inv).map(|s| s.clamp(0.0, 1.0));
+    let d = [p[0] - s * ab[0], p[1] - s * ab[1], p[2] - s * ab[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+/// Squared distance from the point in every lane to the box (0 inside).
+#[inline(always)]
+fn box_distance2(c: &[F; 3], center: [f32; 3], axes: &[[f32; 3]; 3], half: [f32; 3]) -> F {
+    let p = local(c, center, axes);
+    let out = |k: usize| p[k].map(|v| (v.abs() - half[k]).max(0.0));
+    let (x, y, z) = (out(0), out(1), out(2));
+    x * x + y * y + z * z
+}
+
+/// Squared distance from the point in every lane to the solid cylinder along the z axis of
+/// `axes` (0 inside).
+#[inline(always)]
+fn cylinder_distance2(
+    c: &[F; 3],
+    center: [f32; 3],
+    axes: &[[f32; 3]; 3],
+    radius: f32,
+    half: f32,
+) -> F {
+    let [x, y, z] = local(c, center, axes);
+    let radial = (x * x + y * y).map(|v| (v.sqrt() - radius).max(0.0));
+    let axial = z.map(|v| (v.abs() - half).max(0.0));
+    radial * radial + axial * axial
+}
+
+/// The rows of the transposed rotation of `pose` (world → object frame), in `f32`.
+fn inverse_axes(pose: &nalgebra::Isometry3<f64>) -> [[f32; 3]; 3] {
+    let m = pose.rotation.to_rotation_matrix();
+    let m = m.matrix();
+    std::array::from_fn(|r| to_f32(Vector3::new(m[(0, r)], m[(1, r)], m[(2, r)])))
+}
+
+/// The same point in every lane.
+fn splat(p: [f32; 3]) -> [F; 3] {
+    [F::splat(p[0]), F::splat(p[1]), F::splat(p[2])]
+}
+
+fn to_f32(v: Vector3<f64>) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+fn norm(v: [f32; 3]) -> f64 {
+    Vector3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])).norm()
+}
+
+/// A sphere enclosing the spheres (centre: the middle of their bounding box), rounded up so
+/// that it still encloses them in `f32`.
+fn bounding_ball(spheres: &[(Point3<f64>, f64)]) -> Ball {
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for (c, r) in spheres {
+        lo = lo.inf(&(c.coords - Vector3::repeat(*r)));
+        hi = hi.sup(&(c.coords + Vector3::repeat(*r)));
+    }
+    let center = (lo + hi) / 2.0;
+    let radius = spheres
+        .iter()
+        .map(|(c, r)| (c.coords - center).norm() + r)
+        .fold(0.0, f64::max);
+    Ball {
+        center: to_f32(center),
+        radius: (radius * (1.0 + 1e-6) + 1e-7) as f32,
+    }
+}

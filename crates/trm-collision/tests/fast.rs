@@ -1,0 +1,172 @@
+//! The single-precision sphere screen (`trm_collision::fast`) answers as the exact model does:
+//! VAMP's spherized Panda, random configurations, an empty world and a world of every object
+//! shape, blocks of eight and single configurations.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use trm_collision::fast::{FAST_LANES, FastChecker};
+use trm_collision::{CollisionModel, Shape, World};
+use trm_kinematics::RobotModel;
+
+fn panda() -> (RobotModel, CollisionModel) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/panda-mbm/panda_spherized.ron"
+    );
+    let robot = RobotModel::load(path).unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    (robot, collision)
+}
+
+fn pose(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(xyz[0], xyz[1], xyz[2]),
+        UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
+    )
+}
+
+/// A shelf-like world with one object of every shape, in the Panda's reach.
+fn cluttered() -> World {
+    let mut w = World::new();
+    w.add(
+        "table",
+        Shape::Box {
+            size: [0.8, 1.2, 0.05],
+        },
+        pose([0.5, 0.0, 0.1], [0.0, 0.0, 0.3]),
+    )
+    .unwrap();
+    w.add(
+        "ball",
+        Shape::Sphere { radius: 0.08 },
+        pose([0.3, 0.3, 0.6], [0.0; 3]),
+    )
+    .unwrap();
+    w.add(
+        "bar",
+        Shape::Capsule {
+            radius: 0.03,
+            length: 0.5,
+        },
+        pose([0.0, -0.4, 0.5], [1.0, 0.2, 0.0]),
+    )
+    .unwrap();
+    w.add(
+        "can",
+        Shape::Cylinder {
+            radius: 0.05,
+            length: 0.2,
+        },
+        pose([0.45, -0.2, 0.4], [0.0, 0.4, 0.0]),
+    )
+    .unwrap();
+    w.add(
+        "tetra",
+        Shape::Convex {
+            points: vec![
+                [0.0, 0.0, 0.0],
+                [0.1, 0.0, 0.0],
+                [0.0, 0.1, 0.0],
+                [0.0, 0.0, 0.1],
+            ],
+        },
+        pose([-0.3, 0.2, 0.7], [0.0; 3]),
+    )
+    .unwrap();
+    w
+}
+
+#[test]
+fn the_screen_answers_as_the_exact_model_does() {
+    let (robot, collision) = panda();
+    let active = robot.all_active();
+    let d = active.len();
+    let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
+    assert_eq!(checker.model().num_spheres(), 59);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let qs: Vec<f64> = (0..4000).flat_map(|_| active.random(&mut rng)).collect();
+    let mut pose = robot.pose_buffer();
+    let mut placed = collision.placed_bodies();
+    let mut primitives = cluttered();
+    primitives.remove("tetra").unwrap();
+    for (w, world) in [World::new(), primitives, cluttered()]
+        .into_iter()
+        .enumerate()
+    {
+        checker.uncertain = 0;
+        let fast_world = checker.model().world(&world);
+        assert!(
+            fast_world.margin() > 0.0 && fast_world.margin() < 1e-4,
+            "{}",
+            fast_world.margin()
+        );
+        let exact: Vec<bool> = qs
+            .chunks(d)
+            .map(|q| {
+                active.forward(q, &mut pose).unwrap();
+                collision.place(&pose, &mut placed);
+                !collision.is_colliding(&placed, &world)
+            })
+            .collect();
+        let free = exact.iter().filter(|&&f| f).count();
+        assert!(
+            free > 200 && free < exact.len() - 200,
+            "{free} of {} free: a test of both answers",
+            exact.len()
+        );
+        for (i, q) in qs.chunks(d).enumerate() {
+            assert_eq!(
+                checker.all_free(q, &world, &fast_world),
+                exact[i],
+                "configuration {i}"
+            );
+        }
+        for (k, block) in qs.chunks(d * FAST_LANES).enumerate() {
+            let expected = exact[k * FAST_LANES..][..block.len() / d]
+                .iter()
+                .all(|&f| f);
+            assert_eq!(
+                checker.all_free(block, &world, &fast_world),
+                expected,
+                "block {k}"
+            );
+        }
+        eprintln!("world {w}: {} uncertain", checker.uncertain);
+        // grazing contact is rare: with spheres, capsules, boxes and cylinders the screen decides
+        // nearly everything itself; near a convex hull (its bounding sphere) it defers
+        if w < 2 {
+            assert!(
+                checker.uncertain <= 5,
+                "world {w}: {} uncertain",
+                checker.uncertain
+            );
+        }
+    }
+}
+
+#[test]
+fn nan_is_never_free_and_other_shapes_are_refused() {
+    let (robot, collision) = panda();
+    let mut checker = FastChecker::new(&collision, robot.all_active()).unwrap();
+    let world = World::new();
+    let fast_world = checker.model().world(&world);
+    let mut q = robot
+        .all_active()
+        .from_motors(&vec![0.0; robot.motors().len()]);
+    q[2] = f64::NAN;
+    assert!(!checker.all_free(&q, &world, &fast_world));
+    let hulls = RobotModel::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/panda-mbm/panda.ron"
+    ))
+    .unwrap();
+    let e = FastChecker::new(&CollisionModel::new(&hulls).unwrap(), hulls.all_active())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("sphere models only") && e.contains("fit-proxies"),
+        "{e}"
+    );
+    let _ = Vector3::<f64>::zeros();
+}
