@@ -196,6 +196,10 @@ pub struct FastModel {
     reach: f64,
     /// Most movable joints between the root and a link.
     depth: usize,
+    /// Whether the spheres are the model itself (a sphere model), so that a certain contact is
+    /// a certain collision; otherwise they enclose the bodies and only screen: contact is
+    /// uncertain.
+    exact: bool,
 }
 
 /// A world object as the single-precision checks see it.
@@ -276,50 +280,42 @@ pub struct FastScratch {
 }
 
 impl FastModel {
-    /// Compiles `model`, whose bodies must all be spheres; an error names the first body that
-    /// is not one.
+    /// Compiles `model`: its spheres as they are when every body is a sphere, else the spheres
+    /// enclosing each body ([`CollisionModel::enclosing_spheres`]), which only screen.
     pub fn new(model: &CollisionModel) -> Result<Self> {
         let bodies = model.bodies();
         let tree = model.robot().tree();
-        if let Some(body) = bodies
-            .iter()
-            .find(|b| !matches!(b.shape, Shape::Sphere { .. }))
-        {
-            return Err(CollisionError::InvalidValue {
-                what: format!("body `{}`", body.name),
-                problem: format!(
-                    "is a {}: single-precision checks take sphere models only\n  fix: load a spherized URDF, or fit one with `trm fit-proxies URDF --spheres N --out OUT`",
-                    body.shape.kind()
-                ),
-            });
-        }
-        // balls grouped by link, in link order
+        let exact = Self::is_sphere_model(model);
+        // balls grouped by link, in link order: the bodies themselves (a sphere model), or the
+        // spheres enclosing each body
         let mut by_link: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
         for (i, b) in bodies.iter().enumerate() {
             by_link.entry(b.link).or_default().push(i);
         }
         let (mut balls, mut ball_bodies, mut groups) = (Vec::new(), Vec::new(), Vec::new());
         let mut group_of_body = vec![usize::MAX; bodies.len()];
-        let mut ball_of_body = vec![usize::MAX; bodies.len()];
+        let mut balls_of_body = vec![0..0; bodies.len()];
         for (&link, members) in &by_link {
             let start = balls.len();
-            let spheres: Vec<(Point3<f64>, f64)> = members
-                .iter()
-                .map(|&i| {
-                    let Shape::Sphere { radius } = bodies[i].shape else {
-                        unreachable!("checked above")
-                    };
-                    (Point3::from(bodies[i].local.translation.vector), radius)
-                })
-                .collect();
-            for (&i, &(c, r)) in members.iter().zip(&spheres) {
+            let mut spheres: Vec<(Point3<f64>, f64)> = Vec::new();
+            for &i in members {
+                let first = balls.len();
+                for s in model.enclosing_spheres(i) {
+                    spheres.push((s.center, s.radius));
+                    balls.push(Ball {
+                        center: to_f32(s.center.coords),
+                        radius: s.radius as f32,
+                    });
+                    ball_bodies.push(i);
+                }
+                if balls.len() == first {
+                    return Err(CollisionError::InvalidValue {
+                        what: format!("body `{}`", bodies[i].name),
+                        problem: "has no enclosing sphere (an invalid shape)".into(),
+                    });
+                }
                 group_of_body[i] = groups.len();
-                ball_of_body[i] = balls.len();
-                balls.push(Ball {
-                    center: to_f32(c.coords),
-                    radius: r as f32,
-                });
-                ball_bodies.push(i);
+                balls_of_body[i] = first..balls.len();
             }
             groups.push(Group {
                 frame: link,
@@ -327,17 +323,19 @@ impl FastModel {
                 balls: start..balls.len(),
             });
         }
-        // the model's checked body pairs, grouped by link pair
+        // the model's checked body pairs as ball pairs, grouped by link pair
         let mut by_pair: BTreeMap<(usize, usize), Vec<BallPair>> = BTreeMap::new();
         for p in model.pairs() {
             let (a, b) = (p.a as usize, p.b as usize);
-            let (ga, gb) = (group_of_body[a], group_of_body[b]);
-            let (ba, bb) = (ball_of_body[a], ball_of_body[b]);
-            by_pair.entry((ga, gb)).or_default().push((
-                ba as u32,
-                bb as u32,
-                balls[ba].radius + balls[bb].radius,
-            ));
+            let list = by_pair
+                .entry((group_of_body[a], group_of_body[b]))
+                .or_default();
+            for x in balls_of_body[a].clone() {
+                for y in balls_of_body[b].clone() {
+                    let r = balls[x].radius + balls[y].radius;
+                    list.push((x as u32, y as u32, r));
+                }
+            }
         }
         let (mut pairs, mut group_pairs) = (Vec::new(), Vec::new());
         for ((a, b), mut list) in by_pair {
@@ -375,6 +373,7 @@ impl FastModel {
             depth_of[j.child] = depth_of[j.parent] + usize::from(j.kind != JointKind::Fixed);
         }
         Ok(FastModel {
+            exact,
             depth: depth_of.into_iter().max().unwrap_or(0),
             balls,
             bodies: ball_bodies,
@@ -383,6 +382,21 @@ impl FastModel {
             pairs,
             reach: chain + farthest,
         })
+    }
+
+    /// Whether every body of `model` is a sphere: whether [`FastModel::new`] makes an exact
+    /// model of it ([`FastModel::is_exact`]), known without compiling it.
+    pub fn is_sphere_model(model: &CollisionModel) -> bool {
+        model
+            .bodies()
+            .iter()
+            .all(|b| matches!(b.shape, Shape::Sphere { .. }))
+    }
+
+    /// Whether the spheres are the model itself (every body a sphere): its certain contacts
+    /// are certain collisions. Otherwise the spheres enclose the bodies and only screen.
+    pub fn is_exact(&self) -> bool {
+        self.exact
     }
 
     /// Number of spheres.
@@ -499,8 +513,8 @@ pub struct FastChecker {
 }
 
 impl FastChecker {
-    /// A checker of `collision`'s robot (its bodies all spheres) moved by `active`'s
-    /// coordinates; an error for a model with other shapes or an active set of another robot.
+    /// A checker of `collision`'s robot moved by `active`'s coordinates; an error for an active
+    /// set of another robot.
     pub fn new(collision: &CollisionModel, active: ActiveSet) -> Result<Self> {
         let fast = FastModel::new(collision)?;
         let robot = collision.robot();
@@ -620,7 +634,7 @@ fn check(
                 contact.add(distance2(ball, &balls[b as usize]), r, m);
             }
         }
-        if verdict.add(near, contact) {
+        if verdict.add(near, contact, model.exact) {
             return verdict;
         }
     }
@@ -635,7 +649,7 @@ fn check(
             for i in group.balls.clone() {
                 object.test(&mut contact, &balls[i], model.balls[i].radius, m);
             }
-            if verdict.add(near, contact) {
+            if verdict.add(near, contact, model.exact) {
                 return verdict;
             }
         }
@@ -672,7 +686,12 @@ impl Verdict {
     /// Adds the contacts of a group of pairs in the lanes of `lanes`; true when a lane certainly
     /// collides.
     #[inline(always)]
-    fn add(&mut self, lanes: LaneMask, contact: Contact) -> bool {
+    fn add(&mut self, lanes: LaneMask, contact: Contact, exact: bool) -> bool {
+        if !exact {
+            // spheres enclosing the bodies: contact is only a reason to look exactly
+            self.uncertain |= lanes & (contact.hit | contact.close).mask();
+            return false;
+        }
         let hit = lanes & contact.hit.mask();
         if hit != 0 {
             self.colliding |= hit;
