@@ -277,6 +277,10 @@ pub struct Verdict {
 pub struct FastScratch {
     balls: Vec<[F; 3]>,
     bounds: Vec<[F; 3]>,
+    /// Per link group: its frame (rotation rows, translation) in every lane.
+    frames: Vec<([F; 9], [F; 3])>,
+    /// Per link group: whether its balls are placed for the current block.
+    placed: Vec<bool>,
 }
 
 impl FastModel {
@@ -414,6 +418,8 @@ impl FastModel {
         FastScratch {
             balls: vec![[F::default(); 3]; self.balls.len()],
             bounds: vec![[F::default(); 3]; self.groups.len()],
+            frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
+            placed: vec![false; self.groups.len()],
         }
     }
 
@@ -608,7 +614,24 @@ fn check(
     place(model, poses, scratch);
     let m = world.margin;
     let mut verdict = Verdict::default();
-    let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+    // the world first: in a planner's queries most collisions are with the world
+    // world: each object against each link's bounding sphere, then its spheres
+    for object in &world.objects {
+        for (g, group) in model.groups.iter().enumerate() {
+            let near = live & object.near(&scratch.bounds[g], group.bound.radius + m);
+            if near == 0 {
+                continue;
+            }
+            place_balls(model, g, scratch);
+            let mut contact = Contact::default();
+            for i in group.balls.clone() {
+                object.test(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
+            }
+            if verdict.add(near, contact, model.exact) {
+                return verdict;
+            }
+        }
+    }
     // self: link bounding spheres, then the pairs of spheres of the links that come close. The
     // pairs of a link pair are tested lane-wise without a branch (flags or-ed together), and
     // the flags turned into lane masks once per link pair.
@@ -616,13 +639,16 @@ fn check(
         let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
         let reach = ga.bound.radius + gb.bound.radius + m;
         let near = live
-            & distance2(&bounds[gp.a], &bounds[gp.b])
+            & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
                 .within(reach * reach)
                 .mask();
         if near == 0 {
             continue;
         }
         // each sphere of link a against link b's bounding sphere, then b's spheres
+        place_balls(model, gp.a, scratch);
+        place_balls(model, gp.b, scratch);
+        let (balls, bounds) = (&scratch.balls, &scratch.bounds);
         let mut contact = Contact::default();
         for (a, run) in &gp.runs {
             let ball = &balls[*a as usize];
@@ -636,22 +662,6 @@ fn check(
         }
         if verdict.add(near, contact, model.exact) {
             return verdict;
-        }
-    }
-    // world: each object against each link's bounding sphere, then its spheres
-    for object in &world.objects {
-        for (g, group) in model.groups.iter().enumerate() {
-            let near = live & object.near(&bounds[g], group.bound.radius + m);
-            if near == 0 {
-                continue;
-            }
-            let mut contact = Contact::default();
-            for i in group.balls.clone() {
-                object.test(&mut contact, &balls[i], model.balls[i].radius, m);
-            }
-            if verdict.add(near, contact, model.exact) {
-                return verdict;
-            }
         }
     }
     verdict
@@ -753,16 +763,29 @@ impl Object {
     }
 }
 
-/// World centres of every bounding sphere and sphere, in every lane.
+/// The frame and bounding-sphere centre of every link group in every lane; balls are placed
+/// later, for the groups that come near something ([`place_balls`]).
 #[inline(always)]
 fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
     for (g, group) in model.groups.iter().enumerate() {
         let (rot, t) = link_frame(poses, group.frame);
         scratch.bounds[g] = transform(&rot, &t, group.bound.center);
-        for i in group.balls.clone() {
-            scratch.balls[i] = transform(&rot, &t, model.balls[i].center);
-        }
+        scratch.frames[g] = (rot, t);
+        scratch.placed[g] = false;
     }
+}
+
+/// The centres of group `g`'s balls in every lane, placed once per block.
+#[inline(always)]
+fn place_balls(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+    if scratch.placed[g] {
+        return;
+    }
+    let (rot, t) = &scratch.frames[g];
+    for i in model.groups[g].balls.clone() {
+        scratch.balls[i] = transform(rot, t, model.balls[i].center);
+    }
+    scratch.placed[g] = true;
 }
 
 /// Rotation matrix (row-major) and translation of link `frame` in every lane, in `f32`.
