@@ -7,8 +7,9 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 use trm_collision::World;
+use trm_collision::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
 use trm_kinematics::ActiveSet;
-use trm_roadmap::{Roadmap, distance, segment_is_collision_free};
+use trm_roadmap::{Roadmap, distance, segment_all, segment_is_collision_free};
 use trm_tasks::Objective;
 
 use crate::trajectory::{Trajectory, time_parametrise};
@@ -394,6 +395,8 @@ pub struct Planner<'a> {
     scratch: trm_tasks::Scratch,
     /// Samples of the segment being checked.
     samples: Vec<f64>,
+    /// For a sphere model: the single-precision screen and the current world compiled for it.
+    fast: Option<(FastChecker, FastWorld)>,
 }
 
 impl<'a> Planner<'a> {
@@ -445,7 +448,15 @@ impl<'a> Planner<'a> {
                 }
             }
         }
+        let fast = FastModel::is_sphere_model(objective.collision())
+            .then(|| FastChecker::new(objective.collision(), objective.active().clone()).ok())
+            .flatten()
+            .map(|checker| {
+                let fast_world = checker.model().world(objective.world());
+                (checker, fast_world)
+            });
         Ok(Planner {
+            fast,
             objective,
             active: objective.active().clone(),
             world: objective.world().clone(),
@@ -465,6 +476,9 @@ impl<'a> Planner<'a> {
 
     /// Replaces the world: every node and edge will be checked again when a search wants it.
     pub fn set_world(&mut self, world: World) {
+        if let Some((checker, fast_world)) = &mut self.fast {
+            *fast_world = checker.model().world(&world);
+        }
         self.world = world;
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
@@ -533,12 +547,30 @@ impl<'a> Planner<'a> {
 
     /// Whether `q` is collision-free in the current world.
     pub fn is_free(&mut self, q: &[f64]) -> bool {
-        self.objective
-            .is_collision_free_in(q, &self.world, &mut self.scratch)
+        match &mut self.fast {
+            Some((checker, fast_world)) => checker.all_free(q, &self.world, fast_world),
+            None => self
+                .objective
+                .is_collision_free_in(q, &self.world, &mut self.scratch),
+        }
     }
 
-    /// Whether the straight segment a → b is free, checked every `resolution` of joint motion.
+    /// Whether the straight segment a → b is free, checked every `resolution` of joint motion
+    /// (a sphere model [`FAST_LANES`] samples at a time on the single-precision screen).
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        if let Some(fast) = &mut self.fast {
+            let world = &self.world;
+            return segment_all(
+                self.objective.dim(),
+                a,
+                b,
+                resolution,
+                FAST_LANES,
+                &mut self.samples,
+                fast,
+                |qs, (checker, fast_world)| checker.all_free(qs, world, fast_world),
+            );
+        }
         let (objective, world) = (&self.objective, &self.world);
         segment_is_collision_free(
             objective,

@@ -182,31 +182,39 @@ pub fn segment_is_collision_free(
         a,
         b,
         resolution,
+        LANES,
         samples,
         scratch,
         |qs, scratch| objective.all_collision_free_in(qs, world, scratch),
     )
 }
 
-/// Whether `check` holds for every batch of [`LANES`] samples of a → b. The samples are
-/// visited raked, as VAMP validates motions: of the segment's n samples, batch k holds samples
-/// k, k + m, k + 2m, … (m = ⌈n / LANES⌉), so the first batch already spans the whole segment
-/// and a blocked segment is usually refused after one batch. The verdict is the same in any
-/// order.
-fn segment_all<S>(
+/// Whether `check` holds for every batch of `width` samples of a → b (the samples of
+/// [`segment_is_free`], `d` values each). The samples are visited raked, as VAMP validates
+/// motions: of the segment's n samples, batch k holds samples k, k + m, k + 2m, …
+/// (m = ⌈n / width⌉), so the first batch already spans the whole segment and a blocked segment
+/// is usually refused after one batch. The verdict is the same in any order. `samples` is
+/// scratch (grown to `width` × `d` once).
+///
+/// # Panics
+/// If `a` or `b` does not hold `d` values, or `width` is 0.
+#[allow(clippy::too_many_arguments)] // the segment, its batching and the caller's check
+pub fn segment_all<S>(
     d: usize,
     a: &[f64],
     b: &[f64],
     resolution: f64,
+    width: usize,
     samples: &mut Vec<f64>,
     scratch: &mut S,
     mut check: impl FnMut(&[f64], &mut S) -> bool,
 ) -> bool {
     assert!(a.len() == d && b.len() == d, "one value per active motor");
+    assert!(width > 0, "at least one sample per batch");
     let steps = segment_steps(a, b, resolution);
     let count = steps + 1;
-    let stride = count.div_ceil(LANES);
-    samples.resize(LANES * d, 0.0);
+    let stride = count.div_ceil(width);
+    samples.resize(width * d, 0.0);
     for k in 0..stride {
         let mut n = 0;
         for s in (k..count).step_by(stride) {
@@ -236,6 +244,7 @@ mod tests {
             &a,
             &b,
             0.01,
+            LANES,
             &mut Vec::new(),
             &mut scratch,
             |qs, _| {
@@ -256,6 +265,7 @@ mod tests {
             &a,
             &b,
             0.01,
+            LANES,
             &mut Vec::new(),
             &mut scratch,
             |qs, _| {
