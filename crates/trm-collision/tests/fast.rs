@@ -12,7 +12,7 @@ use trm_kinematics::RobotModel;
 
 fn panda(file: &str) -> (RobotModel, CollisionModel) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../models/panda-mbm")
+        .join("../../models")
         .join(file);
     let robot = RobotModel::load(path).unwrap();
     let collision = CollisionModel::new(&robot).unwrap();
@@ -26,8 +26,10 @@ fn pose(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
     )
 }
 
-/// A shelf-like world with one object of every shape, in the Panda's reach.
-fn cluttered() -> World {
+/// A shelf-like world with one object of every shape, in the Panda's reach (moved by `shift`
+/// for another robot).
+fn cluttered(shift: [f64; 3]) -> World {
+    let pose = |xyz: [f64; 3], rpy| pose([xyz[0] + shift[0], xyz[1] + shift[1], xyz[2] + shift[2]], rpy);
     let mut w = World::new();
     w.add(
         "table",
@@ -79,16 +81,17 @@ fn cluttered() -> World {
 
 #[test]
 fn the_screen_answers_as_the_exact_model_does() {
-    for (file, exact, configurations) in [
-        ("panda_spherized.ron", true, 4000),
-        ("panda.ron", false, 600),
+    for (file, exact, configurations, shift) in [
+        ("panda-mbm/panda_spherized.ron", true, 4000, [0.0; 3]),
+        ("panda-mbm/panda.ron", false, 600, [0.0; 3]),
+        ("fetch-mbm/fetch_spherized.ron", true, 4000, [0.4, 0.0, 0.9]),
     ] {
         let (robot, collision) = panda(file);
         let active = robot.all_active();
         let d = active.len();
         let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
         assert_eq!(checker.model().is_exact(), exact, "{file}");
-        if exact {
+        if file.starts_with("panda") && exact {
             assert_eq!(checker.model().num_spheres(), 59);
         }
         let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -97,9 +100,9 @@ fn the_screen_answers_as_the_exact_model_does() {
             .collect();
         let mut pose = robot.pose_buffer();
         let mut placed = collision.placed_bodies();
-        let mut primitives = cluttered();
+        let mut primitives = cluttered(shift);
         primitives.remove("tetra").unwrap();
-        for (w, world) in [World::new(), primitives, cluttered()]
+        for (w, world) in [World::new(), primitives, cluttered(shift)]
             .into_iter()
             .enumerate()
         {
@@ -157,7 +160,7 @@ fn the_screen_answers_as_the_exact_model_does() {
 
 #[test]
 fn nan_is_never_free() {
-    let (robot, collision) = panda("panda_spherized.ron");
+    let (robot, collision) = panda("panda-mbm/panda_spherized.ron");
     let mut checker = FastChecker::new(&collision, robot.all_active()).unwrap();
     let world = World::new();
     let fast_world = checker.model().world(&world);

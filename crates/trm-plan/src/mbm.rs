@@ -440,118 +440,144 @@ pub fn solve_with_experience(
             .filter(|&k| problems[k].family == family)
             .collect();
         let first = MotionPlanRequest::load(&problems[members[0]].request)?;
-        let (objective, active, _) =
+        let (_, active, _) =
             problem_objective(robot, collision, &trm_collision::World::new(), &first)?;
-        let mut planner = crate::Planner::new(&objective, &[])?;
+        // every path kept so far: each planner of the family starts from them
+        let mut kept: Vec<Vec<Vec<f64>>> = Vec::new();
         for (pass, results) in outcomes.iter_mut().enumerate() {
-            for &k in &members {
-                let p = &problems[k];
-                let scene = PlanningScene::load(&p.scene)?;
-                let request = MotionPlanRequest::load(&p.request)?;
-                joint_goal_only(&request, "experience runs")?;
-                let (other, other_active, mut start) =
-                    problem_objective(robot, collision, &trm_collision::World::new(), &request)?;
-                if other_active != active
-                    || other.active().to_motors(&start) != objective.active().to_motors(&start)
-                {
-                    return Err(PlanError::InvalidMoveIt {
-                        path: request.origin.clone(),
-                        line: 0,
-                        problem: format!(
-                            "its goal's joints or its start's other motors differ from {}'s",
-                            problems[members[0]].request.display()
-                        ),
-                        fix: "give a family whose problems share the robot's planning group and its other joints' values".into(),
-                    });
+            let mut next = 0;
+            while next < members.len() {
+                // one planner per run of problems whose scenes allow the same collisions (each
+                // problem is planned and checked with its own scene's matrix)
+                let scene = PlanningScene::load(&problems[members[next]].scene)?;
+                let (acm_collision, _) = scene_collision(collision, &scene)?;
+                let acm = acm_collision.acm().clone();
+                let (objective, _, _) =
+                    problem_objective(robot, &acm_collision, &trm_collision::World::new(), &first)?;
+                let mut planner = crate::Planner::new(&objective, &[])?;
+                for path in &kept {
+                    planner.add_path(path)?;
                 }
-                planner.set_world(scene.to_world()?);
-                let mut goal = request.goal.positions.clone();
-                let outcome = &mut results[k];
-                if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| {
-                    planner.is_free(q)
-                }) {
-                    outcome.note = why.into();
-                    done(pass, k);
-                    continue;
-                }
-                outcome.valid = true;
-                let began = std::time::Instant::now();
-                let rrt = RrtOptions {
-                    max_seconds: options.max_seconds.or(request.planning_time),
-                    ..options.clone()
-                };
-                let plan_options = crate::PlanOptions {
-                    resolution: options.resolution,
-                    shortcuts: 0,
-                    seed: options.seed,
-                    exact_goal: false,
-                    sampling: Some(rrt.clone()),
-                    ..Default::default()
-                };
-                let found = match planner.plan(
-                    &start,
-                    &crate::Goal::Configuration(goal.clone()),
-                    &plan_options,
-                ) {
-                    Ok(planned) if planned.stats.sampled.is_some() => Ok((
-                        planned.waypoints,
-                        planned.stats.sampled.map_or(0, |s| s.1),
-                        None,
-                    )),
-                    Ok(planned) => {
-                        // through experience: shortcut greedily, and checked at half the
-                        // resolution as RRT-Connect's paths are; RRT-Connect where that fails
-                        let world = planner.world().clone();
-                        let mut checker = Checker::new(&objective, &world);
-                        let mut path = planned.waypoints;
-                        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(
-                            options.seed,
-                        );
-                        shortcut(
-                            &mut path,
-                            &RrtOptions {
-                                shortcuts: 0,
-                                ..options.clone()
-                            },
-                            &mut checker,
-                            &mut rng,
-                        );
-                        let how = if planned.nodes.is_empty() {
-                            "straight"
-                        } else {
-                            "experience"
-                        };
-                        if path
-                            .windows(2)
-                            .all(|w| checker.edge_free(&w[0], &w[1], options.resolution / 2.0))
-                        {
-                            Ok((path, checker.checks, Some(how)))
-                        } else {
-                            rrt_connect(&objective, &world, &start, &goal, &rrt)
-                                .map(|f| (f.path, checker.checks + f.checks, None))
-                        }
+                while next < members.len() {
+                    let k = members[next];
+                    let p = &problems[k];
+                    let scene = PlanningScene::load(&p.scene)?;
+                    if scene_collision(collision, &scene)?.0.acm() != &acm {
+                        break;
                     }
-                    Err(e) => Err(e),
-                };
-                match found {
-                    Ok((path, checks, answered)) => {
-                        outcome.solved = true;
-                        outcome.seconds = began.elapsed().as_secs_f64();
-                        outcome.length = path_length(&path);
-                        outcome.waypoints = path.len();
-                        outcome.checks = checks;
-                        outcome.note = match answered {
-                            Some(how) => how.into(),
-                            None => {
-                                planner.add_path(&path)?;
-                                "RRT-Connect (path kept)".into()
+                    next += 1;
+                    let request = MotionPlanRequest::load(&p.request)?;
+                    joint_goal_only(&request, "experience runs")?;
+                    let (other, other_active, mut start) = problem_objective(
+                        robot,
+                        collision,
+                        &trm_collision::World::new(),
+                        &request,
+                    )?;
+                    if other_active != active
+                        || other.active().to_motors(&start) != objective.active().to_motors(&start)
+                    {
+                        return Err(PlanError::InvalidMoveIt {
+                            path: request.origin.clone(),
+                            line: 0,
+                            problem: format!(
+                                "its goal's joints or its start's other motors differ from {}'s",
+                                problems[members[0]].request.display()
+                            ),
+                            fix: "give a family whose problems share the robot's planning group and its other joints' values".into(),
+                        });
+                    }
+                    planner.set_world(scene.to_world()?);
+                    let mut goal = request.goal.positions.clone();
+                    let outcome = &mut results[k];
+                    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| {
+                        planner.is_free(q)
+                    }) {
+                        outcome.note = why.into();
+                        done(pass, k);
+                        continue;
+                    }
+                    outcome.valid = true;
+                    let began = std::time::Instant::now();
+                    let rrt = RrtOptions {
+                        max_seconds: options.max_seconds.or(request.planning_time),
+                        ..options.clone()
+                    };
+                    let plan_options = crate::PlanOptions {
+                        resolution: options.resolution,
+                        shortcuts: 0,
+                        seed: options.seed,
+                        exact_goal: false,
+                        sampling: Some(rrt.clone()),
+                        ..Default::default()
+                    };
+                    let found = match planner.plan(
+                        &start,
+                        &crate::Goal::Configuration(goal.clone()),
+                        &plan_options,
+                    ) {
+                        Ok(planned) if planned.stats.sampled.is_some() => Ok((
+                            planned.waypoints,
+                            planned.stats.sampled.map_or(0, |s| s.1),
+                            None,
+                        )),
+                        Ok(planned) => {
+                            // through experience: shortcut greedily, and checked at half the
+                            // resolution as RRT-Connect's paths are; RRT-Connect where that fails
+                            let world = planner.world().clone();
+                            let mut checker = Checker::new(&objective, &world);
+                            let mut path = planned.waypoints;
+                            let mut rng =
+                                <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(
+                                    options.seed,
+                                );
+                            shortcut(
+                                &mut path,
+                                &RrtOptions {
+                                    shortcuts: 0,
+                                    ..options.clone()
+                                },
+                                &mut checker,
+                                &mut rng,
+                            );
+                            let how = if planned.nodes.is_empty() {
+                                "straight"
+                            } else {
+                                "experience"
+                            };
+                            if path
+                                .windows(2)
+                                .all(|w| checker.edge_free(&w[0], &w[1], options.resolution / 2.0))
+                            {
+                                Ok((path, checker.checks, Some(how)))
+                            } else {
+                                rrt_connect(&objective, &world, &start, &goal, &rrt)
+                                    .map(|f| (f.path, checker.checks + f.checks, None))
                             }
-                        };
-                        outcome.path = path;
+                        }
+                        Err(e) => Err(e),
+                    };
+                    match found {
+                        Ok((path, checks, answered)) => {
+                            outcome.solved = true;
+                            outcome.seconds = began.elapsed().as_secs_f64();
+                            outcome.length = path_length(&path);
+                            outcome.waypoints = path.len();
+                            outcome.checks = checks;
+                            outcome.note = match answered {
+                                Some(how) => how.into(),
+                                None => {
+                                    planner.add_path(&path)?;
+                                    kept.push(path.clone());
+                                    "RRT-Connect (path kept)".into()
+                                }
+                            };
+                            outcome.path = path;
+                        }
+                        Err(e) => outcome.note = e.to_string(),
                     }
-                    Err(e) => outcome.note = e.to_string(),
+                    done(pass, k);
                 }
-                done(pass, k);
             }
         }
     }

@@ -660,3 +660,48 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
         }
     }
 }
+
+/// Experience runs plan each problem with its own scene's allowed-collision matrix, as single
+/// runs do: a scene that forbids a pair the model skips (adjacent links that touch: links 1
+/// and 2) makes its problem invalid in both, and the family's other problems are still solved.
+#[test]
+fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let dir = std::env::temp_dir().join(format!("trm-acm-experience-{}", std::process::id()));
+    let family = dir.join("box_panda");
+    std::fs::create_dir_all(&family).unwrap();
+    for entry in std::fs::read_dir(fixtures().join("box_panda")).unwrap() {
+        let path = entry.unwrap().path();
+        std::fs::copy(&path, family.join(path.file_name().unwrap())).unwrap();
+    }
+    let problems = find_problems(&dir).unwrap();
+    let strict = &problems[1];
+    let mut scene = PlanningScene::load(&strict.scene).unwrap();
+    let m = scene.allowed_collisions.as_mut().unwrap();
+    let a = m.names.iter().position(|n| n == "panda_link1").unwrap();
+    let b = m.names.iter().position(|n| n == "panda_link2").unwrap();
+    m.allowed[a][b] = false;
+    m.allowed[b][a] = false;
+    std::fs::write(&strict.scene, scene.to_yaml().unwrap()).unwrap();
+    let options = RrtOptions::default();
+    let request = MotionPlanRequest::load(&strict.request).unwrap();
+    let single = solve(&robot, &collision, &scene, &request, &options).unwrap();
+    assert!(!single.valid, "{}", single.note);
+    let passes =
+        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 1, |_, _| {})
+            .unwrap();
+    for (p, o) in problems.iter().zip(&passes[0]) {
+        assert_eq!(
+            o.valid,
+            p.index != strict.index,
+            "{} {}: {}",
+            p.family,
+            p.index,
+            o.note
+        );
+        assert_eq!(o.solved, o.valid, "{} {}: {}", p.family, p.index, o.note);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
