@@ -29,7 +29,12 @@ fn pose(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
 /// A shelf-like world with one object of every shape, in the Panda's reach (moved by `shift`
 /// for another robot).
 fn cluttered(shift: [f64; 3]) -> World {
-    let pose = |xyz: [f64; 3], rpy| pose([xyz[0] + shift[0], xyz[1] + shift[1], xyz[2] + shift[2]], rpy);
+    let pose = |xyz: [f64; 3], rpy| {
+        pose(
+            [xyz[0] + shift[0], xyz[1] + shift[1], xyz[2] + shift[2]],
+            rpy,
+        )
+    };
     let mut w = World::new();
     w.add(
         "table",
