@@ -545,6 +545,22 @@ impl FastChecker {
         })
     }
 
+    /// A checker and `world` compiled for it when every body of `collision` is a sphere (the
+    /// case where the screen pays: [`FastModel::is_exact`]), else `None` — decided before
+    /// compiling anything.
+    pub fn for_sphere_model(
+        collision: &CollisionModel,
+        active: &ActiveSet,
+        world: &World,
+    ) -> Option<(FastChecker, FastWorld)> {
+        if !FastModel::is_sphere_model(collision) {
+            return None;
+        }
+        let checker = FastChecker::new(collision, active.clone()).ok()?;
+        let fast_world = checker.model().world(world);
+        Some((checker, fast_world))
+    }
+
     /// The compiled sphere model.
     pub fn model(&self) -> &FastModel {
         &self.fast

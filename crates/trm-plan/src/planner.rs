@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
 use trm_collision::World;
-use trm_collision::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
+use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
 use trm_kinematics::ActiveSet;
 use trm_roadmap::{Roadmap, distance, segment_all, segment_is_collision_free};
 use trm_tasks::Objective;
@@ -448,13 +448,11 @@ impl<'a> Planner<'a> {
                 }
             }
         }
-        let fast = FastModel::is_sphere_model(objective.collision())
-            .then(|| FastChecker::new(objective.collision(), objective.active().clone()).ok())
-            .flatten()
-            .map(|checker| {
-                let fast_world = checker.model().world(objective.world());
-                (checker, fast_world)
-            });
+        let fast = FastChecker::for_sphere_model(
+            objective.collision(),
+            objective.active(),
+            objective.world(),
+        );
         Ok(Planner {
             fast,
             objective,

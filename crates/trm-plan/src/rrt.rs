@@ -10,7 +10,7 @@ use std::time::Instant;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use trm_collision::World;
-use trm_collision::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
+use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
 use trm_kinematics::LANES;
 use trm_tasks::{Objective, Scratch};
 
@@ -148,13 +148,7 @@ impl<'a> Checker<'a> {
         // bodies leaves most lanes of the Panda's hulls uncertain, and checking those one by
         // one took twice the batched f64 checks' time on MotionBenchMaker (6.3 ms against
         // 3.2 ms median)
-        let fast = FastModel::is_sphere_model(objective.collision())
-            .then(|| FastChecker::new(objective.collision(), objective.active().clone()).ok())
-            .flatten()
-            .map(|checker| {
-                let fast_world = checker.model().world(world);
-                (checker, fast_world)
-            });
+        let fast = FastChecker::for_sphere_model(objective.collision(), objective.active(), world);
         Checker {
             objective,
             world,
