@@ -13,11 +13,16 @@
 //! handed back ([`Verdict::uncertain`]) for the exact `f64` check, so a caller that checks those
 //! lanes exactly answers as the `f64` path does, configuration by configuration (tested on
 //! random configurations of the Panda against [`CollisionModel::is_colliding`]).
+//! [`FastChecker`] checks them pair by pair: only the link pairs and (link, object) pairs that
+//! left the lane uncertain, each body placed alone.
 //!
-//! Robot bodies must be spheres (a spherized URDF, or one written by
-//! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)). World objects of every shape are
-//! taken: spheres, capsules and boxes are checked in single precision, cylinders and convex hulls
-//! through their bounding spheres (a lane near one is uncertain).
+//! Robot bodies that are spheres (a spherized URDF, or one written by
+//! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)) are the model itself; other bodies
+//! are *screened* through the spheres enclosing them ([`CollisionModel::enclosing_spheres`]: a
+//! mesh's convex hull cut into cells, each enclosed exactly), so that contact is only a reason to
+//! look exactly. World objects of every shape are taken: spheres, capsules and boxes are checked
+//! in single precision, cylinders and convex hulls through their bounding spheres (a lane near
+//! one is uncertain).
 
 // Lane loops index several arrays at once, the form the vectoriser turns into one instruction;
 // `!(x > limit)` is the NaN-inclusive test on purpose.
@@ -165,10 +170,15 @@ struct Group {
     bound: Ball,
     /// The link's spheres: indices into [`FastModel::balls`].
     balls: std::ops::Range<usize>,
+    /// The link's bodies (indices into [`CollisionModel::bodies`]).
+    bodies: Vec<u32>,
 }
 
 /// Two balls (indices into [`FastModel::balls`]) and the sum of their radii.
 type BallPair = (u32, u32, f32);
+
+/// A link pair's ball pairs and checked body pairs, while compiling.
+type LinkPairTests = (Vec<BallPair>, Vec<(u32, u32)>);
 
 /// Two links whose spheres are tested against each other.
 #[derive(Debug, Clone)]
@@ -178,6 +188,17 @@ struct GroupPair {
     /// Per ball of link `a`: the ball and its pairs with link `b`'s balls, a range of
     /// [`FastModel::pairs`].
     runs: Vec<(u32, std::ops::Range<usize>)>,
+    /// The checked body pairs of the two links (indices into [`CollisionModel::bodies`]).
+    bodies: Vec<(u32, u32)>,
+}
+
+/// What left lanes of a block uncertain: checked exactly, only it, in those lanes.
+#[derive(Debug, Clone, Copy)]
+enum Suspect {
+    /// A link pair: an index into [`FastModel::group_pairs`].
+    Pair(u32),
+    /// A world object and a link group.
+    Object { object: u32, group: u32 },
 }
 
 /// A sphere model compiled for single-precision checks of [`FAST_LANES`] configurations at
@@ -281,6 +302,8 @@ pub struct FastScratch {
     frames: Vec<([F; 9], [F; 3])>,
     /// Per link group: whether its balls are placed for the current block.
     placed: Vec<bool>,
+    /// What left lanes uncertain in the last check, and in which lanes.
+    suspects: Vec<(Suspect, LaneMask)>,
 }
 
 impl FastModel {
@@ -325,15 +348,17 @@ impl FastModel {
                 frame: link,
                 bound: bounding_ball(&spheres),
                 balls: start..balls.len(),
+                bodies: members.iter().map(|&i| i as u32).collect(),
             });
         }
         // the model's checked body pairs as ball pairs, grouped by link pair
-        let mut by_pair: BTreeMap<(usize, usize), Vec<BallPair>> = BTreeMap::new();
+        let mut by_pair: BTreeMap<(usize, usize), LinkPairTests> = BTreeMap::new();
         for p in model.pairs() {
             let (a, b) = (p.a as usize, p.b as usize);
-            let list = by_pair
+            let (list, body_pairs) = by_pair
                 .entry((group_of_body[a], group_of_body[b]))
                 .or_default();
+            body_pairs.push((p.a, p.b));
             for x in balls_of_body[a].clone() {
                 for y in balls_of_body[b].clone() {
                     let r = balls[x].radius + balls[y].radius;
@@ -342,7 +367,7 @@ impl FastModel {
             }
         }
         let (mut pairs, mut group_pairs) = (Vec::new(), Vec::new());
-        for ((a, b), mut list) in by_pair {
+        for ((a, b), (mut list, bodies)) in by_pair {
             list.sort_by_key(|&(x, y, _)| (x, y));
             let mut runs: Vec<(u32, std::ops::Range<usize>)> = Vec::new();
             for pair in list {
@@ -352,7 +377,7 @@ impl FastModel {
                 }
                 pairs.push(pair);
             }
-            group_pairs.push(GroupPair { a, b, runs });
+            group_pairs.push(GroupPair { a, b, runs, bodies });
         }
         // reach: every joint offset and prismatic travel end to end, then the farthest sphere
         let chain: f64 = tree
@@ -397,6 +422,17 @@ impl FastModel {
             .all(|b| matches!(b.shape, Shape::Sphere { .. }))
     }
 
+    /// Whether the screen pays for `model`: every body a sphere (the screen is the model) or a
+    /// convex hull (a mesh: its [`CONVEX_SPHERES`](crate::CONVEX_SPHERES) spheres leave
+    /// few lanes uncertain, and those are checked pair by pair). Boxes, capsules and cylinders
+    /// have exact `f64` tests nearly as fast as the screen.
+    pub fn screens_well(model: &CollisionModel) -> bool {
+        model
+            .bodies()
+            .iter()
+            .all(|b| matches!(b.shape, Shape::Sphere { .. } | Shape::Convex { .. }))
+    }
+
     /// Whether the spheres are the model itself (every body a sphere): its certain contacts
     /// are certain collisions. Otherwise the spheres enclose the bodies and only screen.
     pub fn is_exact(&self) -> bool {
@@ -420,6 +456,7 @@ impl FastModel {
             bounds: vec![[F::default(); 3]; self.groups.len()],
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
+            suspects: Vec::with_capacity(self.group_pairs.len() + self.groups.len()),
         }
     }
 
@@ -499,10 +536,10 @@ impl FastModel {
     }
 }
 
-/// Exact collision checks of a sphere model's configurations, [`FAST_LANES`] at a time: forward
-/// kinematics of a block in `f64`, the [`FastModel`] screen in `f32`, and the exact `f64` check
-/// ([`CollisionModel::is_colliding`]) of the lanes it leaves uncertain. Its answers are the exact
-/// model's; only the work differs. Caller-owned: make one per thread.
+/// Exact collision checks, [`FAST_LANES`] configurations at a time: forward kinematics of a
+/// block in `f32`, the [`FastModel`] screen, and for each lane it leaves uncertain the exact
+/// `f64` check of the pairs that left it so. Its answers are the exact model's
+/// ([`CollisionModel::is_colliding`]); only the work differs. Caller-owned: make one per thread.
 #[derive(Debug, Clone)]
 pub struct FastChecker {
     fast: FastModel,
@@ -545,15 +582,14 @@ impl FastChecker {
         })
     }
 
-    /// A checker and `world` compiled for it when every body of `collision` is a sphere (the
-    /// case where the screen pays: [`FastModel::is_exact`]), else `None` — decided before
-    /// compiling anything.
-    pub fn for_sphere_model(
+    /// A checker and `world` compiled for it when the screen pays for `collision`
+    /// ([`FastModel::screens_well`]), else `None` — decided before compiling anything.
+    pub fn for_model(
         collision: &CollisionModel,
         active: &ActiveSet,
         world: &World,
     ) -> Option<(FastChecker, FastWorld)> {
-        if !FastModel::is_sphere_model(collision) {
+        if !FastModel::screens_well(collision) {
             return None;
         }
         let checker = FastChecker::new(collision, active.clone()).ok()?;
@@ -604,15 +640,52 @@ impl FastChecker {
         if verdict.colliding != 0 {
             return false;
         }
-        (0..n)
-            .filter(|l| verdict.uncertain & (1 << l) != 0)
-            .all(|l| {
-                self.uncertain += 1;
-                self.active
-                    .forward_unchecked(&qs[l * d..(l + 1) * d], &mut self.pose);
-                self.collision.place(&self.pose, &mut self.placed);
-                !self.collision.is_colliding(&self.placed, world)
-            })
+        // each uncertain lane: its suspects alone, exactly
+        let FastChecker {
+            fast,
+            collision,
+            active,
+            scratch,
+            pose,
+            placed,
+            uncertain,
+            ..
+        } = self;
+        for l in (0..n).filter(|l| verdict.uncertain & (1 << l) != 0) {
+            *uncertain += 1;
+            active.forward_unchecked(&qs[l * d..(l + 1) * d], pose);
+            for &(suspect, lanes) in &scratch.suspects {
+                if lanes & (1 << l) != 0
+                    && suspect_collides(fast, collision, pose, placed, world, suspect)
+                {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Whether `suspect` collides exactly (`f64`) in the configuration whose link poses are `pose`.
+fn suspect_collides(
+    fast: &FastModel,
+    collision: &CollisionModel,
+    pose: &PoseBuffer,
+    placed: &mut PlacedBodies,
+    world: &World,
+    suspect: Suspect,
+) -> bool {
+    match suspect {
+        Suspect::Pair(k) => fast.group_pairs[k as usize].bodies.iter().any(|&(a, b)| {
+            let (a, b) = (a as usize, b as usize);
+            collision.place_body(pose, a, placed);
+            collision.place_body(pose, b, placed);
+            collision.bodies_touch(placed, a, b)
+        }),
+        Suspect::Object { object, group } => fast.groups[group as usize].bodies.iter().any(|&b| {
+            collision.place_body(pose, b as usize, placed);
+            collision.body_touches_object(placed, b as usize, world, object as usize)
+        }),
     }
 }
 
@@ -628,11 +701,12 @@ fn check(
     scratch: &mut FastScratch,
 ) -> Verdict {
     place(model, poses, scratch);
+    scratch.suspects.clear();
     let m = world.margin;
     let mut verdict = Verdict::default();
     // the world first: in a planner's queries most collisions are with the world
     // world: each object against each link's bounding sphere, then its spheres
-    for object in &world.objects {
+    for (o, object) in world.objects.iter().enumerate() {
         for (g, group) in model.groups.iter().enumerate() {
             let near = live & object.near(&scratch.bounds[g], group.bound.radius + m);
             if near == 0 {
@@ -643,15 +717,21 @@ fn check(
             for i in group.balls.clone() {
                 object.test(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
             }
-            if verdict.add(near, contact, model.exact) {
-                return verdict;
+            let suspect = Suspect::Object {
+                object: o as u32,
+                group: g as u32,
+            };
+            match verdict.add(near, contact, model.exact) {
+                None => return verdict,
+                Some(0) => {}
+                Some(lanes) => scratch.suspects.push((suspect, lanes)),
             }
         }
     }
     // self: link bounding spheres, then the pairs of spheres of the links that come close. The
     // pairs of a link pair are tested lane-wise without a branch (flags or-ed together), and
     // the flags turned into lane masks once per link pair.
-    for gp in &model.group_pairs {
+    for (k, gp) in model.group_pairs.iter().enumerate() {
         let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
         let reach = ga.bound.radius + gb.bound.radius + m;
         let near = live
@@ -676,8 +756,10 @@ fn check(
                 contact.add(distance2(ball, &balls[b as usize]), r, m);
             }
         }
-        if verdict.add(near, contact, model.exact) {
-            return verdict;
+        match verdict.add(near, contact, model.exact) {
+            None => return verdict,
+            Some(0) => {}
+            Some(lanes) => scratch.suspects.push((Suspect::Pair(k as u32), lanes)),
         }
     }
     verdict
@@ -709,22 +791,23 @@ impl Contact {
 }
 
 impl Verdict {
-    /// Adds the contacts of a group of pairs in the lanes of `lanes`; true when a lane certainly
-    /// collides.
+    /// Adds the contacts of a group of pairs in the lanes of `lanes`: `None` when a lane
+    /// certainly collides, else the lanes the group left uncertain.
     #[inline(always)]
-    fn add(&mut self, lanes: LaneMask, contact: Contact, exact: bool) -> bool {
-        if !exact {
+    fn add(&mut self, lanes: LaneMask, contact: Contact, exact: bool) -> Option<LaneMask> {
+        let uncertain = if exact {
+            let hit = lanes & contact.hit.mask();
+            if hit != 0 {
+                self.colliding |= hit;
+                return None;
+            }
+            lanes & contact.close.mask()
+        } else {
             // spheres enclosing the bodies: contact is only a reason to look exactly
-            self.uncertain |= lanes & (contact.hit | contact.close).mask();
-            return false;
-        }
-        let hit = lanes & contact.hit.mask();
-        if hit != 0 {
-            self.colliding |= hit;
-            return true;
-        }
-        self.uncertain |= lanes & contact.close.mask();
-        false
+            lanes & (contact.hit | contact.close).mask()
+        };
+        self.uncertain |= uncertain;
+        Some(uncertain)
     }
 }
 

@@ -313,42 +313,18 @@ pub fn worst_outside(fitted: &Fitted, points: &[Point3<f64>]) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
 }
 
-/// Points on the surface of the convex hull of `points`: each hull triangle sampled on a
-/// barycentric grid whose steps are at most `step` long (its vertices included). Every point of
-/// the hull's surface is within `step` of a sample.
-pub fn hull_surface_points(points: &[Point3<f64>], step: f64) -> Vec<Point3<f64>> {
-    if points.len() < 4 {
-        return points.to_vec();
-    }
-    let (vertices, triangles) = parry3d_f64::transformation::convex_hull(points);
-    let mut out = vertices.clone();
-    for t in &triangles {
-        let [a, b, c] = t.map(|i| vertices[i as usize]);
-        let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-        let n = ((longest / step).ceil() as usize).clamp(1, 10_000);
-        for i in 0..=n {
-            for j in 0..=n - i {
-                if (i == 0 && j == 0) || (i == n) || (j == n) {
-                    continue; // the triangle's vertices are already in
-                }
-                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                out.push(a + (b - a) * u + (c - a) * v);
-            }
-        }
-    }
-    out
-}
+/// Added to every fitted sphere's radius: where a cell's corner is computed (a hull edge cut by a
+/// plane), rounding moves it by about 1e-16 m; a micrometre leaves room for other tools too.
+const SPHERE_MARGIN: f64 = 1e-6;
 
-/// At most `count` spheres (centre, radius) that together enclose every point within `margin`
-/// of `points` (give points sampled on a surface every `step` and `margin = step` to enclose the
-/// whole surface): greedy splits from one bounding sphere, the largest sphere's points split at
-/// the median across their principal axis, until `count` spheres or no cluster can be split.
-/// `None` without finite points.
-pub fn fit_sphere_set(
-    points: &[Point3<f64>],
-    count: usize,
-    margin: f64,
-) -> Option<Vec<(Point3<f64>, f64)>> {
+/// At most `count` spheres (centre, radius) whose union encloses the convex hull of `points`
+/// exactly, not a sample of it: the hull is cut into cells by planes — the cell with the largest
+/// sphere cut across its principal axis, halfway along its extent — until there are `count`
+/// cells or the largest cannot be cut; each cell's sphere encloses the cell's corners (the
+/// hull's vertices on its side and the points where the plane cuts the hull's edges), hence the
+/// cell. Radii are rounded up by a micrometre. `None` without points or with a point that is
+/// not finite.
+pub fn fit_convex_spheres(points: &[Point3<f64>], count: usize) -> Option<Vec<(Point3<f64>, f64)>> {
     if points.is_empty()
         || count == 0
         || points
@@ -357,43 +333,77 @@ pub fn fit_sphere_set(
     {
         return None;
     }
-    let sphere = |cluster: &[Point3<f64>]| {
-        let f = fit_sphere(cluster);
-        let radius = match f.shape {
-            Shape::Sphere { radius } => radius,
-            _ => unreachable!("fit_sphere fits spheres"),
+    let sphere = |corners: &[Point3<f64>]| {
+        let f = fit_sphere(corners);
+        let Shape::Sphere { radius } = f.shape else {
+            unreachable!("fit_sphere fits spheres")
         };
-        (Point3::from(f.pose.translation.vector), radius)
+        (
+            Point3::from(f.pose.translation.vector),
+            radius + SPHERE_MARGIN,
+        )
     };
-    // each cluster of points with its bounding sphere (centre, radius)
-    type Cluster = (Vec<Point3<f64>>, (Point3<f64>, f64));
-    let mut clusters: Vec<Cluster> = vec![(points.to_vec(), sphere(points))];
-    while clusters.len() < count {
-        let Some(k) = (0..clusters.len())
-            .filter(|&k| clusters[k].0.len() > 1)
-            .max_by(|&a, &b| clusters[a].1.1.total_cmp(&clusters[b].1.1))
+    // each cell as its corners and its sphere
+    type Cell = (Vec<Point3<f64>>, (Point3<f64>, f64));
+    let mut cells: Vec<Cell> = vec![(points.to_vec(), sphere(points))];
+    let mut whole = Vec::new(); // cells that cannot be cut (flat or a point)
+    while cells.len() + whole.len() < count {
+        let Some(k) = (0..cells.len()).max_by(|&a, &b| cells[a].1.1.total_cmp(&cells[b].1.1))
         else {
             break;
         };
-        let (cluster, _) = clusters.swap_remove(k);
-        let axis = principal_axis(&cluster);
-        let mut keyed: Vec<(f64, Point3<f64>)> =
-            cluster.iter().map(|p| (p.coords.dot(&axis), *p)).collect();
-        keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let half = keyed.len() / 2;
-        let low: Vec<Point3<f64>> = keyed[..half].iter().map(|k| k.1).collect();
-        let high: Vec<Point3<f64>> = keyed[half..].iter().map(|k| k.1).collect();
-        for part in [low, high] {
-            let s = sphere(&part);
-            clusters.push((part, s));
+        let (corners, s) = cells.swap_remove(k);
+        match cut_hull(&corners) {
+            Some(halves) => cells.extend(halves.map(|h| {
+                let s = sphere(&h);
+                (h, s)
+            })),
+            None => whole.push((corners, s)),
         }
     }
-    Some(
-        clusters
-            .into_iter()
-            .map(|(_, (c, r))| (c, r + margin))
-            .collect(),
-    )
+    Some(cells.into_iter().chain(whole).map(|(_, s)| s).collect())
+}
+
+/// The corners of the two cells the convex hull of `points` falls into when cut across its
+/// principal axis halfway along its extent; `None` when the hull is flat (no volume to cut).
+fn cut_hull(points: &[Point3<f64>]) -> Option<[Vec<Point3<f64>>; 2]> {
+    let (vertices, triangles) = parry3d_f64::transformation::try_convex_hull(points).ok()?;
+    if triangles.is_empty() {
+        return None;
+    }
+    let axis = principal_axis(&vertices);
+    let along: Vec<f64> = vertices.iter().map(|v| v.coords.dot(&axis)).collect();
+    let (lo, hi) = along
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let middle = 0.5 * (lo + hi);
+    if hi <= lo {
+        return None; // a single point (the extent is finite: the points are)
+    }
+    let mut halves = [Vec::new(), Vec::new()];
+    for (v, &x) in vertices.iter().zip(&along) {
+        if x <= middle {
+            halves[0].push(*v);
+        }
+        if x >= middle {
+            halves[1].push(*v);
+        }
+    }
+    for t in &triangles {
+        for (i, j) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let (i, j) = (i as usize, j as usize);
+            // where an edge crosses the plane (found from both its triangles: repeats are harmless)
+            if (along[i] - middle) * (along[j] - middle) < 0.0 {
+                let f = (middle - along[i]) / (along[j] - along[i]);
+                let p = vertices[i] + (vertices[j] - vertices[i]) * f;
+                halves[0].push(p);
+                halves[1].push(p);
+            }
+        }
+    }
+    Some(halves)
 }
 
 /// One link's proxy, as [`fit_model`] fits it.
@@ -569,23 +579,21 @@ pub struct LinkSpheres {
     pub volume: f64,
 }
 
-/// At most `count` spheres for every link of `collision` with mesh collisions, enclosing the
-/// surface of each of the link's convex bodies: sampled every `step` m
-/// ([`hull_surface_points`]) and each radius padded by `step` ([`fit_sphere_set`]). An error
-/// when no link has meshes.
+/// At most `count` spheres for every link of `collision` with mesh collisions, enclosing every
+/// point of the convex hull of the link's convex bodies ([`fit_convex_spheres`]). An error when
+/// no link has meshes.
 pub fn fit_model_spheres(
     collision: &CollisionModel,
     count: usize,
-    step: f64,
 ) -> Result<Vec<LinkSpheres>, CollisionError> {
-    if count == 0 || !(step.is_finite() && step > 0.0) {
+    if count == 0 {
         return Err(CollisionError::InvalidValue {
-            what: format!("{count} spheres per link every {step} m"),
-            problem: "give at least 1 sphere and a finite step above 0".into(),
+            what: "0 spheres per link".into(),
+            problem: "give at least 1 sphere".into(),
         });
     }
     fit_mesh_links(collision, |l, name| {
-        let mut surface = Vec::new();
+        let mut corners = Vec::new();
         let mut hull = 0.0;
         for body in collision.bodies().iter().filter(|b| b.link == l) {
             let Shape::Convex { points } = &body.shape else {
@@ -599,13 +607,13 @@ pub fn fit_model_spheres(
                 use parry3d_f64::shape::Shape as _;
                 h.mass_properties(1.0).mass()
             });
-            surface.extend(hull_surface_points(&local, step));
+            corners.extend(local);
         }
-        if surface.is_empty() {
+        if corners.is_empty() {
             return Ok(None);
         }
         let spheres =
-            fit_sphere_set(&surface, count, step).ok_or_else(|| no_finite_vertices(name))?;
+            fit_convex_spheres(&corners, count).ok_or_else(|| no_finite_vertices(name))?;
         let volume = spheres
             .iter()
             .map(|(_, r)| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))

@@ -58,7 +58,7 @@ pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
 /// [`WorldObject::bounding_box`] return them.
 pub use parry3d_f64::bounding_volume::Aabb;
 pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
-pub use shape::{Shape, ShapeProblem, Sphere};
+pub use shape::{CONVEX_SPHERES, Shape, ShapeProblem, Sphere};
 pub use trm_kinematics::DisableReason;
 pub use world::{ObjectSpec, World, WorldObject, WorldSpec};
 

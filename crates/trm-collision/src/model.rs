@@ -3,7 +3,7 @@
 
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Isometry3, Point3};
 use trm_kinematics::{PoseBuffer, RobotModel, pose_from_xyz_rpy};
@@ -69,6 +69,9 @@ struct Inner {
     pairs: Vec<BodyPair>,
     link_pairs: usize,
     culling: Culling,
+    /// Every body's [`CollisionModel::enclosing_spheres`], fitted on first use and shared by
+    /// the models [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
+    spheres: Arc<OnceLock<Vec<Vec<crate::Sphere>>>>,
 }
 
 /// The collision geometry of a robot with its allowed-collision matrix. Cheap to clone,
@@ -167,8 +170,18 @@ impl CollisionModel {
     /// A collision model from bodies of your own (e.g. simplified proxies) and a matrix.
     pub fn from_bodies(
         robot: &RobotModel,
+        bodies: Vec<Body>,
+        acm: AllowedCollisionMatrix,
+    ) -> Result<Self> {
+        Self::build(robot, bodies, acm, Default::default())
+    }
+
+    /// [`CollisionModel::from_bodies`] with the bodies' spheres, fitted or still to fit.
+    fn build(
+        robot: &RobotModel,
         mut bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
+        spheres: Arc<OnceLock<Vec<Vec<crate::Sphere>>>>,
     ) -> Result<Self> {
         if acm.num_links() != robot.num_links() {
             return Err(CollisionError::InvalidValue {
@@ -226,13 +239,19 @@ impl CollisionModel {
                 pairs,
                 link_pairs,
                 culling,
+                spheres,
             }),
         })
     }
 
     /// The same bodies with another allowed-collision matrix.
     pub fn with_acm(&self, acm: AllowedCollisionMatrix) -> Result<Self> {
-        Self::from_bodies(&self.inner.robot, self.inner.bodies.clone(), acm)
+        Self::build(
+            &self.inner.robot,
+            self.inner.bodies.clone(),
+            acm,
+            self.inner.spheres.clone(),
+        )
     }
 
     /// The robot.
@@ -246,17 +265,26 @@ impl CollisionModel {
     }
 
     /// The spheres enclosing body `body` completely ([`crate::Shape::enclosing_spheres`]) in
-    /// its link's frame: a sphere model of the robot, e.g. for sphere-based planners.
+    /// its link's frame: a sphere model of the robot, e.g. for sphere-based planners. Every
+    /// body's are fitted on the first call, then kept.
     ///
     /// # Panics
     /// If `body` is out of range.
-    pub fn enclosing_spheres(&self, body: usize) -> Vec<crate::Sphere> {
-        let b = &self.inner.bodies[body];
-        let mut spheres = b.shape.enclosing_spheres();
-        for s in &mut spheres {
-            s.center = b.local * s.center;
-        }
-        spheres
+    pub fn enclosing_spheres(&self, body: usize) -> &[crate::Sphere] {
+        let all = self.inner.spheres.get_or_init(|| {
+            self.inner
+                .bodies
+                .iter()
+                .map(|b| {
+                    let mut spheres = b.shape.enclosing_spheres();
+                    for s in &mut spheres {
+                        s.center = b.local * s.center;
+                    }
+                    spheres
+                })
+                .collect()
+        });
+        &all[body]
     }
 
     /// Index of the body with this name.
@@ -320,6 +348,12 @@ impl CollisionModel {
         for (o, &l) in out.origins.iter_mut().zip(&self.inner.culling.origin_links) {
             *o = links[l as usize].translation.vector.into();
         }
+    }
+
+    /// Moves body `body` alone to the world pose of its link (the others keep their places).
+    pub(crate) fn place_body(&self, poses: &PoseBuffer, body: usize, out: &mut PlacedBodies) {
+        let b = &self.inner.bodies[body];
+        self.inner.compiled[body].place(&poses.poses()[b.link], &mut out.placed[body]);
     }
 
     pub(crate) fn compiled(&self) -> &[Compiled] {

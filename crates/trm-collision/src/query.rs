@@ -294,6 +294,25 @@ impl CollisionModel {
         }
     }
 
+    /// Whether placed bodies `a` and `b` touch (whether or not their pair is checked).
+    pub(crate) fn bodies_touch(&self, placed: &PlacedBodies, a: usize, b: usize) -> bool {
+        let (c, p) = (self.compiled(), &placed.placed);
+        !bounds_apart(&p[a], &p[b]) && intersects(&c[a], &p[a], &c[b], &p[b])
+    }
+
+    /// Whether placed body `body` touches world object `object`.
+    pub(crate) fn body_touches_object(
+        &self,
+        placed: &PlacedBodies,
+        body: usize,
+        world: &World,
+        object: usize,
+    ) -> bool {
+        let (c, p) = (&self.compiled()[body], &placed.placed[body]);
+        let o = &world.objects()[object];
+        !bounds_apart(p, &o.placed) && intersects(c, p, &o.compiled, &o.placed)
+    }
+
     /// Signed distance between bodies `a` and `b` (whether or not their pair is checked).
     ///
     /// # Panics

@@ -90,30 +90,63 @@ proptest! {
     }
 }
 
-/// Sphere sets: a hull's surface sampled every `step` lies within `step` of a sample, and the
-/// spheres (radii padded by `step`) enclose every point of the surface: checked on points drawn
-/// on the hull's triangles, far denser than the samples. More spheres are tighter.
+/// Sphere sets enclose the whole convex hull, inside included: checked on its vertices and on
+/// 20 000 random convex combinations of two, three and four of them (surface and inside), for
+/// 1, 4 and 12 spheres; more spheres are tighter; a flat cloud and a single point are covered
+/// too.
 #[test]
-fn sphere_sets_enclose_the_whole_hull_surface_and_tighten_with_more_spheres() {
-    use trm_collision::fit::{fit_sphere_set, hull_surface_points};
+fn sphere_sets_enclose_every_point_of_the_hull_and_tighten_with_more_spheres() {
+    use trm_collision::fit::fit_convex_spheres;
+    let covered = |spheres: &[(Point3<f64>, f64)], p: &Point3<f64>| {
+        spheres.iter().any(|(c, r)| (p - c).norm() <= *r)
+    };
     for kind in 0..3 {
         let points = cloud(kind, 7, 300);
-        let step = 0.004;
-        let surface = hull_surface_points(&points, step);
-        assert!(surface.len() > points.len() / 4, "{}", surface.len());
-        let dense = hull_surface_points(&points, step / 8.0);
+        let (vertices, _) = parry3d_f64::transformation::convex_hull(&points);
+        let weights = cloud(2, 11, 20_000);
         let mut largest = Vec::new();
         for count in [1, 4, 12] {
-            let spheres = fit_sphere_set(&surface, count, step).unwrap();
+            let spheres = fit_convex_spheres(&points, count).unwrap();
             assert!(spheres.len() <= count && !spheres.is_empty());
-            for p in &dense {
-                let inside = spheres.iter().any(|(c, r)| (p - c).norm() <= r + 1e-12);
-                assert!(inside, "kind {kind}, {count} spheres: {p} outside");
+            assert_eq!(
+                spheres.len(),
+                count,
+                "kind {kind}: a solid can always be cut"
+            );
+            for p in &vertices {
+                assert!(
+                    covered(&spheres, p),
+                    "kind {kind}, {count} spheres: vertex {p}"
+                );
+            }
+            for (k, w) in weights.iter().enumerate() {
+                // two to four vertices mixed with positive weights
+                let n = 2 + k % 3;
+                let w = [w.x.abs() + 1e-3, w.y.abs() + 1e-3, w.z.abs() + 1e-3, 0.5];
+                let total: f64 = w[..n].iter().sum();
+                let p = (0..n).fold(Point3::origin(), |s, i| {
+                    let v = vertices[(k * 7 + i * 31) % vertices.len()];
+                    s + v.coords * (w[i] / total)
+                });
+                assert!(
+                    covered(&spheres, &p),
+                    "kind {kind}, {count} spheres: {p} outside"
+                );
             }
             largest.push(spheres.iter().map(|s| s.1).fold(0.0, f64::max));
         }
         assert!(largest[2] < largest[0], "{largest:?}");
     }
-    assert!(fit_sphere_set(&[], 3, 0.01).is_none());
-    assert!(fit_sphere_set(&[Point3::new(f64::NAN, 0.0, 0.0)], 3, 0.01).is_none());
+    // flat: a square; a point
+    let square: Vec<Point3<f64>> = [(0.0, 0.0), (0.1, 0.0), (0.0, 0.1), (0.1, 0.1)]
+        .iter()
+        .map(|&(x, y)| Point3::new(x, y, 0.0))
+        .collect();
+    let spheres = fit_convex_spheres(&square, 4).unwrap();
+    assert!(square.iter().all(|p| covered(&spheres, p)));
+    assert!(covered(&spheres, &Point3::new(0.05, 0.05, 0.0)));
+    let point = [Point3::new(0.1, 0.2, 0.3)];
+    assert_eq!(fit_convex_spheres(&point, 3).unwrap().len(), 1);
+    assert!(fit_convex_spheres(&[], 3).is_none());
+    assert!(fit_convex_spheres(&[Point3::new(f64::NAN, 0.0, 0.0)], 3).is_none());
 }

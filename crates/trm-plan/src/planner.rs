@@ -448,11 +448,8 @@ impl<'a> Planner<'a> {
                 }
             }
         }
-        let fast = FastChecker::for_sphere_model(
-            objective.collision(),
-            objective.active(),
-            objective.world(),
-        );
+        let fast =
+            FastChecker::for_model(objective.collision(), objective.active(), objective.world());
         Ok(Planner {
             fast,
             objective,

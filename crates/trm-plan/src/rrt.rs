@@ -148,7 +148,7 @@ impl<'a> Checker<'a> {
         // bodies leaves most lanes of the Panda's hulls uncertain, and checking those one by
         // one took twice the batched f64 checks' time on MotionBenchMaker (6.3 ms against
         // 3.2 ms median)
-        let fast = FastChecker::for_sphere_model(objective.collision(), objective.active(), world);
+        let fast = FastChecker::for_model(objective.collision(), objective.active(), world);
         Checker {
             objective,
             world,

@@ -25,18 +25,15 @@ pub struct Args {
     #[arg(long, value_name = "MODEL", conflicts_with = "spheres")]
     compare: Option<PathBuf>,
     /// Fit up to N spheres per link instead of one primitive (a sphere model, as VAMP's
-    /// spherized URDFs): every point of each convex body's surface enclosed.
+    /// spherized URDFs): every point of the convex hull of the link's bodies enclosed.
     #[arg(long, value_name = "N", value_parser = crate::parse::count(1, 1000))]
     spheres: Option<usize>,
-    /// With --spheres: the surface is sampled every STEP m and each radius padded by STEP.
-    #[arg(long, value_name = "STEP", default_value_t = 0.005, value_parser = crate::parse::positive, requires = "spheres")]
-    sphere_step: f64,
 }
 
 /// Fits sphere sets, prints the table, writes the URDF when asked.
 fn run_spheres(args: &Args, collision: &CollisionModel, count: usize) -> Result<()> {
-    let sets = fit_model_spheres(collision, count, args.sphere_step)
-        .with_context(|| args.model.display().to_string())?;
+    let sets =
+        fit_model_spheres(collision, count).with_context(|| args.model.display().to_string())?;
     println!(
         "{:<24} {:>9} {:>8} {:>12} {:>10}",
         "link", "hull cm³", "spheres", "spheres cm³", "ratio"
@@ -56,12 +53,11 @@ fn run_spheres(args: &Args, collision: &CollisionModel, count: usize) -> Result<
         );
     }
     println!(
-        "{} links, {total} spheres: {:.1} cm³ of spheres (overlaps counted twice) against hulls {:.1} cm³ ({:.2}×); every hull surface point within a sphere (sampled every {} m, radii padded by it)",
+        "{} links, {total} spheres: {:.1} cm³ of spheres (overlaps counted twice) against hulls {:.1} cm³ ({:.2}×); every point of every hull within a sphere",
         sets.len(),
         volume * 1e6,
         hull * 1e6,
         volume / hull.max(1e-12),
-        args.sphere_step
     );
     if let Some(out) = &args.out {
         let text = std::fs::read_to_string(&args.model)
@@ -218,7 +214,6 @@ mod tests {
             out: Some(out.clone()),
             compare: None,
             spheres: None,
-            sphere_step: 0.005,
         };
         super::run(&args).unwrap();
         let options = CollisionOptions::with_ros_package_path(vec![fixtures]);
@@ -266,7 +261,6 @@ mod committed {
             out: Some(fitted.clone()),
             compare: None,
             spheres: None,
-            sphere_step: 0.005,
         })
         .unwrap();
         let read = |p: &std::path::Path| std::fs::read_to_string(p).unwrap();

@@ -18,7 +18,7 @@ pub(crate) use pair::{
     Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
 };
 pub(crate) use segment_lanes::{PointLanes, segment_distance_squared_lanes};
-pub use spheres::Sphere;
+pub use spheres::{CONVEX_SPHERES, Sphere};
 
 /// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
 /// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.
