@@ -29,6 +29,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use nalgebra::{Point3, Vector3};
 use trm_kinematics::{ActiveSet, BLOCK_LANES, JointKind, PoseBlock, PoseBuffer, PoseLanes32};
@@ -413,6 +414,18 @@ impl FastModel {
         })
     }
 
+    /// `model` compiled by [`FastModel::new`] once and kept with it: later calls (from clones
+    /// of `model` too) share that compilation, so that checkers made per query cost no
+    /// compiling.
+    pub fn of(model: &CollisionModel) -> Result<Arc<FastModel>> {
+        let cell = model.fast_cell();
+        if let Some(fast) = cell.get() {
+            return Ok(fast.clone());
+        }
+        let fast = Arc::new(FastModel::new(model)?);
+        Ok(cell.get_or_init(|| fast).clone())
+    }
+
     /// Whether every body of `model` is a sphere: whether [`FastModel::new`] makes an exact
     /// model of it ([`FastModel::is_exact`]), known without compiling it.
     pub fn is_sphere_model(model: &CollisionModel) -> bool {
@@ -542,7 +555,7 @@ impl FastModel {
 /// ([`CollisionModel::is_colliding`]); only the work differs. Caller-owned: make one per thread.
 #[derive(Debug, Clone)]
 pub struct FastChecker {
-    fast: FastModel,
+    fast: Arc<FastModel>,
     collision: CollisionModel,
     active: ActiveSet,
     /// `FAST_LANES × dim` inputs (unused lanes repeat the first configuration).
@@ -559,7 +572,7 @@ impl FastChecker {
     /// A checker of `collision`'s robot moved by `active`'s coordinates; an error for an active
     /// set of another robot.
     pub fn new(collision: &CollisionModel, active: ActiveSet) -> Result<Self> {
-        let fast = FastModel::new(collision)?;
+        let fast = FastModel::of(collision)?;
         let robot = collision.robot();
         if active.model().num_frames() != robot.num_frames()
             || active.model().name() != robot.name()

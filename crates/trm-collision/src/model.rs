@@ -72,6 +72,8 @@ struct Inner {
     /// Every body's [`CollisionModel::enclosing_spheres`], fitted on first use and shared by
     /// the models [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
     spheres: Arc<OnceLock<Vec<Vec<crate::Sphere>>>>,
+    /// The model compiled for single-precision checks ([`crate::fast::FastModel::of`]).
+    fast: OnceLock<Arc<crate::fast::FastModel>>,
 }
 
 /// The collision geometry of a robot with its allowed-collision matrix. Cheap to clone,
@@ -240,6 +242,7 @@ impl CollisionModel {
                 link_pairs,
                 culling,
                 spheres,
+                fast: OnceLock::new(),
             }),
         })
     }
@@ -354,6 +357,11 @@ impl CollisionModel {
     pub(crate) fn place_body(&self, poses: &PoseBuffer, body: usize, out: &mut PlacedBodies) {
         let b = &self.inner.bodies[body];
         self.inner.compiled[body].place(&poses.poses()[b.link], &mut out.placed[body]);
+    }
+
+    /// Where [`crate::fast::FastModel::of`] keeps this model's compilation.
+    pub(crate) fn fast_cell(&self) -> &OnceLock<Arc<crate::fast::FastModel>> {
+        &self.inner.fast
     }
 
     pub(crate) fn compiled(&self) -> &[Compiled] {
