@@ -917,6 +917,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         ("--max-iterations", &["0", "1e12"][..]),
         ("--seed", &["-1", "1.5"][..]),
         ("--ompl", &["0", "-1", "NaN"][..]),
+        ("--sampler", &["sobol", ""][..]),
     ] {
         let names = if flag == "--resolution" {
             "resolution"

@@ -43,6 +43,94 @@ pub struct RrtOptions {
     /// Grow the smaller tree (the trees swap roles only while their sizes are within a factor
     /// of 2), as VAMP does; otherwise they alternate.
     pub balance: bool,
+    /// Where samples come from.
+    pub sampler: Sampler,
+}
+
+/// The sequence of samples an RRT-Connect search draws, in the box of the joint limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sampler {
+    /// Independent uniform draws (ChaCha8, seeded).
+    #[default]
+    Uniform,
+    /// The Halton sequence (coordinate k: the radical inverse in the (k+1)-th prime base, 3, 5,
+    /// 7, …, as VAMP samples): low discrepancy, so that a few hundred samples already cover the
+    /// box evenly.
+    /// Shifted modulo 1 per coordinate by a seeded random offset (a Cranley–Patterson
+    /// rotation), so that seeds give different, equally even sequences. On MotionBenchMaker's
+    /// Panda set (seeds 0–2, both models) it changed the median by ≤ 3 % either way and the
+    /// 95th percentile by −37 % to +23 %: no gain measured, so uniform stays the default.
+    Halton,
+}
+
+/// Samples of a [`Sampler`] in the box `lower..=upper`.
+struct Samples {
+    kind: Sampler,
+    rng: ChaCha8Rng,
+    /// Halton: the index of the next point, the bases and the seeded shifts.
+    index: u64,
+    bases: Vec<u64>,
+    shifts: Vec<f64>,
+}
+
+impl Samples {
+    fn new(kind: Sampler, seed: u64, dim: usize) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let shifts = match kind {
+            Sampler::Uniform => Vec::new(),
+            Sampler::Halton => (0..dim).map(|_| rng.random_range(0.0..1.0)).collect(),
+        };
+        Samples {
+            kind,
+            rng,
+            index: 0,
+            bases: primes(dim + 1).split_off(1),
+            shifts,
+        }
+    }
+
+    /// The next sample, into `out`.
+    fn next(&mut self, lower: &[f64], upper: &[f64], out: &mut [f64]) {
+        match self.kind {
+            Sampler::Uniform => {
+                for (k, v) in out.iter_mut().enumerate() {
+                    *v = self.rng.random_range(lower[k]..=upper[k]);
+                }
+            }
+            Sampler::Halton => {
+                self.index += 1;
+                for (k, v) in out.iter_mut().enumerate() {
+                    let u = (radical_inverse(self.index, self.bases[k]) + self.shifts[k]).fract();
+                    *v = lower[k] + u * (upper[k] - lower[k]);
+                }
+            }
+        }
+    }
+}
+
+/// The first `n` primes.
+fn primes(n: usize) -> Vec<u64> {
+    let mut out: Vec<u64> = Vec::with_capacity(n);
+    let mut k = 2;
+    while out.len() < n {
+        if out.iter().take_while(|&&p| p * p <= k).all(|&p| k % p != 0) {
+            out.push(k);
+        }
+        k += 1;
+    }
+    out
+}
+
+/// `i`'s digits in `base` mirrored about the point: 0.d₁d₂… for i = …d₂d₁.
+fn radical_inverse(mut i: u64, base: u64) -> f64 {
+    let (mut value, mut scale) = (0.0, 1.0);
+    let inverse = 1.0 / base as f64;
+    while i > 0 {
+        scale *= inverse;
+        value += (i % base) as f64 * scale;
+        i /= base;
+    }
+    value
 }
 
 /// Draws per counted sample at most: samples outside every dynamic domain are drawn again
@@ -68,6 +156,7 @@ impl Default for RrtOptions {
             shortcuts: 0,
             dynamic_domain: true,
             balance: true,
+            sampler: Sampler::default(),
         }
     }
 }
@@ -423,6 +512,7 @@ fn search(
     }
     let (lower, upper) = objective.active().bounds();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut samples = Samples::new(options.sampler, options.seed, dim);
     let mut result = RrtPath::default();
     // the straight line first: many queries need nothing else
     let mut raw = if checker.edge_free(start, goal, options.resolution) {
@@ -445,9 +535,7 @@ fn search(
         if draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
             break;
         }
-        for (k, v) in sample.iter_mut().enumerate() {
-            *v = rng.random_range(lower[k]..=upper[k]);
-        }
+        samples.next(&lower, &upper, &mut sample);
         let new = match extend(
             &mut a,
             &sample,
@@ -569,4 +657,38 @@ pub fn shortcut(
 /// Length of a path, rad.
 pub fn path_length(path: &[Vec<f64>]) -> f64 {
     path.windows(2).map(|w| distance(&w[0], &w[1])).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halton_points_are_radical_inverses_in_the_odd_prime_bases() {
+        assert_eq!(primes(6), vec![2, 3, 5, 7, 11, 13]);
+        assert_eq!(radical_inverse(1, 3), 1.0 / 3.0);
+        assert_eq!(radical_inverse(2, 3), 2.0 / 3.0);
+        assert!((radical_inverse(3, 3) - 1.0 / 9.0).abs() < 1e-15);
+        assert!((radical_inverse(5, 5) - 1.0 / 25.0).abs() < 1e-15);
+        // the first point of every coordinate: 1/base, shifted modulo 1, scaled into the box
+        let mut samples = Samples::new(Sampler::Halton, 4, 3);
+        let (lower, upper) = ([-1.0, 0.0, 2.0], [1.0, 0.5, 3.0]);
+        let mut q = [0.0; 3];
+        samples.next(&lower, &upper, &mut q);
+        for (k, base) in [3.0, 5.0, 7.0].into_iter().enumerate() {
+            let u = (1.0 / base + samples.shifts[k]).fract();
+            assert!((q[k] - (lower[k] + u * (upper[k] - lower[k]))).abs() < 1e-12);
+        }
+        // evenly spread: every eighth of each axis gets 1 000 of 8 000 points, ± 1 %
+        let mut counts = [[0usize; 8]; 3];
+        for _ in 0..8000 {
+            samples.next(&[0.0; 3], &[1.0; 3], &mut q);
+            for k in 0..3 {
+                counts[k][(q[k] * 8.0) as usize] += 1;
+            }
+        }
+        for row in counts {
+            assert!(row.iter().all(|&c| (990..=1010).contains(&c)), "{row:?}");
+        }
+    }
 }

@@ -481,6 +481,37 @@ fn plain_and_dynamic_domain_rrt_connect_both_solve() {
     );
 }
 
+/// The Halton sampler solves every sample problem too, the same path for the same seed twice
+/// and another path for another seed (its shift).
+#[test]
+fn halton_samples_solve_reproducibly_and_seeds_shift_them() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let halton = |seed| RrtOptions {
+        sampler: trm_plan::rrt::Sampler::Halton,
+        seed,
+        ..Default::default()
+    };
+    let mut differ = 0;
+    for p in find_problems(&fixtures()).unwrap() {
+        let scene = PlanningScene::load(&p.scene).unwrap();
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        let run = |seed| solve(&robot, &collision, &scene, &request, &halton(seed)).unwrap();
+        let (first, again, other) = (run(0), run(0), run(1));
+        assert!(
+            first.solved && other.solved,
+            "{} {}: {}",
+            p.family,
+            p.index,
+            first.note
+        );
+        assert_eq!(first.path, again.path, "{} {}", p.family, p.index);
+        differ += usize::from(first.path != other.path);
+    }
+    assert!(differ > 0, "seeds 0 and 1 gave the same paths everywhere");
+}
+
 /// Requests round-trip through the writer (every field the reader reads), and the writer
 /// refuses a goal or start that is not one finite value per name.
 #[test]

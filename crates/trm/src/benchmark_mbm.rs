@@ -41,6 +41,10 @@ pub struct Args {
     /// Largest gap between checked points of an edge, rad.
     #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]
     resolution: f64,
+    /// Where RRT-Connect's samples come from: `uniform` (independent seeded draws) or `halton`
+    /// (low discrepancy, shifted by the seed; VAMP's sampler).
+    #[arg(long, value_enum, default_value_t = SamplerArg::Uniform)]
+    sampler: SamplerArg,
     /// Random shortcut attempts per path (after the greedy pass).
     #[arg(long, default_value_t = 0, value_parser = crate::parse::count(0, 1_000_000))]
     shortcuts: usize,
@@ -80,6 +84,15 @@ pub struct Args {
     pub out_dir: PathBuf,
 }
 
+/// `--sampler`: [`trm_plan::rrt::Sampler`] on the command line.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum SamplerArg {
+    /// Independent uniform draws.
+    Uniform,
+    /// The Halton sequence, shifted by the seed.
+    Halton,
+}
+
 /// Runs the set, prints the per-family table, writes the files.
 pub fn run(args: &Args) -> Result<()> {
     if let Some(binary) = &args.vamp {
@@ -101,6 +114,10 @@ pub fn run(args: &Args) -> Result<()> {
         max_seconds: args.max_seconds,
         resolution: args.resolution,
         shortcuts: args.shortcuts,
+        sampler: match args.sampler {
+            SamplerArg::Halton => trm_plan::rrt::Sampler::Halton,
+            SamplerArg::Uniform => trm_plan::rrt::Sampler::Uniform,
+        },
         ..Default::default()
     };
     let mut progress = crate::progress::Progress::new("problems", problems.len() as u64);
