@@ -217,9 +217,10 @@ pub struct RrtPath {
     pub refinements: u32,
 }
 
-/// Collision checks of configurations and edges in one world, counted. A sphere model is
-/// checked by the single-precision screen ([`FastChecker`], [`FAST_LANES`] configurations at
-/// a time, exact answers); any other model by the objective's batched `f64` checks.
+/// Collision checks of configurations and edges in one world, counted. Models of spheres and
+/// mesh hulls are checked by the single-precision screen ([`FastChecker`], [`FAST_LANES`]
+/// configurations at a time, exact answers); any other model by the objective's batched `f64`
+/// checks.
 pub struct Checker<'a> {
     objective: &'a Objective,
     world: &'a World,
@@ -233,10 +234,6 @@ pub struct Checker<'a> {
 impl<'a> Checker<'a> {
     /// A checker for `objective`'s robot in `world`.
     pub fn new(objective: &'a Objective, world: &'a World) -> Self {
-        // sphere models only: screening other models through the spheres enclosing their
-        // bodies leaves most lanes of the Panda's hulls uncertain, and checking those one by
-        // one took twice the batched f64 checks' time on MotionBenchMaker (6.3 ms against
-        // 3.2 ms median)
         let fast = FastChecker::for_model(objective.collision(), objective.active(), world);
         Checker {
             objective,
@@ -248,7 +245,8 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// Whether the single-precision screen checks this robot (a sphere model).
+    /// Whether the single-precision screen checks this robot (spheres or mesh hulls:
+    /// [`trm_collision::fast::FastModel::screens_well`]).
     pub fn is_fast(&self) -> bool {
         self.fast.is_some()
     }
@@ -278,14 +276,25 @@ impl<'a> Checker<'a> {
     /// the edge's n points (m = ⌈n / lanes⌉, lanes = [`FAST_LANES`] on the screen, else
     /// [`LANES`]).
     pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let d = a.len();
-        let length = distance(a, b);
-        let steps = (length / resolution).ceil().max(1.0) as usize;
+        let steps = edge_steps(a, b, resolution);
         // interior points 1..steps (0 and steps are the checked ends)
-        let n = steps.saturating_sub(1);
+        self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64)
+    }
+
+    /// Whether the points halfway between those [`Checker::edge_free`] checks at `resolution`
+    /// are free (raked the same way): after `edge_free(a, b, resolution)`, the edge is then free
+    /// at every `resolution / 2`, for half the checks of `edge_free(a, b, resolution / 2)`.
+    pub fn edge_midpoints_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        self.rake(a, b, steps, |i| (2 * i + 1) as f64 / (2 * steps) as f64)
+    }
+
+    /// Whether the `n` points a + s(i)·(b − a), i < n, are free, visited raked.
+    fn rake(&mut self, a: &[f64], b: &[f64], n: usize, s: impl Fn(usize) -> f64) -> bool {
         if n == 0 {
             return true;
         }
+        let d = a.len();
         let width = if self.fast.is_some() {
             FAST_LANES
         } else {
@@ -302,7 +311,7 @@ impl<'a> Checker<'a> {
                 if i >= n {
                     break;
                 }
-                let s = (i + 1) as f64 / steps as f64;
+                let s = s(i);
                 for (j, q) in batch[lanes * d..(lanes + 1) * d].iter_mut().enumerate() {
                     *q = a[j] + s * (b[j] - a[j]);
                 }
@@ -317,6 +326,11 @@ impl<'a> Checker<'a> {
         self.batch = batch;
         free
     }
+}
+
+/// Pieces of the edge a → b no longer than `resolution` (at least 1).
+fn edge_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
+    (distance(a, b) / resolution).ceil().max(1.0) as usize
 }
 
 /// Euclidean distance between configurations.
@@ -431,7 +445,8 @@ fn extend(
 /// A collision-free path from `start` to `goal` in `world` (both checked first), by RRT-Connect
 /// in the box of the active motors' limits, then shortcut.
 ///
-/// The shortcut path is checked again at half the resolution (raked, as every edge); where an
+/// The shortcut path is checked again at half the resolution: the points halfway between those
+/// its edges were checked at ([`Checker::edge_midpoints_free`], raked as every edge); where an
 /// edge grazes an obstacle between the points first checked, the search runs again at that
 /// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
 /// it was checked. [`RrtPath::refinements`] counts the reruns.
@@ -453,11 +468,13 @@ pub fn rrt_connect(
             ..options.clone()
         };
         let mut found = search(objective, world, start, goal, &attempt, began)?;
+        // every edge of the path was checked at `resolution` (by the search or the shortcut):
+        // its midpoints make it checked at half that
         let mut checker = Checker::new(objective, world);
         let free = found
             .path
             .windows(2)
-            .all(|w| checker.edge_free(&w[0], &w[1], resolution / 2.0));
+            .all(|w| checker.edge_midpoints_free(&w[0], &w[1], resolution));
         checks += found.checks + checker.checks;
         iterations += found.iterations;
         if free {
