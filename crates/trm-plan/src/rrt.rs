@@ -281,6 +281,15 @@ impl<'a> Checker<'a> {
         self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64)
     }
 
+    /// Whether the straight edge a → b is free at every `resolution` and at `b` (`a` is not
+    /// checked): [`Checker::edge_free`] with the end in the first block, so that a new node
+    /// costs no block of its own (a block of one configuration costs a whole block).
+    pub fn edge_and_end_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        // from b back towards a: b first, where an extension usually fails
+        self.rake(a, b, steps, |i| (steps - i) as f64 / steps as f64)
+    }
+
     /// Whether the points halfway between those [`Checker::edge_free`] checks at `resolution`
     /// are free (raked the same way): after `edge_free(a, b, resolution)`, the edge is then free
     /// at every `resolution / 2`, for half the checks of `edge_free(a, b, resolution / 2)`.
@@ -416,8 +425,7 @@ fn extend(
             false,
         )
     };
-    if !checker.free(&to) || !checker.edge_free(&tree.nodes[near].clone(), &to, options.resolution)
-    {
+    if !checker.edge_and_end_free(&tree.nodes[near], &to, options.resolution) {
         if domain {
             let r = &mut tree.radii[near];
             *r = if r.is_infinite() {
