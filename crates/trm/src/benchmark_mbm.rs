@@ -318,8 +318,7 @@ pub fn run(args: &Args) -> Result<()> {
         md.push_str(&text);
     }
     if let Some(limit) = args.ompl {
-        let script =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../benches/python/mbm_ompl.py");
+        let script = ompl_script();
         let python = std::env::var("TRM_PYTHON").unwrap_or_else(|_| "python3".into());
         let mut command = std::process::Command::new(python);
         command.arg(&script).arg(set.root()).args([
@@ -354,6 +353,11 @@ pub fn run(args: &Args) -> Result<()> {
     let names: Vec<&str> = files.iter().map(|f| f.0).collect();
     println!("wrote {}/{{{}}}", args.out_dir.display(), names.join(", "));
     Ok(())
+}
+
+/// The OMPL side of `--ompl`, in the repository the tool was built from.
+fn ompl_script() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/python/mbm_ompl.py")
 }
 
 /// How to get VAMP's program.
@@ -424,4 +428,13 @@ fn run_vamp(
         ordered.push((p.family.clone(), outcome));
     }
     Ok((ordered, exported))
+}
+
+#[cfg(test)]
+mod tests {
+    /// `--ompl` finds its script (it moved once with the command and was lost).
+    #[test]
+    fn the_ompl_script_is_where_the_command_looks() {
+        assert!(super::ompl_script().is_file(), "{}", super::ompl_script().display());
+    }
 }
