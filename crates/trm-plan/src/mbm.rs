@@ -545,10 +545,10 @@ pub fn solve_with_experience(
                             } else {
                                 "experience"
                             };
-                            if path
-                                .windows(2)
-                                .all(|w| checker.edge_free(&w[0], &w[1], options.resolution / 2.0))
-                            {
+                            if path.windows(2).all(|w| {
+                                checker.edge_free(&w[0], &w[1], options.resolution)
+                                    && checker.edge_midpoints_free(&w[0], &w[1], options.resolution)
+                            }) {
                                 Ok((path, checker.checks, Some(how)))
                             } else {
                                 rrt_connect(&objective, &world, &start, &goal, &rrt)
@@ -585,8 +585,10 @@ pub fn solve_with_experience(
 }
 
 /// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
-/// configuration at a time from one end to the other (an independent check of a planner's
-/// raked, batched edge checks).
+/// configuration at a time in `f64` from one end to the other (an independent check of a
+/// planner's raked, batched, single-precision edge checks): at the points a planner checking
+/// at `2 × resolution` and then at the midpoints visits ([`crate::rrt::edge_steps`]), no more
+/// than `resolution` apart.
 pub fn path_is_free(
     robot: &RobotModel,
     collision: &CollisionModel,
@@ -600,9 +602,9 @@ pub fn path_is_free(
     let (objective, _, _) = problem_objective(robot, &collision, &world, request)?;
     let mut scratch = objective.scratch();
     for w in path.windows(2) {
-        let steps = (crate::rrt::distance(&w[0], &w[1]) / resolution)
-            .ceil()
-            .max(1.0) as usize;
+        // the points the planner's half-resolution check visits (`resolution` is that half):
+        // those at the full resolution and the midpoints between them
+        let steps = 2 * crate::rrt::edge_steps(&w[0], &w[1], 2.0 * resolution);
         for s in 0..=steps {
             let t = s as f64 / steps as f64;
             let q: Vec<f64> = w[0]

@@ -337,8 +337,11 @@ impl<'a> Checker<'a> {
     }
 }
 
-/// Pieces of the edge a → b no longer than `resolution` (at least 1).
-fn edge_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
+/// Pieces of the edge a → b no longer than `resolution` (at least 1): [`Checker::edge_free`]
+/// checks the points between them; checked "at half the resolution", an edge's points are
+/// these and the midpoints between them ([`Checker::edge_midpoints_free`]), `2 ×` this many
+/// pieces.
+pub fn edge_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
     (distance(a, b) / resolution).ceil().max(1.0) as usize
 }
 

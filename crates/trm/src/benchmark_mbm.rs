@@ -435,6 +435,10 @@ mod tests {
     /// `--ompl` finds its script (it moved once with the command and was lost).
     #[test]
     fn the_ompl_script_is_where_the_command_looks() {
-        assert!(super::ompl_script().is_file(), "{}", super::ompl_script().display());
+        assert!(
+            super::ompl_script().is_file(),
+            "{}",
+            super::ompl_script().display()
+        );
     }
 }
