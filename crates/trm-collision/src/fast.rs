@@ -620,16 +620,42 @@ impl FastChecker {
         self.active.len()
     }
 
-    /// Whether every configuration of `qs` (at most [`FAST_LANES`] of them, one after the
-    /// other) is free of self-collisions and of `world` (`fast_world` is `world` compiled by
-    /// [`FastModel::world`]): the exact model's answer. False for NaN.
-    ///
-    /// # Panics
-    /// If `qs` does not hold 1 to [`FAST_LANES`] whole configurations.
-    pub fn all_free(&mut self, qs: &[f64], world: &World, fast_world: &FastWorld) -> bool {
+    /// Whether every configuration of `qs` (1 to [`FAST_LANES`] of them, one after the other)
+    /// is free of self-collisions and of `world` (`fast_world` is `world` compiled by
+    /// [`FastModel::world`]): the exact model's answer. An error for a length that is not 1 to
+    /// [`FAST_LANES`] whole configurations or a value that is not finite.
+    pub fn all_free(&mut self, qs: &[f64], world: &World, fast_world: &FastWorld) -> Result<bool> {
         let d = self.active.len();
         let n = qs.len() / d.max(1);
-        assert!(
+        if d == 0 || n == 0 || n > FAST_LANES || qs.len() != n * d {
+            return Err(CollisionError::InvalidValue {
+                what: format!("{} configuration values", qs.len()),
+                problem: format!(
+                    "are not 1 to {FAST_LANES} whole configurations of {d} active motors"
+                ),
+            });
+        }
+        if let Some(i) = qs.iter().position(|v| !v.is_finite()) {
+            return Err(CollisionError::InvalidValue {
+                what: format!("value {} of configuration {}", i % d, i / d),
+                problem: format!("is {}, not a finite number", qs[i]),
+            });
+        }
+        Ok(self.all_free_unchecked(qs, world, fast_world))
+    }
+
+    /// [`FastChecker::all_free`] without its checks, for callers that made `qs` themselves:
+    /// false for NaN; `qs` must hold 1 to [`FAST_LANES`] whole configurations (checked in debug
+    /// builds; otherwise a wrong length gives a wrong answer or a panic, never unsafety).
+    pub fn all_free_unchecked(
+        &mut self,
+        qs: &[f64],
+        world: &World,
+        fast_world: &FastWorld,
+    ) -> bool {
+        let d = self.active.len();
+        let n = qs.len() / d.max(1);
+        debug_assert!(
             d > 0 && n > 0 && n <= FAST_LANES && qs.len() == n * d,
             "1 to {FAST_LANES} whole configurations"
         );

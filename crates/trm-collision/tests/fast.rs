@@ -3,7 +3,7 @@
 //! enclosing spheres), random configurations, an empty world and worlds of every object shape,
 //! blocks of eight and single configurations.
 
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use trm_collision::fast::{FAST_LANES, FastChecker};
@@ -133,7 +133,7 @@ fn the_screen_answers_as_the_exact_model_does() {
             );
             for (i, q) in qs.chunks(d).enumerate() {
                 assert_eq!(
-                    checker.all_free(q, &world, &fast_world),
+                    checker.all_free(q, &world, &fast_world).unwrap(),
                     truth[i],
                     "{file}: configuration {i}"
                 );
@@ -143,7 +143,7 @@ fn the_screen_answers_as_the_exact_model_does() {
                     .iter()
                     .all(|&f| f);
                 assert_eq!(
-                    checker.all_free(block, &world, &fast_world),
+                    checker.all_free_unchecked(block, &world, &fast_world),
                     expected,
                     "{file}: block {k}"
                 );
@@ -163,8 +163,10 @@ fn the_screen_answers_as_the_exact_model_does() {
     }
 }
 
+/// NaN is never free unchecked and an error checked, as are wrong lengths (none, a part of a
+/// configuration, more than a block).
 #[test]
-fn nan_is_never_free() {
+fn nan_is_never_free_and_bad_input_is_an_error() {
     let (robot, collision) = panda("panda-mbm/panda_spherized.ron");
     let mut checker = FastChecker::new(&collision, robot.all_active()).unwrap();
     let world = World::new();
@@ -172,7 +174,26 @@ fn nan_is_never_free() {
     let mut q = robot
         .all_active()
         .from_motors(&vec![0.0; robot.motors().len()]);
+    assert!(checker.all_free(&q, &world, &fast_world).is_ok());
+    let d = q.len();
+    for n in [0, d - 1, d + 1, (FAST_LANES + 1) * d] {
+        let qs = vec![0.0; n];
+        let e = checker
+            .all_free(&qs, &world, &fast_world)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("whole configurations"), "{n}: {e}");
+    }
     q[2] = f64::NAN;
-    assert!(!checker.all_free(&q, &world, &fast_world));
-    let _ = Vector3::<f64>::zeros();
+    assert!(!checker.all_free_unchecked(&q, &world, &fast_world));
+    let e = checker
+        .all_free(&q, &world, &fast_world)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("value 2 of configuration 0") && e.contains("NaN"),
+        "{e}"
+    );
+    q[2] = f64::INFINITY;
+    assert!(checker.all_free(&q, &world, &fast_world).is_err());
 }

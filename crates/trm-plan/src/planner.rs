@@ -543,7 +543,7 @@ impl<'a> Planner<'a> {
     /// Whether `q` is collision-free in the current world.
     pub fn is_free(&mut self, q: &[f64]) -> bool {
         match &mut self.fast {
-            Some((checker, fast_world)) => checker.all_free(q, &self.world, fast_world),
+            Some((checker, fast_world)) => checker.all_free_unchecked(q, &self.world, fast_world),
             None => self
                 .objective
                 .is_collision_free_in(q, &self.world, &mut self.scratch),
@@ -563,7 +563,7 @@ impl<'a> Planner<'a> {
                 FAST_LANES,
                 &mut self.samples,
                 fast,
-                |qs, (checker, fast_world)| checker.all_free(qs, world, fast_world),
+                |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world),
             );
         }
         let (objective, world) = (&self.objective, &self.world);

@@ -260,7 +260,7 @@ impl<'a> Checker<'a> {
     /// Whether every configuration of `qs` (at most a block's worth) is collision-free.
     fn all_free(&mut self, qs: &[f64]) -> bool {
         match &mut self.fast {
-            Some((checker, fast_world)) => checker.all_free(qs, self.world, fast_world),
+            Some((checker, fast_world)) => checker.all_free_unchecked(qs, self.world, fast_world),
             None if qs.len() == self.objective.dim() => {
                 self.objective
                     .is_collision_free_in(qs, self.world, &mut self.scratch)
