@@ -63,6 +63,28 @@ pub enum Sampler {
     Halton,
 }
 
+impl std::str::FromStr for Sampler {
+    type Err = PlanError;
+
+    /// `uniform` or `halton`; anything else is an error naming the two.
+    fn from_str(name: &str) -> Result<Self, PlanError> {
+        match name {
+            "uniform" => Ok(Sampler::Uniform),
+            "halton" => Ok(Sampler::Halton),
+            _ => {
+                let close = trm_io::closest_names(name, ["uniform", "halton"]);
+                let hint = close
+                    .first()
+                    .map_or(String::new(), |c| format!(" (did you mean `{c}`?)"));
+                Err(PlanError::InvalidOptions {
+                    what: "sampler".into(),
+                    problem: format!("`{name}` is not `uniform` or `halton`{hint}"),
+                })
+            }
+        }
+    }
+}
+
 /// Samples of a [`Sampler`] in the box `lower..=upper`.
 struct Samples {
     kind: Sampler,
@@ -690,6 +712,17 @@ pub fn path_length(path: &[Vec<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn samplers_are_named_and_a_wrong_name_says_the_two() {
+        assert_eq!("halton".parse::<Sampler>().unwrap(), Sampler::Halton);
+        assert_eq!("uniform".parse::<Sampler>().unwrap(), Sampler::Uniform);
+        let e = "halton2".parse::<Sampler>().unwrap_err().to_string();
+        assert!(
+            e.contains("did you mean `halton`") && e.contains("uniform"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn halton_points_are_radical_inverses_in_the_odd_prime_bases() {

@@ -50,12 +50,13 @@ pub(crate) fn compare_optimisers<'py>(
 /// embedded model's name), as `trm benchmark-mbm`: `families` and `per_family` select
 /// problems, `verify` re-checks each path one configuration at a time, `task_space` (a link)
 /// poses each joint goal as the task-space goal it implies for that link (a cube of side
-/// `position_tolerance`, `orientation_tolerance` about each axis). Returns a dict: `runs`
+/// `position_tolerance`, `orientation_tolerance` about each axis), `sampler` is `uniform` or
+/// `halton` (RRT-Connect's samples). Returns a dict: `runs`
 /// (per problem: family, index, outcome {valid, solved, seconds, length, waypoints, checks,
 /// note, path}, verified), `table` (markdown: solved %, median and p95 time per family) and
 /// `csv`.
 #[pyfunction]
-#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05))]
+#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05, sampler = "uniform"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn benchmark_mbm<'py>(
     py: Python<'py>,
@@ -70,7 +71,9 @@ pub(crate) fn benchmark_mbm<'py>(
     task_space: Option<String>,
     position_tolerance: f64,
     orientation_tolerance: f64,
+    sampler: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let sampler: trm_plan::rrt::Sampler = sampler.parse().map_err(err)?;
     let task_space = task_space.map(|link| trm_plan::mbm::TaskSpaceGoals {
         link,
         position_tolerance,
@@ -86,6 +89,7 @@ pub(crate) fn benchmark_mbm<'py>(
     let rrt = trm_plan::rrt::RrtOptions {
         seed,
         max_iterations,
+        sampler,
         ..Default::default()
     };
     let runs = py

@@ -368,6 +368,10 @@ def test_motionbenchmaker_from_python_solves_and_verifies():
     assert all(run["outcome"]["solved"] and run["verified"] for run in t["runs"])
     with pytest.raises(trm.TrmError, match="box_panda"):
         trm.benchmark_mbm(str(fixtures), model, families=["box_pand"])
+    h = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=1, verify=True, sampler="halton")
+    assert h["runs"][0]["outcome"]["solved"] and h["runs"][0]["verified"]
+    with pytest.raises(trm.TrmError, match="did you mean `halton`"):
+        trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], sampler="halton2")
 
 
 def small_stick(tmp_path):
