@@ -1,4 +1,5 @@
-//! Single-precision collision checks of sphere models, [`FAST_LANES`] configurations at once.
+//! Single-precision collision checks, [`FAST_LANES`] configurations at once: sphere models as
+//! they are, other models (mesh hulls) through spheres that enclose their bodies.
 //!
 //! VAMP's way (Thomason, Kingston and Kavraki, ICRA 2024): the robot as spheres, and every
 //! number of a block of eight configurations one `f32` lane, so that each arithmetic step is one
@@ -202,8 +203,8 @@ enum Suspect {
     Object { object: u32, group: u32 },
 }
 
-/// A sphere model compiled for single-precision checks of [`FAST_LANES`] configurations at
-/// once (made by [`FastModel::new`] from a [`CollisionModel`] whose bodies are all spheres).
+/// A collision model compiled for single-precision checks of [`FAST_LANES`] configurations at
+/// once (made by [`FastModel::new`]): its spheres, or the spheres enclosing its bodies.
 #[derive(Debug, Clone)]
 pub struct FastModel {
     balls: Vec<Ball>,
@@ -610,7 +611,7 @@ impl FastChecker {
         Some((checker, fast_world))
     }
 
-    /// The compiled sphere model.
+    /// The compiled model.
     pub fn model(&self) -> &FastModel {
         &self.fast
     }

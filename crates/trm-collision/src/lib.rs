@@ -34,7 +34,9 @@
 //! For sphere models (VAMP's spherized URDFs, or [`fit::urdf_with_spheres`]),
 //! [`fast::FastChecker`] checks eight configurations at once in single precision, deferring the
 //! few within rounding distance of contact to the exact check, so its answers are the exact
-//! model's (the planner uses it whenever the robot is a sphere model).
+//! model's; mesh hulls go through spheres that enclose them exactly
+//! ([`fit::fit_convex_spheres`]), the lanes they leave uncertain decided by the hulls pair by
+//! pair (the planner uses it for both).
 
 mod acm;
 mod batch;

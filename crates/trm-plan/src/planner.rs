@@ -395,7 +395,8 @@ pub struct Planner<'a> {
     scratch: trm_tasks::Scratch,
     /// Samples of the segment being checked.
     samples: Vec<f64>,
-    /// For a sphere model: the single-precision screen and the current world compiled for it.
+    /// For spheres and mesh hulls: the single-precision screen and the current world compiled
+    /// for it.
     fast: Option<(FastChecker, FastWorld)>,
 }
 
@@ -438,11 +439,7 @@ impl<'a> Planner<'a> {
         // inter-map edges: each node to its 3 nearest nodes of every other map
         for (ma, mb) in (0..maps.len()).flat_map(|a| (a + 1..maps.len()).map(move |b| (a, b))) {
             for i in starts[ma]..starts[ma + 1] {
-                let mut near: Vec<(f64, usize)> = (starts[mb]..starts[mb + 1])
-                    .map(|j| (distance(&nodes[i].0, &nodes[j].0), j))
-                    .collect();
-                near.sort_by(|x, y| x.0.total_cmp(&y.0));
-                for &(l, j) in near.iter().take(3) {
+                for (l, j) in k_nearest(&nodes[i].0, &nodes, starts[mb]..starts[mb + 1], 3) {
                     edges.push((i, j, l));
                     edge_state.push(State::Unknown);
                 }
@@ -507,11 +504,7 @@ impl<'a> Planner<'a> {
                     self.nodes.push((q.clone(), t));
                     self.node_state.push(State::Valid);
                     let me = self.nodes.len() - 1;
-                    let mut near: Vec<(f64, usize)> = (0..old)
-                        .map(|j| (distance(q, &self.nodes[j].0), j))
-                        .collect();
-                    near.sort_by(|x, y| x.0.total_cmp(&y.0));
-                    for &(l, j) in near.iter().take(3) {
+                    for (l, j) in k_nearest(q, &self.nodes, 0..old, 3) {
                         self.edges.push((me, j, l));
                         self.edge_state.push(State::Unknown);
                     }
@@ -551,7 +544,7 @@ impl<'a> Planner<'a> {
     }
 
     /// Whether the straight segment a → b is free, checked every `resolution` of joint motion
-    /// (a sphere model [`FAST_LANES`] samples at a time on the single-precision screen).
+    /// (spheres and mesh hulls [`FAST_LANES`] samples at a time on the single-precision screen).
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         if let Some(fast) = &mut self.fast {
             let world = &self.world;
@@ -677,11 +670,7 @@ impl<'a> Planner<'a> {
                       me: usize,
                       extra: &mut Vec<(usize, usize, f64)>,
                       nodes: &[(Vec<f64>, Vec<f64>)]| {
-            let mut near: Vec<(f64, usize)> = (0..nodes.len())
-                .map(|j| (distance(q, &nodes[j].0), j))
-                .collect();
-            near.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for &(l, j) in near.iter().take(options.attach_neighbours) {
+            for (l, j) in k_nearest(q, nodes, 0..nodes.len(), options.attach_neighbours) {
                 extra.push((me, j, l));
             }
         };
@@ -1000,4 +989,24 @@ impl<'a> Planner<'a> {
             task_path,
         }
     }
+}
+
+/// The `k` nodes of `candidates` nearest to `q` in configuration space, as (distance, index),
+/// nearest first and ties by index (the order of a stable sort): a selection, then a sort of
+/// `k` — not a sort of every node (experience graphs hold thousands).
+fn k_nearest(
+    q: &[f64],
+    nodes: &[(Vec<f64>, Vec<f64>)],
+    candidates: std::ops::Range<usize>,
+    k: usize,
+) -> Vec<(f64, usize)> {
+    let order = |x: &(f64, usize), y: &(f64, usize)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+    let mut near: Vec<(f64, usize)> = candidates.map(|j| (distance(q, &nodes[j].0), j)).collect();
+    let k = k.min(near.len());
+    if k > 0 && k < near.len() {
+        near.select_nth_unstable_by(k - 1, order);
+    }
+    near.truncate(k);
+    near.sort_unstable_by(order);
+    near
 }
