@@ -12,7 +12,7 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
-use crate::rrt::{Checker, RrtOptions, path_length, rrt_connect, shortcut};
+use crate::rrt::{Checker, EdgeCheck, RrtOptions, path_length, rrt_connect, shortcut};
 
 /// One problem of a set.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -531,7 +531,7 @@ pub fn solve_with_experience(
                                 <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(
                                     options.seed,
                                 );
-                            shortcut(
+                            let edges = shortcut(
                                 &mut path,
                                 &RrtOptions {
                                     shortcuts: 0,
@@ -545,9 +545,13 @@ pub fn solve_with_experience(
                             } else {
                                 "experience"
                             };
-                            if path.windows(2).all(|w| {
-                                checker.edge_free(&w[0], &w[1], options.resolution)
-                                    && checker.edge_midpoints_free(&w[0], &w[1], options.resolution)
+                            // at half the resolution: the edges the shortcut found free need only
+                            // their midpoints; the planner's own edges (checked at its
+                            // per-joint points) all of theirs
+                            let r = options.resolution;
+                            if path.windows(2).zip(&edges).all(|(w, e)| {
+                                (*e == EdgeCheck::Checked || checker.edge_free(&w[0], &w[1], r))
+                                    && checker.edge_midpoints_free(&w[0], &w[1], r)
                             }) {
                                 Ok((path, checker.checks, Some(how)))
                             } else {

@@ -479,7 +479,8 @@ fn extend(
 /// in the box of the active motors' limits, then shortcut.
 ///
 /// The shortcut path is checked again at half the resolution: the points halfway between those
-/// its edges were checked at ([`Checker::edge_midpoints_free`], raked as every edge); where an
+/// its edges were checked at ([`Checker::edge_midpoints_free`], raked as every edge; the pieces
+/// of edges a random shortcut cut, at all their points); where an
 /// edge grazes an obstacle between the points first checked, the search runs again at that
 /// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
 /// it was checked. [`RrtPath::refinements`] counts the reruns.
@@ -500,14 +501,21 @@ pub fn rrt_connect(
             resolution,
             ..options.clone()
         };
-        let mut found = search(objective, world, start, goal, &attempt, began)?;
-        // every edge of the path was checked at `resolution` (by the search or the shortcut):
-        // its midpoints make it checked at half that
+        let (mut found, edges) = search(objective, world, start, goal, &attempt, began)?;
+        // the edges checked at `resolution` (by the search: the edges it kept, or by the
+        // shortcut) need only their midpoints to be checked at half that; a piece of an edge
+        // a random shortcut cut needs its own points too
         let mut checker = Checker::new(objective, world);
-        let free = found
-            .path
-            .windows(2)
-            .all(|w| checker.edge_midpoints_free(&w[0], &w[1], resolution));
+        let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
+            (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
+                && checker.edge_midpoints_free(&w[0], &w[1], resolution)
+                // a refined search's points are not those of the asked resolution: those too,
+                // so that the path is free at every point a check at `options.resolution / 2`
+                // visits
+                && (refinement == 0
+                    || checker.edge_free(&w[0], &w[1], options.resolution)
+                        && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
+        });
         checks += found.checks + checker.checks;
         iterations += found.iterations;
         if free {
@@ -536,7 +544,7 @@ fn search(
     goal: &[f64],
     options: &RrtOptions,
     began: Instant,
-) -> Result<RrtPath, PlanError> {
+) -> Result<(RrtPath, Vec<EdgeCheck>), PlanError> {
     let dim = objective.dim();
     for (what, q) in [("start", start), ("goal", goal)] {
         if q.len() != dim || q.iter().any(|v| !v.is_finite()) {
@@ -643,23 +651,37 @@ fn search(
         });
     };
     result.raw_waypoints = path.len();
-    shortcut(&mut path, options, &mut checker, &mut rng);
+    let edges = shortcut(&mut path, options, &mut checker, &mut rng);
     result.path = path;
     result.checks = checker.checks;
     result.seconds = began.elapsed().as_secs_f64();
-    Ok(result)
+    Ok((result, edges))
+}
+
+/// How [`shortcut`] left an edge of the path it returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EdgeCheck {
+    /// Found free by the shortcut at its resolution ([`Checker::edge_free`]'s points).
+    Checked,
+    /// An edge of the given path, unchanged: checked however the path's maker checked it.
+    Given,
+    /// A piece of a given edge (an end of a random shortcut), not checked at points of its own.
+    Piece,
 }
 
 /// Shortens `path`: first every waypoint skipped whose neighbours see each other (greedy, from
 /// the start), then random pairs of points on the path joined where the straight edge is free.
+/// Returns how each edge of the result was checked (one per edge), so that a caller checking
+/// the path again can skip what is known.
 pub fn shortcut(
     path: &mut Vec<Vec<f64>>,
     options: &RrtOptions,
     checker: &mut Checker,
     rng: &mut impl RngExt,
-) {
+) -> Vec<EdgeCheck> {
     // greedy: from each kept point, the farthest later waypoint it sees
     let mut kept = vec![path[0].clone()];
+    let mut edges = Vec::with_capacity(path.len());
     let mut i = 0;
     while i + 1 < path.len() {
         let mut j = path.len() - 1;
@@ -667,6 +689,12 @@ pub fn shortcut(
             j -= 1;
         }
         kept.push(path[j].clone());
+        // j > i + 1: that edge was just found free; else the given edge i → i + 1, unchecked
+        edges.push(if j > i + 1 {
+            EdgeCheck::Checked
+        } else {
+            EdgeCheck::Given
+        });
         i = j;
     }
     *path = kept;
@@ -693,15 +721,32 @@ pub fn shortcut(
                 .map(|w| distance(&w[0], &w[1]))
                 .sum::<f64>()
             + distance(&path[j - 1], &q);
-        if distance(&p, &q) < before - 1e-9 && checker.edge_free(&p, &q, options.resolution) {
+        // p and q become waypoints: checked themselves (edges are checked between their ends)
+        if distance(&p, &q) < before - 1e-9
+            && checker.edge_free(&p, &q, options.resolution)
+            && checker.free(&p)
+            && checker.free(&q)
+        {
             let mut next: Vec<Vec<f64>> = path[..=i].to_vec();
             next.push(p);
             next.push(q);
             next.extend_from_slice(&path[j..]);
-            next.dedup();
-            *path = next;
+            let mut next_edges = edges[..i].to_vec();
+            next_edges.extend([EdgeCheck::Piece, EdgeCheck::Checked, EdgeCheck::Piece]);
+            next_edges.extend_from_slice(&edges[j..]);
+            // repeated waypoints (a cut at an edge's end) dropped with their empty edges
+            let (mut points, mut kept_edges) = (vec![next[0].clone()], Vec::new());
+            for (q, e) in next.into_iter().skip(1).zip(next_edges) {
+                if points.last() != Some(&q) {
+                    points.push(q);
+                    kept_edges.push(e);
+                }
+            }
+            *path = points;
+            edges = kept_edges;
         }
     }
+    edges
 }
 
 /// Length of a path, rad.
