@@ -2,7 +2,11 @@
 //! needed) and placed at a pose.
 
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
-use parry3d_f64::shape::{Ball, Capsule, Shape as ParryShape, SharedShape};
+use std::sync::Arc;
+
+use parry3d_f64::shape::{Ball, Capsule, Shape as ParryShape, SharedShape, SupportMap};
+
+use super::hull::HullWalk;
 
 /// A shape in the form the hot path uses, fixed in a parent frame (a link or the world).
 #[derive(Clone)]
@@ -29,6 +33,8 @@ pub(crate) enum Geometry {
         local: Isometry3<f64>,
         shape: SharedShape,
         half_extents: Option<Vector3<f64>>,
+        /// Convex hulls: their vertex graph, for support points by hill climbing.
+        walk: Option<Arc<HullWalk>>,
     },
 }
 
@@ -128,6 +134,13 @@ pub(crate) enum RoundShape {
 
 impl RoundShape {
     pub(crate) fn shape(&self) -> &dyn ParryShape {
+        match self {
+            RoundShape::Ball(b) => b,
+            RoundShape::Capsule(c) => c,
+        }
+    }
+
+    pub(crate) fn support_map(&self) -> &dyn SupportMap {
         match self {
             RoundShape::Ball(b) => b,
             RoundShape::Capsule(c) => c,

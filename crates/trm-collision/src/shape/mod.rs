@@ -3,11 +3,16 @@
 //! analytic round shapes, parry for the rest) and the exact segment–box distance those tests
 //! use (`segment_box`).
 
+use std::sync::Arc;
+
 use nalgebra::{Isometry3, Point3, Vector3};
 use parry3d_f64::shape::SharedShape;
 use serde::{Deserialize, Serialize};
 
+use hull::HullWalk;
+
 mod compiled;
+mod hull;
 mod pair;
 mod segment_box;
 mod segment_lanes;
@@ -195,6 +200,10 @@ impl Shape {
                     Shape::Box { size } => Some(Vector3::from(*size) / 2.0),
                     _ => None,
                 };
+                let walk = shape
+                    .as_convex_polyhedron()
+                    .and_then(HullWalk::new)
+                    .map(Arc::new);
                 Compiled {
                     center: local * sphere.center,
                     bound: sphere.radius,
@@ -202,6 +211,7 @@ impl Shape {
                         local,
                         shape,
                         half_extents,
+                        walk,
                     },
                 }
             }

@@ -5,9 +5,12 @@
 use nalgebra::{Isometry3, Point3, Vector3};
 use parry3d_f64::query;
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
-use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape};
+use std::sync::Arc;
+
+use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape, SharedShape, SupportMap};
 
 use super::compiled::{Compiled, Geometry, Placed, RoundShape};
+use super::hull::HullWalk;
 use super::segment_box::segment_box_distance_squared;
 
 #[inline]
@@ -105,32 +108,72 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
         ) => {
             !round_box_apart(p2, p1, h) && round_box_distance_squared(p2, p1, h) <= radius * radius
         }
-        (Geometry::Round { radius, .. }, Geometry::General { shape, .. }) => {
+        (Geometry::Round { radius, .. }, Geometry::General { shape, walk, .. }) => {
             let (iso, round) = Compiled::round_as_parry(p1, *radius);
-            parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref())
+            match walk {
+                Some(walk) => support_maps_intersect(&iso, round.support_map(), &p2.iso, &**walk),
+                None => parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref()),
+            }
         }
-        (Geometry::General { shape, .. }, Geometry::Round { radius, .. }) => {
+        (Geometry::General { shape, walk, .. }, Geometry::Round { radius, .. }) => {
             let (iso, round) = Compiled::round_as_parry(p2, *radius);
-            parry_intersects(&p1.iso, shape.as_ref(), &iso, round.shape())
+            match walk {
+                Some(walk) => support_maps_intersect(&p1.iso, &**walk, &iso, round.support_map()),
+                None => parry_intersects(&p1.iso, shape.as_ref(), &iso, round.shape()),
+            }
         }
         (
             Geometry::General {
                 shape: s1,
                 half_extents: h1,
+                walk: w1,
                 ..
             },
             Geometry::General {
                 shape: s2,
                 half_extents: h2,
+                walk: w2,
                 ..
             },
         ) => {
             // boxes: each bounding sphere against the other's slabs before SAT/GJK
             let apart = h2.is_some_and(|h| sphere_box_apart(&p1.center, p1.bound, p2, &h))
                 || h1.is_some_and(|h| sphere_box_apart(&p2.center, p2.bound, p1, &h));
-            !apart && parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref())
+            if apart {
+                return false;
+            }
+            // hulls: GJK with their walked support points; other pairs as parry chooses
+            match (
+                w1.is_some() || w2.is_some(),
+                support(s1, w1),
+                support(s2, w2),
+            ) {
+                (true, Some(g1), Some(g2)) => support_maps_intersect(&p1.iso, g1, &p2.iso, g2),
+                _ => parry_intersects(&p1.iso, s1.as_ref(), &p2.iso, s2.as_ref()),
+            }
         }
     }
+}
+
+/// A hull's walked support points, else the shape's own support map (if it has one).
+fn support<'a>(
+    shape: &'a SharedShape,
+    walk: &'a Option<Arc<HullWalk>>,
+) -> Option<&'a dyn SupportMap> {
+    match walk {
+        Some(walk) => Some(&**walk),
+        None => shape.as_support_map(),
+    }
+}
+
+/// GJK's intersection test of two support-mapped shapes at their poses.
+fn support_maps_intersect(
+    i1: &Isometry3<f64>,
+    g1: &dyn SupportMap,
+    i2: &Isometry3<f64>,
+    g2: &dyn SupportMap,
+) -> bool {
+    query::details::intersection_test_support_map_support_map(&i1.inv_mul(i2), g1, g2)
 }
 
 fn parry_intersects(

@@ -214,11 +214,19 @@ mod general_pairs {
         query::intersection_test(&(pa * fa), sa.as_ref(), &(pb * fb), sb.as_ref()).unwrap()
     }
 
+    /// Plain parry's distance between the two shapes (0 when they overlap).
+    fn gap(a: &Shape, pa: &Isometry3<f64>, b: &Shape, pb: &Isometry3<f64>) -> f64 {
+        let ((fa, sa), (fb, sb)) = (a.to_parry().unwrap(), b.to_parry().unwrap());
+        query::distance(&(pa * fa), sa.as_ref(), &(pb * fb), sb.as_ref()).unwrap()
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(512))]
         /// The bounding spheres and slabs in front of parry never change its answer, at random
         /// poses and at poses bisected to within 1e-12 of contact along the line between the
-        /// two (cylinders included, turned to run along z).
+        /// two (cylinders included, turned to run along z). Hulls' support points come from
+        /// walking their edges ([`super::super::hull`]): GJK may then end on the other
+        /// side of its tolerance, within 10 nm of contact (measured: 2 nm against a cylinder).
         #[test]
         fn rejects_before_parry_keep_its_answer_up_to_contact(
             a in general_shape(),
@@ -231,7 +239,14 @@ mod general_pairs {
                 let (c2, p2) = placed(&b, *pb);
                 let want = parry(&a, &pa, &b, pb);
                 let ours = !bounds_apart(&p1, &p2) && intersects(&c1, &p1, &c2, &p2);
-                prop_assert_eq!(ours, want, "at {:?}", pb.translation);
+                if ours != want {
+                    // hulls take other (equally far) support points than parry's scan, so
+                    // GJK may stop on the other side of its tolerance at contact, never away
+                    // from it
+                    let hull = |s: &Shape| matches!(s, Shape::Convex { .. });
+                    prop_assert!(hull(&a) || hull(&b), "at {:?}", pb.translation);
+                    prop_assert!(gap(&a, &pa, &b, pb) < 1e-8, "at {:?}: ours {ours} parry {want} gap {}", pb.translation, gap(&a, &pa, &b, pb));
+                }
                 Ok(want)
             };
             let far = pa.translation.vector + (pb.translation.vector - pa.translation.vector).normalize() * 2.0;
