@@ -133,13 +133,15 @@ const PORTABLE: bool = false;
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx {
-    use super::{Contact, F, FAST_LANES, Flags, LaneMask, Object};
+    use super::{
+        Contact, F, FAST_LANES, FastModel, FastScratch, Flags, GroupPair, LaneMask, Object,
+    };
     use std::arch::x86_64::{
         __m256, __m256i, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_and_ps, _mm256_and_si256,
         _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_fnmadd_ps,
         _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
-        _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_slli_epi32, _mm256_sqrt_ps,
-        _mm256_sub_ps, _mm256_testz_ps,
+        _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_slli_epi32,
+        _mm256_sqrt_ps, _mm256_sub_ps, _mm256_testz_ps,
     };
 
     const _: () = assert!(FAST_LANES == 8, "one 8-lane AVX register per block");
@@ -297,6 +299,67 @@ mod avx {
             ));
             contact.hit = contact.hit | hit;
         }
+    }
+
+    /// The three coordinates of a point in every lane.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn load3(c: &[F; 3]) -> [__m256; 3] {
+        [load(&c[0]), load(&c[1]), load(&c[2])]
+    }
+
+    /// Squared distance between two points in every lane.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn distance2_between(a: &[__m256; 3], b: &[__m256; 3]) -> __m256 {
+        let d = [
+            _mm256_sub_ps(a[0], b[0]),
+            _mm256_sub_ps(a[1], b[1]),
+            _mm256_sub_ps(a[2], b[2]),
+        ];
+        _mm256_fmadd_ps(
+            d[2],
+            d[2],
+            _mm256_fmadd_ps(d[1], d[1], _mm256_mul_ps(d[0], d[0])),
+        )
+    }
+
+    /// [`super::pair_contacts`] written out.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    pub(super) fn pair_contacts(
+        model: &FastModel,
+        gp: &GroupPair,
+        scratch: &FastScratch,
+        m: f32,
+    ) -> (LaneMask, LaneMask) {
+        let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+        let bound_b = load3(&bounds[gp.b]);
+        let bound_radius = model.groups[gp.b].bound.radius;
+        let (mut hit, mut close) = (_mm256_setzero_ps(), _mm256_setzero_ps());
+        for (a, run) in &gp.runs {
+            let ball = load3(&balls[*a as usize]);
+            let reach = model.balls[*a as usize].radius + bound_radius + m;
+            let near = _mm256_cmp_ps::<_CMP_NGT_UQ>(
+                distance2_between(&ball, &bound_b),
+                _mm256_set1_ps(reach * reach),
+            );
+            if _mm256_testz_ps(near, near) != 0 {
+                continue;
+            }
+            for &(_, b, r) in &model.pairs[run.clone()] {
+                let d2 = distance2_between(&ball, &load3(&balls[b as usize]));
+                let (inner, outer) = ((r - m).max(0.0), r + m);
+                let h = _mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inner * inner));
+                let c = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer));
+                hit = _mm256_or_ps(hit, h);
+                close = _mm256_or_ps(close, c);
+            }
+        }
+        (
+            _mm256_movemask_ps(hit) as LaneMask,
+            _mm256_movemask_ps(close) as LaneMask,
+        )
     }
 
     /// [`Flags::mask`]: the flags (0 or 1) moved to the sign bits, then gathered.
@@ -965,7 +1028,8 @@ fn check(
                 object: o as u32,
                 group: g as u32,
             };
-            match verdict.add::<AVX>(near, contact, model.exact) {
+            let (hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
+            match verdict.add(near, hit, close, model.exact) {
                 None => return verdict,
                 Some(0) => {}
                 Some(lanes) => scratch.suspects.push((suspect, lanes)),
@@ -988,25 +1052,50 @@ fn check(
         // each sphere of link a against link b's bounding sphere, then b's spheres
         place_balls(model, gp.a, scratch);
         place_balls(model, gp.b, scratch);
-        let (balls, bounds) = (&scratch.balls, &scratch.bounds);
-        let mut contact = Contact::default();
-        for (a, run) in &gp.runs {
-            let ball = &balls[*a as usize];
-            let reach = model.balls[*a as usize].radius + gb.bound.radius + m;
-            if !distance2(ball, &bounds[gp.b]).any_within::<AVX>(reach * reach) {
-                continue;
-            }
-            for &(_, b, r) in &model.pairs[run.clone()] {
-                contact.add(distance2(ball, &balls[b as usize]), r, m);
-            }
-        }
-        match verdict.add::<AVX>(near, contact, model.exact) {
+        let (hit, close) = pair_contacts::<AVX>(model, gp, scratch, m);
+        match verdict.add(near, hit, close, model.exact) {
             None => return verdict,
             Some(0) => {}
             Some(lanes) => scratch.suspects.push((Suspect::Pair(k as u32), lanes)),
         }
     }
     verdict
+}
+
+/// The lanes in which link pair `gp`'s spheres certainly collide, and those in which they come
+/// within the margin `m` of contact (or NaN): each sphere of link a against link b's bounding
+/// sphere, then b's spheres. Without a branch per pair: flags or-ed together, turned into lane
+/// masks once.
+#[inline(always)]
+fn pair_contacts<const AVX: bool>(
+    model: &FastModel,
+    gp: &GroupPair,
+    scratch: &FastScratch,
+    m: f32,
+) -> (LaneMask, LaneMask) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::pair_contacts(model, gp, scratch, m) };
+    }
+    let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+    let bound_b = model.groups[gp.b].bound.radius;
+    let mut contact = Contact::default();
+    for (a, run) in &gp.runs {
+        let ball = &balls[*a as usize];
+        let reach = model.balls[*a as usize].radius + bound_b + m;
+        if !distance2(ball, &bounds[gp.b]).any_within::<PORTABLE>(reach * reach) {
+            continue;
+        }
+        for &(_, b, r) in &model.pairs[run.clone()] {
+            contact.add(distance2(ball, &balls[b as usize]), r, m);
+        }
+    }
+    (
+        contact.hit.mask::<PORTABLE>(),
+        contact.close.mask::<PORTABLE>(),
+    )
 }
 
 /// Lane flags of a group of pairs: certainly colliding, or within the margin of contact (or
@@ -1035,25 +1124,27 @@ impl Contact {
 }
 
 impl Verdict {
-    /// Adds the contacts of a group of pairs in the lanes of `lanes`: `None` when a lane
-    /// certainly collides, else the lanes the group left uncertain.
+    /// Adds the contacts of a group of pairs (the lanes certainly colliding, and those within
+    /// the margin of contact) in the lanes of `lanes`: `None` when a lane certainly collides,
+    /// else the lanes the group left uncertain.
     #[inline(always)]
-    fn add<const AVX: bool>(
+    fn add(
         &mut self,
         lanes: LaneMask,
-        contact: Contact,
+        hit: LaneMask,
+        close: LaneMask,
         exact: bool,
     ) -> Option<LaneMask> {
         let uncertain = if exact {
-            let hit = lanes & contact.hit.mask::<AVX>();
+            let hit = lanes & hit;
             if hit != 0 {
                 self.colliding |= hit;
                 return None;
             }
-            lanes & contact.close.mask::<AVX>()
+            lanes & close
         } else {
             // spheres enclosing the bodies: contact is only a reason to look exactly
-            lanes & (contact.hit | contact.close).mask::<AVX>()
+            lanes & (hit | close)
         };
         self.uncertain |= uncertain;
         Some(uncertain)
@@ -1379,5 +1470,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The written-out AVX pair tests give the portable ones' lane masks, on the spherized
+    /// Panda's link pairs in random blocks of configurations.
+    #[test]
+    fn avx_pair_contacts_are_the_portable_ones() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../models/panda-mbm/panda_spherized.ron"
+        );
+        let robot = trm_kinematics::RobotModel::load(file).unwrap();
+        let model = FastModel::new(&CollisionModel::new(&robot).unwrap()).unwrap();
+        let active = robot.all_active();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let (mut block, mut scratch) = (robot.pose_block(), model.scratch());
+        let mut contacts = 0;
+        for _ in 0..200 {
+            let qs: Vec<f64> = (0..FAST_LANES)
+                .flat_map(|_| active.random(&mut rng))
+                .collect();
+            active.forward_block_unchecked(&qs, &mut block);
+            place(&model, block.lanes(), &mut scratch);
+            for gp in &model.group_pairs {
+                place_balls(&model, gp.a, &mut scratch);
+                place_balls(&model, gp.b, &mut scratch);
+                let avx = pair_contacts::<true>(&model, gp, &scratch, 1e-3);
+                assert_eq!(avx, pair_contacts::<false>(&model, gp, &scratch, 1e-3));
+                contacts += usize::from(avx.0 != 0);
+            }
+        }
+        assert!(
+            contacts > 100,
+            "{contacts} pairs in contact: the test saw too few"
+        );
     }
 }
