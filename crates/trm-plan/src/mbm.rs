@@ -545,12 +545,12 @@ pub fn solve_with_experience(
                             } else {
                                 "experience"
                             };
-                            // at half the resolution: the edges the shortcut found free need only
-                            // their midpoints; the planner's own edges (checked at its
-                            // per-joint points) all of theirs
+                            // at half the resolution: the edges the shortcut found free and the
+                            // planner's own (checked at the same points,
+                            // `Planner::segment_free`) need only their midpoints
                             let r = options.resolution;
                             if path.windows(2).zip(&edges).all(|(w, e)| {
-                                (*e == EdgeCheck::Checked || checker.edge_free(&w[0], &w[1], r))
+                                (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
                                     && checker.edge_midpoints_free(&w[0], &w[1], r)
                             }) {
                                 Ok((path, checker.checks, Some(how)))

@@ -9,7 +9,7 @@ use thiserror::Error;
 use trm_collision::World;
 use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
 use trm_kinematics::ActiveSet;
-use trm_roadmap::{Roadmap, distance, segment_all, segment_is_collision_free};
+use trm_roadmap::{Roadmap, distance};
 use trm_tasks::Objective;
 
 use crate::trajectory::{Trajectory, time_parametrise};
@@ -543,32 +543,43 @@ impl<'a> Planner<'a> {
         }
     }
 
-    /// Whether the straight segment a → b is free, checked every `resolution` of joint motion
-    /// (spheres and mesh hulls [`FAST_LANES`] samples at a time on the single-precision screen).
+    /// Whether the straight segment a → b is free, both ends included, at points no more than
+    /// `resolution` apart (Euclidean, the rule of RRT-Connect's edges:
+    /// [`crate::rrt::edge_steps`]), visited raked ([`trm_roadmap::rake`]): spheres and mesh hulls
+    /// [`FAST_LANES`] points at a time on the single-precision screen, other models
+    /// [`LANES`](trm_kinematics::LANES) at a time in `f64`.
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        if let Some(fast) = &mut self.fast {
-            let world = &self.world;
-            return segment_all(
-                self.objective.dim(),
+        let steps = crate::rrt::edge_steps(a, b, resolution);
+        let at = |s: usize| s as f64 / steps as f64;
+        let (d, world) = (self.objective.dim(), &self.world);
+        match &mut self.fast {
+            Some(fast) => trm_roadmap::rake(
+                d,
                 a,
                 b,
-                resolution,
+                steps + 1,
+                at,
                 FAST_LANES,
                 &mut self.samples,
                 fast,
-                |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world),
-            );
+                { |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world) },
+            ),
+            None => {
+                let objective = &self.objective;
+                let width = trm_kinematics::LANES;
+                trm_roadmap::rake(
+                    d,
+                    a,
+                    b,
+                    steps + 1,
+                    at,
+                    width,
+                    &mut self.samples,
+                    &mut self.scratch,
+                    { |qs, scratch| objective.all_collision_free_in(qs, world, scratch) },
+                )
+            }
         }
-        let (objective, world) = (&self.objective, &self.world);
-        segment_is_collision_free(
-            objective,
-            world,
-            a,
-            b,
-            resolution,
-            &mut self.samples,
-            &mut self.scratch,
-        )
     }
 
     fn task_of(&mut self, q: &[f64]) -> Vec<f64> {

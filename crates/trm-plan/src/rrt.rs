@@ -320,40 +320,22 @@ impl<'a> Checker<'a> {
         self.rake(a, b, steps, |i| (2 * i + 1) as f64 / (2 * steps) as f64)
     }
 
-    /// Whether the `n` points a + s(i)·(b − a), i < n, are free, visited raked.
+    /// Whether the `n` points a + s(i)·(b − a), i < n, are free, visited raked
+    /// ([`trm_roadmap::rake`]).
     fn rake(&mut self, a: &[f64], b: &[f64], n: usize, s: impl Fn(usize) -> f64) -> bool {
         if n == 0 {
             return true;
         }
-        let d = a.len();
         let width = if self.fast.is_some() {
             FAST_LANES
         } else {
             LANES
         };
-        let stride = n.div_ceil(width);
         let mut batch = std::mem::take(&mut self.batch);
-        batch.resize(width * d, 0.0);
-        let mut free = true;
-        for k in 0..stride {
-            let mut lanes = 0;
-            for l in 0..width {
-                let i = k + l * stride;
-                if i >= n {
-                    break;
-                }
-                let s = s(i);
-                for (j, q) in batch[lanes * d..(lanes + 1) * d].iter_mut().enumerate() {
-                    *q = a[j] + s * (b[j] - a[j]);
-                }
-                lanes += 1;
-            }
-            self.checks += lanes as u64;
-            if !self.all_free(&batch[..lanes * d]) {
-                free = false;
-                break;
-            }
-        }
+        let free = trm_roadmap::rake(a.len(), a, b, n, s, width, &mut batch, self, |qs, me| {
+            me.checks += (qs.len() / a.len()) as u64;
+            me.all_free(qs)
+        });
         self.batch = batch;
         free
     }

@@ -207,21 +207,45 @@ pub fn segment_all<S>(
     width: usize,
     samples: &mut Vec<f64>,
     scratch: &mut S,
+    check: impl FnMut(&[f64], &mut S) -> bool,
+) -> bool {
+    let steps = segment_steps(a, b, resolution);
+    let at = |s: usize| s as f64 / steps as f64;
+    rake(d, a, b, steps + 1, at, width, samples, scratch, check)
+}
+
+/// Whether `check` holds for the `n` points a + at(i)·(b − a), i < n (`d` values each), in
+/// batches of `width` visited raked as [`segment_all`] visits its samples: batch k holds points
+/// k, k + m, k + 2m, … (m = ⌈n / width⌉). For callers with their own rule for an edge's points.
+///
+/// # Panics
+/// If `a` or `b` does not hold `d` values, or `width` is 0.
+#[allow(clippy::too_many_arguments)] // the segment, its points, their batching and the check
+pub fn rake<S>(
+    d: usize,
+    a: &[f64],
+    b: &[f64],
+    n: usize,
+    at: impl Fn(usize) -> f64,
+    width: usize,
+    samples: &mut Vec<f64>,
+    scratch: &mut S,
     mut check: impl FnMut(&[f64], &mut S) -> bool,
 ) -> bool {
     assert!(a.len() == d && b.len() == d, "one value per active motor");
     assert!(width > 0, "at least one sample per batch");
-    let steps = segment_steps(a, b, resolution);
-    let count = steps + 1;
-    let stride = count.div_ceil(width);
+    let stride = n.div_ceil(width);
     samples.resize(width * d, 0.0);
     for k in 0..stride {
-        let mut n = 0;
-        for s in (k..count).step_by(stride) {
-            segment_point(a, b, s, steps, &mut samples[n * d..(n + 1) * d]);
-            n += 1;
+        let mut m = 0;
+        for i in (k..n).step_by(stride) {
+            let u = at(i);
+            for ((q, a), b) in samples[m * d..(m + 1) * d].iter_mut().zip(a).zip(b) {
+                *q = a + u * (b - a);
+            }
+            m += 1;
         }
-        if !check(&samples[..n * d], scratch) {
+        if !check(&samples[..m * d], scratch) {
             return false;
         }
     }

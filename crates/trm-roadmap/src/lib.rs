@@ -32,7 +32,7 @@ pub use build::{
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
-    MIN_RESOLUTION, check_edge_resolution, connect, distance, segment_all,
+    MIN_RESOLUTION, check_edge_resolution, connect, distance, rake, segment_all,
     segment_is_collision_free, segment_is_free,
 };
 pub use error::{Result, RoadmapError};
