@@ -292,10 +292,7 @@ fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) 
             *v = affine(constant, terms, &inputs[l * stride..(l + 1) * stride]);
         }
         if revolute {
-            for l in 0..BLOCK_LANES {
-                v[l] *= 0.5;
-            }
-            let (s, c) = sin_cos_block(v);
+            let (s, c) = sin_cos_block(v.map(|x| 0.5 * x));
             out[0] = s;
             out[1] = c;
             out[2] = [0.0; BLOCK_LANES];

@@ -562,7 +562,7 @@ impl<'a> Planner<'a> {
                 FAST_LANES,
                 &mut self.samples,
                 fast,
-                { |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world) },
+                |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world),
             ),
             None => {
                 let objective = &self.objective;
@@ -576,7 +576,7 @@ impl<'a> Planner<'a> {
                     width,
                     &mut self.samples,
                     &mut self.scratch,
-                    { |qs, scratch| objective.all_collision_free_in(qs, world, scratch) },
+                    |qs, scratch| objective.all_collision_free_in(qs, world, scratch),
                 )
             }
         }

@@ -413,7 +413,7 @@ impl Objective {
         mut f: impl FnMut(usize, &mut Scratch) -> bool,
     ) -> bool {
         let d = self.dim();
-        assert!(d > 0 && qs.len() % d == 0, "whole configurations");
+        assert!(d > 0 && qs.len().is_multiple_of(d), "whole configurations");
         if qs.iter().any(|v| v.is_nan()) {
             return false;
         }
