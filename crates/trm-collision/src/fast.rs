@@ -134,7 +134,8 @@ const PORTABLE: bool = false;
 #[allow(unsafe_code)]
 mod avx {
     use super::{
-        Contact, F, FAST_LANES, FastModel, FastScratch, Flags, GroupPair, LaneMask, Object,
+        Contact, F, FAST_LANES, FastModel, FastScratch, FastWorld, Flags, GroupPair, LaneMask,
+        Object,
     };
     use std::arch::x86_64::{
         __m256, __m256i, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_and_ps, _mm256_and_si256,
@@ -331,8 +332,9 @@ mod avx {
         model: &FastModel,
         gp: &GroupPair,
         scratch: &FastScratch,
-        m: f32,
+        world: &FastWorld,
     ) -> (LaneMask, LaneMask) {
+        let m = world.margin;
         let (balls, bounds) = (&scratch.balls, &scratch.bounds);
         let bound_b = load3(&bounds[gp.b]);
         let bound_radius = model.groups[gp.b].bound.radius;
@@ -347,11 +349,13 @@ mod avx {
             if _mm256_testz_ps(near, near) != 0 {
                 continue;
             }
-            for &(_, b, r) in &model.pairs[run.clone()] {
+            let pairs = model.pairs[run.clone()]
+                .iter()
+                .zip(&world.limits[run.clone()]);
+            for (&(_, b, _), &[inner2, outer2]) in pairs {
                 let d2 = distance2_between(&ball, &load3(&balls[b as usize]));
-                let (inner, outer) = ((r - m).max(0.0), r + m);
-                let h = _mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inner * inner));
-                let c = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer));
+                let h = _mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inner2));
+                let c = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer2));
                 hit = _mm256_or_ps(hit, h);
                 close = _mm256_or_ps(close, c);
             }
@@ -522,6 +526,8 @@ enum Object {
 pub struct FastWorld {
     objects: Vec<Object>,
     margin: f32,
+    /// Per ball pair of the model ([`FastModel::pairs`]): its [`limits`] with this margin.
+    limits: Vec<[f32; 2]>,
 }
 
 impl FastWorld {
@@ -786,9 +792,15 @@ impl FastModel {
             })
             .collect();
         let largest = self.reach.max(farthest);
+        let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * (2 + self.depth) as f64) as f32;
         FastWorld {
             objects,
-            margin: (MARGIN_PER_METRE_JOINT * (1.0 + largest) * (2 + self.depth) as f64) as f32,
+            margin,
+            limits: self
+                .pairs
+                .iter()
+                .map(|&(_, _, r)| limits(r, margin))
+                .collect(),
         }
     }
 
@@ -1052,7 +1064,7 @@ fn check(
         // each sphere of link a against link b's bounding sphere, then b's spheres
         place_balls(model, gp.a, scratch);
         place_balls(model, gp.b, scratch);
-        let (hit, close) = pair_contacts::<AVX>(model, gp, scratch, m);
+        let (hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
         match verdict.add(near, hit, close, model.exact) {
             None => return verdict,
             Some(0) => {}
@@ -1071,14 +1083,15 @@ fn pair_contacts<const AVX: bool>(
     model: &FastModel,
     gp: &GroupPair,
     scratch: &FastScratch,
-    m: f32,
+    world: &FastWorld,
 ) -> (LaneMask, LaneMask) {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: as in `F::any_within`
         #[allow(unsafe_code)]
-        return unsafe { avx::pair_contacts(model, gp, scratch, m) };
+        return unsafe { avx::pair_contacts(model, gp, scratch, world) };
     }
+    let m = world.margin;
     let (balls, bounds) = (&scratch.balls, &scratch.bounds);
     let bound_b = model.groups[gp.b].bound.radius;
     let mut contact = Contact::default();
@@ -1088,14 +1101,25 @@ fn pair_contacts<const AVX: bool>(
         if !distance2(ball, &bounds[gp.b]).any_within::<PORTABLE>(reach * reach) {
             continue;
         }
-        for &(_, b, r) in &model.pairs[run.clone()] {
-            contact.add(distance2(ball, &balls[b as usize]), r, m);
+        let pairs = model.pairs[run.clone()]
+            .iter()
+            .zip(&world.limits[run.clone()]);
+        for (&(_, b, _), &limits) in pairs {
+            contact.add_within(distance2(ball, &balls[b as usize]), limits);
         }
     }
     (
         contact.hit.mask::<PORTABLE>(),
         contact.close.mask::<PORTABLE>(),
     )
+}
+
+/// The squared distances below which two spheres whose radii sum to `r` certainly collide,
+/// and beyond which they are certainly clear, with the margin `m`.
+#[inline(always)]
+fn limits(r: f32, m: f32) -> [f32; 2] {
+    let (inner, outer) = ((r - m).max(0.0), r + m);
+    [inner * inner, outer * outer]
 }
 
 /// Lane flags of a group of pairs: certainly colliding, or within the margin of contact (or
@@ -1110,10 +1134,14 @@ impl Contact {
     /// Adds a pair at squared distance `d2` whose radii sum to `r`.
     #[inline(always)]
     fn add(&mut self, d2: F, r: f32, m: f32) {
-        let inner = (r - m).max(0.0);
-        let outer = r + m;
-        self.hit = self.hit | d2.below(inner * inner);
-        self.close = self.close | d2.within(outer * outer);
+        self.add_within(d2, limits(r, m));
+    }
+
+    /// Adds a pair at squared distance `d2` whose [`limits`] are `[inner2, outer2]`.
+    #[inline(always)]
+    fn add_within(&mut self, d2: F, [inner2, outer2]: [f32; 2]) {
+        self.hit = self.hit | d2.below(inner2);
+        self.close = self.close | d2.within(outer2);
     }
 
     /// Flags certainly uncertain in every lane (a shape seen through its bounding sphere).
@@ -1488,6 +1516,7 @@ mod tests {
         let active = robot.all_active();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let (mut block, mut scratch) = (robot.pose_block(), model.scratch());
+        let world = model.world(&World::new());
         let mut contacts = 0;
         for _ in 0..200 {
             let qs: Vec<f64> = (0..FAST_LANES)
@@ -1498,8 +1527,8 @@ mod tests {
             for gp in &model.group_pairs {
                 place_balls(&model, gp.a, &mut scratch);
                 place_balls(&model, gp.b, &mut scratch);
-                let avx = pair_contacts::<true>(&model, gp, &scratch, 1e-3);
-                assert_eq!(avx, pair_contacts::<false>(&model, gp, &scratch, 1e-3));
+                let avx = pair_contacts::<true>(&model, gp, &scratch, &world);
+                assert_eq!(avx, pair_contacts::<false>(&model, gp, &scratch, &world));
                 contacts += usize::from(avx.0 != 0);
             }
         }

@@ -8,7 +8,7 @@
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
-use crate::fk::{FrameId, Plan, PoseBuffer, affine};
+use crate::fk::{FrameId, Plan, PoseBuffer, StepConstants, affine};
 
 /// Configurations per batch.
 pub const LANES: usize = 4;
@@ -151,8 +151,8 @@ pub(crate) trait Real:
     const ZERO: Self;
     const ONE: Self;
     const TWO: Self;
-    /// `x` rounded to this type.
-    fn of(x: f64) -> Self;
+    /// The constants of step `k` of `plan` in this type.
+    fn step(plan: &Plan, k: usize) -> StepConstants<Self>;
 }
 
 impl Real for f64 {
@@ -160,8 +160,16 @@ impl Real for f64 {
     const ONE: f64 = 1.0;
     const TWO: f64 = 2.0;
     #[inline(always)]
-    fn of(x: f64) -> f64 {
-        x
+    fn step(plan: &Plan, k: usize) -> StepConstants<f64> {
+        let step = &plan.steps[k];
+        let (r, b) = (&step.rotation, &step.axis_quat);
+        let (t, a) = (&step.translation, &step.axis_in_parent);
+        StepConstants {
+            rotation: [r.w, r.i, r.j, r.k],
+            axis_quat: [b.w, b.i, b.j, b.k],
+            translation: [t.x, t.y, t.z],
+            axis_in_parent: [a.x, a.y, a.z],
+        }
     }
 }
 
@@ -170,8 +178,8 @@ impl Real for f32 {
     const ONE: f32 = 1.0;
     const TWO: f32 = 2.0;
     #[inline(always)]
-    fn of(x: f64) -> f32 {
-        x as f32
+    fn step(plan: &Plan, k: usize) -> StepConstants<f32> {
+        plan.steps32[k]
     }
 }
 
@@ -189,15 +197,14 @@ fn run_steps<T: Real, const L: usize>(
         p
     };
     poses[0] = identity;
-    for step in &plan.steps {
+    for (k, step) in plan.steps.iter().enumerate() {
         let parent = poses[step.parent as usize];
         let [s, c, d] = slots[step.slot as usize];
-        let (r, b) = (&step.rotation, &step.axis_quat);
-        let (rw, ri, rj, rk) = (T::of(r.w), T::of(r.i), T::of(r.j), T::of(r.k));
-        let (bw, bi, bj, bk) = (T::of(b.w), T::of(b.i), T::of(b.j), T::of(b.k));
-        let (t, a) = (&step.translation, &step.axis_in_parent);
-        let (tx0, ty0, tz0) = (T::of(t.x), T::of(t.y), T::of(t.z));
-        let (ax, ay, az) = (T::of(a.x), T::of(a.y), T::of(a.z));
+        let constants = T::step(plan, k);
+        let [rw, ri, rj, rk] = constants.rotation;
+        let [bw, bi, bj, bk] = constants.axis_quat;
+        let [tx0, ty0, tz0] = constants.translation;
+        let [ax, ay, az] = constants.axis_in_parent;
         let mut child = identity;
         for l in 0..L {
             // local rotation c·r + s·b, local translation t + d·axis

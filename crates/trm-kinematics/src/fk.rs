@@ -74,6 +74,32 @@ pub(crate) struct Plan {
     /// the constant `(0, 1, 0)` of fixed transforms.
     pub(crate) revolute: Vec<bool>,
     pub(crate) steps: Vec<Step>,
+    /// The steps' constants rounded to `f32`, for single-precision blocks (rounded once here,
+    /// not in every block).
+    pub(crate) steps32: Vec<StepConstants<f32>>,
+}
+
+/// A step's constants in the precision of a pass: its rotation and axis quaternions
+/// (`w, i, j, k`), translation and axis in the parent frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepConstants<T> {
+    pub(crate) rotation: [T; 4],
+    pub(crate) axis_quat: [T; 4],
+    pub(crate) translation: [T; 3],
+    pub(crate) axis_in_parent: [T; 3],
+}
+
+impl StepConstants<f32> {
+    fn of(step: &Step) -> Self {
+        let (r, b) = (&step.rotation, &step.axis_quat);
+        let (t, a) = (&step.translation, &step.axis_in_parent);
+        StepConstants {
+            rotation: [r.w, r.i, r.j, r.k].map(|v| v as f32),
+            axis_quat: [b.w, b.i, b.j, b.k].map(|v| v as f32),
+            translation: [t.x, t.y, t.z].map(|v| v as f32),
+            axis_in_parent: [a.x, a.y, a.z].map(|v| v as f32),
+        }
+    }
 }
 
 /// Identifies joints that always share a value: (constant bits, (input, factor bits) terms,
@@ -95,6 +121,7 @@ impl Plan {
             terms: Vec::new(),
             revolute: vec![false],
             steps: Vec::new(),
+            steps32: Vec::new(),
         };
         let mut slot_of: HashMap<SlotKey, u32> = HashMap::new();
         for joint in &tree.joints {
@@ -153,6 +180,7 @@ impl Plan {
             depth[k + 1] = depth[step.parent as usize] + 1;
         }
         plan.steps.sort_by_key(|s| depth[s.child as usize]);
+        plan.steps32 = plan.steps.iter().map(StepConstants::of).collect();
         plan
     }
 
