@@ -440,6 +440,9 @@ struct Group {
     bound: Ball,
     /// The link's spheres: indices into [`FastModel::balls`].
     balls: std::ops::Range<usize>,
+    /// Spheres inside the link's bodies, when its spheres enclose them (not a sphere model):
+    /// indices into [`FastModel::inner`]. Touching one is a certain collision.
+    inner: std::ops::Range<usize>,
     /// The link's bodies (indices into [`CollisionModel::bodies`]).
     bodies: Vec<u32>,
 }
@@ -476,6 +479,8 @@ enum Suspect {
 #[derive(Debug, Clone)]
 pub struct FastModel {
     balls: Vec<Ball>,
+    /// Spheres inside the bodies ([`Shape::inscribed_spheres`]), grouped by link.
+    inner: Vec<Ball>,
     /// For each ball, the index of the body it came from.
     bodies: Vec<usize>,
     groups: Vec<Group>,
@@ -569,6 +574,7 @@ pub struct Verdict {
 #[derive(Debug, Clone)]
 pub struct FastScratch {
     balls: Vec<[F; 3]>,
+    inner: Vec<[F; 3]>,
     bounds: Vec<[F; 3]>,
     /// Per link group: its frame (rotation rows, translation) in every lane.
     frames: Vec<([F; 9], [F; 3])>,
@@ -592,10 +598,11 @@ impl FastModel {
             by_link.entry(b.link).or_default().push(i);
         }
         let (mut balls, mut ball_bodies, mut groups) = (Vec::new(), Vec::new(), Vec::new());
+        let mut inner = Vec::new();
         let mut group_of_body = vec![usize::MAX; bodies.len()];
         let mut balls_of_body = vec![0..0; bodies.len()];
         for (&link, members) in &by_link {
-            let start = balls.len();
+            let (start, inner_start) = (balls.len(), inner.len());
             let mut spheres: Vec<(Point3<f64>, f64)> = Vec::new();
             for &i in members {
                 let first = balls.len();
@@ -615,11 +622,19 @@ impl FastModel {
                 }
                 group_of_body[i] = groups.len();
                 balls_of_body[i] = first..balls.len();
+                if !exact {
+                    let body = &bodies[i];
+                    inner.extend(body.shape.inscribed_spheres().into_iter().map(|s| Ball {
+                        center: to_f32((body.local * s.center).coords),
+                        radius: s.radius as f32,
+                    }));
+                }
             }
             groups.push(Group {
                 frame: link,
                 bound: bounding_ball(&spheres),
                 balls: start..balls.len(),
+                inner: inner_start..inner.len(),
                 bodies: members.iter().map(|&i| i as u32).collect(),
             });
         }
@@ -677,6 +692,7 @@ impl FastModel {
             exact,
             depth: depth_of.into_iter().max().unwrap_or(0),
             balls,
+            inner,
             bodies: ball_bodies,
             groups,
             group_pairs,
@@ -737,6 +753,7 @@ impl FastModel {
     pub fn scratch(&self) -> FastScratch {
         FastScratch {
             balls: vec![[F::default(); 3]; self.balls.len()],
+            inner: vec![[F::default(); 3]; self.inner.len()],
             bounds: vec![[F::default(); 3]; self.groups.len()],
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
@@ -1040,8 +1057,19 @@ fn check(
                 object: o as u32,
                 group: g as u32,
             };
-            let (hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
-            match verdict.add(near, hit, close, model.exact) {
+            let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
+            if !model.exact {
+                // enclosing spheres only say "maybe"; a sphere inside a body says "certainly"
+                let mut inside = Contact::default();
+                if near & close != 0 {
+                    for i in group.inner.clone() {
+                        let r = model.inner[i].radius;
+                        object.test::<AVX>(&mut inside, &scratch.inner[i], r, m);
+                    }
+                }
+                hit = inside.hit.mask::<AVX>();
+            }
+            match verdict.add(near, hit, close, true) {
                 None => return verdict,
                 Some(0) => {}
                 Some(lanes) => scratch.suspects.push((suspect, lanes)),
@@ -1260,6 +1288,9 @@ fn place_balls(model: &FastModel, g: usize, scratch: &mut FastScratch) {
     let (rot, t) = &scratch.frames[g];
     for i in model.groups[g].balls.clone() {
         scratch.balls[i] = transform(rot, t, model.balls[i].center);
+    }
+    for i in model.groups[g].inner.clone() {
+        scratch.inner[i] = transform(rot, t, model.inner[i].center);
     }
     scratch.placed[g] = true;
 }

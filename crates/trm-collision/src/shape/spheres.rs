@@ -55,6 +55,50 @@ impl Shape {
     }
 }
 
+impl Shape {
+    /// Spheres wholly inside the shape, in its own frame, each radius rounded down by a
+    /// micrometre: whatever touches one of them touches the shape. For a convex hull, one about
+    /// the centre of each of its [`Shape::enclosing_spheres`] and one about the mean of its
+    /// points (those inside it), each as large as the hull's face planes allow; none for other
+    /// shapes (and for a shape that fails [`Shape::check`]).
+    pub fn inscribed_spheres(&self) -> Vec<Sphere> {
+        let Shape::Convex { points } = self else {
+            return Vec::new();
+        };
+        let points: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
+        let Some(hull) = parry3d_f64::shape::ConvexPolyhedron::from_convex_hull(&points) else {
+            return Vec::new();
+        };
+        let (vertices, on_face) = (hull.points(), hull.vertices_adj_to_face());
+        // each face as (outward normal, offset): inside is n·x ≤ offset
+        let planes: Vec<(Vector3<f64>, f64)> = hull
+            .faces()
+            .iter()
+            .map(|f| {
+                let v = vertices[on_face[f.first_vertex_or_edge as usize] as usize];
+                (f.normal.into_inner(), f.normal.dot(&v.coords))
+            })
+            .collect();
+        let mean = Point3::from(
+            points.iter().map(|p| p.coords).sum::<Vector3<f64>>() / points.len() as f64,
+        );
+        let centres = self.enclosing_spheres().into_iter().map(|s| s.center);
+        centres
+            .chain(std::iter::once(mean))
+            .filter_map(|center| {
+                let depth = planes
+                    .iter()
+                    .map(|(n, offset)| offset - n.dot(&center.coords))
+                    .fold(f64::INFINITY, f64::min);
+                (depth > 2.0 * MARGIN).then(|| Sphere {
+                    center,
+                    radius: depth - MARGIN,
+                })
+            })
+            .collect()
+    }
+}
+
 fn sphere(center: Point3<f64>, radius: f64) -> Sphere {
     Sphere {
         center,
@@ -161,6 +205,38 @@ mod tests {
             let samples: Vec<_> = samples.into_iter().map(Vector3::from).collect();
             prop_assert!(encloses(&shape, &samples));
         }
+    }
+
+    proptest! {
+        /// Every inscribed sphere of a hull lies inside it: its points along 64 directions are
+        /// inside the hull, and a hull that spans a volume gets at least one.
+        #[test]
+        fn inscribed_spheres_lie_inside_the_hull(
+            points in proptest::collection::vec([-0.3..0.3f64, -0.3..0.3, -0.3..0.3], 8..40),
+            directions in proptest::collection::vec([-1.0..=1.0f64, -1.0..=1.0, -1.0..=1.0], 64),
+        ) {
+            let shape = Shape::Convex { points };
+            prop_assume!(shape.check().is_ok());
+            let (_, parry) = shape.to_parry().expect("valid shape");
+            let inscribed = shape.inscribed_spheres();
+            prop_assert!(!inscribed.is_empty());
+            for s in &inscribed {
+                prop_assert!(s.radius > 0.0);
+                for u in &directions {
+                    let Some(u) = nalgebra::Unit::try_new(Vector3::from(*u), 1e-9) else {
+                        continue;
+                    };
+                    let p = s.center + u.into_inner() * s.radius;
+                    prop_assert!(parry.contains_local_point(&p), "{:?} r {}", s.center, s.radius);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn only_hulls_have_inscribed_spheres_yet() {
+        assert!(Shape::Sphere { radius: 0.1 }.inscribed_spheres().is_empty());
+        assert!(Shape::Box { size: [0.1; 3] }.inscribed_spheres().is_empty());
     }
 
     #[test]
