@@ -90,7 +90,7 @@ impl Shape {
                     .iter()
                     .map(|(n, offset)| offset - n.dot(&center.coords))
                     .fold(f64::INFINITY, f64::min);
-                (depth > 2.0 * MARGIN).then(|| Sphere {
+                (depth > 2.0 * MARGIN).then_some(Sphere {
                     center,
                     radius: depth - MARGIN,
                 })
