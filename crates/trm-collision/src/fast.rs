@@ -463,6 +463,9 @@ struct GroupPair {
     runs: Vec<(u32, std::ops::Range<usize>)>,
     /// The checked body pairs of the two links (indices into [`CollisionModel::bodies`]).
     bodies: Vec<(u32, u32)>,
+    /// Pairs of spheres inside the two links' checked bodies (indices into
+    /// [`FastModel::inner`]) and the sums of their radii: touching is a certain collision.
+    inner: Vec<BallPair>,
 }
 
 /// What left lanes of a block uncertain: checked exactly, only it, in those lanes.
@@ -599,6 +602,7 @@ impl FastModel {
         }
         let (mut balls, mut ball_bodies, mut groups) = (Vec::new(), Vec::new(), Vec::new());
         let mut inner = Vec::new();
+        let mut inner_of_body = vec![0..0; bodies.len()];
         let mut group_of_body = vec![usize::MAX; bodies.len()];
         let mut balls_of_body = vec![0..0; bodies.len()];
         for (&link, members) in &by_link {
@@ -623,11 +627,12 @@ impl FastModel {
                 group_of_body[i] = groups.len();
                 balls_of_body[i] = first..balls.len();
                 if !exact {
-                    let body = &bodies[i];
+                    let (body, first) = (&bodies[i], inner.len());
                     inner.extend(body.shape.inscribed_spheres().into_iter().map(|s| Ball {
                         center: to_f32((body.local * s.center).coords),
                         radius: s.radius as f32,
                     }));
+                    inner_of_body[i] = first..inner.len();
                 }
             }
             groups.push(Group {
@@ -664,7 +669,24 @@ impl FastModel {
                 }
                 pairs.push(pair);
             }
-            group_pairs.push(GroupPair { a, b, runs, bodies });
+            let inner_pairs = bodies
+                .iter()
+                .flat_map(|&(x, y)| {
+                    let (x, y) = (
+                        inner_of_body[x as usize].clone(),
+                        inner_of_body[y as usize].clone(),
+                    );
+                    x.flat_map(move |i| y.clone().map(move |j| (i, j)))
+                })
+                .map(|(i, j)| (i as u32, j as u32, inner[i].radius + inner[j].radius))
+                .collect();
+            group_pairs.push(GroupPair {
+                a,
+                b,
+                runs,
+                bodies,
+                inner: inner_pairs,
+            });
         }
         // reach: every joint offset and prismatic travel end to end, then the farthest sphere
         let chain: f64 = tree
@@ -1092,8 +1114,19 @@ fn check(
         // each sphere of link a against link b's bounding sphere, then b's spheres
         place_balls(model, gp.a, scratch);
         place_balls(model, gp.b, scratch);
-        let (hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
-        match verdict.add(near, hit, close, model.exact) {
+        let (mut hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
+        if !model.exact {
+            // enclosing spheres only say "maybe"; spheres inside the bodies say "certainly"
+            let mut inside = Contact::default();
+            if near & close != 0 {
+                for &(i, j, r) in &gp.inner {
+                    let (i, j) = (&scratch.inner[i as usize], &scratch.inner[j as usize]);
+                    inside.add(distance2(i, j), r, m);
+                }
+            }
+            hit = inside.hit.mask::<AVX>();
+        }
+        match verdict.add(near, hit, close, true) {
             None => return verdict,
             Some(0) => {}
             Some(lanes) => scratch.suspects.push((Suspect::Pair(k as u32), lanes)),
