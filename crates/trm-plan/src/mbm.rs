@@ -540,7 +540,9 @@ pub fn solve_with_experience(
                                 &mut checker,
                                 &mut rng,
                             );
-                            let how = if planned.nodes.is_empty() {
+                            let how = if planned.stats.retrieved {
+                                "retrieved"
+                            } else if planned.nodes.is_empty() {
                                 "straight"
                             } else {
                                 "experience"

@@ -360,6 +360,9 @@ pub struct PlanStats {
     /// The maps did not join start and goal: RRT-Connect found the path
     /// ([`PlanOptions::sampling`]); its samples and collision checks.
     pub sampled: Option<(usize, u64)>,
+    /// The path is a kept one whose ends the query repeats, retrieved without a search
+    /// ([`RETRIEVE_STEPS`]).
+    pub retrieved: bool,
 }
 
 /// A planned motion.
@@ -382,6 +385,11 @@ enum State {
     Invalid,
 }
 
+/// How near, in steps of the planning resolution, both ends of a query must lie to a kept path's
+/// ends for [`Planner::plan`] to try that path before searching: a query that repeats one
+/// planned before.
+pub const RETRIEVE_STEPS: f64 = 2.0;
+
 /// The roadmap graph with lazily checked states, for one robot and a current world.
 #[derive(Debug)]
 pub struct Planner<'a> {
@@ -398,6 +406,8 @@ pub struct Planner<'a> {
     /// For spheres and mesh hulls: the single-precision screen and the current world compiled
     /// for it.
     fast: Option<(FastChecker, FastWorld)>,
+    /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
+    kept: Vec<(Vec<usize>, Vec<usize>)>,
 }
 
 impl<'a> Planner<'a> {
@@ -458,6 +468,7 @@ impl<'a> Planner<'a> {
             edge_state,
             scratch: objective.scratch(),
             samples: Vec::new(),
+            kept: Vec::new(),
         })
     }
 
@@ -481,7 +492,8 @@ impl<'a> Planner<'a> {
     /// is that node), its segments as edges known free in the current world, and each new node
     /// is joined to its 3 nearest older nodes by edges checked when a search first wants them.
     /// Later queries, in this world or another (after [`Planner::set_world`]), search through
-    /// it. Returns the number of nodes added.
+    /// it; a query that repeats the path's ends tries the path itself first
+    /// ([`Planner::plan`]). Returns the number of nodes added.
     pub fn add_path(&mut self, path: &[Vec<f64>]) -> Result<usize, PlanError> {
         let d = self.active.len();
         if let Some(bad) = path
@@ -513,13 +525,15 @@ impl<'a> Planner<'a> {
             };
             ids.push(id);
         }
+        ids.dedup();
+        let mut edges = Vec::with_capacity(ids.len());
         for w in ids.windows(2) {
-            if w[0] != w[1] {
-                let l = distance(&self.nodes[w[0]].0, &self.nodes[w[1]].0);
-                self.edges.push((w[0], w[1], l));
-                self.edge_state.push(State::Valid);
-            }
+            let l = distance(&self.nodes[w[0]].0, &self.nodes[w[1]].0);
+            edges.push(self.edges.len());
+            self.edges.push((w[0], w[1], l));
+            self.edge_state.push(State::Valid);
         }
+        self.kept.push((ids, edges));
         Ok(self.nodes.len() - old)
     }
 
@@ -701,6 +715,11 @@ impl<'a> Planner<'a> {
             }
             _ => None,
         };
+        if let Some(q) = &goal_q {
+            if let Some(planned) = self.retrieve(start, q, options, began)? {
+                return Ok(planned);
+            }
+        }
         let goal_t = match goal {
             Goal::Configuration(q) => self.task_of(q),
             Goal::TaskPoint { t, .. } => t.clone(),
@@ -880,6 +899,102 @@ impl<'a> Planner<'a> {
                 stats,
             });
         }
+    }
+
+    /// The kept path whose ends lie nearest to `start` and `goal` (either way round), when both
+    /// lie within [`RETRIEVE_STEPS`] steps of `options.resolution` of them and the path with
+    /// its two joining edges is free in the current world (its nodes and edges checked as a
+    /// search checks them, states kept): experience retrieved as Lightning retrieves it
+    /// (Berenson, Abbeel and Goldberg, ICRA 2012), for queries that repeat one planned before.
+    fn retrieve(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &PlanOptions,
+        began: Instant,
+    ) -> Result<Option<Planned>, PlanError> {
+        let near = RETRIEVE_STEPS * options.resolution;
+        let ends = |k: usize, this: &Self| {
+            let (ids, _) = &this.kept[k];
+            let (first, last) = (&this.nodes[ids[0]].0, &this.nodes[ids[ids.len() - 1]].0);
+            let forward = distance(start, first).max(distance(goal, last));
+            let backward = distance(start, last).max(distance(goal, first));
+            (forward.min(backward), backward < forward)
+        };
+        let Some((k, reversed)) = (0..self.kept.len())
+            .map(|k| (k, ends(k, self)))
+            .filter(|(_, (d, _))| *d <= near)
+            .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
+            .map(|(k, (_, reversed))| (k, reversed))
+        else {
+            return Ok(None);
+        };
+        let (mut ids, mut edges) = self.kept[k].clone();
+        if reversed {
+            ids.reverse();
+            edges.reverse();
+        }
+        let mut stats = PlanStats::default();
+        for &i in &ids {
+            if self.node_state[i] == State::Unknown {
+                let q = self.nodes[i].0.clone();
+                self.node_state[i] = if self.is_free(&q) {
+                    State::Valid
+                } else {
+                    State::Invalid
+                };
+            }
+            if self.node_state[i] == State::Invalid {
+                return Ok(None);
+            }
+        }
+        for (&e, w) in edges.iter().zip(ids.windows(2)) {
+            if self.edge_state[e] == State::Unknown {
+                let (a, b) = (self.nodes[w[0]].0.clone(), self.nodes[w[1]].0.clone());
+                stats.edges_checked += 1;
+                self.edge_state[e] = if self.segment_free(&a, &b, options.resolution) {
+                    State::Valid
+                } else {
+                    State::Invalid
+                };
+            }
+            if self.edge_state[e] == State::Invalid {
+                return Ok(None);
+            }
+        }
+        let mut waypoints: Vec<Vec<f64>> = ids.iter().map(|&i| self.nodes[i].0.clone()).collect();
+        // the joining edges (none where an end is the node itself)
+        for (end, at_start) in [(start, true), (goal, false)] {
+            let node = if at_start {
+                &waypoints[0]
+            } else {
+                &waypoints[waypoints.len() - 1]
+            };
+            if distance(end, node) > 1e-9 {
+                let node = node.clone();
+                stats.edges_checked += 1;
+                if !self.segment_free(end, &node, options.resolution) {
+                    return Ok(None);
+                }
+                if at_start {
+                    waypoints.insert(0, end.to_vec());
+                } else {
+                    waypoints.push(end.to_vec());
+                }
+            }
+        }
+        stats.path_nodes = ids.len();
+        stats.retrieved = true;
+        self.shortcut(&mut waypoints, options);
+        stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
+        let trajectory = self.timed(&waypoints, options);
+        stats.seconds = began.elapsed().as_secs_f64();
+        Ok(Some(Planned {
+            trajectory,
+            nodes: ids,
+            waypoints,
+            stats,
+        }))
     }
 
     /// Appends a posture at the task point `t` reached by NGIK from the last waypoint, when it

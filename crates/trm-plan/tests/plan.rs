@@ -612,3 +612,75 @@ fn a_configuration_goal_the_maps_do_not_reach_is_finished_by_rrt_connect() {
     }
     assert_eq!(found, 3, "too few goals the map alone cannot reach");
 }
+
+/// A query that repeats a kept path's ends is answered by that path, without a search, when it
+/// is free (checked in the current world), and by a search otherwise; a query elsewhere
+/// searches.
+#[test]
+fn repeated_queries_retrieve_the_kept_path_while_it_is_free() {
+    let p = problem();
+    let map = map();
+    let options = PlanOptions {
+        shortcuts: 0,
+        exact_goal: false,
+        sampling: None,
+        ..Default::default()
+    };
+    let goal = map.points[map.points.len() / 2].q.clone();
+    let found = Planner::new(&p.objective, &[map])
+        .unwrap()
+        .plan(&p.start, &Goal::Configuration(goal.clone()), &options)
+        .unwrap();
+    assert!(!found.stats.retrieved && found.waypoints.len() >= 2);
+    // a planner that knows only this path
+    let mut planner = Planner::new(&p.objective, &[]).unwrap();
+    planner.add_path(&found.waypoints).unwrap();
+    let again = planner
+        .plan(&p.start, &Goal::Configuration(goal.clone()), &options)
+        .unwrap();
+    assert!(again.stats.retrieved);
+    assert_eq!(again.waypoints, found.waypoints);
+    check(&mut planner, &p.start, &again, &options);
+    // backwards, and with ends a resolution step away
+    let mut nudged = p.start.clone();
+    nudged[0] += options.resolution;
+    let back = planner
+        .plan(&goal, &Goal::Configuration(nudged.clone()), &options)
+        .unwrap();
+    assert!(back.stats.retrieved);
+    assert_eq!(back.waypoints.last().unwrap(), &nudged);
+    // far from the kept ends: no retrieval
+    let mut far = p.start.clone();
+    far[0] += 3.0 * options.resolution;
+    if let Ok(plan) = planner.plan(&far, &Goal::Configuration(goal.clone()), &options) {
+        assert!(!plan.stats.retrieved);
+    }
+    // an obstacle on the path's middle edge: the path is not returned through it
+    let (a, b) = {
+        let m = found.waypoints.len() / 2;
+        (&found.waypoints[m - 1], &found.waypoints[m])
+    };
+    let middle: Vec<f64> = a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect();
+    let mut scratch = p.objective.scratch();
+    let hand = p.objective.task_value(&middle, &mut scratch);
+    let mut world = p.objective.world().clone();
+    world
+        .add(
+            "on_the_path",
+            Shape::Sphere { radius: 0.005 },
+            Isometry3::translation(hand[0], hand[1], hand[2]),
+        )
+        .unwrap();
+    planner.set_world(world);
+    if !planner.is_free(a) || !planner.is_free(b) || planner.segment_free(a, b, options.resolution)
+    {
+        return; // the sphere missed the edge or hit its ends: nothing to learn here
+    }
+    match planner.plan(&p.start, &Goal::Configuration(goal), &options) {
+        Ok(plan) => {
+            assert!(!plan.stats.retrieved);
+            check(&mut planner, &p.start, &plan, &options);
+        }
+        Err(e) => assert!(matches!(e, PlanError::Unreachable { .. }), "{e}"),
+    }
+}

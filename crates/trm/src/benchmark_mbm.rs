@@ -249,19 +249,23 @@ pub fn run(args: &Args) -> Result<()> {
                 .map(|p| p.family.as_str())
                 .zip(outcomes.iter())
                 .collect();
-            let from_experience = outcomes
-                .iter()
-                .filter(|o| o.solved && o.note == "experience")
-                .count();
+            let answered = |note: &str| {
+                outcomes
+                    .iter()
+                    .filter(|o| o.solved && o.note == note)
+                    .count()
+            };
+            let (retrieved, from_experience) = (answered("retrieved"), answered("experience"));
             let _ = write!(
                 text,
-                "\nWith experience kept, pass {} ({}; {from_experience} of {} solved problems answered by the experience alone):\n\n{}",
+                "\nWith experience kept, pass {} ({}; {} of {} solved problems answered by the experience alone, {retrieved} of them by retrieving the kept path whose ends they repeat):\n\n{}",
                 pass + 1,
                 if pass == 0 {
                     "one planner per family: each problem planned through the paths of the family's earlier problems, checked lazily in its scene, RRT-Connect where they do not reach"
                 } else {
                     "the set again, every path of pass 1 kept, the problem's own included"
                 },
+                from_experience + retrieved,
                 outcomes.iter().filter(|o| o.solved).count(),
                 trm_plan::mbm::markdown_table(pairs)
             );
