@@ -135,14 +135,14 @@ const PORTABLE: bool = false;
 mod avx {
     use super::{
         Contact, F, FAST_LANES, FastModel, FastScratch, FastWorld, Flags, GroupPair, LaneMask,
-        Object,
+        Object, PoseLanes32,
     };
     use std::arch::x86_64::{
-        __m256, __m256i, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_and_ps, _mm256_and_si256,
+        __m256, __m256i, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256,
         _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_fnmadd_ps,
-        _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps,
-        _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_slli_epi32,
-        _mm256_sqrt_ps, _mm256_sub_ps, _mm256_testz_ps,
+        _mm256_load_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps,
+        _mm256_slli_epi32, _mm256_sqrt_ps, _mm256_store_ps, _mm256_sub_ps, _mm256_testz_ps,
     };
 
     const _: () = assert!(FAST_LANES == 8, "one 8-lane AVX register per block");
@@ -225,7 +225,11 @@ mod avx {
                     _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(a[1])),
                     _mm256_sub_ps(load(&c[2]), _mm256_set1_ps(a[2])),
                 ];
-                let ab = ab.map(|v| _mm256_set1_ps(v));
+                let ab = [
+                    _mm256_set1_ps(ab[0]),
+                    _mm256_set1_ps(ab[1]),
+                    _mm256_set1_ps(ab[2]),
+                ];
                 let along = _mm256_fmadd_ps(
                     p[2],
                     ab[2],
@@ -364,6 +368,121 @@ mod avx {
             _mm256_movemask_ps(hit) as LaneMask,
             _mm256_movemask_ps(close) as LaneMask,
         )
+    }
+
+    /// Eight `f32` lanes as one register (unaligned).
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn load_lanes(v: &[f32; FAST_LANES]) -> __m256 {
+        // SAFETY: eight `f32`
+        unsafe { _mm256_loadu_ps(v.as_ptr()) }
+    }
+
+    /// One register into an `F`.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn store(v: __m256) -> F {
+        let mut out = F::default();
+        // SAFETY: `F` is eight `f32` aligned to 32 bytes
+        unsafe { _mm256_store_ps(out.0.as_mut_ptr(), v) };
+        out
+    }
+
+    /// Three registers into a point in every lane.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn store3(v: [__m256; 3]) -> [F; 3] {
+        [store(v[0]), store(v[1]), store(v[2])]
+    }
+
+    /// `rot · p + t` in every lane ([`super::transform`]).
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn transform(rot: &[__m256; 9], t: &[__m256; 3], p: [f32; 3]) -> [__m256; 3] {
+        let (x, y, z) = (
+            _mm256_set1_ps(p[0]),
+            _mm256_set1_ps(p[1]),
+            _mm256_set1_ps(p[2]),
+        );
+        let row = |k: usize| {
+            let xy = _mm256_fmadd_ps(rot[3 * k + 1], y, _mm256_fmadd_ps(rot[3 * k], x, t[k]));
+            _mm256_fmadd_ps(rot[3 * k + 2], z, xy)
+        };
+        [row(0), row(1), row(2)]
+    }
+
+    /// [`super::place`] written out: each link's rotation matrix from its quaternion, and its
+    /// bounding sphere's centre.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    pub(super) fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
+        let (one, two) = (_mm256_set1_ps(1.0), _mm256_set1_ps(2.0));
+        for (g, group) in model.groups.iter().enumerate() {
+            let p = &poses[group.frame];
+            // no array `map` here: its closures would be compiled without AVX
+            let (w, x, y, z) = (
+                load_lanes(&p[0]),
+                load_lanes(&p[1]),
+                load_lanes(&p[2]),
+                load_lanes(&p[3]),
+            );
+            let t = [load_lanes(&p[4]), load_lanes(&p[5]), load_lanes(&p[6])];
+            let (xx, yy, zz) = (
+                _mm256_mul_ps(x, x),
+                _mm256_mul_ps(y, y),
+                _mm256_mul_ps(z, z),
+            );
+            let (xy, xz, yz) = (
+                _mm256_mul_ps(x, y),
+                _mm256_mul_ps(x, z),
+                _mm256_mul_ps(y, z),
+            );
+            let (wx, wy, wz) = (
+                _mm256_mul_ps(w, x),
+                _mm256_mul_ps(w, y),
+                _mm256_mul_ps(w, z),
+            );
+            let diagonal = |a: __m256, b: __m256| _mm256_fnmadd_ps(two, _mm256_add_ps(a, b), one);
+            let twice = |a: __m256| _mm256_mul_ps(two, a);
+            let rot = [
+                diagonal(yy, zz),
+                twice(_mm256_sub_ps(xy, wz)),
+                twice(_mm256_add_ps(xz, wy)),
+                twice(_mm256_add_ps(xy, wz)),
+                diagonal(xx, zz),
+                twice(_mm256_sub_ps(yz, wx)),
+                twice(_mm256_sub_ps(xz, wy)),
+                twice(_mm256_add_ps(yz, wx)),
+                diagonal(xx, yy),
+            ];
+            scratch.bounds[g] = store3(transform(&rot, &t, group.bound.center));
+            let frame = &mut scratch.frames[g];
+            for k in 0..9 {
+                frame.0[k] = store(rot[k]);
+            }
+            frame.1 = store3(t);
+            scratch.placed[g] = false;
+        }
+    }
+
+    /// [`super::place_balls`] written out.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    pub(super) fn place_balls(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+        let (rot, t) = &scratch.frames[g];
+        let mut m = [_mm256_setzero_ps(); 9];
+        for k in 0..9 {
+            m[k] = load(&rot[k]);
+        }
+        let (rot, t) = (m, load3(t));
+        let group = &model.groups[g];
+        for i in group.balls.clone() {
+            scratch.balls[i] = store3(transform(&rot, &t, model.balls[i].center));
+        }
+        for i in group.inner.clone() {
+            scratch.inner[i] = store3(transform(&rot, &t, model.inner[i].center));
+        }
+        scratch.placed[g] = true;
     }
 
     /// [`Flags::mask`]: the flags (0 or 1) moved to the sign bits, then gathered.
@@ -1058,7 +1177,7 @@ fn check(
     // the AVX code paths take AVX2 and FMA: the plain-AVX clone goes without them
     const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
         && multiversion::target::selected_target!().supports_feature_str("fma");
-    place(model, poses, scratch);
+    place::<AVX>(model, poses, scratch);
     scratch.suspects.clear();
     let m = world.margin;
     let mut verdict = Verdict::default();
@@ -1070,7 +1189,7 @@ fn check(
             if near == 0 {
                 continue;
             }
-            place_balls(model, g, scratch);
+            place_balls::<AVX>(model, g, scratch);
             let mut contact = Contact::default();
             for i in group.balls.clone() {
                 object.test::<AVX>(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
@@ -1112,8 +1231,8 @@ fn check(
             continue;
         }
         // each sphere of link a against link b's bounding sphere, then b's spheres
-        place_balls(model, gp.a, scratch);
-        place_balls(model, gp.b, scratch);
+        place_balls::<AVX>(model, gp.a, scratch);
+        place_balls::<AVX>(model, gp.b, scratch);
         let (mut hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
         if !model.exact {
             // enclosing spheres only say "maybe"; spheres inside the bodies say "certainly"
@@ -1303,7 +1422,13 @@ impl Object {
 /// The frame and bounding-sphere centre of every link group in every lane; balls are placed
 /// later, for the groups that come near something ([`place_balls`]).
 #[inline(always)]
-fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
+fn place<const AVX: bool>(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::place(model, poses, scratch) };
+    }
     for (g, group) in model.groups.iter().enumerate() {
         let (rot, t) = link_frame(poses, group.frame);
         scratch.bounds[g] = transform(&rot, &t, group.bound.center);
@@ -1314,9 +1439,15 @@ fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
 
 /// The centres of group `g`'s balls in every lane, placed once per block.
 #[inline(always)]
-fn place_balls(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+fn place_balls<const AVX: bool>(model: &FastModel, g: usize, scratch: &mut FastScratch) {
     if scratch.placed[g] {
         return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::place_balls(model, g, scratch) };
     }
     let (rot, t) = &scratch.frames[g];
     for i in model.groups[g].balls.clone() {
@@ -1587,10 +1718,10 @@ mod tests {
                 .flat_map(|_| active.random(&mut rng))
                 .collect();
             active.forward_block_unchecked(&qs, &mut block);
-            place(&model, block.lanes(), &mut scratch);
+            place::<false>(&model, block.lanes(), &mut scratch);
             for gp in &model.group_pairs {
-                place_balls(&model, gp.a, &mut scratch);
-                place_balls(&model, gp.b, &mut scratch);
+                place_balls::<false>(&model, gp.a, &mut scratch);
+                place_balls::<false>(&model, gp.b, &mut scratch);
                 let avx = pair_contacts::<true>(&model, gp, &scratch, &world);
                 assert_eq!(avx, pair_contacts::<false>(&model, gp, &scratch, &world));
                 contacts += usize::from(avx.0 != 0);

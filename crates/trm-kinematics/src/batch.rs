@@ -289,6 +289,9 @@ impl Plan {
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
 fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) {
+    // the AVX paths need AVX2 and FMA: the plain-AVX clone goes without them
+    const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
+        && multiversion::target::selected_target!().supports_feature_str("fma");
     let slots = &mut block.slots[..plan.rows.len()];
     for ((out, &(constant, start, end)), &revolute) in
         slots.iter_mut().zip(&plan.rows).zip(&plan.revolute)
@@ -299,7 +302,21 @@ fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) 
             *v = affine(constant, terms, &inputs[l * stride..(l + 1) * stride]);
         }
         if revolute {
-            let (s, c) = sin_cos_block(v.map(|x| 0.5 * x));
+            for v in &mut v {
+                *v *= 0.5;
+            }
+            #[cfg(target_arch = "x86_64")]
+            let (s, c) = if AVX {
+                // SAFETY: as below
+                #[allow(unsafe_code)]
+                unsafe {
+                    avx::sin_cos_block(&v)
+                }
+            } else {
+                sin_cos_block(v)
+            };
+            #[cfg(not(target_arch = "x86_64"))]
+            let (s, c) = sin_cos_block(v);
             out[0] = s;
             out[1] = c;
             out[2] = [0.0; BLOCK_LANES];
@@ -311,7 +328,163 @@ fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) 
             }
         }
     }
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` is true only in this function's clone compiled for AVX2 and FMA, which
+        // runs only where the CPU has them (multiversion's run-time dispatch)
+        #[allow(unsafe_code)]
+        return unsafe { avx::run_steps(plan, &block.slots, &mut block.poses) };
+    }
     run_steps(plan, &block.slots, &mut block.poses);
+}
+
+/// The steps of a single-precision block written out in AVX2: the compiler vectorises
+/// [`run_steps`]' lane loops over `[f32; 8]` arrays into shuffled 4-wide pieces.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx {
+    use super::{BLOCK_LANES, C32, PIO2_1, PIO2_2, PIO2_3, Plan, PoseLanes32, S32};
+    use std::arch::x86_64::*;
+
+    const _: () = assert!(BLOCK_LANES == 8, "one 8-lane AVX register per block");
+
+    /// Eight lanes as one register.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn load(v: &[f32; BLOCK_LANES]) -> __m256 {
+        // SAFETY: eight `f32`
+        unsafe { _mm256_loadu_ps(v.as_ptr()) }
+    }
+
+    /// One register into eight lanes.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn store(v: __m256, out: &mut [f32; BLOCK_LANES]) {
+        // SAFETY: eight `f32`
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), v) }
+    }
+
+    /// [`super::sin_cos_block`] written out: the reduction in two `f64` registers, the
+    /// polynomials and the quadrant's signs in one `f32` register.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn sin_cos_block(
+        x: &[f64; BLOCK_LANES],
+    ) -> ([f32; BLOCK_LANES], [f32; BLOCK_LANES]) {
+        let reduce = |v: __m256d| {
+            let k = _mm256_round_pd::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(
+                _mm256_mul_pd(v, _mm256_set1_pd(std::f64::consts::FRAC_2_PI)),
+            );
+            let r = _mm256_fnmadd_pd(k, _mm256_set1_pd(PIO2_1), v);
+            let r = _mm256_fnmadd_pd(k, _mm256_set1_pd(PIO2_2), r);
+            let r = _mm256_fnmadd_pd(k, _mm256_set1_pd(PIO2_3), r);
+            (_mm256_cvtpd_ps(r), _mm256_cvtpd_epi32(k))
+        };
+        // SAFETY: eight `f64`, read as two registers of four
+        let (lo, hi) = unsafe {
+            (
+                _mm256_loadu_pd(x.as_ptr()),
+                _mm256_loadu_pd(x.as_ptr().add(4)),
+            )
+        };
+        let ((r_lo, k_lo), (r_hi, k_hi)) = (reduce(lo), reduce(hi));
+        let r = _mm256_set_m128(r_hi, r_lo);
+        let q = _mm256_set_m128i(k_hi, k_lo);
+        let z = _mm256_mul_ps(r, r);
+        let set = _mm256_set1_ps;
+        let ps = _mm256_fmadd_ps(z, _mm256_fmadd_ps(z, set(S32[2]), set(S32[1])), set(S32[0]));
+        let sin = _mm256_fmadd_ps(_mm256_mul_ps(r, z), ps, r);
+        let pc = _mm256_fmadd_ps(z, _mm256_fmadd_ps(z, set(C32[2]), set(C32[1])), set(C32[0]));
+        let cos = _mm256_fmadd_ps(
+            _mm256_mul_ps(z, z),
+            pc,
+            _mm256_fnmadd_ps(set(0.5), z, set(1.0)),
+        );
+        // quadrant k mod 4: odd swaps sine and cosine; bit 1 flips the sine's sign, bit 1 of
+        // k + 1 the cosine's
+        let odd = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            _mm256_and_si256(q, _mm256_set1_epi32(1)),
+            _mm256_set1_epi32(1),
+        ));
+        let (a, b) = (
+            _mm256_blendv_ps(sin, cos, odd),
+            _mm256_blendv_ps(cos, sin, odd),
+        );
+        let sign = |bits: __m256i| {
+            _mm256_castsi256_ps(_mm256_slli_epi32::<30>(_mm256_and_si256(
+                bits,
+                _mm256_set1_epi32(2),
+            )))
+        };
+        let sin = _mm256_xor_ps(a, sign(q));
+        let cos = _mm256_xor_ps(b, sign(_mm256_add_epi32(q, _mm256_set1_epi32(1))));
+        let (mut s, mut c) = ([0.0; BLOCK_LANES], [0.0; BLOCK_LANES]);
+        store(sin, &mut s);
+        store(cos, &mut c);
+        (s, c)
+    }
+
+    /// [`super::run_steps`] for blocks of eight `f32` lanes (the same arithmetic, fused
+    /// multiply-adds where they fit).
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn run_steps(
+        plan: &Plan,
+        slots: &[[[f32; BLOCK_LANES]; 3]],
+        poses: &mut [PoseLanes32],
+    ) {
+        let mut identity = [[0.0; BLOCK_LANES]; 7];
+        identity[0] = [1.0; BLOCK_LANES];
+        poses[0] = identity;
+        let two = _mm256_set1_ps(2.0);
+        for (step, k) in plan.steps.iter().zip(&plan.steps32) {
+            let [s, c, d] = &slots[step.slot as usize];
+            let (s, c, d) = (load(s), load(c), load(d));
+            let p = &poses[step.parent as usize];
+            let (w, x, y, z) = (load(&p[0]), load(&p[1]), load(&p[2]), load(&p[3]));
+            let (px, py, pz) = (load(&p[4]), load(&p[5]), load(&p[6]));
+            // local rotation c·r + s·b, local translation t + d·axis
+            let local = |r: f32, b: f32| {
+                _mm256_fmadd_ps(s, _mm256_set1_ps(b), _mm256_mul_ps(c, _mm256_set1_ps(r)))
+            };
+            let (r, b) = (k.rotation, k.axis_quat);
+            let (lw, li, lj, lk) = (
+                local(r[0], b[0]),
+                local(r[1], b[1]),
+                local(r[2], b[2]),
+                local(r[3], b[3]),
+            );
+            let along = |t: f32, a: f32| _mm256_fmadd_ps(d, _mm256_set1_ps(a), _mm256_set1_ps(t));
+            let (t, a) = (k.translation, k.axis_in_parent);
+            let (tx, ty, tz) = (along(t[0], a[0]), along(t[1], a[1]), along(t[2], a[2]));
+            // parent rotation applied to the local translation: v + w·u + q×u, u = 2 q×v
+            let cross = |a: __m256, b: __m256, c: __m256, e: __m256| {
+                _mm256_fmsub_ps(a, b, _mm256_mul_ps(c, e))
+            };
+            let ux = _mm256_mul_ps(two, cross(y, tz, z, ty));
+            let uy = _mm256_mul_ps(two, cross(z, tx, x, tz));
+            let uz = _mm256_mul_ps(two, cross(x, ty, y, tx));
+            let moved = |p: __m256, t: __m256, u: __m256, q: __m256| {
+                _mm256_add_ps(_mm256_add_ps(p, t), _mm256_fmadd_ps(w, u, q))
+            };
+            let mut child = identity;
+            store(moved(px, tx, ux, cross(y, uz, z, uy)), &mut child[4]);
+            store(moved(py, ty, uy, cross(z, ux, x, uz)), &mut child[5]);
+            store(moved(pz, tz, uz, cross(x, uy, y, ux)), &mut child[6]);
+            // parent rotation ⊗ local rotation
+            let product = |a: __m256, b: __m256, c: __m256, e: __m256| {
+                _mm256_fmadd_ps(
+                    w,
+                    a,
+                    _mm256_fmadd_ps(x, b, _mm256_fmadd_ps(y, c, _mm256_mul_ps(z, e))),
+                )
+            };
+            let neg = |v: __m256| _mm256_sub_ps(_mm256_set1_ps(0.0), v);
+            store(product(lw, neg(li), neg(lj), neg(lk)), &mut child[0]);
+            store(product(li, lw, lk, neg(lj)), &mut child[1]);
+            store(product(lj, neg(lk), lw, li), &mut child[2]);
+            store(product(lk, lj, neg(li), lw), &mut child[3]);
+            poses[step.child as usize] = child;
+        }
+    }
 }
 
 // π/2 in three parts (the first two with trailing zero bits, so k·part is exact for the
@@ -426,6 +599,38 @@ mod tests {
         let mut special = [0.0; BLOCK_LANES];
         special[..3].copy_from_slice(&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
         let (s, c) = sin_cos_block(special);
+        assert!(s[..3].iter().chain(&c[..3]).all(|v| v.is_nan()));
+        assert_eq!((s[3], c[3]), (0.0, 1.0));
+    }
+
+    /// The written-out AVX sines and cosines are the portable ones up to a unit of rounding.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx_block_sin_cos_is_the_portable_one() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let mut x = -1e3;
+        while x < 1e3 {
+            let lanes: [f64; BLOCK_LANES] = std::array::from_fn(|l| x * (1.0 - 0.3 * l as f64));
+            let (s, c) = sin_cos_block(lanes);
+            // SAFETY: the CPU has AVX2 and FMA (checked above)
+            #[allow(unsafe_code)]
+            let (sa, ca) = unsafe { avx::sin_cos_block(&lanes) };
+            for l in 0..BLOCK_LANES {
+                assert!(
+                    (s[l] - sa[l]).abs() <= 2e-7 && (c[l] - ca[l]).abs() <= 2e-7,
+                    "{}",
+                    lanes[l]
+                );
+            }
+            x += 0.0137;
+        }
+        let mut special = [0.0; BLOCK_LANES];
+        special[..3].copy_from_slice(&[f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
+        // SAFETY: as above
+        #[allow(unsafe_code)]
+        let (s, c) = unsafe { avx::sin_cos_block(&special) };
         assert!(s[..3].iter().chain(&c[..3]).all(|v| v.is_nan()));
         assert_eq!((s[3], c[3]), (0.0, 1.0));
     }
