@@ -1094,15 +1094,21 @@ impl FastChecker {
             d > 0 && n > 0 && n <= FAST_LANES && qs.len() == n * d,
             "1 to {FAST_LANES} whole configurations"
         );
-        if qs.iter().any(|v| v.is_nan()) {
+        // every value looked at (a vector loop), not the first NaN searched for
+        if qs.iter().fold(false, |nan, v| nan | v.is_nan()) {
             return false;
         }
-        self.inputs[..n * d].copy_from_slice(qs);
-        for l in n..FAST_LANES {
-            self.inputs.copy_within(..d, l * d);
-        }
-        self.active
-            .forward_block_unchecked(&self.inputs, &mut self.block);
+        // a full block straight from the caller; a partial one padded with its first lane
+        let inputs = if n == FAST_LANES {
+            qs
+        } else {
+            self.inputs[..n * d].copy_from_slice(qs);
+            for l in n..FAST_LANES {
+                self.inputs.copy_within(..d, l * d);
+            }
+            &self.inputs
+        };
+        self.active.forward_block_unchecked(inputs, &mut self.block);
         let live = if n == FAST_LANES {
             ALL_LANES
         } else {
