@@ -1216,7 +1216,7 @@ fn check(
                 }
                 hit = inside.hit.mask::<AVX>();
             }
-            match verdict.add(near, hit, close, true) {
+            match verdict.add(near, hit, close) {
                 None => return verdict,
                 Some(0) => {}
                 Some(lanes) => scratch.suspects.push((suspect, lanes)),
@@ -1251,7 +1251,7 @@ fn check(
             }
             hit = inside.hit.mask::<AVX>();
         }
-        match verdict.add(near, hit, close, true) {
+        match verdict.add(near, hit, close) {
             None => return verdict,
             Some(0) => {}
             Some(lanes) => scratch.suspects.push((Suspect::Pair(k as u32), lanes)),
@@ -1338,28 +1338,18 @@ impl Contact {
 }
 
 impl Verdict {
-    /// Adds the contacts of a group of pairs (the lanes certainly colliding, and those within
-    /// the margin of contact) in the lanes of `lanes`: `None` when a lane certainly collides,
-    /// else the lanes the group left uncertain.
+    /// Adds the contacts of a group of pairs in the lanes of `lanes`: `hit`, the lanes certainly
+    /// colliding (for bodies screened through enclosing spheres, those touching a sphere inside
+    /// them), and `close`, those within the margin of contact. `None` when a lane certainly
+    /// collides, else the lanes the group left uncertain.
     #[inline(always)]
-    fn add(
-        &mut self,
-        lanes: LaneMask,
-        hit: LaneMask,
-        close: LaneMask,
-        exact: bool,
-    ) -> Option<LaneMask> {
-        let uncertain = if exact {
-            let hit = lanes & hit;
-            if hit != 0 {
-                self.colliding |= hit;
-                return None;
-            }
-            lanes & close
-        } else {
-            // spheres enclosing the bodies: contact is only a reason to look exactly
-            lanes & (hit | close)
-        };
+    fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask> {
+        let hit = lanes & hit;
+        if hit != 0 {
+            self.colliding |= hit;
+            return None;
+        }
+        let uncertain = lanes & close;
         self.uncertain |= uncertain;
         Some(uncertain)
     }

@@ -828,17 +828,9 @@ impl<'a> Planner<'a> {
             let mut blocked = false;
             for v in &path {
                 let i = v.index();
-                if i < n && self.node_state[i] == State::Unknown {
-                    let q = self.nodes[i].0.clone();
-                    self.node_state[i] = if self.is_free(&q) {
-                        State::Valid
-                    } else {
-                        State::Invalid
-                    };
-                    if self.node_state[i] == State::Invalid {
-                        stats.nodes_invalid += 1;
-                        blocked = true;
-                    }
+                if i < n && self.node_state[i] == State::Unknown && !self.node_free(i) {
+                    stats.nodes_invalid += 1;
+                    blocked = true;
                 }
             }
             if blocked {
@@ -935,18 +927,8 @@ impl<'a> Planner<'a> {
             edges.reverse();
         }
         let mut stats = PlanStats::default();
-        for &i in &ids {
-            if self.node_state[i] == State::Unknown {
-                let q = self.nodes[i].0.clone();
-                self.node_state[i] = if self.is_free(&q) {
-                    State::Valid
-                } else {
-                    State::Invalid
-                };
-            }
-            if self.node_state[i] == State::Invalid {
-                return Ok(None);
-            }
+        if !ids.iter().all(|&i| self.node_free(i)) {
+            return Ok(None);
         }
         for (&e, w) in edges.iter().zip(ids.windows(2)) {
             if self.edge_state[e] == State::Unknown {
@@ -995,6 +977,20 @@ impl<'a> Planner<'a> {
             waypoints,
             stats,
         }))
+    }
+
+    /// Whether map node `i` is free in the current world: checked the first time it is asked,
+    /// its state kept.
+    fn node_free(&mut self, i: usize) -> bool {
+        if self.node_state[i] == State::Unknown {
+            let q = self.nodes[i].0.clone();
+            self.node_state[i] = if self.is_free(&q) {
+                State::Valid
+            } else {
+                State::Invalid
+            };
+        }
+        self.node_state[i] == State::Valid
     }
 
     /// Appends a posture at the task point `t` reached by NGIK from the last waypoint, when it
