@@ -20,8 +20,10 @@
 //! Robot bodies that are spheres (a spherized URDF, or one written by
 //! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)) are the model itself; other bodies
 //! are *screened* through the spheres enclosing them ([`CollisionModel::enclosing_spheres`]: a
-//! mesh's convex hull cut into cells, each enclosed exactly), so that contact is only a reason to
-//! look exactly. World objects of every shape are taken: spheres, capsules and boxes are checked
+//! mesh's convex hull cut into cells, each enclosed exactly; a capsule's caps and pieces of its
+//! cylinder), so that contact is only a reason to look exactly, and through spheres inside them
+//! ([`Shape::inscribed_spheres`]), whose contact is a certain collision. A link that is one box
+//! is tested as that box: the other link's spheres are taken into its frame. World objects of every shape are taken: spheres, capsules and boxes are checked
 //! in single precision, cylinders and convex hulls through their bounding spheres (a lane near
 //! one is uncertain).
 
@@ -564,6 +566,9 @@ struct Group {
     inner: std::ops::Range<usize>,
     /// The link's bodies (indices into [`CollisionModel::bodies`]).
     bodies: Vec<u32>,
+    /// The link's body in the link frame when it is one box: other links' spheres are tested
+    /// against the box itself, not against the spheres enclosing it.
+    solid: Option<Object>,
 }
 
 /// Two balls (indices into [`FastModel::balls`]) and the sum of their radii.
@@ -585,6 +590,10 @@ struct GroupPair {
     /// Pairs of spheres inside the two links' checked bodies (indices into
     /// [`FastModel::inner`]) and the sums of their radii: touching is a certain collision.
     inner: Vec<BallPair>,
+    /// `(solid, other)` when one link is a box ([`Group::solid`]) checked against every body of
+    /// the other: the other's spheres are tested against the box in its link's frame instead
+    /// of the sphere pairs.
+    solid: Option<(usize, usize)>,
 }
 
 /// What left lanes of a block uncertain: checked exactly, only it, in those lanes.
@@ -661,7 +670,8 @@ impl FastWorld {
     /// The band, m, around contact within which a verdict is uncertain: 1 µm per metre of the
     /// largest coordinate involved (the robot's reach and the farthest object, plus one metre)
     /// per joint of the deepest chain (plus two, for placing the spheres and measuring their
-    /// distance). Single precision errs by a few units of 2⁻²⁴ (6e-8) of relative error per
+    /// distance, and one more for taking spheres into a box link's frame when the model has
+    /// one). Single precision errs by a few units of 2⁻²⁴ (6e-8) of relative error per
     /// step — under 0.5 µm per metre per joint — so the band is at least twice the worst
     /// rounding of both spheres of a pair (25 µm on the Panda; measured FK rounding: 0.7 µm on
     /// the 75-joint iCub).
@@ -754,12 +764,24 @@ impl FastModel {
                     inner_of_body[i] = first..inner.len();
                 }
             }
+            let solid = match (members.as_slice(), exact) {
+                (&[i], false) => match bodies[i].shape {
+                    Shape::Box { size } => Some(Object::Box {
+                        center: to_f32(bodies[i].local.translation.vector),
+                        axes: inverse_axes(&bodies[i].local),
+                        half: size.map(|s| (0.5 * s) as f32),
+                    }),
+                    _ => None,
+                },
+                _ => None,
+            };
             groups.push(Group {
                 frame: link,
                 bound: bounding_ball(&spheres),
                 balls: start..balls.len(),
                 inner: inner_start..inner.len(),
                 bodies: members.iter().map(|&i| i as u32).collect(),
+                solid,
             });
         }
         // the model's checked body pairs as ball pairs, grouped by link pair
@@ -799,12 +821,19 @@ impl FastModel {
                 })
                 .map(|(i, j)| (i as u32, j as u32, inner[i].radius + inner[j].radius))
                 .collect();
+            // a box against every body of the other link: its spheres against the box
+            let against = |s: usize, o: usize| {
+                (groups[s].solid.is_some() && bodies.len() == groups[o].bodies.len())
+                    .then_some((s, o))
+            };
+            let solid = against(a, b).or_else(|| against(b, a));
             group_pairs.push(GroupPair {
                 a,
                 b,
                 runs,
                 bodies,
                 inner: inner_pairs,
+                solid,
             });
         }
         // reach: every joint offset and prismatic travel end to end, then the farthest sphere
@@ -861,17 +890,6 @@ impl FastModel {
             .bodies()
             .iter()
             .all(|b| matches!(b.shape, Shape::Sphere { .. }))
-    }
-
-    /// Whether the screen pays for `model`: every body a sphere (the screen is the model) or a
-    /// convex hull (a mesh: its [`CONVEX_SPHERES`](crate::CONVEX_SPHERES) spheres leave
-    /// few lanes uncertain, and those are checked pair by pair). Boxes, capsules and cylinders
-    /// have exact `f64` tests nearly as fast as the screen.
-    pub fn screens_well(model: &CollisionModel) -> bool {
-        model
-            .bodies()
-            .iter()
-            .all(|b| matches!(b.shape, Shape::Sphere { .. } | Shape::Convex { .. }))
     }
 
     /// Whether the spheres are the model itself (every body a sphere): its certain contacts
@@ -950,7 +968,10 @@ impl FastModel {
             })
             .collect();
         let largest = self.reach.max(farthest);
-        let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * (2 + self.depth) as f64) as f32;
+        // placing and measuring, one more step where a sphere is taken into a box link's frame
+        let solid = self.groups.iter().any(|g| g.solid.is_some());
+        let steps = self.depth + 2 + usize::from(solid);
+        let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
         FastWorld {
             objects,
             margin,
@@ -1030,16 +1051,13 @@ impl FastChecker {
         })
     }
 
-    /// A checker and `world` compiled for it when the screen pays for `collision`
-    /// ([`FastModel::screens_well`]), else `None` — decided before compiling anything.
+    /// A checker and `world` compiled for it; `None` when the model cannot be compiled (a
+    /// body without enclosing spheres: an invalid shape), for the `f64` path to answer.
     pub fn for_model(
         collision: &CollisionModel,
         active: &ActiveSet,
         world: &World,
     ) -> Option<(FastChecker, FastWorld)> {
-        if !FastModel::screens_well(collision) {
-            return None;
-        }
         let checker = FastChecker::new(collision, active.clone()).ok()?;
         let fast_world = checker.model().world(world);
         Some((checker, fast_world))
@@ -1234,6 +1252,32 @@ fn check(
                 .within(reach * reach)
                 .mask::<AVX>();
         if near == 0 {
+            continue;
+        }
+        if let Some((s, o)) = gp.solid {
+            // the other link's spheres in the box link's frame, against the box itself
+            place_balls::<AVX>(model, o, scratch);
+            let (box_, group, frame) =
+                (&model.groups[s].solid, &model.groups[o], &scratch.frames[s]);
+            let Some(box_) = box_ else { continue };
+            let mut contact = Contact::default();
+            for i in group.balls.clone() {
+                let c = inverse_transform(frame, &scratch.balls[i]);
+                box_.test::<AVX>(&mut contact, &c, model.balls[i].radius, m);
+            }
+            let close = contact.close.mask::<AVX>();
+            let mut inside = Contact::default();
+            if near & close != 0 {
+                for i in group.inner.clone() {
+                    let c = inverse_transform(frame, &scratch.inner[i]);
+                    box_.test::<AVX>(&mut inside, &c, model.inner[i].radius, m);
+                }
+            }
+            match verdict.add(near, inside.hit.mask::<AVX>(), close) {
+                None => return verdict,
+                Some(0) => {}
+                Some(lanes) => scratch.suspects.push((Suspect::Pair(k as u32), lanes)),
+            }
             continue;
         }
         // each sphere of link a against link b's bounding sphere, then b's spheres
@@ -1498,6 +1542,18 @@ fn transform(rot: &[F; 9], t: &[F; 3], p: [f32; 3]) -> [F; 3] {
         rot[0] * x + rot[1] * y + rot[2] * z + t[0],
         rot[3] * x + rot[4] * y + rot[5] * z + t[1],
         rot[6] * x + rot[7] * y + rot[8] * z + t[2],
+    ]
+}
+
+/// The point in every lane in the frame `(rot, t)` (row-major rotation and translation in
+/// every lane, as [`link_frame`] gives them) maps to the world: `rotᵀ (p − t)`.
+#[inline(always)]
+fn inverse_transform((rot, t): &([F; 9], [F; 3]), p: &[F; 3]) -> [F; 3] {
+    let (x, y, z) = (p[0] - t[0], p[1] - t[1], p[2] - t[2]);
+    [
+        rot[0] * x + rot[3] * y + rot[6] * z,
+        rot[1] * x + rot[4] * y + rot[7] * z,
+        rot[2] * x + rot[5] * y + rot[8] * z,
     ]
 }
 

@@ -239,10 +239,9 @@ pub struct RrtPath {
     pub refinements: u32,
 }
 
-/// Collision checks of configurations and edges in one world, counted. Models of spheres and
-/// mesh hulls are checked by the single-precision screen ([`FastChecker`], [`FAST_LANES`]
-/// configurations at a time, exact answers); any other model by the objective's batched `f64`
-/// checks.
+/// Collision checks of configurations and edges in one world, counted: by the single-precision
+/// screen ([`FastChecker`], [`FAST_LANES`] configurations at a time, exact answers), or by the
+/// objective's batched `f64` checks for a model the screen cannot compile.
 pub struct Checker<'a> {
     objective: &'a Objective,
     world: &'a World,
@@ -267,8 +266,7 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// Whether the single-precision screen checks this robot (spheres or mesh hulls:
-    /// [`trm_collision::fast::FastModel::screens_well`]).
+    /// Whether the single-precision screen checks this robot ([`FastChecker::for_model`]).
     pub fn is_fast(&self) -> bool {
         self.fast.is_some()
     }
