@@ -782,9 +782,9 @@ impl FastModel {
                 group_of_body[i] = groups.len();
                 balls_of_body[i] = first..balls.len();
                 if !exact {
-                    let (body, first) = (&bodies[i], inner.len());
-                    inner.extend(body.shape.inscribed_spheres().into_iter().map(|s| Ball {
-                        center: to_f32((body.local * s.center).coords),
+                    let first = inner.len();
+                    inner.extend(model.inscribed_spheres(i).iter().map(|s| Ball {
+                        center: to_f32(s.center.coords),
                         radius: s.radius as f32,
                     }));
                     inner_of_body[i] = first..inner.len();

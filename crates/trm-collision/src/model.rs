@@ -69,11 +69,19 @@ struct Inner {
     pairs: Vec<BodyPair>,
     link_pairs: usize,
     culling: Culling,
-    /// Every body's [`CollisionModel::enclosing_spheres`], fitted on first use and shared by
-    /// the models [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
-    spheres: Arc<OnceLock<Vec<Vec<crate::Sphere>>>>,
+    /// Every body's [`CollisionModel::enclosing_spheres`] and
+    /// [`CollisionModel::inscribed_spheres`], fitted on first use and shared by the models
+    /// [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
+    spheres: Arc<SphereSets>,
     /// The model compiled for single-precision checks ([`crate::fast::FastModel::of`]).
     fast: OnceLock<Arc<crate::fast::FastModel>>,
+}
+
+/// Per body, its spheres in its link's frame, each set fitted on first use.
+#[derive(Debug, Default)]
+struct SphereSets {
+    enclosing: OnceLock<Vec<Vec<crate::Sphere>>>,
+    inscribed: OnceLock<Vec<Vec<crate::Sphere>>>,
 }
 
 /// The collision geometry of a robot with its allowed-collision matrix. Cheap to clone,
@@ -183,7 +191,7 @@ impl CollisionModel {
         robot: &RobotModel,
         mut bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
-        spheres: Arc<OnceLock<Vec<Vec<crate::Sphere>>>>,
+        spheres: Arc<SphereSets>,
     ) -> Result<Self> {
         if acm.num_links() != robot.num_links() {
             return Err(CollisionError::InvalidValue {
@@ -274,20 +282,45 @@ impl CollisionModel {
     /// # Panics
     /// If `body` is out of range.
     pub fn enclosing_spheres(&self, body: usize) -> &[crate::Sphere] {
-        let all = self.inner.spheres.get_or_init(|| {
-            self.inner
-                .bodies
-                .iter()
-                .map(|b| {
-                    let mut spheres = b.shape.enclosing_spheres();
-                    for s in &mut spheres {
-                        s.center = b.local * s.center;
-                    }
-                    spheres
-                })
-                .collect()
-        });
+        let all = self
+            .inner
+            .spheres
+            .enclosing
+            .get_or_init(|| self.in_link_frames(crate::Shape::enclosing_spheres));
         &all[body]
+    }
+
+    /// Spheres wholly inside body `body` ([`crate::Shape::inscribed_spheres`]) in its link's
+    /// frame: whatever touches one touches the body. Every body's are fitted on the first
+    /// call, then kept.
+    ///
+    /// # Panics
+    /// If `body` is out of range.
+    pub fn inscribed_spheres(&self, body: usize) -> &[crate::Sphere] {
+        let all = self
+            .inner
+            .spheres
+            .inscribed
+            .get_or_init(|| self.in_link_frames(crate::Shape::inscribed_spheres));
+        &all[body]
+    }
+
+    /// `spheres` of every body's shape, moved into its link's frame.
+    fn in_link_frames(
+        &self,
+        spheres: impl Fn(&crate::Shape) -> Vec<crate::Sphere>,
+    ) -> Vec<Vec<crate::Sphere>> {
+        self.inner
+            .bodies
+            .iter()
+            .map(|b| {
+                let mut spheres = spheres(&b.shape);
+                for s in &mut spheres {
+                    s.center = b.local * s.center;
+                }
+                spheres
+            })
+            .collect()
     }
 
     /// Index of the body with this name.
