@@ -1113,6 +1113,11 @@ impl FastChecker {
                 problem: format!("belongs to another robot than `{}`", robot.name()),
             });
         }
+        // forward kinematics of the links the checks read only (bodies' links and the culling
+        // spheres' centres), not of frames and links without geometry
+        let links = (collision.bodies().iter().map(|b| b.link))
+            .chain(fast.origins.iter().map(|&o| o as usize));
+        let active = active.pruned_to(links);
         Ok(FastChecker {
             scratch: fast.scratch(),
             inputs: vec![0.0; FAST_LANES * active.len()],

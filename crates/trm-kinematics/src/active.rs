@@ -175,6 +175,24 @@ impl ActiveSet {
         motors
     }
 
+    /// The same active set, its forward kinematics computing only the poses of `links` (link
+    /// indices, as [`crate::PoseBuffer`] and [`crate::PoseBlock`] hold them) and of their
+    /// ancestors, and only the joint values those need: the poses of the other links and
+    /// frames are left as they were. For a caller that reads a few poses, e.g. a collision
+    /// check (links without collision geometry skipped). Out-of-range indices are ignored.
+    pub fn pruned_to(&self, links: impl IntoIterator<Item = usize>) -> ActiveSet {
+        let mut keep = vec![false; self.model.num_links() + self.model.named_frames().len()];
+        for l in links {
+            if let Some(k) = keep.get_mut(l) {
+                *k = true;
+            }
+        }
+        ActiveSet {
+            plan: self.plan.pruned(&keep),
+            ..self.clone()
+        }
+    }
+
     /// Number of distinct joint values one FK pass computes (joints held constant by locked
     /// motors are folded away; joints that always share a value share one computation).
     pub fn num_distinct_joint_values(&self) -> usize {

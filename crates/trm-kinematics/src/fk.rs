@@ -184,6 +184,43 @@ impl Plan {
         plan
     }
 
+    /// The plan computing only the pose entries `keep` marks and their ancestors (the others
+    /// are left as they were), with only the joint values those need.
+    pub(crate) fn pruned(&self, keep: &[bool]) -> Plan {
+        // steps run parents first: walking them backwards marks every ancestor of a kept entry
+        let mut needed = keep.to_vec();
+        needed.resize(self.steps.len() + 1, false);
+        for step in self.steps.iter().rev() {
+            if needed[step.child as usize] {
+                needed[step.parent as usize] = true;
+            }
+        }
+        let mut plan = Plan {
+            rows: vec![self.rows[0]],
+            terms: self.terms.clone(),
+            revolute: vec![self.revolute[0]],
+            steps: Vec::new(),
+            steps32: Vec::new(),
+        };
+        // slot 0 (fixed transforms) stays 0; the others renumbered in order of first use
+        let mut slot_of = vec![None; self.rows.len()];
+        slot_of[0] = Some(0);
+        for (step, constants) in self.steps.iter().zip(&self.steps32) {
+            if !needed[step.child as usize] {
+                continue;
+            }
+            let old = step.slot as usize;
+            let slot = *slot_of[old].get_or_insert_with(|| {
+                plan.rows.push(self.rows[old]);
+                plan.revolute.push(self.revolute[old]);
+                plan.rows.len() as u32 - 1
+            });
+            plan.steps.push(Step { slot, ..*step });
+            plan.steps32.push(*constants);
+        }
+        plan
+    }
+
     /// Number of distinct joint values the pass computes.
     pub fn num_slots(&self) -> usize {
         self.rows.len() - 1

@@ -194,3 +194,70 @@ fn single_precision_blocks_stay_within_their_rounding_bound() {
         assert!(e.contains("active motor values"), "{e}");
     }
 }
+
+/// A pruned active set computes the kept links and their ancestors as the full one does, bit
+/// for bit (one configuration, batches and single-precision blocks), and leaves every other
+/// pose as it was.
+#[test]
+fn pruned_forward_kinematics_computes_the_kept_links_and_leaves_the_rest() {
+    use trm_kinematics::BLOCK_LANES;
+    let model = model("icub_upper_body.ron");
+    let active = model.all_active();
+    let d = active.len();
+    let kept = [
+        model.tree().link_index("r_hand").unwrap(),
+        model.tree().link_index("head").unwrap(),
+    ];
+    let pruned = active.pruned_to(kept);
+    assert!(pruned.num_distinct_joint_values() < active.num_distinct_joint_values());
+    // the kept links' ancestors, by the parents of the tree
+    let tree = model.tree();
+    let mut needed = vec![false; model.num_links()];
+    for &k in &kept {
+        let mut l = k;
+        needed[l] = true;
+        while let Some(j) = tree.joints.iter().find(|j| j.child == l) {
+            l = j.parent;
+            needed[l] = true;
+        }
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut full, mut part) = (model.pose_buffer(), model.pose_buffer());
+    let (mut full_block, mut part_block) = (model.pose_block(), model.pose_block());
+    for _ in 0..20 {
+        let q: Vec<f64> = (0..BLOCK_LANES)
+            .flat_map(|_| active.random(&mut rng))
+            .collect();
+        active.forward(&q[..d], &mut full).unwrap();
+        // stale poses: those of another configuration
+        pruned.forward(&q[d..2 * d], &mut part).unwrap();
+        active.forward(&q[d..2 * d], &mut part).unwrap();
+        let stale = part.poses().to_vec();
+        pruned.forward(&q[..d], &mut part).unwrap();
+        for (l, (a, b)) in full.poses().iter().zip(part.poses()).enumerate() {
+            if l < needed.len() && needed[l] {
+                assert_eq!(a, b, "link {l}");
+            } else {
+                assert_eq!(*b, stale[l], "link {l} left as it was");
+            }
+        }
+        active.forward_block(&q, &mut full_block).unwrap();
+        let mut other = q.clone();
+        other.rotate_left(d);
+        active.forward_block(&other, &mut part_block).unwrap();
+        let stale = part_block.lanes().to_vec();
+        pruned.forward_block(&q, &mut part_block).unwrap();
+        for (l, (a, b)) in full_block
+            .lanes()
+            .iter()
+            .zip(part_block.lanes())
+            .enumerate()
+        {
+            if l < needed.len() && needed[l] {
+                assert_eq!(a, b, "link {l} (block)");
+            } else {
+                assert_eq!(*b, stale[l], "link {l} (block) left as it was");
+            }
+        }
+    }
+}
