@@ -23,7 +23,10 @@
 //! mesh's convex hull cut into cells, each enclosed exactly; a capsule's caps and pieces of its
 //! cylinder), so that contact is only a reason to look exactly, and through spheres inside them
 //! ([`Shape::inscribed_spheres`]), whose contact is a certain collision. A link that is one box
-//! is tested as that box: the other link's spheres are taken into its frame. World objects of every shape are taken: spheres, capsules and boxes are checked
+//! is tested as that box: the other link's spheres are taken into its frame. A block whose
+//! lanes are left uncertain by two links of convex hulls gets a second, tighter screen before
+//! the exact checks: each link's spheres against the other's 18-sided bounding polytope
+//! (k-DOP). World objects of every shape are taken: spheres, capsules and boxes are checked
 //! in single precision, cylinders and convex hulls through their bounding spheres (a lane near
 //! one is uncertain).
 
@@ -125,6 +128,16 @@ impl F {
         }
         Flags(flags)
     }
+
+    /// The lanes > `limit`.
+    #[inline(always)]
+    fn above(self, limit: f32) -> Flags {
+        let mut flags = [0; FAST_LANES];
+        for l in 0..FAST_LANES {
+            flags[l] = u32::from(self.0[l] > limit);
+        }
+        Flags(flags)
+    }
 }
 
 /// [`Flags::mask`]'s lane-by-lane form: the world's tests keep it, as they vectorise worse
@@ -140,11 +153,12 @@ mod avx {
         Object, PoseLanes32,
     };
     use std::arch::x86_64::{
-        __m256, __m256i, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_ps, _mm256_and_ps, _mm256_and_si256,
-        _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_fnmadd_ps,
-        _mm256_load_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps,
-        _mm256_slli_epi32, _mm256_sqrt_ps, _mm256_store_ps, _mm256_sub_ps, _mm256_testz_ps,
+        __m256, __m256i, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_ps, _mm256_and_ps,
+        _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_fmadd_ps,
+        _mm256_fnmadd_ps, _mm256_load_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps,
+        _mm256_setzero_ps, _mm256_slli_epi32, _mm256_sqrt_ps, _mm256_store_ps, _mm256_sub_ps,
+        _mm256_testz_ps,
     };
 
     const _: () = assert!(FAST_LANES == 8, "one 8-lane AVX register per block");
@@ -372,6 +386,71 @@ mod avx {
         )
     }
 
+    /// [`super::kdop_clear`] written out, for [`super::KDOP`]'s directions: the axes, then
+    /// the face diagonals as sums and differences of two coordinates.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn kdop_clear(
+        model: &FastModel,
+        a: usize,
+        kdop: &[[f32; 2]; super::KDOP.len()],
+        frame: &([F; 9], [F; 3]),
+        scratch: &FastScratch,
+        m: f32,
+    ) -> LaneMask {
+        let mut rot = [_mm256_setzero_ps(); 9];
+        for k in 0..9 {
+            rot[k] = load(&frame.0[k]);
+        }
+        let t = load3(&frame.1);
+        let mut clear = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+        for i in model.groups[a].balls.clone() {
+            let c = load3(&scratch.balls[i]);
+            let d = [
+                _mm256_sub_ps(c[0], t[0]),
+                _mm256_sub_ps(c[1], t[1]),
+                _mm256_sub_ps(c[2], t[2]),
+            ];
+            // rotᵀ d: the centre in the link's frame
+            let local = |j: usize| {
+                _mm256_fmadd_ps(
+                    rot[6 + j],
+                    d[2],
+                    _mm256_fmadd_ps(rot[3 + j], d[1], _mm256_mul_ps(rot[j], d[0])),
+                )
+            };
+            let (x, y, z) = (local(0), local(1), local(2));
+            let s = [
+                x,
+                y,
+                z,
+                _mm256_add_ps(x, y),
+                _mm256_sub_ps(x, y),
+                _mm256_add_ps(x, z),
+                _mm256_sub_ps(x, z),
+                _mm256_add_ps(y, z),
+                _mm256_sub_ps(y, z),
+            ];
+            let r = model.balls[i].radius + m;
+            let mut beyond = _mm256_setzero_ps();
+            for (k, &[lo, hi]) in kdop.iter().enumerate() {
+                // the diagonals are √2 long
+                let reach = if k < 3 {
+                    r
+                } else {
+                    r * std::f32::consts::SQRT_2
+                };
+                let above = _mm256_cmp_ps::<_CMP_GT_OQ>(s[k], _mm256_set1_ps(hi + reach));
+                let below = _mm256_cmp_ps::<_CMP_LT_OQ>(s[k], _mm256_set1_ps(lo - reach));
+                beyond = _mm256_or_ps(beyond, _mm256_or_ps(above, below));
+            }
+            clear = _mm256_and_ps(clear, beyond);
+            if _mm256_testz_ps(clear, clear) != 0 {
+                return 0;
+            }
+        }
+        _mm256_movemask_ps(clear) as LaneMask
+    }
+
     /// Eight `f32` lanes as one register (unaligned).
     #[target_feature(enable = "avx")]
     #[inline]
@@ -569,7 +648,27 @@ struct Group {
     /// The link's body in the link frame when it is one box: other links' spheres are tested
     /// against the box itself, not against the spheres enclosing it.
     solid: Option<Object>,
+    /// When every body of the link is a convex hull: the polytope bounding them along the
+    /// [`KDOP`] directions in the link frame, `[lowest, highest]` per direction. A sphere
+    /// beyond one of its slabs is clear of the link's bodies.
+    kdop: Option<[[f32; 2]; KDOP.len()]>,
 }
+
+/// The 9 directions of an 18-sided discrete orientation polytope (k-DOP): the axes and the
+/// face diagonals of a cube, unnormalised (slab values scale with them). Measured against the
+/// 26-sided one (adding the corner diagonals) and the 6-sided box: fewest lanes left to the
+/// exact checks for the time spent on the MotionBenchMaker Panda's and Fetch's hulls.
+const KDOP: [[f32; 3]; 9] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [1.0, 1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 0.0, 1.0],
+    [1.0, 0.0, -1.0],
+    [0.0, 1.0, 1.0],
+    [0.0, 1.0, -1.0],
+];
 
 /// Two balls (indices into [`FastModel::balls`]) and the sum of their radii.
 type BallPair = (u32, u32, f32);
@@ -801,6 +900,9 @@ impl FastModel {
                 },
                 _ => None,
             };
+            let kdop = (!exact)
+                .then(|| kdop_of(members.iter().map(|&i| &bodies[i])))
+                .flatten();
             groups.push(Group {
                 frame: link,
                 bound: bounding_ball(&spheres),
@@ -808,6 +910,7 @@ impl FastModel {
                 inner: inner_start..inner.len(),
                 bodies: members.iter().map(|&i| i as u32).collect(),
                 solid,
+                kdop,
             });
         }
         // the model's checked body pairs as ball pairs, grouped by link pair
@@ -1044,7 +1147,7 @@ impl FastModel {
             .collect();
         let largest = self.reach.max(farthest);
         // placing and measuring, one more step where a sphere is taken into a box link's frame
-        let solid = self.groups.iter().any(|g| g.solid.is_some());
+        let solid = (self.groups.iter()).any(|g| g.solid.is_some() || g.kdop.is_some());
         let steps = self.depth + 2 + usize::from(solid);
         let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
         FastWorld {
@@ -1329,7 +1432,7 @@ fn check(
                 return verdict;
             }
         }
-        return verdict;
+        return clear_suspects::<AVX>(model, scratch, m, verdict);
     }
     let steps = &model.steps;
     let mut open = [(0u32, 0 as LaneMask); MAX_NESTING];
@@ -1363,6 +1466,35 @@ fn check(
         }
         i += 1;
     }
+    clear_suspects::<AVX>(model, scratch, m, verdict)
+}
+
+/// `verdict` without the link-pair suspects' lanes in which either link's spheres all lie
+/// beyond a slab of the other's k-DOP (when both are convex hulls): a second, tighter screen
+/// that only a block left uncertain pays for, before its lanes are checked exactly.
+#[inline(always)]
+fn clear_suspects<const AVX: bool>(
+    model: &FastModel,
+    scratch: &mut FastScratch,
+    m: f32,
+    mut verdict: Verdict,
+) -> Verdict {
+    if verdict.colliding != 0 || verdict.uncertain == 0 || model.exact {
+        return verdict;
+    }
+    let mut suspects = std::mem::take(&mut scratch.suspects);
+    verdict.uncertain = 0;
+    for (suspect, lanes) in &mut suspects {
+        if let Suspect::Pair(k) = *suspect {
+            let gp = &model.group_pairs[k as usize];
+            let cleared = kdop_clear::<AVX>(model, gp.a, gp.b, scratch, m)
+                | kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
+            *lanes &= !cleared;
+        }
+        verdict.uncertain |= *lanes;
+    }
+    suspects.retain(|&(_, lanes)| lanes != 0);
+    scratch.suspects = suspects;
     verdict
 }
 
@@ -1480,6 +1612,66 @@ fn pair_contacts<const AVX: bool>(
         contact.hit.mask::<PORTABLE>(),
         contact.close.mask::<PORTABLE>(),
     )
+}
+
+/// The lanes in which every sphere of link group `a` lies beyond a slab of group `b`'s k-DOP
+/// (with the margin `m`): there `a`'s bodies are clear of `b`'s. None without `b`'s k-DOP.
+#[inline(always)]
+fn kdop_clear<const AVX: bool>(
+    model: &FastModel,
+    a: usize,
+    b: usize,
+    scratch: &FastScratch,
+    m: f32,
+) -> LaneMask {
+    let Some(kdop) = &model.groups[b].kdop else {
+        return 0;
+    };
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::kdop_clear(model, a, kdop, &scratch.frames[b], scratch, m) };
+    }
+    let frame = &scratch.frames[b];
+    let mut clear = ALL_LANES;
+    for i in model.groups[a].balls.clone() {
+        let c = inverse_transform(frame, &scratch.balls[i]);
+        let r = model.balls[i].radius + m;
+        let mut beyond = Flags::default();
+        for (n, &[lo, hi]) in KDOP.iter().zip(kdop) {
+            let s = c[0] * F::splat(n[0]) + c[1] * F::splat(n[1]) + c[2] * F::splat(n[2]);
+            let scale = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            beyond = beyond | s.above(hi + r * scale) | s.below(lo - r * scale);
+        }
+        clear &= beyond.mask::<PORTABLE>();
+        if clear == 0 {
+            break;
+        }
+    }
+    clear
+}
+
+/// The k-DOP of `bodies` in their link's frame when all are convex hulls.
+fn kdop_of<'a>(
+    bodies: impl Iterator<Item = &'a crate::model::Body>,
+) -> Option<[[f32; 2]; KDOP.len()]> {
+    let mut slabs = [[f32::INFINITY, f32::NEG_INFINITY]; KDOP.len()];
+    for body in bodies {
+        let Shape::Convex { points } = &body.shape else {
+            return None;
+        };
+        for p in points {
+            let p = body.local * Point3::from(*p);
+            for (n, slab) in KDOP.iter().zip(&mut slabs) {
+                let s = f64::from(n[0]) * p.x + f64::from(n[1]) * p.y + f64::from(n[2]) * p.z;
+                // rounded outwards: the slab holds every point
+                slab[0] = slab[0].min((s as f32).next_down());
+                slab[1] = slab[1].max((s as f32).next_up());
+            }
+        }
+    }
+    slabs.iter().all(|s| s[0] <= s[1]).then_some(slabs)
 }
 
 /// The squared distances below which two spheres whose radii sum to `r` certainly collide,
@@ -1926,6 +2118,80 @@ mod tests {
         assert!(
             contacts > 100,
             "{contacts} pairs in contact: the test saw too few"
+        );
+    }
+
+    /// The k-DOP screen: every hull point lies within each link's slabs, and a sphere it
+    /// clears is clear of the hulls, as GJK finds; the AVX code clears the same lanes.
+    #[test]
+    fn kdop_slabs_hold_the_hulls_and_clear_only_what_is_clear() {
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../models/panda-mbm/panda.ron"
+        );
+        let robot = trm_kinematics::RobotModel::load(file).unwrap();
+        let collision = CollisionModel::new(&robot).unwrap();
+        let model = FastModel::new(&collision).unwrap();
+        for group in &model.groups {
+            let kdop = group.kdop.expect("every Panda link is a hull");
+            for &b in &group.bodies {
+                let body = &collision.bodies()[b as usize];
+                let Shape::Convex { points } = &body.shape else {
+                    panic!("a hull")
+                };
+                for p in points {
+                    let p = body.local * Point3::from(*p);
+                    for (n, &[lo, hi]) in KDOP.iter().zip(&kdop) {
+                        let s =
+                            f64::from(n[0]) * p.x + f64::from(n[1]) * p.y + f64::from(n[2]) * p.z;
+                        assert!(
+                            f64::from(lo) <= s && s <= f64::from(hi),
+                            "{s} not in [{lo}, {hi}]"
+                        );
+                    }
+                }
+            }
+        }
+        let active = robot.all_active();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let (mut block, mut scratch) = (robot.pose_block(), model.scratch());
+        let (mut pose, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+        let world = model.world(&World::new());
+        let avx = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
+        let (mut cleared, mut close) = (0, 0);
+        for _ in 0..100 {
+            let qs: Vec<f64> = (0..FAST_LANES)
+                .flat_map(|_| active.random(&mut rng))
+                .collect();
+            active.forward_block_unchecked(&qs, &mut block);
+            place::<false>(&model, block.lanes(), &mut scratch);
+            for gp in &model.group_pairs {
+                place_balls::<false>(&model, gp.a, &mut scratch);
+                place_balls::<false>(&model, gp.b, &mut scratch);
+                let (_, near) = pair_contacts::<false>(&model, gp, &scratch, &world);
+                let m = world.margin;
+                let clear = kdop_clear::<false>(&model, gp.a, gp.b, &scratch, m);
+                if avx {
+                    assert_eq!(clear, kdop_clear::<true>(&model, gp.a, gp.b, &scratch, m));
+                }
+                close += near.count_ones();
+                for l in 0..FAST_LANES {
+                    if clear & near & (1 << l) == 0 {
+                        continue;
+                    }
+                    cleared += 1;
+                    let q = &qs[l * active.len()..(l + 1) * active.len()];
+                    active.forward(q, &mut pose).unwrap();
+                    collision.place(&pose, &mut placed);
+                    for &(a, b) in &gp.bodies {
+                        assert!(!collision.bodies_touch(&placed, a as usize, b as usize));
+                    }
+                }
+            }
+        }
+        assert!(
+            cleared > 10 && cleared < close,
+            "{cleared} of {close} close lanes cleared"
         );
     }
 }
