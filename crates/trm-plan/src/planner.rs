@@ -403,8 +403,8 @@ pub struct Planner<'a> {
     scratch: trm_tasks::Scratch,
     /// Samples of the segment being checked.
     samples: Vec<f64>,
-    /// For spheres and mesh hulls: the single-precision screen and the current world compiled
-    /// for it.
+    /// The single-precision screen and the current world compiled for it (`None` for a model
+    /// the screen cannot compile).
     fast: Option<(FastChecker, FastWorld)>,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
@@ -559,9 +559,9 @@ impl<'a> Planner<'a> {
 
     /// Whether the straight segment a → b is free, both ends included, at points no more than
     /// `resolution` apart (Euclidean, the rule of RRT-Connect's edges:
-    /// [`crate::rrt::edge_steps`]), visited raked ([`trm_roadmap::rake`]): spheres and mesh hulls
-    /// [`FAST_LANES`] points at a time on the single-precision screen, other models
-    /// [`LANES`](trm_kinematics::LANES) at a time in `f64`.
+    /// [`crate::rrt::edge_steps`]), visited raked ([`trm_roadmap::rake`]): [`FAST_LANES`]
+    /// points at a time on the single-precision screen (a model it cannot compile
+    /// [`LANES`](trm_kinematics::LANES) at a time in `f64`).
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let steps = crate::rrt::edge_steps(a, b, resolution);
         let at = |s: usize| s as f64 / steps as f64;
