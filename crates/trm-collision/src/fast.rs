@@ -714,6 +714,16 @@ enum CullStep {
     Pair(u32),
 }
 
+/// One step of a world object's walk, in the order of [`crate::cull`]'s world steps.
+#[derive(Debug, Clone, Copy)]
+enum WorldStep {
+    /// When the object is farther than `radius` from the centre `ball` (an index into
+    /// [`FastScratch::bounds`]) in every lane, continue at step `end`.
+    Cull { ball: u32, radius: f32, end: u32 },
+    /// A link group: an index into [`FastModel::groups`].
+    Link(u32),
+}
+
 /// What left lanes of a block uncertain: checked exactly, only it, in those lanes.
 #[derive(Debug, Clone, Copy)]
 enum Suspect {
@@ -739,7 +749,10 @@ pub struct FastModel {
     /// The self-collision walk through the culling spheres (when `culls`): culls and link
     /// pairs.
     steps: Vec<CullStep>,
-    /// Whether the walk takes `steps` ([`CULLED_LINK_PAIRS`]); else the link pairs in order.
+    /// Each world object's walk through the culling spheres (when `culls`): culls and links.
+    world_steps: Vec<WorldStep>,
+    /// Whether the walks take `steps` and `world_steps` ([`CULLED_LINK_PAIRS`]); else the
+    /// link pairs and links in order.
     culls: bool,
     /// Pose index of each culling sphere's link (after the groups in [`FastScratch::bounds`]).
     origins: Vec<u32>,
@@ -1006,6 +1019,28 @@ impl FastModel {
                 })
                 .collect()
         };
+        // a block of one link's bodies: its group
+        let world_steps = if !culls {
+            Vec::new()
+        } else {
+            culling
+                .world_steps
+                .iter()
+                .map(|step| match *step {
+                    crate::cull::Step::Cull { a, end, .. } => {
+                        let (ball, radius) = cull_ball(a);
+                        WorldStep::Cull {
+                            ball,
+                            radius: radius as f32,
+                            end,
+                        }
+                    }
+                    crate::cull::Step::Test { start, .. } => {
+                        WorldStep::Link(group_of_body[start as usize] as u32)
+                    }
+                })
+                .collect()
+        };
         let origins = if culls {
             culling.origin_links.clone()
         } else {
@@ -1043,6 +1078,7 @@ impl FastModel {
             group_pairs,
             pairs,
             steps,
+            world_steps,
             culls,
             origins,
             reach: chain + farthest,
@@ -1388,40 +1424,48 @@ fn check(
     scratch.suspects.clear();
     let m = world.margin;
     let mut verdict = Verdict::default();
-    // the world first: in a planner's queries most collisions are with the world
-    // world: each object against each link's bounding sphere, then its spheres
+    // the world first: in a planner's queries most collisions are with the world. Each object
+    // against each link's bounding sphere, then its spheres; for a model of many links,
+    // against the culling spheres of the kinematic tree's subtrees first
     for (o, object) in world.objects.iter().enumerate() {
-        for (g, group) in model.groups.iter().enumerate() {
-            let near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
-            if near == 0 {
-                continue;
+        if !model.culls {
+            for g in 0..model.groups.len() {
+                if object_link::<AVX>(model, o, object, g, live, world, scratch, &mut verdict) {
+                    return verdict;
+                }
             }
-            place_balls::<AVX>(model, g, scratch);
-            let mut contact = Contact::default();
-            for i in group.balls.clone() {
-                object.test::<AVX>(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
+            continue;
+        }
+        let steps = &model.world_steps;
+        let mut open = [(0u32, 0 as LaneMask); MAX_NESTING];
+        let (mut depth, mut mask, mut i) = (0, live, 0);
+        while i < steps.len() {
+            while depth > 0 && open[depth - 1].0 as usize <= i {
+                depth -= 1;
+                mask = open[depth].1;
             }
-            let suspect = Suspect::Object {
-                object: o as u32,
-                group: g as u32,
-            };
-            let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
-            if !model.exact {
-                // enclosing spheres only say "maybe"; a sphere inside a body says "certainly"
-                let mut inside = Contact::default();
-                if near & close != 0 {
-                    for i in group.inner.clone() {
-                        let r = model.inner[i].radius;
-                        object.test::<AVX>(&mut inside, &scratch.inner[i], r, m);
+            match steps[i] {
+                WorldStep::Cull { ball, radius, end } => {
+                    let c = &scratch.bounds[ball as usize];
+                    let near = mask & object.near::<AVX>(c, radius + m);
+                    if near == 0 {
+                        i = end as usize;
+                        continue;
+                    }
+                    if depth < MAX_NESTING {
+                        open[depth] = (end, mask);
+                        depth += 1;
+                        mask = near;
                     }
                 }
-                hit = inside.hit.mask::<AVX>();
+                WorldStep::Link(g) => {
+                    let g = g as usize;
+                    if object_link::<AVX>(model, o, object, g, mask, world, scratch, &mut verdict) {
+                        return verdict;
+                    }
+                }
             }
-            match verdict.add(near, hit, close) {
-                None => return verdict,
-                Some(0) => {}
-                Some(lanes) => scratch.suspects.push((suspect, lanes)),
-            }
+            i += 1;
         }
     }
     // self: the culling spheres of the kinematic tree (one test clears a hand against the
@@ -1496,6 +1540,58 @@ fn clear_suspects<const AVX: bool>(
     suspects.retain(|&(_, lanes)| lanes != 0);
     scratch.suspects = suspects;
     verdict
+}
+
+/// Checks world object `o` against link group `g` in the lanes of `live`: the link's bounding
+/// sphere, then its spheres (and the spheres inside its bodies). True when a lane certainly
+/// collides (then `verdict` says which); lanes left uncertain are added to `verdict` and the
+/// suspects.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn object_link<const AVX: bool>(
+    model: &FastModel,
+    o: usize,
+    object: &Object,
+    g: usize,
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut Verdict,
+) -> bool {
+    let (m, group) = (world.margin, &model.groups[g]);
+    let near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
+    if near == 0 {
+        return false;
+    }
+    place_balls::<AVX>(model, g, scratch);
+    let mut contact = Contact::default();
+    for i in group.balls.clone() {
+        object.test::<AVX>(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
+    }
+    let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
+    if !model.exact {
+        // enclosing spheres only say "maybe"; a sphere inside a body says "certainly"
+        let mut inside = Contact::default();
+        if near & close != 0 {
+            for i in group.inner.clone() {
+                let r = model.inner[i].radius;
+                object.test::<AVX>(&mut inside, &scratch.inner[i], r, m);
+            }
+        }
+        hit = inside.hit.mask::<AVX>();
+    }
+    match verdict.add(near, hit, close) {
+        None => true,
+        Some(0) => false,
+        Some(lanes) => {
+            let suspect = Suspect::Object {
+                object: o as u32,
+                group: g as u32,
+            };
+            scratch.suspects.push((suspect, lanes));
+            false
+        }
+    }
 }
 
 /// Checks link pair `gp` (index `k` in [`FastModel::group_pairs`]) in the lanes of `live`:
