@@ -14,7 +14,7 @@
 
 use std::time::Instant;
 
-use trm_benches::random_configurations;
+use trm_benches::{median, random_configurations};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
@@ -25,11 +25,6 @@ fn main() {
         eprintln!("error: {e}");
         std::process::exit(2);
     }
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 fn run() -> Result<(), String> {

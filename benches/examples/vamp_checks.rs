@@ -18,7 +18,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use trm_benches::random_configurations;
+use trm_benches::{median, random_configurations};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
@@ -33,11 +33,6 @@ fn objective(path: &str) -> Result<Objective, String> {
 /// trm's `f64` batch, trm's single-precision screen of the timed model and of the exact model
 /// (each when it screens), VAMP's times per configuration (one per round) and VAMP's verdicts.
 type Exchanged = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<bool>);
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
-}
 
 fn main() {
     if let Err(e) = run() {

@@ -10,3 +10,12 @@ pub fn random_configurations(active: &ActiveSet, n: usize, seed: u64) -> Vec<Vec
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n).map(|_| active.random(&mut rng)).collect()
 }
+
+/// The median of `values` (the upper one of an even count), sorting them in place.
+///
+/// # Panics
+/// If `values` is empty.
+pub fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}

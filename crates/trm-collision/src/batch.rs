@@ -145,23 +145,25 @@ fn follow(answer: Option<Next>, l: usize, pending: &mut Mask, live: &mut Mask, m
     }
 }
 
-/// Culls followed lane by lane: the lanes still live inside each open cull, and where it ends.
-struct Nest {
-    open: [(u32, Mask); MAX_DEPTH],
+/// Culls followed lane by lane: the lanes still live inside each open cull, and where it ends;
+/// at most `N` open at once (deeper ones test but do not narrow the lanes). The `f64` walks and
+/// the single-precision screen's walks ([`crate::fast`]) share it.
+pub(crate) struct Nest<const N: usize> {
+    open: [(u32, Mask); N],
     depth: usize,
 }
 
-impl Nest {
-    fn new() -> Self {
+impl<const N: usize> Nest<N> {
+    pub(crate) fn new() -> Self {
         Nest {
-            open: [(0, 0); MAX_DEPTH],
+            open: [(0, 0); N],
             depth: 0,
         }
     }
 
     /// Closes every cull that ends at or before step `i`; returns the lanes live after them.
     #[inline(always)]
-    fn close(&mut self, i: usize, mut mask: Mask, live: Mask) -> Mask {
+    pub(crate) fn close(&mut self, i: usize, mut mask: Mask, live: Mask) -> Mask {
         while self.depth > 0 && self.open[self.depth - 1].0 as usize <= i {
             self.depth -= 1;
             mask = self.open[self.depth].1;
@@ -179,11 +181,11 @@ impl Nest {
         }
     }
 
-    /// Opens a cull ending at `end`; `outer` are the lanes live before it. Beyond
-    /// [`MAX_DEPTH`] the cull is not narrowed (returns `outer`).
+    /// Opens a cull ending at `end`; `outer` are the lanes live before it. Beyond `N` open
+    /// culls it is not narrowed (returns `outer`).
     #[inline(always)]
-    fn open(&mut self, end: u32, outer: Mask, inner: Mask) -> Mask {
-        if self.depth == MAX_DEPTH {
+    pub(crate) fn open(&mut self, end: u32, outer: Mask, inner: Mask) -> Mask {
+        if self.depth == N {
             return outer;
         }
         self.open[self.depth] = (end, outer);
@@ -350,7 +352,7 @@ fn walk_self(
 ) {
     let (pairs, compiled) = (model.pairs(), model.compiled());
     let steps = &model.culling().self_steps;
-    let mut nest = Nest::new();
+    let mut nest = Nest::<MAX_DEPTH>::new();
     let mut mask = live;
     let mut i = 0;
     while i < steps.len() && live != 0 {
@@ -513,7 +515,7 @@ fn walk_world(
     for (o, object) in world.objects().iter().enumerate() {
         let (oc, op) = (&object.compiled, &object.placed);
         let obstacle = Obstacle::new(object);
-        let mut nest = Nest::new();
+        let mut nest = Nest::<MAX_DEPTH>::new();
         let mut mask = live;
         let mut s = 0;
         while s < steps.len() && live != 0 {

@@ -40,6 +40,7 @@ use std::sync::Arc;
 use nalgebra::{Point3, Vector3};
 use trm_kinematics::{ActiveSet, BLOCK_LANES, JointKind, PoseBlock, PoseBuffer, PoseLanes32};
 
+use crate::batch::Nest;
 use crate::error::{CollisionError, Result};
 use crate::model::{CollisionModel, PlacedBodies};
 use crate::shape::Shape;
@@ -1437,13 +1438,10 @@ fn check(
             continue;
         }
         let steps = &model.world_steps;
-        let mut open = [(0u32, 0 as LaneMask); MAX_NESTING];
-        let (mut depth, mut mask, mut i) = (0, live, 0);
+        let mut nest = Nest::<MAX_NESTING>::new();
+        let (mut mask, mut i) = (live, 0);
         while i < steps.len() {
-            while depth > 0 && open[depth - 1].0 as usize <= i {
-                depth -= 1;
-                mask = open[depth].1;
-            }
+            mask = nest.close(i, mask, live);
             match steps[i] {
                 WorldStep::Cull { ball, radius, end } => {
                     let c = &scratch.bounds[ball as usize];
@@ -1452,11 +1450,7 @@ fn check(
                         i = end as usize;
                         continue;
                     }
-                    if depth < MAX_NESTING {
-                        open[depth] = (end, mask);
-                        depth += 1;
-                        mask = near;
-                    }
+                    mask = nest.open(end, mask, near);
                 }
                 WorldStep::Link(g) => {
                     let g = g as usize;
@@ -1479,13 +1473,10 @@ fn check(
         return clear_suspects::<AVX>(model, scratch, m, verdict);
     }
     let steps = &model.steps;
-    let mut open = [(0u32, 0 as LaneMask); MAX_NESTING];
-    let (mut depth, mut mask, mut i) = (0, live, 0);
+    let mut nest = Nest::<MAX_NESTING>::new();
+    let (mut mask, mut i) = (live, 0);
     while i < steps.len() {
-        while depth > 0 && open[depth - 1].0 as usize <= i {
-            depth -= 1;
-            mask = open[depth].1;
-        }
+        mask = nest.close(i, mask, live);
         match steps[i] {
             CullStep::Cull { a, b, reach, end } => {
                 let (ca, cb) = (&scratch.bounds[a as usize], &scratch.bounds[b as usize]);
@@ -1495,11 +1486,7 @@ fn check(
                     i = end as usize;
                     continue;
                 }
-                if depth < MAX_NESTING {
-                    open[depth] = (end, mask);
-                    depth += 1;
-                    mask = near;
-                }
+                mask = nest.open(end, mask, near);
             }
             CullStep::Pair(k) => {
                 let gp = &model.group_pairs[k as usize];
@@ -1531,9 +1518,10 @@ fn clear_suspects<const AVX: bool>(
     for (suspect, lanes) in &mut suspects {
         if let Suspect::Pair(k) = *suspect {
             let gp = &model.group_pairs[k as usize];
-            let cleared = kdop_clear::<AVX>(model, gp.a, gp.b, scratch, m)
-                | kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
-            *lanes &= !cleared;
+            *lanes &= !kdop_clear::<AVX>(model, gp.a, gp.b, scratch, m);
+            if *lanes != 0 {
+                *lanes &= !kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
+            }
         }
         verdict.uncertain |= *lanes;
     }
