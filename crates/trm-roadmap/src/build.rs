@@ -9,7 +9,7 @@
 //! threads.
 
 use std::collections::BTreeSet;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use rand::{RngExt, SeedableRng};
@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use trm_kinematics::LANES;
 use trm_optim::{Bounds, Optimizer, Population, Start, StopOptions, Xnes, XnesOptions};
 
-use crate::checkpoint::{Checkpoint, SearchState, StreamPosition};
+use crate::checkpoint::{CHECKPOINT_VERSION, Checkpoint, SearchState, StreamPosition};
 use trm_tasks::spec::{FailureCount, MapSpec};
 use trm_tasks::{Objective, Problem, ScratchPool};
 
@@ -95,14 +95,38 @@ pub struct Progress {
     pub seconds: f64,
 }
 
+/// A running search, as every process of the [`Team`] knows it.
 struct Search {
-    xnes: Xnes,
-    rng: ChaCha8Rng,
+    /// The process that runs it.
+    owner: usize,
+    /// The map point it started from (none for the first search, from the start posture).
     from: Option<usize>,
+    /// Candidates per generation.
+    population: usize,
+    /// g and h* of its last centre (h* NaN before the first generation).
     centre_t: Vec<f64>,
     centre_f: f64,
+    /// Its converged (clamped) mean, once it has stopped.
+    stopped: Option<Vec<f64>>,
+    /// Its distribution and stream, on its owner only.
+    own: Option<Owned>,
+}
+
+/// What only a search's owner holds.
+struct Owned {
+    xnes: Xnes,
+    rng: ChaCha8Rng,
     /// The last ask's candidates, copied into a buffer kept from generation to generation.
     candidates: Population,
+}
+
+/// The process with the fewest running searches (the lowest of ties): the owner of the next.
+fn least_loaded(searches: &[Search], size: usize) -> usize {
+    let mut load = vec![0usize; size];
+    for s in searches {
+        load[s.owner] += 1;
+    }
+    (0..size).min_by_key(|&r| (load[r], r)).unwrap_or(0)
 }
 
 /// The map under construction: points, their index and the SELECTPROPORTIONAL bookkeeping.
@@ -187,39 +211,62 @@ pub const MAX_POINTS: usize = 10_000_000;
 /// The most concurrent searches P.
 pub const MAX_SEARCHES: usize = 4096;
 
-/// Where a build's candidates are evaluated: h(q) and g(q) for a batch, on this process's
-/// threads ([`Threads`]) or spread over processes (the `mpi` feature's `trm_roadmap::mpi`).
-/// Every evaluation of an [`Objective`] gives the same bits however candidates are split, so a
-/// seed and P give the same map whatever evaluates them.
-pub trait Evaluator {
-    /// h(qs\[k\]) into `fitness[k]` and g(qs\[k\]) into `tasks[k·dim..(k + 1)·dim]`.
-    fn evaluate(
-        &mut self,
-        objective: &Objective,
-        qs: &[&[f64]],
-        fitness: &mut [f64],
-        tasks: &mut [f64],
-    ) -> Result<()>;
+/// The processes a build is shared among. Every process runs the same build (the same problem,
+/// options and seed) and keeps the same map; each owns some of the P concurrent searches, whose
+/// asks, evaluations, h_map and tells it runs on its own threads, and after every generation
+/// they exchange the searches' centres and outcomes. Every evaluation gives the same bits
+/// wherever it runs and the map changes only between generations, in search order, so a seed
+/// and P give the same map on any number of processes × threads. [`Solo`] is this process
+/// alone; the `mpi` feature's `trm_roadmap::mpi::Ranks` the ranks of an MPI communicator.
+pub trait Team {
+    /// This process's index, `0..size()`. Rank 0 writes the checkpoints.
+    fn rank(&self) -> usize;
+    /// The number of processes.
+    fn size(&self) -> usize;
+    /// Every process's `mine`, in rank order, on every process. Collective: every process
+    /// calls it at the same point of the build.
+    fn all_gather(&mut self, mine: &[u8]) -> Result<Vec<Vec<u8>>>;
 }
 
-/// Evaluates on the threads of the current rayon pool, [`LANES`] candidates at a time, with
-/// scratch buffers kept from call to call (no allocation per evaluation).
-#[derive(Debug, Default)]
-pub struct Threads {
-    scratch: ScratchPool,
-}
+/// A team of one: the build runs in this process, on the threads of the current rayon pool.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Solo;
 
-impl Evaluator for Threads {
-    fn evaluate(
-        &mut self,
-        objective: &Objective,
-        qs: &[&[f64]],
-        fitness: &mut [f64],
-        tasks: &mut [f64],
-    ) -> Result<()> {
-        evaluate_on_threads(objective, qs, fitness, tasks, &self.scratch);
-        Ok(())
+impl Team for Solo {
+    fn rank(&self) -> usize {
+        0
     }
+    fn size(&self) -> usize {
+        1
+    }
+    fn all_gather(&mut self, mine: &[u8]) -> Result<Vec<Vec<u8>>> {
+        Ok(vec![mine.to_vec()])
+    }
+}
+
+/// The contiguous slice of `n` items that rank `rank` of `size` takes.
+pub(crate) fn share(n: usize, size: usize, rank: usize) -> std::ops::Range<usize> {
+    n * rank / size..n * (rank + 1) / size
+}
+
+/// Each process's values, gathered on every process and concatenated in rank order: `mine` as
+/// little-endian bits, so every f64 arrives bit for bit.
+pub(crate) fn all_gather_f64(team: &mut dyn Team, mine: &[f64]) -> Result<Vec<f64>> {
+    let bytes: Vec<u8> = mine.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let mut all = Vec::new();
+    for (rank, part) in team.all_gather(&bytes)?.into_iter().enumerate() {
+        if part.len() % 8 != 0 {
+            return Err(RoadmapError::Unsuitable(format!(
+                "process {rank} of the build sent {} bytes, not whole numbers; start every process with the same spec and options",
+                part.len()
+            )));
+        }
+        all.extend(
+            part.chunks_exact(8)
+                .map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())),
+        );
+    }
+    Ok(all)
 }
 
 thread_local! {
@@ -227,7 +274,7 @@ thread_local! {
     static NEAREST: std::cell::RefCell<Vec<(f64, usize)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time ([`Threads`]),
+/// h and g of `qs` on the current rayon pool's threads, [`LANES`] at a time,
 /// with scratch buffers from `pool`.
 pub fn evaluate_on_threads(
     objective: &Objective,
@@ -356,22 +403,57 @@ impl State {
         }
     }
 
-    fn checkpoint(&self, setup: &Setup, every: usize, seconds: f64) -> Result<Checkpoint> {
+    /// The checkpoint of this state, on rank 0 (`None` on the other processes, which send it
+    /// their searches' distributions).
+    fn checkpoint(
+        &self,
+        setup: &Setup,
+        every: usize,
+        seconds: f64,
+        team: &mut dyn Team,
+    ) -> Result<Option<Checkpoint>> {
         let problem = setup.problem;
-        let running = self
+        let owned = self
             .searches
             .iter()
-            .map(|s| {
-                Ok(SearchState {
-                    xnes: s.xnes.snapshot()?,
-                    rng: StreamPosition::of(&s.rng),
-                    from: s.from,
-                    centre_t: s.centre_t.clone(),
-                    centre_f: s.centre_f,
-                })
+            .enumerate()
+            .filter_map(|(i, s)| s.own.as_ref().map(|own| (i, s, own)))
+            .map(|(i, s, own)| {
+                Ok((
+                    i,
+                    SearchState {
+                        xnes: own.xnes.snapshot()?,
+                        rng: StreamPosition::of(&own.rng),
+                        from: s.from,
+                        centre_t: s.centre_t.clone(),
+                        centre_f: s.centre_f,
+                    },
+                ))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Checkpoint {
+        let label = Path::new("the running searches");
+        let format = "trm-searches";
+        let bytes = trm_io::binary_bytes(label, &owned, format, CHECKPOINT_VERSION)?;
+        let parts = team.all_gather(&bytes)?;
+        if team.rank() != 0 {
+            return Ok(None);
+        }
+        let mut running = vec![None; self.searches.len()];
+        for part in parts {
+            let states: Vec<(usize, SearchState)> =
+                trm_io::parse_binary_versioned(label, &part, format, CHECKPOINT_VERSION)?;
+            for (i, state) in states {
+                if let Some(slot) = running.get_mut(i) {
+                    *slot = Some(state);
+                }
+            }
+        }
+        let running = running.into_iter().collect::<Option<Vec<_>>>().ok_or_else(|| {
+            RoadmapError::Unsuitable(
+                "a process of the build sent no state for a search it runs; start every process with the same spec and options".into(),
+            )
+        })?;
+        Ok(Some(Checkpoint {
             software: software(),
             spec_path: problem.origin.clone(),
             spec: problem.text.clone(),
@@ -391,7 +473,7 @@ impl State {
             total_failures: self.total_failures,
             evaluations: self.evaluations,
             seconds,
-        })
+        }))
     }
 
     /// A build continuing from `points` (a repair): searches start only from the points
@@ -411,8 +493,9 @@ impl State {
         state
     }
 
-    /// The state a checkpoint holds, for `setup` (which checked the checkpoint's settings).
-    fn restore(setup: &Setup, checkpoint: Checkpoint) -> Result<Self> {
+    /// The state a checkpoint holds, for `setup` (which checked the checkpoint's settings), with
+    /// the searches shared among `team` as the build shares them.
+    fn restore(setup: &Setup, checkpoint: Checkpoint, team: &dyn Team) -> Result<Self> {
         let unfit = |what: String| {
             RoadmapError::Unsuitable(format!(
                 "the checkpoint does not fit its own spec ({}): {what}; start the build again",
@@ -434,24 +517,28 @@ impl State {
             map.add(point, 1.5 * setup.settings.spacing, &mut near, true);
             map.set_fails(i, fails);
         }
-        let searches = checkpoint
-            .running
-            .into_iter()
-            .map(|s| {
-                let xnes = Xnes::resume(s.xnes)?;
-                if xnes.dim() != n || s.centre_t.len() != setup.dim {
-                    return Err(unfit("a running search has the wrong dimension".into()));
-                }
-                Ok(Search {
+        let mut searches: Vec<Search> = Vec::with_capacity(checkpoint.running.len());
+        for s in checkpoint.running {
+            let xnes = Xnes::resume(s.xnes)?;
+            if xnes.dim() != n || s.centre_t.len() != setup.dim {
+                return Err(unfit("a running search has the wrong dimension".into()));
+            }
+            // owners as the build assigned them, search by search
+            let owner = least_loaded(&searches, team.size());
+            searches.push(Search {
+                owner,
+                from: s.from,
+                population: xnes.population(),
+                centre_t: s.centre_t,
+                centre_f: s.centre_f,
+                stopped: None,
+                own: (owner == team.rank()).then(|| Owned {
                     xnes,
                     rng: s.rng.rng(setup.seed),
-                    from: s.from,
-                    centre_t: s.centre_t,
-                    centre_f: s.centre_f,
                     candidates: Population::default(),
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
+                }),
+            });
+        }
         Ok(State {
             master: checkpoint.master.rng(setup.seed),
             map,
@@ -485,28 +572,23 @@ pub fn build(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    build_with(problem, options, &mut Threads::default(), progress)
+    build_with(problem, options, &mut Solo, progress)
 }
 
-/// [`build`] with the candidates evaluated by `evaluator` (e.g. across MPI processes): the
-/// same map as [`build`].
+/// [`build`] shared among the processes of `team` (e.g. the ranks of an MPI job: every one
+/// calls it with the same problem and options, and every one returns the map): the same map as
+/// [`build`].
 pub fn build_with(
     problem: &Problem,
     options: &BuildOptions,
-    evaluator: &mut dyn Evaluator,
+    team: &mut dyn Team,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     let mut setup = Setup::new(problem, options.points, options.searches, options.seed)?;
     setup.max_generations = options.max_generations;
     setup.repel_weight = options.repel_weight;
     let state = State::fresh(&setup);
-    run(
-        &setup,
-        state,
-        options.checkpoint.as_ref(),
-        evaluator,
-        progress,
-    )
+    run(&setup, state, options.checkpoint.as_ref(), team, progress)
 }
 
 /// A map ready to plan with: built ([`build`]) and connected ([`connect`]: each point to the
@@ -517,29 +599,30 @@ pub fn build_connected(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    build_connected_with(problem, options, None, &mut Threads::default(), progress)
+    build_connected_with(problem, options, None, &mut Solo, progress)
 }
 
 /// [`build_connected`] finishing a killed build from its checkpoint when `resumed` is given
-/// ([`resume_with`]), the candidates evaluated by `evaluator` ([`build_with`]).
+/// ([`resume_with`]), shared among `team` as [`build_with`] shares a build (the edges too).
 pub fn build_connected_with(
     problem: &Problem,
     options: &BuildOptions,
     resumed: Option<Checkpoint>,
-    evaluator: &mut dyn Evaluator,
+    team: &mut dyn Team,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     crate::edges::check_edge_resolution(options.edge_resolution)?;
     let mut map = match resumed {
-        Some(checkpoint) => resume_with(problem, checkpoint, options, evaluator, progress)?,
-        None => build_with(problem, options, evaluator, progress)?,
+        Some(checkpoint) => resume_with(problem, checkpoint, options, team, progress)?,
+        None => build_with(problem, options, team, progress)?,
     };
     let neighbours = map.settings.edge_neighbours;
-    crate::edges::connect(
+    crate::edges::connect_with(
         &mut map,
         &problem.objective,
         neighbours,
         options.edge_resolution,
+        team,
     )?;
     Ok(map)
 }
@@ -555,21 +638,15 @@ pub fn resume(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    resume_with(
-        problem,
-        checkpoint,
-        options,
-        &mut Threads::default(),
-        progress,
-    )
+    resume_with(problem, checkpoint, options, &mut Solo, progress)
 }
 
-/// [`resume`] with the candidates evaluated by `evaluator`, as [`build_with`].
+/// [`resume`] shared among `team`, as [`build_with`] (every process gives it the checkpoint).
 pub fn resume_with(
     problem: &Problem,
     checkpoint: Checkpoint,
     options: &BuildOptions,
-    evaluator: &mut dyn Evaluator,
+    team: &mut dyn Team,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     for (what, given, stored) in [
@@ -601,14 +678,8 @@ pub fn resume_with(
     )?;
     setup.max_generations = checkpoint.max_generations;
     setup.repel_weight = checkpoint.repel_weight;
-    let state = State::restore(&setup, checkpoint)?;
-    run(
-        &setup,
-        state,
-        options.checkpoint.as_ref(),
-        evaluator,
-        progress,
-    )
+    let state = State::restore(&setup, checkpoint, team)?;
+    run(&setup, state, options.checkpoint.as_ref(), team, progress)
 }
 
 /// Algorithm 2 from `state` on; see the module documentation.
@@ -616,7 +687,7 @@ pub(crate) fn run(
     setup: &Setup,
     mut state: State,
     checkpoint: Option<&CheckpointOptions>,
-    evaluator: &mut dyn Evaluator,
+    team: &mut dyn Team,
     mut progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
     let problem = setup.problem;
@@ -641,11 +712,15 @@ pub(crate) fn run(
     let mut near = Vec::new();
     let stopped_because;
 
+    let pool = ScratchPool::default();
+    let (rank, size) = (team.rank(), team.size());
     loop {
         if let Some(c) = checkpoint
             && state.map.points.len() >= checkpointed + c.every
         {
-            state.checkpoint(setup, c.every, seconds())?.save(&c.path)?;
+            if let Some(file) = state.checkpoint(setup, c.every, seconds(), team)? {
+                file.save(&c.path)?;
+            }
             checkpointed = state.map.points.len();
         }
         let State {
@@ -670,15 +745,25 @@ pub(crate) fn run(
             stopped_because = format!("{counted} {which} (k = {})", settings.failure_limit);
             break;
         }
-        if setup.deadline.is_some_and(|d| Instant::now() >= d) {
-            stopped_because = "time budget spent".to_string();
-            break;
+        if let Some(deadline) = setup.deadline {
+            // rank 0's clock decides for every process
+            let now = [f64::from(u8::from(Instant::now() >= deadline))];
+            let spent = if size > 1 {
+                all_gather_f64(team, &now)?[0]
+            } else {
+                now[0]
+            };
+            if spent != 0.0 {
+                stopped_because = "time budget spent".to_string();
+                break;
+            }
         }
         if setup.max_evaluations.is_some_and(|m| *evaluations >= m) {
             stopped_because = format!("evaluation budget spent ({} evaluations)", *evaluations);
             break;
         }
-        // start searches: one from home while the map is empty, then up to P
+        // start searches: one from home while the map is empty, then up to P; each on the
+        // process that runs the fewest
         let wanted = if map.points.is_empty() {
             1
         } else {
@@ -690,35 +775,48 @@ pub(crate) fn run(
                 Some(i) => (map.points[i].q.clone(), settings.later_search),
                 None => (problem.start.clone(), settings.first_search),
             };
-            let start = Start::new(q0, sigma)
-                .with_bounds(bounds.clone())
-                .with_stop(StopOptions {
-                    center_stagnation: Some((20, 40)),
-                    max_generations: Some(setup.max_generations),
-                    tol_x: None,
-                    tol_fun: None,
-                    ..Default::default()
-                });
-            let xnes = Xnes::new(
-                &start,
-                &XnesOptions {
-                    population: Some(lambda),
-                    ..Default::default()
-                },
-            )?;
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream(*started_count + 1);
+            let owner = least_loaded(searches, size);
+            let own = if owner == rank {
+                let start =
+                    Start::new(q0, sigma)
+                        .with_bounds(bounds.clone())
+                        .with_stop(StopOptions {
+                            center_stagnation: Some((20, 40)),
+                            max_generations: Some(setup.max_generations),
+                            tol_x: None,
+                            tol_fun: None,
+                            ..Default::default()
+                        });
+                let xnes = Xnes::new(
+                    &start,
+                    &XnesOptions {
+                        population: Some(lambda),
+                        ..Default::default()
+                    },
+                )?;
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                rng.set_stream(*started_count + 1);
+                Some(Owned {
+                    xnes,
+                    rng,
+                    candidates: Population::default(),
+                })
+            } else {
+                None
+            };
             *started_count += 1;
             searches.push(Search {
-                xnes,
-                rng,
+                owner,
                 from,
+                population: lambda,
                 centre_t: vec![0.0; dim],
                 centre_f: f64::NAN,
-                candidates: Population::default(),
+                stopped: None,
+                own,
             });
         }
-        // one generation of every search: ask, evaluate all candidates in parallel, tell
+        // one generation of every search: each process asks its searches, evaluates their
+        // candidates in parallel and tells them
         let parallel_start = Instant::now();
         let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
         let have_centres = searches
@@ -726,13 +824,15 @@ pub(crate) fn run(
             .map(|s| s.centre_f.is_finite())
             .collect::<Vec<_>>();
         // asks in parallel (each search draws from its own stream)
-        searches.par_iter_mut().for_each(|s| {
-            s.candidates.clone_from(s.xnes.ask(&mut s.rng));
-        });
+        searches
+            .par_iter_mut()
+            .filter_map(|s| s.own.as_mut())
+            .for_each(|own| own.candidates.clone_from(own.xnes.ask(&mut own.rng)));
         let jobs: Vec<(usize, &[f64])> = searches
             .iter()
             .enumerate()
-            .flat_map(|(i, s)| s.candidates.iter().map(move |x| (i, x)))
+            .filter_map(|(i, s)| s.own.as_ref().map(|own| (i, own)))
+            .flat_map(|(i, own)| own.candidates.iter().map(move |x| (i, x)))
             .collect();
         // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
         let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {
@@ -753,15 +853,11 @@ pub(crate) fn run(
             h += setup.repel_weight * h_rep;
             h
         };
-        // h* of (search, candidate) jobs: h and g by the evaluator, then h_map and h_repel in
-        // parallel batches: `fitness[k]`, and g in `tasks[k·dim..]`
-        let evaluate = |evaluator: &mut dyn Evaluator,
-                        jobs: &[(usize, &[f64])],
-                        fitness: &mut [f64],
-                        tasks: &mut [f64]|
-         -> Result<()> {
+        // h* of (search, candidate) jobs: h and g on this process's threads, then h_map and
+        // h_repel in parallel batches: `fitness[k]`, and g in `tasks[k·dim..]`
+        let evaluate = |jobs: &[(usize, &[f64])], fitness: &mut [f64], tasks: &mut [f64]| {
             let qs: Vec<&[f64]> = jobs.iter().map(|job| job.1).collect();
-            evaluator.evaluate(objective, &qs, fitness, tasks)?;
+            evaluate_on_threads(objective, &qs, fitness, tasks, &pool);
             fitness
                 .par_chunks_mut(LANES)
                 .zip(tasks.par_chunks(LANES * dim))
@@ -774,47 +870,80 @@ pub(crate) fn run(
                         }
                     })
                 });
-            Ok(())
         };
-        // every candidate of every search
+        // every candidate of this process's searches
         let mut fitness = vec![0.0; jobs.len()];
         let mut tasks = vec![0.0; jobs.len() * dim];
-        evaluate(evaluator, &jobs, &mut fitness, &mut tasks)?;
-        *evaluations += jobs.len() as u64;
+        evaluate(&jobs, &mut fitness, &mut tasks);
         // tells in parallel, one task per search; then every search's centre
         let mut offsets = Vec::with_capacity(searches.len());
         let mut offset = 0;
         for s in searches.iter() {
             offsets.push(offset);
-            offset += s.xnes.population();
+            offset += s.own.as_ref().map_or(0, |_| s.population);
         }
-        let told: Vec<trm_optim::Result<Vec<f64>>> = searches
+        let told: Vec<trm_optim::Result<(usize, Vec<f64>)>> = searches
             .par_iter_mut()
             .enumerate()
-            .map(|(i, s)| {
-                let n = s.xnes.population();
-                s.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
-                let mut q = s.xnes.mean().to_vec();
+            .filter_map(|(i, s)| s.own.as_mut().map(|own| (i, s.population, own)))
+            .map(|(i, n, own)| {
+                own.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
+                let mut q = own.xnes.mean().to_vec();
                 bounds.clamp(&mut q);
-                Ok(q)
+                Ok((i, q))
             })
             .collect();
         let centre_qs = told.into_iter().collect::<trm_optim::Result<Vec<_>>>()?;
-        let centre_jobs: Vec<(usize, &[f64])> = centre_qs
-            .iter()
-            .enumerate()
-            .map(|(i, q)| (i, q.as_slice()))
-            .collect();
-        let mut centre_f = vec![0.0; searches.len()];
-        let mut centre_t = vec![0.0; searches.len() * dim];
-        evaluate(evaluator, &centre_jobs, &mut centre_f, &mut centre_t)?;
-        for (i, s) in searches.iter_mut().enumerate() {
-            s.xnes.record_center_fitness(&centre_qs[i], centre_f[i]);
-            s.centre_f = centre_f[i];
-            s.centre_t
-                .copy_from_slice(&centre_t[i * dim..(i + 1) * dim]);
+        let centre_jobs: Vec<(usize, &[f64])> =
+            centre_qs.iter().map(|(i, q)| (*i, q.as_slice())).collect();
+        let mut centre_f = vec![0.0; centre_jobs.len()];
+        let mut centre_t = vec![0.0; centre_jobs.len() * dim];
+        evaluate(&centre_jobs, &mut centre_f, &mut centre_t);
+        // each search's outcome: [index, h* and g of its centre, whether it stopped, its mean]
+        let mut outcomes = Vec::new();
+        for (k, (i, q)) in centre_qs.iter().enumerate() {
+            let Some(own) = searches[*i].own.as_mut() else {
+                continue;
+            };
+            own.xnes.record_center_fitness(q, centre_f[k]);
+            let stopped = !own.xnes.stop().is_empty();
+            outcomes.push(*i as f64);
+            outcomes.push(centre_f[k]);
+            outcomes.extend_from_slice(&centre_t[k * dim..(k + 1) * dim]);
+            outcomes.push(f64::from(u8::from(stopped)));
+            outcomes.extend_from_slice(q);
         }
-        *evaluations += searches.len() as u64;
+        let outcomes = if size > 1 {
+            all_gather_f64(team, &outcomes)?
+        } else {
+            outcomes
+        };
+        let record = 3 + dim + objective.dim();
+        if outcomes.len() != searches.len() * record {
+            return Err(RoadmapError::Unsuitable(format!(
+                "the processes of the build reported {} values for {} searches; start every process with the same spec and options",
+                outcomes.len(),
+                searches.len()
+            )));
+        }
+        let running = searches.len();
+        for outcome in outcomes.chunks_exact(record) {
+            let s = searches.get_mut(outcome[0] as usize).ok_or_else(|| {
+                RoadmapError::Unsuitable(format!(
+                    "a process of the build reported search {} of {running}",
+                    outcome[0]
+                ))
+            })?;
+            s.centre_f = outcome[1];
+            s.centre_t.copy_from_slice(&outcome[2..2 + dim]);
+            if outcome[2 + dim] != 0.0 {
+                s.stopped = Some(outcome[3 + dim..].to_vec());
+            }
+        }
+        *evaluations += searches
+            .iter()
+            .map(|s| s.population as u64 + 1)
+            .sum::<u64>();
         parallel_seconds += parallel_start.elapsed().as_secs_f64();
         generations += 1;
 
@@ -822,13 +951,12 @@ pub(crate) fn run(
         let mut changed = false;
         let mut k = 0;
         while k < searches.len() {
-            if searches[k].xnes.stop().is_empty() {
+            if searches[k].stopped.is_none() {
                 k += 1;
                 continue;
             }
             let s = searches.remove(k);
-            let mut q = s.xnes.mean().to_vec();
-            bounds.clamp(&mut q);
+            let q = s.stopped.unwrap_or_default();
             let mut scratch = objective.scratch();
             let mut t = vec![0.0; dim];
             let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
@@ -869,7 +997,9 @@ pub(crate) fn run(
         }
     }
     if let Some(c) = checkpoint {
-        state.checkpoint(setup, c.every, seconds())?.save(&c.path)?;
+        if let Some(file) = state.checkpoint(setup, c.every, seconds(), team)? {
+            file.save(&c.path)?;
+        }
     }
     let build_seconds = seconds();
     progress(&Progress {
@@ -908,4 +1038,43 @@ pub(crate) fn run(
             threads: rayon::current_num_threads(),
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shares_cover_every_item_once() {
+        for n in [0, 1, 5, 31, 120] {
+            for size in 1..6 {
+                let mut next = 0;
+                for rank in 0..size {
+                    let s = share(n, size, rank);
+                    assert_eq!(s.start, next);
+                    next = s.end;
+                }
+                assert_eq!(next, n);
+            }
+        }
+    }
+
+    #[test]
+    fn new_searches_go_to_the_least_loaded_process() {
+        let on = |owner| Search {
+            owner,
+            from: None,
+            population: 2,
+            centre_t: Vec::new(),
+            centre_f: f64::NAN,
+            stopped: None,
+            own: None,
+        };
+        assert_eq!(least_loaded(&[], 3), 0);
+        assert_eq!(least_loaded(&[on(0)], 3), 1);
+        assert_eq!(least_loaded(&[on(0), on(1)], 3), 2);
+        assert_eq!(least_loaded(&[on(0), on(1), on(2)], 3), 0);
+        assert_eq!(least_loaded(&[on(1), on(2), on(1)], 3), 0);
+        assert_eq!(least_loaded(&[on(0), on(0)], 1), 0);
+    }
 }

@@ -8,6 +8,7 @@ use trm_collision::World;
 use trm_kinematics::LANES;
 use trm_tasks::{Objective, Scratch};
 
+use crate::build::{Solo, Team, all_gather_f64, share};
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
 
@@ -34,6 +35,18 @@ pub fn connect(
     neighbours: usize,
     resolution: f64,
 ) -> Result<()> {
+    connect_with(map, objective, neighbours, resolution, &mut Solo)
+}
+
+/// [`connect`] shared among the processes of `team` (each checks the edges of a slice of the
+/// points; every one calls it and gets every edge): the same edges.
+pub fn connect_with(
+    map: &mut Roadmap,
+    objective: &Objective,
+    neighbours: usize,
+    resolution: f64,
+    team: &mut dyn Team,
+) -> Result<()> {
     if neighbours == 0 {
         return Err(RoadmapError::Unsuitable(
             "0 edge neighbours: give at least 1 (spec `map.edge_neighbours`)".into(),
@@ -48,10 +61,45 @@ pub fn connect(
         )));
     }
     let started = Instant::now();
-    map.edges = edges_from(map, objective, neighbours, resolution, 0);
+    let points = share(map.points.len(), team.size(), team.rank());
+    let mine = edges_of(map, objective, neighbours, resolution, points);
+    let flat: Vec<f64> = mine
+        .iter()
+        .flat_map(|&(i, j, l)| [i as f64, j as f64, l])
+        .collect();
+    let all = if team.size() > 1 {
+        all_gather_f64(team, &flat)?
+    } else {
+        flat
+    };
+    let n = map.points.len();
+    let foreign = || {
+        RoadmapError::Unsuitable(
+            "a process of the build sent edges of another map; start every process with the same spec and options".into(),
+        )
+    };
+    if all.len() % 3 != 0 {
+        return Err(foreign());
+    }
+    let mut edges = Vec::with_capacity(all.len() / 3);
+    for e in all.chunks_exact(3) {
+        let (i, j) = (e[0] as usize, e[1] as usize);
+        if i >= n || j >= n {
+            return Err(foreign());
+        }
+        edges.push((i, j, e[2]));
+    }
+    sorted_unique(&mut edges);
+    map.edges = edges;
     map.edge_resolution = resolution;
     map.stats.edge_seconds = started.elapsed().as_secs_f64();
     Ok(())
+}
+
+/// Sorts edges by their ends and drops repeats.
+fn sorted_unique(edges: &mut Vec<(usize, usize, f64)>) {
+    edges.sort_by_key(|e| (e.0, e.1));
+    edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
 }
 
 /// Adds to `map`'s edges those of points `from..` to their `neighbours` nearest points (as
@@ -64,26 +112,31 @@ pub(crate) fn connect_from(
     from: usize,
 ) -> Result<()> {
     check_edge_resolution(resolution)?;
-    let mut edges = edges_from(map, objective, neighbours, resolution, from);
+    let mut edges = edges_of(
+        map,
+        objective,
+        neighbours,
+        resolution,
+        from..map.points.len(),
+    );
     edges.extend_from_slice(&map.edges);
-    edges.sort_by_key(|e| (e.0, e.1));
-    edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    sorted_unique(&mut edges);
     map.edges = edges;
     map.edge_resolution = resolution;
     Ok(())
 }
 
-/// The collision-free edges of points `from..` to their `neighbours` nearest points, sorted
+/// The collision-free edges of the points in `of` to their `neighbours` nearest points, sorted
 /// and without duplicates.
-fn edges_from(
+fn edges_of(
     map: &Roadmap,
     objective: &Objective,
     neighbours: usize,
     resolution: f64,
-    from: usize,
+    of: std::ops::Range<usize>,
 ) -> Vec<(usize, usize, f64)> {
     let points = &map.points;
-    let mut edges: Vec<(usize, usize, f64)> = (from..points.len())
+    let mut edges: Vec<(usize, usize, f64)> = of
         .into_par_iter()
         .map_init(
             || (objective.scratch(), Vec::new()),
@@ -114,8 +167,7 @@ fn edges_from(
         )
         .flatten()
         .collect();
-    edges.sort_by_key(|e| (e.0, e.1));
-    edges.dedup_by(|a, b| a.0 == b.0 && a.1 == b.1);
+    sorted_unique(&mut edges);
     edges
 }
 

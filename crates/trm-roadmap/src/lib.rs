@@ -1,8 +1,8 @@
 //! Task-relevant roadmaps: maps of postures that evenly cover a task space while satisfying a
 //! task's costs (Stollenga et al., IROS 2013; parallel E-TRM of Stollenga, Schmidhuber and
 //! Gomez). [`build`] grows a map with P concurrent xNES searches (writing [`Checkpoint`]s that
-//! [`resume`] finishes exactly; [`build_with`] evaluates the candidates elsewhere, e.g. across
-//! MPI processes with the `mpi` feature's `trm_roadmap::mpi`), [`connect`] adds
+//! [`resume`] finishes exactly; [`build_with`] shares a build among processes, e.g. the ranks
+//! of an MPI job with the `mpi` feature's `trm_roadmap::mpi`), [`connect`] adds
 //! configuration-space edges, and [`Roadmap`] saves and loads map files.
 //!
 //! ```no_run
@@ -26,13 +26,13 @@ mod repair;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
-    BuildOptions, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, Evaluator, MAX_POINTS, MAX_SEARCHES,
-    Progress, Threads, build, build_connected, build_connected_with, build_with,
-    evaluate_on_threads, resume, resume_with,
+    BuildOptions, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, MAX_POINTS, MAX_SEARCHES, Progress,
+    Solo, Team, build, build_connected, build_connected_with, build_with, evaluate_on_threads,
+    resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
-    MIN_RESOLUTION, check_edge_resolution, connect, distance, rake, segment_all,
+    MIN_RESOLUTION, check_edge_resolution, connect, connect_with, distance, rake, segment_all,
     segment_is_collision_free, segment_is_free,
 };
 pub use error::{Result, RoadmapError};

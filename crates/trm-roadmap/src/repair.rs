@@ -15,7 +15,7 @@ use trm_collision::World;
 use trm_tasks::Problem;
 
 use crate::blocked::{BlockIndex, Changes};
-use crate::build::{Region, Setup, State, Threads, run};
+use crate::build::{Region, Setup, Solo, State, run};
 use crate::edges::connect_from;
 use crate::error::{Result, RoadmapError};
 use crate::index::TaskIndex;
@@ -302,7 +302,7 @@ impl<'p> LiveMap<'p> {
             &setup,
             State::from_points(&setup, current),
             None,
-            &mut Threads::default(),
+            &mut Solo,
             |_| {},
         )?;
         report.stopped_because = grown.stats.stopped_because.clone();
@@ -320,7 +320,7 @@ impl<'p> LiveMap<'p> {
                 .evaluations
                 .map(|m| m.saturating_sub(grown.stats.evaluations));
             let state = State::from_points(&setup, points);
-            let refilled = run(&setup, state, None, &mut Threads::default(), |_| {})?;
+            let refilled = run(&setup, state, None, &mut Solo, |_| {})?;
             report.stopped_because = refilled.stats.stopped_because;
             points = refilled.points;
         }

@@ -2,7 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use trm_roadmap::{BuildOptions, Checkpoint, CheckpointOptions, Roadmap, build, connect, resume};
+use std::sync::{Arc, Barrier, Mutex};
+
+use trm_roadmap::{
+    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build, build_connected_with,
+    connect, resume,
+};
 use trm_tasks::Problem;
 
 fn reach() -> Problem {
@@ -167,6 +172,102 @@ fn resumed_builds_give_the_uninterrupted_map() {
     }
     let _ = std::fs::remove_file(&path);
     let _ = std::fs::remove_file(&damaged);
+}
+
+/// Threads of this process standing in for the processes of an MPI job: each runs the build
+/// as a rank does, exchanging through a shared board.
+struct Board {
+    slots: Mutex<Vec<Vec<u8>>>,
+    barrier: Barrier,
+}
+
+struct Member {
+    rank: usize,
+    size: usize,
+    board: Arc<Board>,
+}
+
+impl Team for Member {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+    fn size(&self) -> usize {
+        self.size
+    }
+    fn all_gather(&mut self, mine: &[u8]) -> trm_roadmap::Result<Vec<Vec<u8>>> {
+        self.board.slots.lock().unwrap()[self.rank] = mine.to_vec();
+        self.board.barrier.wait();
+        let all = self.board.slots.lock().unwrap().clone();
+        self.board.barrier.wait();
+        Ok(all)
+    }
+}
+
+/// `f` run by every member of a team of `size`, in rank order.
+fn on_team<T: Send>(size: usize, f: impl Fn(&mut dyn Team) -> T + Sync) -> Vec<T> {
+    let board = Arc::new(Board {
+        slots: Mutex::new(vec![Vec::new(); size]),
+        barrier: Barrier::new(size),
+    });
+    std::thread::scope(|s| {
+        let members: Vec<_> = (0..size)
+            .map(|rank| {
+                let (f, board) = (&f, board.clone());
+                s.spawn(move || f(&mut Member { rank, size, board }))
+            })
+            .collect();
+        members.into_iter().map(|m| m.join().unwrap()).collect()
+    })
+}
+
+/// A build shared among 2 or 3 processes (threads here, MPI ranks in `xtask/tests/mpi.rs`),
+/// each running some of the searches and a slice of the edge checks, gives every one of them
+/// the map one process builds, edges included; a checkpoint written by a team of 3 resumes on
+/// a team of 2 to it.
+#[test]
+fn a_build_shared_among_processes_gives_the_map_of_one() {
+    let problem = reach();
+    let options = BuildOptions {
+        points: Some(40),
+        ..Default::default()
+    };
+    let alone =
+        build_connected_with(&problem, &options, None, &mut trm_roadmap::Solo, |_| {}).unwrap();
+    for size in [2, 3] {
+        let maps = on_team(size, |team| {
+            build_connected_with(&problem, &options, None, team, |_| {}).unwrap()
+        });
+        for (rank, map) in maps.iter().enumerate() {
+            assert_eq!(map.points, alone.points, "{size} processes, rank {rank}");
+            assert_eq!(map.edges, alone.edges, "{size} processes, rank {rank}");
+            assert_eq!(map.stats.evaluations, alone.stats.evaluations);
+            assert_eq!(map.stats.searches_started, alone.stats.searches_started);
+        }
+    }
+    let path = tmp("team.checkpoint");
+    let first = BuildOptions {
+        points: Some(25),
+        checkpoint: Some(CheckpointOptions {
+            path: path.clone(),
+            every: 10,
+        }),
+        ..Default::default()
+    };
+    on_team(3, |team| {
+        build_connected_with(&problem, &first, None, team, |_| {}).unwrap()
+    });
+    let checkpoint = Checkpoint::load(&path).unwrap();
+    assert_eq!(checkpoint.points(), 25);
+    let maps = on_team(2, |team| {
+        let checkpoint = checkpoint.clone();
+        build_connected_with(&problem, &options, Some(checkpoint), team, |_| {}).unwrap()
+    });
+    for map in maps {
+        assert_eq!(map.points, alone.points);
+        assert_eq!(map.edges, alone.edges);
+        assert_eq!(map.stats.evaluations, alone.stats.evaluations);
+    }
+    let _ = std::fs::remove_file(&path);
 }
 
 #[test]

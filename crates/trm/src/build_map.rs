@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Evaluator, Roadmap, Threads, build_connected_with,
+    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Solo, Team, build_connected_with,
 };
 use trm_tasks::Problem;
 
@@ -149,11 +149,11 @@ pub fn run(args: &Args) -> Result<()> {
     if args.mpi {
         return crate::distributed::build_map(job, resumed);
     }
-    job.run(resumed, &mut Threads::default())
+    job.run(resumed, &mut Solo)
 }
 
-/// A build-map run, ready to go: its evaluations on this process's threads or spread over the
-/// ranks of an MPI job.
+/// A build-map run, ready to go: on this process's threads, or shared among the ranks of an MPI
+/// job.
 pub struct Job<'a> {
     /// The arguments.
     pub args: &'a Args,
@@ -166,17 +166,22 @@ pub struct Job<'a> {
 }
 
 impl Job<'_> {
-    /// Builds (or resumes), connects and writes the map, evaluating with `evaluator`.
-    pub fn run(self, resumed: Option<Checkpoint>, evaluator: &mut dyn Evaluator) -> Result<()> {
+    /// Builds (or resumes), connects and writes the map, shared among `team`: every process
+    /// builds, rank 0 shows progress and writes.
+    pub fn run(self, resumed: Option<Checkpoint>, team: &mut dyn Team) -> Result<()> {
         let Job {
             args,
             problem,
             options,
             out,
         } = self;
+        let writes = team.rank() == 0;
         let mut progress = crate::progress::Progress::new("points", 0);
         let map = (|| -> Result<Roadmap> {
             let report = |p: &trm_roadmap::Progress| {
+                if !writes {
+                    return;
+                }
                 let rate = p.evaluations as f64 / p.seconds.max(1e-9);
                 progress.set(
                     p.points as u64,
@@ -187,10 +192,15 @@ impl Job<'_> {
                     ),
                 );
             };
-            let map = build_connected_with(problem, options, resumed, evaluator, report)?;
-            progress.finish();
+            let map = build_connected_with(problem, options, resumed, team, report)?;
+            if writes {
+                progress.finish();
+            }
             Ok(map)
         })()?;
+        if !writes {
+            return Ok(());
+        }
         crate::write_atomic(out, map.to_json(out)?.as_bytes())?;
         print_summary(&map);
         let svg = out.with_extension("svg");

@@ -1,6 +1,6 @@
-//! `build-map --mpi`: the build's evaluations spread over the ranks of an MPI job (feature
-//! `mpi`). Rank 0 builds, connects and writes the map; the other ranks evaluate their slices of
-//! every generation and write nothing.
+//! `build-map --mpi`: the build shared among the ranks of an MPI job (feature `mpi`): each rank
+//! runs some of the concurrent searches and a slice of the edge checks, every rank holds the
+//! map, rank 0 shows progress and writes it.
 
 use anyhow::Result;
 use trm_roadmap::Checkpoint;
@@ -14,14 +14,13 @@ pub fn build_map(job: Job, resumed: Option<Checkpoint>) -> Result<()> {
     let universe =
         mpi::initialize().ok_or_else(|| anyhow::anyhow!("--mpi: MPI could not be initialised"))?;
     let world = universe.world();
-    if world.rank() != 0 {
-        return Ok(trm_roadmap::mpi::serve(&world, &job.problem.objective)?);
+    if world.rank() == 0 {
+        println!(
+            "MPI: {} ranks × {} threads",
+            world.size(),
+            rayon::current_num_threads()
+        );
     }
-    println!(
-        "MPI: {} ranks × {} threads",
-        world.size(),
-        rayon::current_num_threads()
-    );
     let mut ranks = trm_roadmap::mpi::Ranks::new(&world);
     job.run(resumed, &mut ranks)
 }
