@@ -26,6 +26,7 @@ use crate::edges::distance;
 use crate::error::{Result, RoadmapError};
 use crate::index::TaskIndex;
 use crate::map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};
+use crate::team::{Solo, Team, all_gather_f64, on_threads};
 
 /// Execution settings of a build (the algorithm settings are the spec's `map`).
 #[derive(Debug, Clone)]
@@ -210,64 +211,6 @@ impl Growing {
 pub const MAX_POINTS: usize = 10_000_000;
 /// The most concurrent searches P.
 pub const MAX_SEARCHES: usize = 4096;
-
-/// The processes a build is shared among. Every process runs the same build (the same problem,
-/// options and seed) and keeps the same map; each owns some of the P concurrent searches, whose
-/// asks, evaluations, h_map and tells it runs on its own threads, and after every generation
-/// they exchange the searches' centres and outcomes. Every evaluation gives the same bits
-/// wherever it runs and the map changes only between generations, in search order, so a seed
-/// and P give the same map on any number of processes × threads. [`Solo`] is this process
-/// alone; the `mpi` feature's `trm_roadmap::mpi::Ranks` the ranks of an MPI communicator.
-pub trait Team {
-    /// This process's index, `0..size()`. Rank 0 writes the checkpoints.
-    fn rank(&self) -> usize;
-    /// The number of processes.
-    fn size(&self) -> usize;
-    /// Every process's `mine`, in rank order, on every process. Collective: every process
-    /// calls it at the same point of the build.
-    fn all_gather(&mut self, mine: &[u8]) -> Result<Vec<Vec<u8>>>;
-}
-
-/// A team of one: the build runs in this process, on the threads of the current rayon pool.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct Solo;
-
-impl Team for Solo {
-    fn rank(&self) -> usize {
-        0
-    }
-    fn size(&self) -> usize {
-        1
-    }
-    fn all_gather(&mut self, mine: &[u8]) -> Result<Vec<Vec<u8>>> {
-        Ok(vec![mine.to_vec()])
-    }
-}
-
-/// The contiguous slice of `n` items that rank `rank` of `size` takes.
-pub(crate) fn share(n: usize, size: usize, rank: usize) -> std::ops::Range<usize> {
-    n * rank / size..n * (rank + 1) / size
-}
-
-/// Each process's values, gathered on every process and concatenated in rank order: `mine` as
-/// little-endian bits, so every f64 arrives bit for bit.
-pub(crate) fn all_gather_f64(team: &mut dyn Team, mine: &[f64]) -> Result<Vec<f64>> {
-    let bytes: Vec<u8> = mine.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let mut all = Vec::new();
-    for (rank, part) in team.all_gather(&bytes)?.into_iter().enumerate() {
-        if part.len() % 8 != 0 {
-            return Err(RoadmapError::Unsuitable(format!(
-                "process {rank} of the build sent {} bytes, not whole numbers; start every process with the same spec and options",
-                part.len()
-            )));
-        }
-        all.extend(
-            part.chunks_exact(8)
-                .map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default())),
-        );
-    }
-    Ok(all)
-}
 
 thread_local! {
     /// Each worker's kNN result buffer for h_map (kept: no allocation per candidate).
@@ -565,14 +508,48 @@ fn active_names(problem: &Problem) -> Vec<String> {
         .collect()
 }
 
-/// Builds the map of a spec (it needs a task function and `map` settings, or their defaults).
-/// Zero or absurd point and search counts are errors.
+/// Builds the map of a spec (it needs a task function and `map` settings, or their defaults)
+/// on the current rayon pool's threads. Zero or absurd point and search counts are errors.
+///
+/// When P is a multiple of T > 1 threads the build runs as a team of T threads
+/// ([`on_threads`]), each owning P / T searches (asks, evaluations, h_map, tells) and
+/// exchanging once per generation, rather than forking and joining every step of every
+/// generation: the same map, faster (reach map on 2 threads: see the book's Roadmaps page).
 pub fn build(
     problem: &Problem,
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    build_with(problem, options, &mut Solo, progress)
+    on_pool(searches_of(problem, options), progress, |team, progress| {
+        build_with(problem, options, team, progress)
+    })
+}
+
+/// P of a build of `problem` with `options` (before it is checked).
+fn searches_of(problem: &Problem, options: &BuildOptions) -> usize {
+    options.searches.unwrap_or_else(|| {
+        problem
+            .spec
+            .map
+            .as_ref()
+            .map_or_else(|| MapSpec::default().searches, |m| m.searches)
+    })
+}
+
+/// `job` on the current rayon pool's threads: a team of T threads when P is a multiple of
+/// T > 1 (so every thread always runs as many searches as the others), else alone on the pool.
+fn on_pool(
+    searches: usize,
+    mut progress: impl FnMut(&Progress),
+    job: impl Fn(&mut dyn Team, &mut dyn FnMut(&Progress)) -> Result<Roadmap> + Sync,
+) -> Result<Roadmap> {
+    let threads = rayon::current_num_threads();
+    if threads <= 1 || !searches.is_multiple_of(threads) {
+        return job(&mut Solo, &mut progress);
+    }
+    let mut map = on_threads(threads, 1, job, progress)?;
+    map.stats.threads = threads;
+    Ok(map)
 }
 
 /// [`build`] shared among the processes of `team` (e.g. the ranks of an MPI job: every one
@@ -599,7 +576,23 @@ pub fn build_connected(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    build_connected_with(problem, options, None, &mut Solo, progress)
+    build_connected_on_threads(problem, options, None, progress)
+}
+
+/// [`build_connected`], finishing a killed build from its checkpoint when `resumed` is given
+/// ([`resume`]), on the current rayon pool's threads as [`build`] uses them.
+pub fn build_connected_on_threads(
+    problem: &Problem,
+    options: &BuildOptions,
+    resumed: Option<Checkpoint>,
+    progress: impl FnMut(&Progress),
+) -> Result<Roadmap> {
+    let searches = resumed
+        .as_ref()
+        .map_or_else(|| searches_of(problem, options), |c| c.searches);
+    on_pool(searches, progress, |team, progress| {
+        build_connected_with(problem, options, resumed.clone(), team, progress)
+    })
 }
 
 /// [`build_connected`] finishing a killed build from its checkpoint when `resumed` is given
@@ -638,7 +631,9 @@ pub fn resume(
     options: &BuildOptions,
     progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    resume_with(problem, checkpoint, options, &mut Solo, progress)
+    on_pool(checkpoint.searches, progress, |team, progress| {
+        resume_with(problem, checkpoint.clone(), options, team, progress)
+    })
 }
 
 /// [`resume`] shared among `team`, as [`build_with`] (every process gives it the checkpoint).
@@ -1043,21 +1038,6 @@ pub(crate) fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn shares_cover_every_item_once() {
-        for n in [0, 1, 5, 31, 120] {
-            for size in 1..6 {
-                let mut next = 0;
-                for rank in 0..size {
-                    let s = share(n, size, rank);
-                    assert_eq!(s.start, next);
-                    next = s.end;
-                }
-                assert_eq!(next, n);
-            }
-        }
-    }
 
     #[test]
     fn new_searches_go_to_the_least_loaded_process() {

@@ -8,9 +8,9 @@ use trm_collision::World;
 use trm_kinematics::LANES;
 use trm_tasks::{Objective, Scratch};
 
-use crate::build::{Solo, Team, all_gather_f64, share};
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
+use crate::team::{Solo, Team, all_gather_f64, share};
 
 /// The finest edge-checking step, rad: below it a check costs more than it can find.
 pub const MIN_RESOLUTION: f64 = 1e-4;

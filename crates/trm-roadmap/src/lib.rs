@@ -23,12 +23,13 @@ mod map;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 mod repair;
+mod team;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
     BuildOptions, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, MAX_POINTS, MAX_SEARCHES, Progress,
-    Solo, Team, build, build_connected, build_connected_with, build_with, evaluate_on_threads,
-    resume, resume_with,
+    build, build_connected, build_connected_on_threads, build_connected_with, build_with,
+    evaluate_on_threads, resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{
@@ -39,5 +40,6 @@ pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Parked, Roadmap, VERSION};
 pub use repair::{LiveMap, REPAIR_FAILURE_LIMIT, RepairOptions, RepairReport, repair};
+pub use team::{Solo, Team, on_threads};
 /// Scratch buffers kept between a build's parallel evaluations (from `trm_tasks`).
 pub use trm_tasks::ScratchPool;

@@ -27,8 +27,8 @@ use mpi::datatype::PartitionMut;
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::*;
 
-use crate::build::Team;
 use crate::error::{Result, RoadmapError};
+use crate::team::Team;
 
 /// The ranks of an MPI communicator as a build's [`Team`] (rank 0 writes the checkpoints).
 pub struct Ranks<'w> {

@@ -15,11 +15,12 @@ use trm_collision::World;
 use trm_tasks::Problem;
 
 use crate::blocked::{BlockIndex, Changes};
-use crate::build::{Region, Setup, Solo, State, run};
+use crate::build::{Region, Setup, State, run};
 use crate::edges::connect_from;
 use crate::error::{Result, RoadmapError};
 use crate::index::TaskIndex;
 use crate::map::{MapPoint, Parked, Roadmap, cell};
+use crate::team::Solo;
 
 /// Consecutive failed searches after which a repair stops growing near the hole (at most the
 /// map's own `failure_limit`).

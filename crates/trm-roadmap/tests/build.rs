@@ -2,11 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use std::sync::{Arc, Barrier, Mutex};
+use std::sync::Mutex;
 
 use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build, build_connected_with,
-    connect, resume,
+    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build, build_connected,
+    build_connected_with, connect, on_threads, resume,
 };
 use trm_tasks::Problem;
 
@@ -174,56 +174,30 @@ fn resumed_builds_give_the_uninterrupted_map() {
     let _ = std::fs::remove_file(&damaged);
 }
 
-/// Threads of this process standing in for the processes of an MPI job: each runs the build
-/// as a rank does, exchanging through a shared board.
-struct Board {
-    slots: Mutex<Vec<Vec<u8>>>,
-    barrier: Barrier,
-}
-
-struct Member {
-    rank: usize,
-    size: usize,
-    board: Arc<Board>,
-}
-
-impl Team for Member {
-    fn rank(&self) -> usize {
-        self.rank
-    }
-    fn size(&self) -> usize {
-        self.size
-    }
-    fn all_gather(&mut self, mine: &[u8]) -> trm_roadmap::Result<Vec<Vec<u8>>> {
-        self.board.slots.lock().unwrap()[self.rank] = mine.to_vec();
-        self.board.barrier.wait();
-        let all = self.board.slots.lock().unwrap().clone();
-        self.board.barrier.wait();
-        Ok(all)
-    }
-}
-
-/// `f` run by every member of a team of `size`, in rank order.
+/// `f` run by every member of a team of `size` threads, in rank order.
 fn on_team<T: Send>(size: usize, f: impl Fn(&mut dyn Team) -> T + Sync) -> Vec<T> {
-    let board = Arc::new(Board {
-        slots: Mutex::new(vec![Vec::new(); size]),
-        barrier: Barrier::new(size),
-    });
-    std::thread::scope(|s| {
-        let members: Vec<_> = (0..size)
-            .map(|rank| {
-                let (f, board) = (&f, board.clone());
-                s.spawn(move || f(&mut Member { rank, size, board }))
-            })
-            .collect();
-        members.into_iter().map(|m| m.join().unwrap()).collect()
-    })
+    let all = Mutex::new(Vec::new());
+    on_threads(
+        size,
+        1,
+        |team, _| {
+            let rank = team.rank();
+            let value = f(team);
+            all.lock().unwrap().push((rank, value));
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap();
+    let mut all = all.into_inner().unwrap();
+    all.sort_by_key(|(rank, _)| *rank);
+    all.into_iter().map(|(_, value)| value).collect()
 }
 
 /// A build shared among 2 or 3 processes (threads here, MPI ranks in `xtask/tests/mpi.rs`),
 /// each running some of the searches and a slice of the edge checks, gives every one of them
 /// the map one process builds, edges included; a checkpoint written by a team of 3 resumes on
-/// a team of 2 to it.
+/// a team of 2 to it; a member that fails stops the others (no hang) with its own error.
 #[test]
 fn a_build_shared_among_processes_gives_the_map_of_one() {
     let problem = reach();
@@ -268,6 +242,26 @@ fn a_build_shared_among_processes_gives_the_map_of_one() {
         assert_eq!(map.stats.evaluations, alone.stats.evaluations);
     }
     let _ = std::fs::remove_file(&path);
+    // rank 0 cannot write its checkpoint (its directory would be a file): the build on 2
+    // threads ends with that error
+    let file = tmp("not-a-dir");
+    std::fs::write(&file, "").unwrap();
+    let nowhere = BuildOptions {
+        checkpoint: Some(CheckpointOptions {
+            path: file.join("map.checkpoint"),
+            every: 5,
+        }),
+        ..options.clone()
+    };
+    let e = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| build_connected(&problem, &nowhere, |_| {}))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not-a-dir"), "{e}");
+    let _ = std::fs::remove_file(&file);
 }
 
 #[test]

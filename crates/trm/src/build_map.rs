@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Solo, Team, build_connected_with,
+    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build_connected_on_threads,
+    build_connected_with,
 };
 use trm_tasks::Problem;
 
@@ -149,7 +150,7 @@ pub fn run(args: &Args) -> Result<()> {
     if args.mpi {
         return crate::distributed::build_map(job, resumed);
     }
-    job.run(resumed, &mut Solo)
+    job.run(resumed, None)
 }
 
 /// A build-map run, ready to go: on this process's threads, or shared among the ranks of an MPI
@@ -166,16 +167,16 @@ pub struct Job<'a> {
 }
 
 impl Job<'_> {
-    /// Builds (or resumes), connects and writes the map, shared among `team`: every process
-    /// builds, rank 0 shows progress and writes.
-    pub fn run(self, resumed: Option<Checkpoint>, team: &mut dyn Team) -> Result<()> {
+    /// Builds (or resumes), connects and writes the map, on this process's threads or shared
+    /// among `team` (every process builds; rank 0 shows progress and writes).
+    pub fn run(self, resumed: Option<Checkpoint>, team: Option<&mut dyn Team>) -> Result<()> {
         let Job {
             args,
             problem,
             options,
             out,
         } = self;
-        let writes = team.rank() == 0;
+        let writes = team.as_ref().is_none_or(|t| t.rank() == 0);
         let mut progress = crate::progress::Progress::new("points", 0);
         let map = (|| -> Result<Roadmap> {
             let report = |p: &trm_roadmap::Progress| {
@@ -192,7 +193,10 @@ impl Job<'_> {
                     ),
                 );
             };
-            let map = build_connected_with(problem, options, resumed, team, report)?;
+            let map = match team {
+                Some(team) => build_connected_with(problem, options, resumed, team, report)?,
+                None => build_connected_on_threads(problem, options, resumed, report)?,
+            };
             if writes {
                 progress.finish();
             }

@@ -22,7 +22,7 @@ pub fn build_map(job: Job, resumed: Option<Checkpoint>) -> Result<()> {
         );
     }
     let mut ranks = trm_roadmap::mpi::Ranks::new(&world);
-    job.run(resumed, &mut ranks)
+    job.run(resumed, Some(&mut ranks))
 }
 
 /// Without the `mpi` feature: says how to get it.
