@@ -35,7 +35,21 @@ pub(crate) enum Geometry {
         half_extents: Option<Vector3<f64>>,
         /// Convex hulls: their vertex graph, for support points by hill climbing.
         walk: Option<Arc<HullWalk>>,
+        /// Cylinders: the capsules about the shape's local y axis that enclose it and that it
+        /// holds, for exact answers against round shapes before GJK.
+        axial: Option<Axial>,
     },
+}
+
+/// A shape between two capsules of one radius about its local y axis (a cylinder of half
+/// height `outer` and that radius): every point of it lies within `radius` of the segment
+/// `y ∈ [−outer, outer]`, and every point within `radius` of `y ∈ [−inner, inner]` is in it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Axial {
+    pub outer: f64,
+    /// `None` when the shape is too flat to hold a capsule of its radius.
+    pub inner: Option<f64>,
+    pub radius: f64,
 }
 
 impl std::fmt::Debug for Compiled {

@@ -18,7 +18,7 @@ mod segment_box;
 mod segment_lanes;
 mod spheres;
 
-pub(crate) use compiled::{Compiled, Geometry, Placed};
+pub(crate) use compiled::{Axial, Compiled, Geometry, Placed};
 pub(crate) use pair::{
     Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
 };
@@ -204,6 +204,14 @@ impl Shape {
                     .as_convex_polyhedron()
                     .and_then(HullWalk::new)
                     .map(Arc::new);
+                let axial = match self {
+                    Shape::Cylinder { radius, length } => Some(Axial {
+                        outer: length / 2.0,
+                        inner: (length / 2.0 >= *radius).then_some(length / 2.0 - radius),
+                        radius: *radius,
+                    }),
+                    _ => None,
+                };
                 Compiled {
                     center: local * sphere.center,
                     bound: sphere.radius,
@@ -212,6 +220,7 @@ impl Shape {
                         shape,
                         half_extents,
                         walk,
+                        axial,
                     },
                 }
             }

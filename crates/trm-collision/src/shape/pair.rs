@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape, SharedShape, SupportMap};
 
-use super::compiled::{Compiled, Geometry, Placed, RoundShape};
+use super::compiled::{Axial, Compiled, Geometry, Placed, RoundShape};
 use super::hull::HullWalk;
 use super::segment_box::segment_box_distance_squared;
 
@@ -108,14 +108,30 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
         ) => {
             !round_box_apart(p2, p1, h) && round_box_distance_squared(p2, p1, h) <= radius * radius
         }
-        (Geometry::Round { radius, .. }, Geometry::General { shape, walk, .. }) => {
+        (
+            Geometry::Round { radius, .. },
+            Geometry::General {
+                shape, walk, axial, ..
+            },
+        ) => {
+            if let Some(answer) = axial.and_then(|a| round_axial(p1, *radius, p2, &a)) {
+                return answer;
+            }
             let (iso, round) = Compiled::round_as_parry(p1, *radius);
             match walk {
                 Some(walk) => support_maps_intersect(&iso, round.support_map(), &p2.iso, &**walk),
                 None => parry_intersects(&iso, round.shape(), &p2.iso, shape.as_ref()),
             }
         }
-        (Geometry::General { shape, walk, .. }, Geometry::Round { radius, .. }) => {
+        (
+            Geometry::General {
+                shape, walk, axial, ..
+            },
+            Geometry::Round { radius, .. },
+        ) => {
+            if let Some(answer) = axial.and_then(|a| round_axial(p2, *radius, p1, &a)) {
+                return answer;
+            }
             let (iso, round) = Compiled::round_as_parry(p2, *radius);
             match walk {
                 Some(walk) => support_maps_intersect(&p1.iso, &**walk, &iso, round.support_map()),
@@ -167,6 +183,30 @@ fn support<'a>(
 }
 
 /// GJK's intersection test of two support-mapped shapes at their poses.
+/// A round shape (segment `p1.a`–`p1.b` swept by `radius`) against a shape between two
+/// capsules about its axis ([`Axial`]), placed at `p2`: apart when it misses the enclosing
+/// capsule, touching when it reaches into the held one, each by more than [`DECIDED`];
+/// `None` (ask GJK, as without them) otherwise — so the answers are GJK's to the last case.
+#[inline]
+fn round_axial(p1: &Placed, radius: f64, p2: &Placed, axial: &Axial) -> Option<bool> {
+    let reach = radius + axial.radius;
+    let along = |half: f64| {
+        let (a, b) = (Point3::new(0.0, -half, 0.0), Point3::new(0.0, half, 0.0));
+        segment_distance_squared(&p1.a, &p1.b, &(p2.iso * a), &(p2.iso * b))
+    };
+    if along(axial.outer) > (reach + DECIDED).powi(2) {
+        return Some(false);
+    }
+    match axial.inner {
+        Some(inner) if reach > DECIDED && along(inner) < (reach - DECIDED).powi(2) => Some(true),
+        _ => None,
+    }
+}
+
+/// How far from touching the analytic tests in front of GJK decide (1 µm: far beyond GJK's
+/// own tolerance, so that GJK answers every case it might answer otherwise).
+const DECIDED: f64 = 1e-6;
+
 fn support_maps_intersect(
     i1: &Isometry3<f64>,
     g1: &dyn SupportMap,
@@ -322,4 +362,72 @@ pub(crate) fn proximity(
             normal: c.normal1.into_inner(),
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::Shape;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Balls and capsules against cylinders, both ways round: the enclosing and held capsules
+    /// answer as parry's GJK does, and each of the three outcomes (apart, touching, ask GJK)
+    /// is reached.
+    #[test]
+    fn round_shapes_against_cylinders_answer_as_parry() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut outcomes = [0usize; 3];
+        for k in 0..20_000 {
+            let cylinder = Shape::Cylinder {
+                radius: rng.random_range(0.005..0.1),
+                length: rng.random_range(0.005..0.4),
+            };
+            let radius = rng.random_range(0.005..0.08);
+            let round = if k % 4 == 0 {
+                Shape::Sphere { radius }
+            } else {
+                Shape::Capsule {
+                    radius,
+                    length: rng.random_range(0.01..0.3),
+                }
+            };
+            let mut pose = |spread: f64| {
+                let t = Vector3::from_fn(|_, _| rng.random_range(-spread..spread));
+                let axis = Vector3::from_fn(|_, _| rng.random_range(-3.0..3.0));
+                Isometry3::new(t, axis)
+            };
+            let (c1, c2) = (
+                round.compile(&pose(0.1)).unwrap(),
+                cylinder.compile(&pose(0.1)).unwrap(),
+            );
+            let (mut p1, mut p2) = (Placed::default(), Placed::default());
+            c1.place(&pose(0.15), &mut p1);
+            c2.place(&pose(0.15), &mut p2);
+            let Geometry::General {
+                shape,
+                axial: Some(axial),
+                ..
+            } = &c2.geometry
+            else {
+                panic!("a cylinder compiles with its capsules");
+            };
+            let (iso, r) = Compiled::round_as_parry(&p1, radius);
+            let depth = query::contact(&iso, r.shape(), &p2.iso, shape.as_ref(), 1e-9)
+                .unwrap()
+                .map(|c| c.dist);
+            if depth.is_some_and(|d| d.abs() < 1e-12) {
+                continue;
+            }
+            let parry = parry_intersects(&iso, r.shape(), &p2.iso, shape.as_ref());
+            assert_eq!(intersects(&c1, &p1, &c2, &p2), parry, "case {k}");
+            assert_eq!(intersects(&c2, &p2, &c1, &p1), parry, "case {k}");
+            outcomes[match round_axial(&p1, radius, &p2, axial) {
+                Some(false) => 0,
+                Some(true) => 1,
+                None => 2,
+            }] += 1;
+        }
+        assert!(outcomes.iter().all(|&n| n > 200), "{outcomes:?}");
+    }
 }
