@@ -397,14 +397,17 @@ impl State {
             out.push(StopReason::TolX);
         }
         if let Some(t) = s.tol_fun {
+            // the history's range only when the cheap conditions hold (most calls: not)
             let full = self.history_len == self.history.len();
-            let (lo, hi) = self.history[..self.history_len]
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            if full && hi - lo < t && self.last_range < t {
-                out.push(StopReason::TolFun);
+            if full && self.last_range < t {
+                let (lo, hi) = self.history[..self.history_len]
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
+                if hi - lo < t {
+                    out.push(StopReason::TolFun);
+                }
             }
         }
         if let Some((recent, window)) = s.center_stagnation {
@@ -603,7 +606,13 @@ pub trait Optimizer {
 
     /// Every stopping reason that holds now (empty: go on).
     fn stop(&self) -> Vec<StopReason> {
-        self.state().reasons(self.spread())
+        // the spread only matters to tol_x (a simplex's costs O(d²) per step)
+        let spread = if self.state().stop_options().tol_x.is_some() {
+            self.spread()
+        } else {
+            f64::INFINITY
+        };
+        self.state().reasons(spread)
     }
 
     /// Records the fitness `f` of the distribution centre `centre` (a copy of [`Optimizer::mean`])
