@@ -568,7 +568,7 @@ pub fn build_with(
     run(&setup, state, options.checkpoint.as_ref(), team, progress)
 }
 
-/// A map ready to plan with: built ([`build`]) and connected ([`connect`]: each point to the
+/// A map ready to plan with: built ([`build`]) and connected ([`connect`](crate::connect): each point to the
 /// spec's `edge_neighbours` nearest, edges checked every `options.edge_resolution`, which is
 /// checked before any building). Save it with [`Roadmap::save`].
 pub fn build_connected(
