@@ -420,7 +420,8 @@ fn walk_self(
 /// A world object as the world walk tests spheres against it in every lane at once: its
 /// bounding sphere and, for a box, its pose (the inverse rotation as nalgebra applies it) and
 /// half extents.
-struct Obstacle {
+#[derive(Clone, Copy)]
+pub(crate) struct Obstacle {
     center: [f64; 3],
     bound: f64,
     /// Boxes: the conjugate quaternion (w, x, y, z), the translation and the half extents.
@@ -446,6 +447,41 @@ impl Obstacle {
             bound: p.bound,
             slabs,
         }
+    }
+
+    /// One sphere around every object of `objects` when they lie close together — 2 to
+    /// [`CLUSTERED`] objects whose enclosing sphere is at most three times as wide as one of
+    /// their bounding spheres' summed volume (a fixture, a ring of parts; Table III's posture 2:
+    /// its batched runs 7 % faster) — for the world walk to descend the robot's culling tree
+    /// once for them all; `None` otherwise.
+    pub(crate) fn cluster(objects: &[crate::world::WorldObject]) -> Option<Obstacle> {
+        if !(2..=CLUSTERED).contains(&objects.len()) {
+            return None;
+        }
+        // the centre of the box around the objects' spheres
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for o in objects {
+            let (c, r) = (o.placed.center, o.placed.bound);
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k] - r);
+                hi[k] = hi[k].max(c[k] + r);
+            }
+        }
+        let center: [f64; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+        let (mut bound, mut volume) = (0.0f64, 0.0);
+        for o in objects {
+            let c = o.placed.center;
+            let d =
+                ((c.x - center[0]).powi(2) + (c.y - center[1]).powi(2) + (c.z - center[2]).powi(2))
+                    .sqrt();
+            bound = bound.max(d + o.placed.bound);
+            volume += o.placed.bound.powi(3);
+        }
+        (bound.is_finite() && bound.powi(3) <= 27.0 * volume).then_some(Obstacle {
+            center,
+            bound,
+            slabs: None,
+        })
     }
 
     /// Of the lanes `of`, those where the sphere `(c, r)` cannot touch the object: outside its
@@ -512,7 +548,12 @@ fn walk_world(
 ) {
     let compiled = model.compiled();
     let steps = &model.culling().world_steps;
-    for (o, object) in world.objects().iter().enumerate() {
+    let objects = world.objects();
+    if let Some(cluster) = Obstacle::cluster(objects) {
+        walk_cluster(model, placed, objects, &cluster, live, hit);
+        return;
+    }
+    for (o, object) in objects.iter().enumerate() {
         let (oc, op) = (&object.compiled, &object.placed);
         let obstacle = Obstacle::new(object);
         let mut nest = Nest::<MAX_DEPTH>::new();
@@ -555,6 +596,84 @@ fn walk_world(
             }
             s += 1;
         }
+    }
+}
+
+/// Most objects the world walk takes as one ([`Obstacle::cluster`]).
+const CLUSTERED: usize = 16;
+
+/// The world walk for objects close together: the culling steps followed once, against the
+/// sphere around them all (`cluster`), and at each link's bodies every object in turn, as its
+/// own walk would test it — the same pairs reported (link by link rather than object by
+/// object), so the same counts and verdicts.
+#[inline(always)]
+fn walk_cluster(
+    model: &CollisionModel,
+    placed: &PlacedBatch,
+    objects: &[crate::world::WorldObject],
+    cluster: &Obstacle,
+    mut live: Mask,
+    hit: &mut dyn FnMut(usize, usize, usize) -> Option<Next>,
+) {
+    let compiled = model.compiled();
+    let steps = &model.culling().world_steps;
+    let mut obstacles = [*cluster; CLUSTERED];
+    for (slot, object) in obstacles.iter_mut().zip(objects) {
+        *slot = Obstacle::new(object);
+    }
+    let obstacles = &obstacles[..objects.len()];
+    let mut nest = Nest::<MAX_DEPTH>::new();
+    let mut mask = live;
+    let mut s = 0;
+    while s < steps.len() && live != 0 {
+        mask = nest.close(s, mask, live);
+        if mask == 0 {
+            s = nest.next_end(steps.len());
+            continue;
+        }
+        match steps[s] {
+            Step::Cull { a, end, .. } => {
+                let (c, r) = placed.sphere(compiled, a);
+                let inner = mask & !cluster.sphere_apart(c, r, mask);
+                if inner == 0 {
+                    s = end as usize;
+                    continue;
+                }
+                mask = nest.open(end, mask, inner);
+            }
+            Step::Test { start, end } => {
+                // each object's lanes still pending in this link (a hit skips the rest of the
+                // link for that object alone)
+                let mut pending = [mask; CLUSTERED];
+                let bodies = &compiled[start as usize..end as usize];
+                for (i, body) in (start as usize..).zip(bodies) {
+                    let center = &placed.centers[i];
+                    let waiting = pending[..objects.len()].iter().fold(0, |m, p| m | p) & mask;
+                    if waiting == 0 {
+                        break;
+                    }
+                    let close = waiting & !cluster.sphere_apart(center, body.bound, waiting);
+                    if close == 0 {
+                        continue;
+                    }
+                    for (o, (object, obstacle)) in objects.iter().zip(obstacles).enumerate() {
+                        let lanes = pending[o] & close & mask;
+                        if lanes == 0 {
+                            continue;
+                        }
+                        let near = lanes & !obstacle.sphere_apart(center, body.bound, lanes);
+                        for l in lanes_of(near) {
+                            let p = placed.placed(body, i, l);
+                            if !intersects(body, &p, &object.compiled, &object.placed) {
+                                continue;
+                            }
+                            follow(hit(i, o, l), l, &mut pending[o], &mut live, &mut mask);
+                        }
+                    }
+                }
+            }
+        }
+        s += 1;
     }
 }
 

@@ -620,6 +620,64 @@ mod tests {
         (shape, pose)
     }
 
+    /// Worlds of small objects close together, which the batched world walk takes as one
+    /// cluster (a ring, a fixture), placed where the arms reach: every count and verdict is the
+    /// exhaustive one.
+    #[test]
+    fn clustered_objects_give_the_exhaustive_answer() {
+        use rand::{RngExt, SeedableRng};
+        let f = icub();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let (mut clustered, mut touching) = (0, 0);
+        let (mut poses, mut placed) = (f.robot.pose_buffer(), f.model.placed_bodies());
+        for _ in 0..150 {
+            let lanes: Vec<Vec<f64>> = (0..LANES)
+                .map(|_| {
+                    let u: Vec<f64> = (0..f.active.len())
+                        .map(|_| rng.random_range(0.0..1.0))
+                        .collect();
+                    configuration(f, &u)
+                })
+                .collect();
+            // about a body of the first configuration, so that objects touch it
+            f.active.forward(&lanes[0], &mut poses).unwrap();
+            f.model.place(&poses, &mut placed);
+            let body = rng.random_range(0..placed.placed.len());
+            let centre = placed.placed[body].center.coords;
+            let mut world = World::new();
+            for i in 0..rng.random_range(2..9) {
+                let shape = match i % 3 {
+                    0 => Shape::Sphere {
+                        radius: rng.random_range(0.02..0.05),
+                    },
+                    1 => Shape::Capsule {
+                        radius: rng.random_range(0.01..0.03),
+                        length: rng.random_range(0.02..0.08),
+                    },
+                    _ => Shape::Cylinder {
+                        radius: rng.random_range(0.01..0.04),
+                        length: rng.random_range(0.02..0.1),
+                    },
+                };
+                let offset = Vector3::from_fn(|_, _| rng.random_range(-0.05..0.05));
+                let pose = Isometry3::from_parts(
+                    Translation3::from(centre + offset),
+                    UnitQuaternion::from_euler_angles(
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-1.5..1.5),
+                        rng.random_range(-3.0..3.0),
+                    ),
+                );
+                world.add(&format!("o{i}"), shape, pose).unwrap();
+            }
+            clustered += usize::from(crate::batch::Obstacle::cluster(world.objects()).is_some());
+            touching += usize::from(f.model.count(&placed, &world).world_pairs > 0);
+            check_batch(f, &lanes, &world);
+        }
+        assert!(clustered >= 100, "only {clustered} of 150 worlds clustered");
+        assert!(touching >= 75, "only {touching} of 150 worlds touched");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(256))]
         #[test]
