@@ -397,15 +397,21 @@ impl State {
             out.push(StopReason::TolX);
         }
         if let Some(t) = s.tol_fun {
-            // the history's range only when the cheap conditions hold (most calls: not)
+            // the history's range only when the cheap conditions hold, and only until it is
+            // known to reach t (a range never shrinks as values join it; a population of one,
+            // whose history is 10 + 30d generations long, had this fold at every evaluation)
             let full = self.history_len == self.history.len();
             if full && self.last_range < t {
-                let (lo, hi) = self.history[..self.history_len]
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                        (a.min(v), b.max(v))
-                    });
-                if hi - lo < t {
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                let mut within = true;
+                for &v in &self.history[..self.history_len] {
+                    (lo, hi) = (lo.min(v), hi.max(v));
+                    if !(hi - lo < t) && lo.is_finite() {
+                        within = false;
+                        break;
+                    }
+                }
+                if within && hi - lo < t {
                     out.push(StopReason::TolFun);
                 }
             }
@@ -624,7 +630,52 @@ pub trait Optimizer {
 
 #[cfg(test)]
 mod tests {
-    use super::Population;
+    use super::{Population, Start, State, StopOptions, StopReason};
+
+    /// TolFun, which stops scanning the history once its range reaches tol_fun, says what the
+    /// range of the whole history says: flat, drifting, infinite and mixed histories of a
+    /// population of one, whose history is long.
+    #[test]
+    fn tol_fun_reads_the_whole_history_range() {
+        let t = 1e-3;
+        let start = Start::new(vec![0.0; 2], 1.0).with_stop(StopOptions {
+            tol_fun: Some(t),
+            ..Default::default()
+        });
+        let one = Population::new(2, 1);
+        let histories: Vec<Vec<f64>> = vec![
+            vec![1.0; 80],
+            (0..80).map(|k| 1.0 + k as f64 * 1e-6).collect(),
+            (0..80).map(|k| 1.0 + k as f64 * 1e-4).collect(),
+            vec![f64::INFINITY; 80],
+            (0..80)
+                .map(|k| if k % 7 == 0 { f64::INFINITY } else { 2.0 })
+                .collect(),
+            (0..80)
+                .map(|k| if k < 79 { f64::INFINITY } else { 2.0 })
+                .collect(),
+            (0..80)
+                .map(|k| if k == 40 { 2.0005 } else { 2.0 })
+                .collect(),
+        ];
+        for (h, values) in histories.iter().enumerate() {
+            let mut state = State::new(&start, 1);
+            for &v in values {
+                state.asked(1);
+                state.told(&one, &[v]).unwrap();
+            }
+            let n = state.history_len;
+            let window = &state.history[..n];
+            let (lo, hi) = window
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let want = n == state.history.len() && hi - lo < t && state.last_range < t;
+            let got = state.reasons(1.0).contains(&StopReason::TolFun);
+            assert_eq!(got, want, "history {h}");
+        }
+    }
 
     /// A population is its candidates one after the other: indexing, iterating, resizing and
     /// copying agree with the flat buffer, and an empty or zero-dimensional one has none.
