@@ -377,6 +377,11 @@ impl State {
 
     /// Every stopping reason that holds, given the distribution's largest standard deviation.
     pub fn reasons(&self, spread: f64) -> Vec<StopReason> {
+        self.reasons_given(self.stop.tol_x.is_some_and(|t| spread < t))
+    }
+
+    /// [`State::reasons`], given whether the spread is below `tol_x`.
+    fn reasons_given(&self, below_tol_x: bool) -> Vec<StopReason> {
         let s = &self.stop;
         let mut out = Vec::new();
         if s.max_evaluations.is_some_and(|m| self.evaluations >= m) {
@@ -393,7 +398,7 @@ impl State {
         {
             out.push(StopReason::NoImprovement);
         }
-        if s.tol_x.is_some_and(|t| spread < t) {
+        if below_tol_x {
             out.push(StopReason::TolX);
         }
         if let Some(t) = s.tol_fun {
@@ -605,6 +610,12 @@ pub trait Optimizer {
     fn mean(&self) -> &[f64];
     /// The largest standard deviation of the search distribution (for TolX).
     fn spread(&self) -> f64;
+    /// Whether [`Optimizer::spread`] is below `t` (TolX's question), the same answer: an
+    /// algorithm whose spread costs O(d²) stops looking at the first part of it that reaches
+    /// `t`.
+    fn spread_below(&self, t: f64) -> bool {
+        self.spread() < t
+    }
     /// Counts, best point and stopping histories.
     fn state(&self) -> &State;
     /// Mutable bookkeeping (for [`Optimizer::record_center_fitness`]).
@@ -612,13 +623,9 @@ pub trait Optimizer {
 
     /// Every stopping reason that holds now (empty: go on).
     fn stop(&self) -> Vec<StopReason> {
-        // the spread only matters to tol_x (a simplex's costs O(d²) per step)
-        let spread = if self.state().stop_options().tol_x.is_some() {
-            self.spread()
-        } else {
-            f64::INFINITY
-        };
-        self.state().reasons(spread)
+        let tol_x = self.state().stop_options().tol_x;
+        self.state()
+            .reasons_given(tol_x.is_some_and(|t| self.spread_below(t)))
     }
 
     /// Records the fitness `f` of the distribution centre `centre` (a copy of [`Optimizer::mean`])

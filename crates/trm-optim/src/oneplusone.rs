@@ -306,11 +306,23 @@ impl Optimizer for OnePlusOne {
     }
 
     fn spread(&self) -> f64 {
-        let n = self.parent.len();
-        let max_row = (0..n)
+        let max_row = (0..self.parent.len())
             .map(|i| self.a.row(i).norm_squared())
             .fold(0.0, f64::max);
         self.sigma * max_row.sqrt()
+    }
+
+    fn spread_below(&self, t: f64) -> bool {
+        // σ √m grows with m, so the largest row decides: stop at the first that reaches t
+        let mut max_row = 0.0f64;
+        for i in 0..self.parent.len() {
+            let row = self.a.row(i).norm_squared();
+            if self.sigma * row.sqrt() >= t {
+                return false;
+            }
+            max_row = max_row.max(row);
+        }
+        self.sigma * max_row.sqrt() < t
     }
 
     fn state(&self) -> &State {

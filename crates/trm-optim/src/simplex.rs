@@ -114,6 +114,14 @@ impl NelderMead {
         self.state.clamp(&mut self.batch[0]);
     }
 
+    /// Every coordinate's distance from the best vertex, vertex by vertex.
+    fn deviations(&self) -> impl Iterator<Item = f64> + '_ {
+        let best = &self.vertices[self.order[0]];
+        self.vertices
+            .iter()
+            .flat_map(move |v| v.iter().zip(best).map(|(a, b)| (a - b).abs()))
+    }
+
     fn start_reflection(&mut self) {
         self.sort();
         let d = self.centroid.len();
@@ -249,11 +257,18 @@ impl Optimizer for NelderMead {
     }
 
     fn spread(&self) -> f64 {
-        let best = &self.vertices[self.order[0]];
-        self.vertices
-            .iter()
-            .flat_map(|v| v.iter().zip(best).map(|(a, b)| (a - b).abs()))
-            .fold(0.0, f64::max)
+        self.deviations().fold(0.0, f64::max)
+    }
+
+    fn spread_below(&self, t: f64) -> bool {
+        let mut spread = 0.0f64;
+        for d in self.deviations() {
+            if d >= t {
+                return false;
+            }
+            spread = spread.max(d);
+        }
+        spread < t
     }
 
     fn state(&self) -> &State {

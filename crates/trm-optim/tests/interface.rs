@@ -264,3 +264,25 @@ proptest! {
         prop_assert!((f.eval(&r.best_x) - r.best_f).abs() < 1e-12);
     }
 }
+
+/// `spread_below(t)` answers `spread() < t` for every algorithm, at every generation of a run
+/// and for thresholds below, at and above the spread (the simplex and (1+1)-CMA-ES stop
+/// looking at the first part of their spread that reaches t).
+#[test]
+fn spread_below_answers_as_the_spread_does() {
+    let f = TestFunction::by_name("rotated-ellipsoid", 8, 3).unwrap();
+    for algo in ALGOS {
+        let start = Start::new(f.start(), 0.3);
+        let mut o = optimiser(algo, &start);
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for _ in 0..60 {
+            let candidates: Vec<Vec<f64>> = o.ask(&mut rng).iter().map(<[f64]>::to_vec).collect();
+            let fitness: Vec<f64> = candidates.iter().map(|x| f.eval(x)).collect();
+            o.tell(&fitness).unwrap();
+            let s = o.spread();
+            for t in [0.0, s * 0.5, s, s * (1.0 + 1e-15), s * 2.0, f64::INFINITY] {
+                assert_eq!(o.spread_below(t), s < t, "{algo}: spread {s}, t {t}");
+            }
+        }
+    }
+}
