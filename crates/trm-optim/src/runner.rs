@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::core::{Optimizer, Population, StopReason};
 
 /// One generation, as the observer sees it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct Generation<'a> {
     /// Generations so far.
     pub generation: u64,
@@ -16,8 +16,27 @@ pub struct Generation<'a> {
     pub best_f: f64,
     /// Best point so far.
     pub best_x: &'a [f64],
-    /// Largest standard deviation of the search distribution.
-    pub spread: f64,
+    /// The optimiser's spread, computed when asked ([`Generation::spread`]).
+    spread: &'a dyn Fn() -> f64,
+}
+
+impl Generation<'_> {
+    /// Largest standard deviation of the search distribution (computed when asked: O(d²) for
+    /// some algorithms).
+    pub fn spread(&self) -> f64 {
+        (self.spread)()
+    }
+}
+
+impl std::fmt::Debug for Generation<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Generation")
+            .field("generation", &self.generation)
+            .field("evaluations", &self.evaluations)
+            .field("best_f", &self.best_f)
+            .field("best_x", &self.best_x)
+            .finish_non_exhaustive()
+    }
 }
 
 /// What a run found.
@@ -84,7 +103,7 @@ where
             evaluations: s.evaluations(),
             best_f: s.best_f(),
             best_x: s.best_x(),
-            spread: optimizer.spread(),
+            spread: &|| optimizer.spread(),
         };
         if !observer(&generation) {
             break;
