@@ -458,7 +458,13 @@ impl Obstacle {
         if !(2..=CLUSTERED).contains(&objects.len()) {
             return None;
         }
-        // the centre of the box around the objects' spheres
+        let around = Obstacle::around(objects);
+        let volume: f64 = objects.iter().map(|o| o.placed.bound.powi(3)).sum();
+        (around.bound.is_finite() && around.bound.powi(3) <= 27.0 * volume).then_some(around)
+    }
+
+    /// A sphere around the objects' bounding spheres, centred on the box around them.
+    fn around(objects: &[crate::world::WorldObject]) -> Obstacle {
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for o in objects {
             let (c, r) = (o.placed.center, o.placed.bound);
@@ -468,20 +474,19 @@ impl Obstacle {
             }
         }
         let center: [f64; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
-        let (mut bound, mut volume) = (0.0f64, 0.0);
+        let mut bound = 0.0f64;
         for o in objects {
             let c = o.placed.center;
             let d =
                 ((c.x - center[0]).powi(2) + (c.y - center[1]).powi(2) + (c.z - center[2]).powi(2))
                     .sqrt();
             bound = bound.max(d + o.placed.bound);
-            volume += o.placed.bound.powi(3);
         }
-        (bound.is_finite() && bound.powi(3) <= 27.0 * volume).then_some(Obstacle {
+        Obstacle {
             center,
             bound,
             slabs: None,
-        })
+        }
     }
 
     /// Of the lanes `of`, those where the sphere `(c, r)` cannot touch the object: outside its
@@ -601,11 +606,13 @@ fn walk_world(
 
 /// Most objects the world walk takes as one ([`Obstacle::cluster`]).
 const CLUSTERED: usize = 16;
+/// Objects per group inside a cluster (each group's sphere tested before its objects).
+const GROUPED: usize = 4;
 
 /// The world walk for objects close together: the culling steps followed once, against the
-/// sphere around them all (`cluster`), and at each link's bodies every object in turn, as its
-/// own walk would test it — the same pairs reported (link by link rather than object by
-/// object), so the same counts and verdicts.
+/// sphere around them all (`cluster`), and at each link's bodies each group of four objects'
+/// sphere, then its objects in turn, as their own walks would test them — the same pairs
+/// reported (link by link rather than object by object), so the same counts and verdicts.
 #[inline(always)]
 fn walk_cluster(
     model: &CollisionModel,
@@ -622,6 +629,12 @@ fn walk_cluster(
         *slot = Obstacle::new(object);
     }
     let obstacles = &obstacles[..objects.len()];
+    // consecutive objects in fours, each four with a sphere around it (a ring listed in order
+    // falls into arcs), tested before its objects
+    let mut groups = [*cluster; CLUSTERED / GROUPED];
+    for (group, four) in groups.iter_mut().zip(objects.chunks(GROUPED)) {
+        *group = Obstacle::around(four);
+    }
     let mut nest = Nest::<MAX_DEPTH>::new();
     let mut mask = live;
     let mut s = 0;
@@ -656,18 +669,30 @@ fn walk_cluster(
                     if close == 0 {
                         continue;
                     }
-                    for (o, (object, obstacle)) in objects.iter().zip(obstacles).enumerate() {
-                        let lanes = pending[o] & close & mask;
-                        if lanes == 0 {
+                    for (g, group) in groups.iter().enumerate() {
+                        let members = g * GROUPED..((g + 1) * GROUPED).min(objects.len());
+                        if members.is_empty() {
+                            break;
+                        }
+                        let waiting = pending[members.clone()].iter().fold(0, |m, p| m | p);
+                        let lanes = waiting & close & mask;
+                        if lanes == 0 || group.sphere_apart(center, body.bound, lanes) == lanes {
                             continue;
                         }
-                        let near = lanes & !obstacle.sphere_apart(center, body.bound, lanes);
-                        for l in lanes_of(near) {
-                            let p = placed.placed(body, i, l);
-                            if !intersects(body, &p, &object.compiled, &object.placed) {
+                        for o in members {
+                            let (object, obstacle) = (&objects[o], &obstacles[o]);
+                            let lanes = pending[o] & close & mask;
+                            if lanes == 0 {
                                 continue;
                             }
-                            follow(hit(i, o, l), l, &mut pending[o], &mut live, &mut mask);
+                            let near = lanes & !obstacle.sphere_apart(center, body.bound, lanes);
+                            for l in lanes_of(near) {
+                                let p = placed.placed(body, i, l);
+                                if !intersects(body, &p, &object.compiled, &object.placed) {
+                                    continue;
+                                }
+                                follow(hit(i, o, l), l, &mut pending[o], &mut live, &mut mask);
+                            }
                         }
                     }
                 }
