@@ -840,6 +840,20 @@ pub struct Verdict {
     pub uncertain: LaneMask,
 }
 
+/// What a block's count found ([`FastModel::count`]): per lane, the link pairs and the (link,
+/// world object) pairs certainly colliding, and the lanes with pairs left uncertain (the
+/// suspects), whose counts are complete only once those are checked exactly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Tally {
+    /// Link pairs certainly colliding, per lane.
+    pub self_pairs: [u16; FAST_LANES],
+    /// (link, world object) pairs certainly colliding, per lane.
+    pub world_pairs: [u16; FAST_LANES],
+    /// Lanes with a pair neither certainly colliding nor certainly free.
+    pub uncertain: LaneMask,
+    counting_self: bool,
+}
+
 /// Caller-owned scratch of [`FastModel::check`] (made by [`FastModel::scratch`]): world
 /// centres of every sphere and bounding sphere in every lane. Checks do not allocate.
 #[derive(Debug, Clone)]
@@ -1216,7 +1230,23 @@ impl FastModel {
         world: &FastWorld,
         scratch: &mut FastScratch,
     ) -> Verdict {
-        check(self, poses, live, world, scratch)
+        screen::<Verdict>(self, poses, live, world, scratch)
+    }
+
+    /// Counts, in the configurations of a block (as [`FastModel::check`] takes them), the link
+    /// pairs and (link, object) pairs that certainly collide; the pairs left uncertain are
+    /// kept in `scratch` for an exact check ([`FastChecker::count_unchecked`] does both).
+    ///
+    /// # Panics
+    /// If the poses or the scratch belong to another model.
+    pub fn count(
+        &self,
+        poses: &[PoseLanes32],
+        live: LaneMask,
+        world: &FastWorld,
+        scratch: &mut FastScratch,
+    ) -> Tally {
+        screen::<Tally>(self, poses, live, world, scratch)
     }
 }
 
@@ -1336,22 +1366,7 @@ impl FastChecker {
         if qs.iter().fold(false, |nan, v| nan | v.is_nan()) {
             return false;
         }
-        // a full block straight from the caller; a partial one padded with its first lane
-        let inputs = if n == FAST_LANES {
-            qs
-        } else {
-            self.inputs[..n * d].copy_from_slice(qs);
-            for l in n..FAST_LANES {
-                self.inputs.copy_within(..d, l * d);
-            }
-            &self.inputs
-        };
-        self.active.forward_block_unchecked(inputs, &mut self.block);
-        let live = if n == FAST_LANES {
-            ALL_LANES
-        } else {
-            (1 << n) - 1
-        };
+        let live = self.forward_block(qs, n);
         let verdict = self
             .fast
             .check(self.block.lanes(), live, fast_world, &mut self.scratch);
@@ -1382,6 +1397,125 @@ impl FastChecker {
         }
         true
     }
+
+    /// The exact model's counts ([`CollisionModel::count_self`], [`CollisionModel::count_world`])
+    /// of each configuration of `qs` (1 to [`FAST_LANES`] of them, as
+    /// [`FastChecker::all_free_unchecked`] takes them) into `self_pairs` and `world_pairs`: the
+    /// pairs the screen finds certainly colliding ([`FastChecker::screen_counts_unchecked`]),
+    /// and each pair it leaves uncertain checked exactly ([`FastChecker::exact_counts`], with
+    /// the configuration's `f64` forward kinematics). `qs` must hold 1 to [`FAST_LANES`] whole
+    /// configurations and the outputs one value per configuration (checked in debug builds).
+    pub fn count_unchecked(
+        &mut self,
+        qs: &[f64],
+        world: &World,
+        fast_world: &FastWorld,
+        self_pairs: &mut [usize],
+        world_pairs: &mut [usize],
+    ) {
+        let d = self.active.len();
+        debug_assert!(self_pairs.len() * d >= qs.len() && world_pairs.len() * d >= qs.len());
+        let tally = self.screen_counts_unchecked(qs, fast_world);
+        for (l, q) in qs.chunks_exact(d).enumerate() {
+            if tally.uncertain & (1 << l) != 0 || q.iter().any(|v| !v.is_finite()) {
+                self.active.forward_unchecked(q, &mut self.pose);
+            }
+            [self_pairs[l], world_pairs[l]] = self.counts_in(&tally, l, q, None, world);
+        }
+    }
+
+    /// The screen's counts of the configurations of `qs` (as [`FastChecker::count_unchecked`]
+    /// takes them): the pairs certainly colliding in each lane, and the lanes with pairs left
+    /// uncertain, which stay in the checker for [`FastChecker::exact_counts`] until the next
+    /// screen.
+    pub fn screen_counts_unchecked(&mut self, qs: &[f64], fast_world: &FastWorld) -> Tally {
+        let d = self.active.len();
+        let n = qs.len() / d.max(1);
+        debug_assert!(
+            d > 0 && n > 0 && n <= FAST_LANES && qs.len() == n * d,
+            "1 to {FAST_LANES} whole configurations"
+        );
+        let live = self.forward_block(qs, n);
+        self.fast
+            .count(self.block.lanes(), live, fast_world, &mut self.scratch)
+    }
+
+    /// The exact counts [link pairs, (link, object) pairs] of lane `l` of the last screen
+    /// (`tally`, its configuration `q`): the screen's, plus each pair it left uncertain in that
+    /// lane checked exactly in the link poses `pose` (read only then). A configuration with a
+    /// value that is not finite is counted by the `f64` model alone.
+    pub fn exact_counts(
+        &mut self,
+        tally: &Tally,
+        l: usize,
+        q: &[f64],
+        pose: &PoseBuffer,
+        world: &World,
+    ) -> [usize; 2] {
+        self.counts_in(tally, l, q, Some(pose), world)
+    }
+
+    /// [`FastChecker::exact_counts`] in `pose`, or in the checker's own pose buffer.
+    fn counts_in(
+        &mut self,
+        tally: &Tally,
+        l: usize,
+        q: &[f64],
+        pose: Option<&PoseBuffer>,
+        world: &World,
+    ) -> [usize; 2] {
+        let FastChecker {
+            fast,
+            collision,
+            placed,
+            scratch,
+            uncertain,
+            pose: own,
+            ..
+        } = self;
+        let pose = pose.unwrap_or(own);
+        if q.iter().any(|v| !v.is_finite()) {
+            collision.place(pose, placed);
+            return [
+                collision.count_self(placed),
+                collision.count_world(placed, world),
+            ];
+        }
+        let mut counts = [tally.self_pairs[l] as usize, tally.world_pairs[l] as usize];
+        if tally.uncertain & (1 << l) != 0 {
+            *uncertain += 1;
+            for &(suspect, lanes) in &scratch.suspects {
+                if lanes & (1 << l) != 0
+                    && suspect_collides(fast, collision, pose, placed, world, suspect)
+                {
+                    counts[matches!(suspect, Suspect::Object { .. }) as usize] += 1;
+                }
+            }
+        }
+        counts
+    }
+
+    /// Forward kinematics (`f32`) of the `n` configurations of `qs` into the block, a partial
+    /// block padded with its first configuration; the lanes in use.
+    fn forward_block(&mut self, qs: &[f64], n: usize) -> LaneMask {
+        let d = self.active.len();
+        // a full block straight from the caller; a partial one padded with its first lane
+        let inputs = if n == FAST_LANES {
+            qs
+        } else {
+            self.inputs[..n * d].copy_from_slice(qs);
+            for l in n..FAST_LANES {
+                self.inputs.copy_within(..d, l * d);
+            }
+            &self.inputs
+        };
+        self.active.forward_block_unchecked(inputs, &mut self.block);
+        if n == FAST_LANES {
+            ALL_LANES
+        } else {
+            (1 << n) - 1
+        }
+    }
 }
 
 /// Whether `suspect` collides exactly (`f64`) in the configuration whose link poses are `pose`.
@@ -1407,32 +1541,47 @@ fn suspect_collides(
     }
 }
 
-/// [`FastModel::check`], compiled for several instruction sets with the best one chosen at run
-/// time.
+/// [`FastModel::check`] and [`FastModel::count`], compiled for several instruction sets with the
+/// best one chosen at run time.
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
-fn check(
+fn screen<O: Outcome + Default>(
     model: &FastModel,
     poses: &[PoseLanes32],
     live: LaneMask,
     world: &FastWorld,
     scratch: &mut FastScratch,
-) -> Verdict {
+) -> O {
     // the AVX code paths take AVX2 and FMA: the plain-AVX clone goes without them
     const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
         && multiversion::target::selected_target!().supports_feature_str("fma");
+    let mut outcome = O::default();
+    walk::<AVX, _>(model, poses, live, world, scratch, &mut outcome);
+    outcome
+}
+
+/// The screen's walk: the world's objects against the links, then the link pairs, each group
+/// of spheres' contacts handed to `outcome`; ends early when the outcome says so.
+#[inline(always)]
+fn walk<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) {
     place::<AVX>(model, poses, scratch);
     scratch.suspects.clear();
     let m = world.margin;
-    let mut verdict = Verdict::default();
     // the world first: in a planner's queries most collisions are with the world. Each object
     // against each link's bounding sphere, then its spheres; for a model of many links,
     // against the culling spheres of the kinematic tree's subtrees first
     for (o, object) in world.objects.iter().enumerate() {
         if !model.culls {
             for g in 0..model.groups.len() {
-                if object_link::<AVX>(model, o, object, g, live, world, scratch, &mut verdict) {
-                    return verdict;
+                if object_link::<AVX>(model, o, object, g, live, world, scratch, verdict) {
+                    return;
                 }
             }
             continue;
@@ -1454,23 +1603,25 @@ fn check(
                 }
                 WorldStep::Link(g) => {
                     let g = g as usize;
-                    if object_link::<AVX>(model, o, object, g, mask, world, scratch, &mut verdict) {
-                        return verdict;
+                    if object_link::<AVX>(model, o, object, g, mask, world, scratch, verdict) {
+                        return;
                     }
                 }
             }
             i += 1;
         }
     }
+    verdict.enter_self();
     // self: the culling spheres of the kinematic tree (one test clears a hand against the
     // other hand), then each link pair's bounding spheres and spheres
     if !model.culls {
         for (k, gp) in model.group_pairs.iter().enumerate() {
-            if link_pair::<AVX>(model, gp, k, live, world, scratch, &mut verdict) {
-                return verdict;
+            if link_pair::<AVX>(model, gp, k, live, world, scratch, verdict) {
+                return;
             }
         }
-        return clear_suspects::<AVX>(model, scratch, m, verdict);
+        clear_suspects::<AVX, _>(model, scratch, m, verdict);
+        return;
     }
     let steps = &model.steps;
     let mut nest = Nest::<MAX_NESTING>::new();
@@ -1490,31 +1641,32 @@ fn check(
             }
             CullStep::Pair(k) => {
                 let gp = &model.group_pairs[k as usize];
-                if link_pair::<AVX>(model, gp, k as usize, mask, world, scratch, &mut verdict) {
-                    return verdict;
+                if link_pair::<AVX>(model, gp, k as usize, mask, world, scratch, verdict) {
+                    return;
                 }
             }
         }
         i += 1;
     }
-    clear_suspects::<AVX>(model, scratch, m, verdict)
+    clear_suspects::<AVX, _>(model, scratch, m, verdict);
 }
 
 /// `verdict` without the link-pair suspects' lanes in which either link's spheres all lie
 /// beyond a slab of the other's k-DOP (when both are convex hulls): a second, tighter screen
 /// that only a block left uncertain pays for, before its lanes are checked exactly.
 #[inline(always)]
-fn clear_suspects<const AVX: bool>(
+fn clear_suspects<const AVX: bool, O: Outcome>(
     model: &FastModel,
     scratch: &mut FastScratch,
     m: f32,
-    mut verdict: Verdict,
-) -> Verdict {
-    if verdict.colliding != 0 || verdict.uncertain == 0 || model.exact {
-        return verdict;
+    verdict: &mut O,
+) {
+    if verdict.settled() || *verdict.uncertain() == 0 || model.exact {
+        return;
     }
     let mut suspects = std::mem::take(&mut scratch.suspects);
-    verdict.uncertain = 0;
+    let uncertain = verdict.uncertain();
+    *uncertain = 0;
     for (suspect, lanes) in &mut suspects {
         if let Suspect::Pair(k) = *suspect {
             let gp = &model.group_pairs[k as usize];
@@ -1523,11 +1675,10 @@ fn clear_suspects<const AVX: bool>(
                 *lanes &= !kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
             }
         }
-        verdict.uncertain |= *lanes;
+        *uncertain |= *lanes;
     }
     suspects.retain(|&(_, lanes)| lanes != 0);
     scratch.suspects = suspects;
-    verdict
 }
 
 /// Checks world object `o` against link group `g` in the lanes of `live`: the link's bounding
@@ -1544,7 +1695,7 @@ fn object_link<const AVX: bool>(
     live: LaneMask,
     world: &FastWorld,
     scratch: &mut FastScratch,
-    verdict: &mut Verdict,
+    verdict: &mut impl Outcome,
 ) -> bool {
     let (m, group) = (world.margin, &model.groups[g]);
     let near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
@@ -1594,7 +1745,7 @@ fn link_pair<const AVX: bool>(
     live: LaneMask,
     world: &FastWorld,
     scratch: &mut FastScratch,
-    verdict: &mut Verdict,
+    verdict: &mut impl Outcome,
 ) -> bool {
     let m = world.margin;
     let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
@@ -1795,11 +1946,23 @@ impl Contact {
     }
 }
 
-impl Verdict {
+/// What the screen's walk makes of each group of pairs' contacts: a [`Verdict`] (stops at the
+/// first certain collision) or a [`Tally`] (counts every colliding pair).
+trait Outcome {
     /// Adds the contacts of a group of pairs in the lanes of `lanes`: `hit`, the lanes certainly
     /// colliding (for bodies screened through enclosing spheres, those touching a sphere inside
-    /// them), and `close`, those within the margin of contact. `None` when a lane certainly
-    /// collides, else the lanes the group left uncertain.
+    /// them), and `close`, those within the margin of contact. `None` when the walk may stop,
+    /// else the lanes the group left uncertain.
+    fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask>;
+    /// The world's objects are done; link pairs follow.
+    fn enter_self(&mut self) {}
+    /// Whether the outcome is known without the uncertain lanes.
+    fn settled(&self) -> bool;
+    /// The lanes left uncertain.
+    fn uncertain(&mut self) -> &mut LaneMask;
+}
+
+impl Outcome for Verdict {
     #[inline(always)]
     fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask> {
         let hit = lanes & hit;
@@ -1810,6 +1973,41 @@ impl Verdict {
         let uncertain = lanes & close;
         self.uncertain |= uncertain;
         Some(uncertain)
+    }
+    fn settled(&self) -> bool {
+        self.colliding != 0
+    }
+    fn uncertain(&mut self) -> &mut LaneMask {
+        &mut self.uncertain
+    }
+}
+
+impl Outcome for Tally {
+    #[inline(always)]
+    fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask> {
+        let hit = lanes & hit;
+        let counts = if self.counting_self {
+            &mut self.self_pairs
+        } else {
+            &mut self.world_pairs
+        };
+        let mut bits = hit;
+        while bits != 0 {
+            counts[bits.trailing_zeros() as usize] += 1;
+            bits &= bits - 1;
+        }
+        let uncertain = lanes & close & !hit;
+        self.uncertain |= uncertain;
+        Some(uncertain)
+    }
+    fn enter_self(&mut self) {
+        self.counting_self = true;
+    }
+    fn settled(&self) -> bool {
+        false
+    }
+    fn uncertain(&mut self) -> &mut LaneMask {
+        &mut self.uncertain
     }
 }
 

@@ -176,6 +176,74 @@ fn the_screen_answers_as_the_exact_model_does() {
     }
 }
 
+/// The screen's counts are the exact model's: link pairs and (link, object) pairs colliding,
+/// per configuration, in full blocks and partial ones, with a configuration of NaN among them
+/// (counted by the `f64` model, as every other lane still is by the screen).
+#[test]
+fn the_screen_counts_as_the_exact_model_does() {
+    for (file, configurations, shift) in [
+        ("panda-mbm/panda_spherized.ron", 2000, [0.0; 3]),
+        ("panda-mbm/panda.ron", 400, [0.0; 3]),
+        ("icub_upper_body.ron", 1600, [-0.6, 0.0, -0.3]),
+    ] {
+        let (robot, collision) = panda(file);
+        let active = robot.all_active();
+        let d = active.len();
+        let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut qs: Vec<f64> = (0..configurations)
+            .flat_map(|_| active.random(&mut rng))
+            .collect();
+        qs[5 * d + 2] = f64::NAN;
+        let (mut pose, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+        for world in [World::new(), cluttered(shift)] {
+            checker.uncertain = 0;
+            let fast_world = checker.model().world(&world);
+            let truth: Vec<[usize; 2]> = qs
+                .chunks(d)
+                .map(|q| {
+                    active.forward_unchecked(q, &mut pose);
+                    collision.place(&pose, &mut placed);
+                    [
+                        collision.count_self(&placed),
+                        collision.count_world(&placed, &world),
+                    ]
+                })
+                .collect();
+            let several = truth.iter().filter(|t| t[0] + t[1] >= 2).count();
+            assert!(several > configurations / 20, "{file}: {several}");
+            let (mut own, mut objects) = ([0; FAST_LANES], [0; FAST_LANES]);
+            let mut k = 0;
+            // blocks of 8, 3 and 1
+            for (b, size) in [FAST_LANES, 3, 1].into_iter().cycle().enumerate() {
+                let n = size.min(configurations - k);
+                if n == 0 {
+                    break;
+                }
+                let block = &qs[k * d..(k + n) * d];
+                checker.count_unchecked(block, &world, &fast_world, &mut own, &mut objects);
+                for l in 0..n {
+                    assert_eq!(
+                        [own[l], objects[l]],
+                        truth[k + l],
+                        "{file}: configuration {} (block {b})",
+                        k + l
+                    );
+                }
+                k += n;
+            }
+            eprintln!(
+                "{file}: {several} with several pairs, {} uncertain",
+                checker.uncertain
+            );
+            assert!(
+                checker.uncertain > 0,
+                "{file}: the exact checks were reached"
+            );
+        }
+    }
+}
+
 /// NaN is never free unchecked and an error checked, as are wrong lengths (none, a part of a
 /// configuration, more than a block).
 #[test]
