@@ -1328,6 +1328,13 @@ impl FastChecker {
     /// [`FastModel::world`]): the exact model's answer. An error for a length that is not 1 to
     /// [`FAST_LANES`] whole configurations or a value that is not finite.
     pub fn all_free(&mut self, qs: &[f64], world: &World, fast_world: &FastWorld) -> Result<bool> {
+        self.check_block(qs)?;
+        Ok(self.all_free_unchecked(qs, world, fast_world))
+    }
+
+    /// The number of configurations in `qs` (1 to [`FAST_LANES`] whole configurations of
+    /// finite values), or an error that says what is wrong.
+    fn check_block(&self, qs: &[f64]) -> Result<usize> {
         let d = self.active.len();
         let n = qs.len() / d.max(1);
         if d == 0 || n == 0 || n > FAST_LANES || qs.len() != n * d {
@@ -1344,7 +1351,7 @@ impl FastChecker {
                 problem: format!("is {}, not a finite number", qs[i]),
             });
         }
-        Ok(self.all_free_unchecked(qs, world, fast_world))
+        Ok(n)
     }
 
     /// [`FastChecker::all_free`] without its checks, for callers that made `qs` themselves:
@@ -1396,6 +1403,34 @@ impl FastChecker {
             }
         }
         true
+    }
+
+    /// The exact model's counts ([`CollisionModel::count_self`], [`CollisionModel::count_world`])
+    /// of each configuration of `qs` (1 to [`FAST_LANES`] of them, one after the other) into
+    /// `self_pairs` and `world_pairs`, as [`FastChecker::count_unchecked`] gives them. An error
+    /// for a length that is not 1 to [`FAST_LANES`] whole configurations, a value that is not
+    /// finite, or outputs shorter than the configurations.
+    pub fn count(
+        &mut self,
+        qs: &[f64],
+        world: &World,
+        fast_world: &FastWorld,
+        self_pairs: &mut [usize],
+        world_pairs: &mut [usize],
+    ) -> Result<()> {
+        let n = self.check_block(qs)?;
+        if self_pairs.len() < n || world_pairs.len() < n {
+            return Err(CollisionError::InvalidValue {
+                what: format!(
+                    "outputs of {} and {} values",
+                    self_pairs.len(),
+                    world_pairs.len()
+                ),
+                problem: format!("hold fewer than the {n} configurations' counts"),
+            });
+        }
+        self.count_unchecked(qs, world, fast_world, self_pairs, world_pairs);
+        Ok(())
     }
 
     /// The exact model's counts ([`CollisionModel::count_self`], [`CollisionModel::count_world`])

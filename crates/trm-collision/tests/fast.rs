@@ -277,4 +277,27 @@ fn nan_is_never_free_and_bad_input_is_an_error() {
     );
     q[2] = f64::INFINITY;
     assert!(checker.all_free(&q, &world, &fast_world).is_err());
+    // counting: the same checks, and outputs too short for the configurations
+    let (mut own, mut objects) = ([0; FAST_LANES], [0; FAST_LANES]);
+    let e = checker
+        .count(&q, &world, &fast_world, &mut own, &mut objects)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("value 2 of configuration 0"), "{e}");
+    let e = checker
+        .count(&q[..d - 1], &world, &fast_world, &mut own, &mut objects)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("whole configurations"), "{e}");
+    q[2] = 0.0;
+    let two = [q.clone(), q.clone()].concat();
+    let e = checker
+        .count(&two, &world, &fast_world, &mut own[..1], &mut objects)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fewer than the 2 configurations"), "{e}");
+    checker
+        .count(&two, &world, &fast_world, &mut own, &mut objects)
+        .unwrap();
+    assert_eq!([own[0], objects[0]], [own[1], objects[1]]);
 }

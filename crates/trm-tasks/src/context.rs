@@ -3,7 +3,7 @@
 
 use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World};
 use trm_kinematics::nalgebra::{Isometry3, Point3, Vector3};
-use trm_kinematics::{FrameId, PoseBatch, PoseBuffer, RobotModel};
+use trm_kinematics::{FrameId, LANES, PoseBatch, PoseBuffer, RobotModel};
 
 /// One evaluated candidate. Built by [`crate::Objective`] after one forward-kinematics pass.
 pub struct Context<'a> {
@@ -30,6 +30,16 @@ pub enum Anchor {
     Object(usize),
     /// A fixed point in the world frame.
     Point([f64; 3]),
+}
+
+impl Anchor {
+    /// The frame the anchor reads, if it is one.
+    pub fn frame(&self) -> Option<FrameId> {
+        match self {
+            Anchor::Frame(f) => Some(*f),
+            Anchor::Object(_) | Anchor::Point(_) => None,
+        }
+    }
 }
 
 /// What cost and task formulas read of one candidate, whether it was evaluated alone
@@ -141,9 +151,32 @@ pub struct BatchContext<'a> {
     /// One-candidate copies of the poses and placed bodies, made when some term reads them.
     pub(crate) lane_poses: &'a [PoseBuffer],
     pub(crate) lane_placed: &'a [PlacedBodies],
+    /// Per lane, colliding link pairs and (link, object) pairs, when the objective counted
+    /// them with the single-precision screen.
+    pub(crate) counts: Option<&'a [[usize; 2]]>,
 }
 
 impl<'a> BatchContext<'a> {
+    /// Per lane, the number of colliding checked link pairs
+    /// ([`CollisionModel::count_self`]): counted by the objective's screen when its terms read
+    /// collisions only through these counts ([`crate::Cost::counts_collisions_only`]), else
+    /// from the placed bodies.
+    pub fn count_self(&self) -> [usize; LANES] {
+        match self.counts {
+            Some(counts) => std::array::from_fn(|l| counts.get(l).map_or(0, |c| c[0])),
+            None => self.collision.count_self_batch(self.placed),
+        }
+    }
+
+    /// Per lane, the number of colliding (link, world object) pairs
+    /// ([`CollisionModel::count_world`]), as [`BatchContext::count_self`] gives its counts.
+    pub fn count_world(&self) -> [usize; LANES] {
+        match self.counts {
+            Some(counts) => std::array::from_fn(|l| counts.get(l).map_or(0, |c| c[1])),
+            None => self.collision.count_world_batch(self.placed, self.world),
+        }
+    }
+
     /// Number of candidates (lanes in use).
     pub fn len(&self) -> usize {
         self.q.len()

@@ -19,6 +19,20 @@ pub trait Cost: Send + Sync + std::fmt::Debug {
     fn needs_collision(&self) -> bool {
         false
     }
+    /// Whether the term reads collisions only through the counts of
+    /// [`BatchContext::count_self`] and [`BatchContext::count_world`] (and, one candidate at a
+    /// time, [`CollisionModel::count_self`](trm_collision::CollisionModel::count_self) and
+    /// `count_world`): then an objective whose collision terms all do so counts with the
+    /// single-precision screen (the same counts) and places no bodies.
+    fn counts_collisions_only(&self) -> bool {
+        false
+    }
+    /// The frames whose poses the term reads (`None`, the default: any). When every term and
+    /// the task function say, an objective whose bodies need no placing computes only those
+    /// frames (and their ancestors) in its forward kinematics.
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        None
+    }
     /// The cost of one candidate.
     fn eval(&self, ctx: &Context) -> f64;
     /// The cost of every candidate of a batch: `out[l]` for each lane `l < ctx.len()`. The
@@ -77,6 +91,9 @@ impl Cost for HomePosture {
     fn label(&self) -> String {
         "home posture".into()
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(Vec::new())
+    }
     on_frames!();
 }
 
@@ -105,7 +122,14 @@ impl Cost for Collision {
     fn label(&self) -> String {
         "collision".into()
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        // the bodies, when placed, are placed from every link's pose (the objective knows)
+        Some(Vec::new())
+    }
     fn needs_collision(&self) -> bool {
+        true
+    }
+    fn counts_collisions_only(&self) -> bool {
         true
     }
     fn eval(&self, ctx: &Context) -> f64 {
@@ -121,10 +145,10 @@ impl Cost for Collision {
     fn eval_batch(&self, ctx: &BatchContext, out: &mut [f64]) {
         let mut n = [0; trm_kinematics::LANES];
         if self.self_collision {
-            n = ctx.collision.count_self_batch(ctx.placed);
+            n = ctx.count_self();
         }
         if self.world {
-            let world = ctx.collision.count_world_batch(ctx.placed, ctx.world);
+            let world = ctx.count_world();
             n.iter_mut().zip(world).for_each(|(n, w)| *n += w);
         }
         for (o, n) in out[..ctx.len()].iter_mut().zip(n) {
@@ -175,6 +199,13 @@ impl Cost for Position {
     fn label(&self) -> String {
         format!("position {}", self.part_name)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        let anchor = match &self.target {
+            Region::Point(a) | Region::Sphere { center: a, .. } => a.frame(),
+            Region::Box { .. } => None,
+        };
+        Some([Some(self.part), anchor].into_iter().flatten().collect())
+    }
     on_frames!();
 }
 
@@ -221,6 +252,13 @@ impl Cost for Orientation {
     fn label(&self) -> String {
         format!("orientation {}", self.part_name)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        let toward = match &self.target {
+            Direction::Axis(frame, _) => Some(*frame),
+            Direction::Fixed(_) => None,
+        };
+        Some([Some(self.part), toward].into_iter().flatten().collect())
+    }
     on_frames!();
 }
 
@@ -254,6 +292,14 @@ pub struct Pointing {
 impl Cost for Pointing {
     fn label(&self) -> String {
         format!("pointing {}", self.part_name)
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(
+            [Some(self.part), self.target.frame()]
+                .into_iter()
+                .flatten()
+                .collect(),
+        )
     }
     on_frames!();
 }
@@ -292,6 +338,9 @@ impl Cost for Repel {
     fn label(&self) -> String {
         format!("repel {}", self.names)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        crate::tasks::frames_of(&[&self.a, &self.b])
+    }
     on_frames!();
 }
 
@@ -318,6 +367,9 @@ impl Cost for JointLimits {
     fn label(&self) -> String {
         "joint limits".into()
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(Vec::new())
+    }
     on_frames!();
 }
 
@@ -342,6 +394,9 @@ pub struct Displacement {
 impl Cost for Displacement {
     fn label(&self) -> String {
         "displacement".into()
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(Vec::new())
     }
     on_frames!();
 }
@@ -401,6 +456,9 @@ impl Cost for TaskMapCost {
     fn label(&self) -> String {
         format!("task map {}", self.part_name)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(vec![self.part])
+    }
     on_frames!();
 }
 
@@ -457,6 +515,9 @@ impl TaskTarget {
 impl Cost for TaskTarget {
     fn label(&self) -> String {
         format!("target of {}", self.task.label())
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        self.task.frames_read()
     }
     fn eval(&self, ctx: &Context) -> f64 {
         let mut g = [0.0; Self::MAX_DIM];

@@ -29,6 +29,11 @@ pub trait TaskFunction: Send + Sync + std::fmt::Debug {
     fn batched(&self) -> bool {
         false
     }
+    /// The frames whose poses the function reads (`None`, the default: any), as
+    /// [`crate::Cost::frames_read`].
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        None
+    }
 }
 
 /// `eval`, `eval_batch` (each lane read in place) and `batched` of a task function through its
@@ -60,6 +65,11 @@ fn write_masked(v: Vector3<f64>, mask: [bool; 3], out: &mut [f64]) {
     }
 }
 
+/// The frames among `anchors` (for `frames_read`).
+pub(crate) fn frames_of(anchors: &[&Anchor]) -> Option<Vec<FrameId>> {
+    Some(anchors.iter().filter_map(|a| a.frame()).collect())
+}
+
 fn mask_dim(mask: [bool; 3]) -> usize {
     mask.iter().filter(|m| **m).count()
 }
@@ -81,6 +91,9 @@ impl TaskFunction for PositionTask {
     }
     fn label(&self) -> String {
         format!("position {}", self.part_name)
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(vec![self.part])
     }
     on_frames!();
 }
@@ -117,6 +130,14 @@ impl TaskFunction for RotationTask {
             None => format!("rotation {}", self.part_name),
         }
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(
+            [Some(self.part), self.relative_to.as_ref().map(|r| r.0)]
+                .into_iter()
+                .flatten()
+                .collect(),
+        )
+    }
     on_frames!();
 }
 
@@ -152,6 +173,9 @@ impl TaskFunction for PoseTask {
     fn label(&self) -> String {
         format!("pose {}", self.part_name)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        Some(vec![self.part])
+    }
     on_frames!();
 }
 
@@ -181,6 +205,9 @@ impl TaskFunction for DistanceTask {
     }
     fn label(&self) -> String {
         format!("distance {}", self.names)
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        frames_of(&[&self.a, &self.b])
     }
     on_frames!();
 }
@@ -214,6 +241,9 @@ impl TaskFunction for AngleTask {
     fn label(&self) -> String {
         format!("angle {}", self.names)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        frames_of(&[&self.a, &self.b])
+    }
     on_frames!();
 }
 
@@ -244,6 +274,9 @@ impl TaskFunction for MidpointTask {
     fn label(&self) -> String {
         format!("midpoint {}", self.names)
     }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        frames_of(&[&self.a, &self.b])
+    }
     on_frames!();
 }
 
@@ -273,6 +306,9 @@ impl TaskFunction for RodDirectionTask {
     }
     fn label(&self) -> String {
         format!("rod direction {}", self.names)
+    }
+    fn frames_read(&self) -> Option<Vec<FrameId>> {
+        frames_of(&[&self.a, &self.b])
     }
     on_frames!();
 }

@@ -210,6 +210,44 @@ fn every_catalogue_term_batched_equals_one_at_a_time() {
     }
 }
 
+/// Each catalogue term alone on the iCub, reading frames on two branches of its tree (the
+/// hands): batched, the objective computes only the frames its terms say they read
+/// (`Cost::frames_read`, `TaskFunction::frames_read`), so a frame left out would be stale
+/// there and differ from the one-at-a-time value.
+#[test]
+fn every_catalogue_term_on_a_branching_tree_batched_equals_one_at_a_time() {
+    let costs = [
+        "Position(part: \"l_hand\", target: Point((-0.3, 0.2, 0.1)))",
+        "Position(part: \"l_hand\", target: Sphere(center: Part(\"r_hand\"), radius: 0.05))",
+        "Position(part: \"l_hand\", target: Part(\"r_hand\"))",
+        "Orientation(part: \"l_hand\", axis: (1, 0, 0), toward: Axis(part: \"r_hand\", axis: (0, 1, 0)))",
+        "Pointing(part: \"l_hand\", axis: (1, 0, 0), at: Part(\"r_hand\"), distance: Some(0.2))",
+        "Repel(a: Part(\"l_hand\"), b: Part(\"r_hand\"), min_distance: 0.6)",
+    ];
+    let tasks = [
+        "Distance(a: Part(\"l_hand\"), b: Part(\"r_hand\"))",
+        "Angle(a: Part(\"l_hand\"), b: Part(\"r_hand\"), u1: (1, 0, 0), u2: (0, 1, 0))",
+        "Midpoint(a: Part(\"l_hand\"), b: Part(\"r_hand\"), mask: (true, true, false))",
+        "RodDirection(a: Part(\"l_hand\"), b: Part(\"r_hand\"))",
+        "Rotation(part: \"r_hand\", axis: (1, 0, 0), mask: (true, true, false), relative_to: Some(\"l_hand\"))",
+        "Pose(part: \"r_hand\")",
+    ];
+    let objectives = costs
+        .iter()
+        .map(|cost| format!("costs: [(weight: 1.0, cost: {cost})], task: None"))
+        .chain(tasks.iter().map(|task| {
+            format!("costs: [(weight: 1.0, cost: HomePosture())], task: Some({task})")
+        }));
+    for terms in objectives {
+        let text = format!("(model: \"icub_upper_body\", {terms})");
+        let problem =
+            Problem::from_ron(&text, "icub.ron", Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+        let qs = candidates(&problem.objective, 9, 3);
+        agrees_with_one_at_a_time(&problem.objective, &qs);
+        tasks_agree(&problem.objective, &qs);
+    }
+}
+
 #[test]
 fn batched_collision_checks_agree_and_nan_collides() {
     let problem = spec("table_iii/posture1.ron");
