@@ -156,7 +156,11 @@ impl Objective {
             .then(|| FastModel::of(&self.collision).ok())
             .flatten()
             .map(|fast| fast.world(&self.world));
-        // the frames read, when every term and the task function say
+    }
+
+    /// The kinematics of the frames the terms and the task function read, when every one of
+    /// them says which (again after the terms or the task changed).
+    fn prune_kinematics(&mut self) {
         let mut frames = Vec::new();
         let declared = self.terms.iter().all(|t| match t.cost.frames_read() {
             Some(f) => {
@@ -209,6 +213,7 @@ impl Objective {
             cost: Arc::from(cost),
         });
         self.compile_screen();
+        self.prune_kinematics();
         Ok(())
     }
 
@@ -216,7 +221,7 @@ impl Objective {
     pub fn set_task(&mut self, task: Box<dyn TaskFunction>) {
         self.copies_poses |= !task.batched();
         self.task = Some(Arc::from(task));
-        self.compile_screen();
+        self.prune_kinematics();
     }
 
     /// A copy of this objective with one more term, `weight` · ‖g(q) − `target`‖ (g = the task
