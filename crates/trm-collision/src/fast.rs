@@ -846,9 +846,9 @@ pub struct Verdict {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Tally {
     /// Link pairs certainly colliding, per lane.
-    pub self_pairs: [u16; FAST_LANES],
+    pub self_pairs: [u32; FAST_LANES],
     /// (link, world object) pairs certainly colliding, per lane.
-    pub world_pairs: [u16; FAST_LANES],
+    pub world_pairs: [u32; FAST_LANES],
     /// Lanes with a pair neither certainly colliding nor certainly free.
     pub uncertain: LaneMask,
     counting_self: bool,
