@@ -66,100 +66,16 @@ fn run() -> Result<(), String> {
     }
     let qs = random_configurations(timed.active(), n, 0);
     let world = World::new();
-
-    let mut input = format!(
-        "trm-mbm-problems 1\nrobot {}\nconfigurations {n}\n",
-        timed.active().model().name()
-    );
-    for q in &qs {
-        let values: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
-        input.push_str(&values.join(" "));
-        input.push('\n');
-    }
-    input.push_str(&format!("{rounds}\n"));
-    let mut vamp = Command::new(&args[2])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| {
-            format!(
-                "{}: {e} (build it with benches/peers/vamp/build.sh)",
-                args[2]
-            )
-        })?;
-    let (Some(mut to_vamp), Some(out)) = (vamp.stdin.take(), vamp.stdout.take()) else {
-        let _ = vamp.kill();
-        let _ = vamp.wait();
-        return Err("no pipes to VAMP".into());
-    };
-    let mut from_vamp = BufReader::new(out).lines();
-    let lost = |e: std::io::Error| format!("{}: {e}", args[2]);
-    let flat: Vec<f64> = qs.iter().flatten().copied().collect();
-    let d = timed.dim();
+    // VAMP's verdicts on every configuration, and the times on all of them (blocks mostly end
+    // at their first collision) and on the free ones only (every pair looked at)
+    let (mut ours, mut screened, mut screened_exact, mut theirs, vamp_free) =
+        exchange(&args[2], &qs, rounds, &timed, &exact, &world)?;
     let mut scratch = timed.scratch();
-    let mut fast = FastChecker::new(timed.collision(), timed.active().clone()).ok();
-    let fast_world = fast.as_ref().map(|f| f.model().world(&world));
-    let mut fast_exact = FastChecker::for_model(exact.collision(), exact.active(), &world);
-    // trm's passes, then VAMP's, `rounds` times; then VAMP's verdicts
-    let mut exchange = || -> Result<Exchanged, String> {
-        to_vamp.write_all(input.as_bytes()).map_err(lost)?;
-        to_vamp.flush().map_err(lost)?;
-        let (mut ours, mut screened, mut screened_exact, mut theirs) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for round in 0..rounds {
-            let began = Instant::now();
-            let mut free_blocks = 0;
-            for block in flat.chunks(LANES * d) {
-                free_blocks +=
-                    usize::from(timed.all_collision_free_in(block, &world, &mut scratch));
-            }
-            ours.push(began.elapsed().as_nanos() as f64 / n as f64);
-            if let (Some(fast), Some(fast_world)) = (&mut fast, &fast_world) {
-                let began = Instant::now();
-                for block in flat.chunks(FAST_LANES * d) {
-                    free_blocks += usize::from(fast.all_free_unchecked(block, &world, fast_world));
-                }
-                screened.push(began.elapsed().as_nanos() as f64 / n as f64);
-            }
-            if let Some((fast, fast_world)) = &mut fast_exact {
-                let began = Instant::now();
-                for block in flat.chunks(FAST_LANES * d) {
-                    free_blocks += usize::from(fast.all_free_unchecked(block, &world, fast_world));
-                }
-                screened_exact.push(began.elapsed().as_nanos() as f64 / n as f64);
-            }
-            std::hint::black_box(free_blocks);
-            let line = from_vamp
-                .next()
-                .ok_or_else(|| format!("{} stopped answering", args[2]))?
-                .map_err(lost)?;
-            let ns: f64 = line
-                .split_whitespace()
-                .nth(1)
-                .and_then(|v| v.parse().ok())
-                .ok_or_else(|| format!("{} said `{line}`, not `time NS VALID`", args[2]))?;
-            theirs.push(ns);
-            if round + 1 < rounds {
-                to_vamp.write_all(b"next\n").map_err(lost)?;
-                to_vamp.flush().map_err(lost)?;
-            }
-        }
-        let mut free = Vec::with_capacity(n);
-        for _ in 0..n {
-            let line = from_vamp
-                .next()
-                .ok_or_else(|| format!("{} gave too few verdicts", args[2]))?
-                .map_err(lost)?;
-            free.push(line == "valid 1");
-        }
-        Ok((ours, screened, screened_exact, theirs, free))
-    };
-    let exchanged = exchange();
-    let _ = vamp.kill();
-    let _ = vamp.wait();
-    let (mut ours, mut screened, mut screened_exact, mut theirs, vamp_free) = exchanged?;
-    let mut scratch = timed.scratch();
-
+    let free: Vec<Vec<f64>> = qs
+        .iter()
+        .filter(|q| timed.is_collision_free_in(q, &world, &mut scratch))
+        .cloned()
+        .collect();
     let mut exact_scratch = exact.scratch();
     let (mut missed, mut false_positive, mut agree_spheres, mut colliding) = (0, 0, 0, 0);
     for (q, &v) in qs.iter().zip(&vamp_free) {
@@ -170,6 +86,12 @@ fn run() -> Result<(), String> {
         false_positive += usize::from(truth && !v);
         agree_spheres += usize::from(spheres == v);
     }
+    let free_times = if free.is_empty() {
+        None
+    } else {
+        Some(exchange(&args[2], &free, rounds, &timed, &exact, &world)?)
+    };
+
     let (a, b) = (median(&mut ours), median(&mut theirs));
     println!(
         "{n} configurations of {} (seed 0), FK + self-collision in blocks, median of {rounds} interleaved rounds:",
@@ -196,9 +118,128 @@ fn run() -> Result<(), String> {
         );
     }
     println!("  VAMP ({}): {b:.1} ns per configuration", args[2]);
+    if let Some((mut ours, mut screened, mut screened_exact, mut theirs, _)) = free_times {
+        let b = median(&mut theirs);
+        let ratio = |v: &mut Vec<f64>| {
+            let c = median(v);
+            format!("{c:.1} ns ({:.2}× VAMP)", c / b)
+        };
+        println!(
+            "the {} free configurations alone (every pair looked at): trm f64 batches {}, f32 sphere screen {}, f32 screen of the exact model {}, VAMP {b:.1} ns",
+            free.len(),
+            ratio(&mut ours),
+            if screened.is_empty() {
+                "—".into()
+            } else {
+                ratio(&mut screened)
+            },
+            if screened_exact.is_empty() {
+                "—".into()
+            } else {
+                ratio(&mut screened_exact)
+            },
+        );
+    }
     println!(
         "verdicts against the exact model ({}, {colliding} of {n} colliding): VAMP missed {missed} collisions, refused {false_positive} free configurations; VAMP and trm's copy of its spheres agree on {agree_spheres} of {n}",
         args[1]
     );
     Ok(())
+}
+
+/// trm's passes over `qs` and VAMP's (`program`), interleaved `rounds` times, then VAMP's
+/// verdict on each configuration.
+fn exchange(
+    program: &str,
+    qs: &[Vec<f64>],
+    rounds: usize,
+    timed: &Objective,
+    exact: &Objective,
+    world: &World,
+) -> Result<Exchanged, String> {
+    let n = qs.len();
+    let mut input = format!(
+        "trm-mbm-problems 1\nrobot {}\nconfigurations {n}\n",
+        timed.active().model().name()
+    );
+    for q in qs {
+        let values: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
+        input.push_str(&values.join(" "));
+        input.push('\n');
+    }
+    input.push_str(&format!("{rounds}\n"));
+    let mut vamp = Command::new(program)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("{program}: {e} (build it with benches/peers/vamp/build.sh)"))?;
+    let (Some(mut to_vamp), Some(out)) = (vamp.stdin.take(), vamp.stdout.take()) else {
+        let _ = vamp.kill();
+        let _ = vamp.wait();
+        return Err("no pipes to VAMP".into());
+    };
+    let mut from_vamp = BufReader::new(out).lines();
+    let lost = |e: std::io::Error| format!("{program}: {e}");
+    let flat: Vec<f64> = qs.iter().flatten().copied().collect();
+    let d = timed.dim();
+    let mut scratch = timed.scratch();
+    let mut fast = FastChecker::new(timed.collision(), timed.active().clone()).ok();
+    let fast_world = fast.as_ref().map(|f| f.model().world(world));
+    let mut fast_exact = FastChecker::for_model(exact.collision(), exact.active(), world);
+    let mut run = || -> Result<Exchanged, String> {
+        to_vamp.write_all(input.as_bytes()).map_err(lost)?;
+        to_vamp.flush().map_err(lost)?;
+        let (mut ours, mut screened, mut screened_exact, mut theirs) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for round in 0..rounds {
+            let began = Instant::now();
+            let mut free_blocks = 0;
+            for block in flat.chunks(LANES * d) {
+                free_blocks += usize::from(timed.all_collision_free_in(block, world, &mut scratch));
+            }
+            ours.push(began.elapsed().as_nanos() as f64 / n as f64);
+            if let (Some(fast), Some(fast_world)) = (&mut fast, &fast_world) {
+                let began = Instant::now();
+                for block in flat.chunks(FAST_LANES * d) {
+                    free_blocks += usize::from(fast.all_free_unchecked(block, world, fast_world));
+                }
+                screened.push(began.elapsed().as_nanos() as f64 / n as f64);
+            }
+            if let Some((fast, fast_world)) = &mut fast_exact {
+                let began = Instant::now();
+                for block in flat.chunks(FAST_LANES * d) {
+                    free_blocks += usize::from(fast.all_free_unchecked(block, world, fast_world));
+                }
+                screened_exact.push(began.elapsed().as_nanos() as f64 / n as f64);
+            }
+            std::hint::black_box(free_blocks);
+            let line = from_vamp
+                .next()
+                .ok_or_else(|| format!("{program} stopped answering"))?
+                .map_err(lost)?;
+            let ns: f64 = line
+                .split_whitespace()
+                .nth(1)
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| format!("{program} said `{line}`, not `time NS VALID`"))?;
+            theirs.push(ns);
+            if round + 1 < rounds {
+                to_vamp.write_all(b"next\n").map_err(lost)?;
+                to_vamp.flush().map_err(lost)?;
+            }
+        }
+        let mut free = Vec::with_capacity(n);
+        for _ in 0..n {
+            let line = from_vamp
+                .next()
+                .ok_or_else(|| format!("{program} gave too few verdicts"))?
+                .map_err(lost)?;
+            free.push(line == "valid 1");
+        }
+        Ok((ours, screened, screened_exact, theirs, free))
+    };
+    let result = run();
+    let _ = vamp.kill();
+    let _ = vamp.wait();
+    result
 }

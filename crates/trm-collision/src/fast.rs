@@ -799,7 +799,12 @@ enum Object {
 /// the world changes).
 #[derive(Debug, Clone)]
 pub struct FastWorld {
+    /// The objects, nearest the robot's root first.
     objects: Vec<Object>,
+    /// The world's index of each of `objects`.
+    original: Vec<u32>,
+    /// The index in `objects` of each of the world's objects.
+    compiled_of: Vec<u32>,
     margin: f32,
     /// Per ball pair of the model ([`FastModel::pairs`]): its [`limits`] with this margin.
     limits: Vec<[f32; 2]>,
@@ -867,6 +872,10 @@ pub struct FastScratch {
     placed: Vec<bool>,
     /// What left lanes uncertain in the last check, and in which lanes.
     suspects: Vec<(Suspect, LaneMask)>,
+    /// The pair the last check that stopped at a collision stopped at: tested first by the
+    /// next check (consecutive blocks, such as the points of a planner's edges, mostly collide
+    /// where the last one did).
+    last_hit: Option<Suspect>,
 }
 
 impl FastModel {
@@ -1146,13 +1155,14 @@ impl FastModel {
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
             suspects: Vec::with_capacity(self.group_pairs.len() + self.groups.len()),
+            last_hit: None,
         }
     }
 
     /// `world` compiled for [`FastModel::check`], with its margin (see [`FastWorld::margin`]).
     pub fn world(&self, world: &World) -> FastWorld {
         let mut farthest: f64 = 0.0;
-        let objects = world
+        let objects: Vec<Object> = world
             .objects()
             .iter()
             .map(|o| {
@@ -1196,6 +1206,21 @@ impl FastModel {
                 }
             })
             .collect();
+        // nearest the robot's root first (as VAMP sorts its environment): a block that collides
+        // mostly collides there, and the walk stops at its first collision
+        let mut order: Vec<u32> = (0..objects.len() as u32).collect();
+        let reach_of = |o: &Object| {
+            let (center, radius) = o.bounding_sphere();
+            norm(center) - f64::from(radius)
+        };
+        order.sort_by(|&a, &b| {
+            reach_of(&objects[a as usize]).total_cmp(&reach_of(&objects[b as usize]))
+        });
+        let mut compiled_of = vec![0; order.len()];
+        for (k, &o) in order.iter().enumerate() {
+            compiled_of[o as usize] = k as u32;
+        }
+        let objects = order.iter().map(|&o| objects[o as usize]).collect();
         let largest = self.reach.max(farthest);
         // placing and measuring, one more step where a sphere is taken into a box link's frame
         let solid = (self.groups.iter()).any(|g| g.solid.is_some() || g.kdop.is_some());
@@ -1203,6 +1228,8 @@ impl FastModel {
         let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
         FastWorld {
             objects,
+            original: order,
+            compiled_of,
             margin,
             limits: self
                 .pairs
@@ -1608,11 +1635,15 @@ fn walk<const AVX: bool, O: Outcome>(
 ) {
     place::<AVX>(model, poses, scratch);
     scratch.suspects.clear();
+    if O::STOPS_AT_FIRST && last_hit_again::<AVX, O>(model, live, world, scratch, verdict) {
+        return;
+    }
     let m = world.margin;
     // the world first: in a planner's queries most collisions are with the world. Each object
     // against each link's bounding sphere, then its spheres; for a model of many links,
     // against the culling spheres of the kinematic tree's subtrees first
-    for (o, object) in world.objects.iter().enumerate() {
+    for (&o, object) in world.original.iter().zip(&world.objects) {
+        let o = o as usize;
         if !model.culls {
             for g in 0..model.groups.len() {
                 if object_link::<AVX>(model, o, object, g, live, world, scratch, verdict) {
@@ -1686,6 +1717,49 @@ fn walk<const AVX: bool, O: Outcome>(
     clear_suspects::<AVX, _>(model, scratch, m, verdict);
 }
 
+/// Whether the pair the last stopped walk stopped at (when there is one, and its object is in
+/// `world`) certainly collides in a lane of `live`: then `verdict` says so and the walk may
+/// end. Otherwise `verdict` and the suspects are left as they were (the walk tests the pair
+/// again in its turn).
+#[inline(always)]
+fn last_hit_again<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) -> bool {
+    let (before, marked) = (*verdict.uncertain(), scratch.suspects.len());
+    let stopped = match scratch.last_hit {
+        Some(Suspect::Object { object, group }) => world
+            .compiled_of
+            .get(object as usize)
+            .and_then(|&k| world.objects.get(k as usize))
+            .is_some_and(|object_shape| {
+                object_link::<AVX>(
+                    model,
+                    object as usize,
+                    object_shape,
+                    group as usize,
+                    live,
+                    world,
+                    scratch,
+                    verdict,
+                )
+            }),
+        Some(Suspect::Pair(k)) => {
+            let gp = &model.group_pairs[k as usize];
+            link_pair::<AVX>(model, gp, k as usize, live, world, scratch, verdict)
+        }
+        None => false,
+    };
+    if !stopped {
+        *verdict.uncertain() = before;
+        scratch.suspects.truncate(marked);
+    }
+    stopped
+}
+
 /// `verdict` without the link-pair suspects' lanes in which either link's spheres all lie
 /// beyond a slab of the other's k-DOP (when both are convex hulls): a second, tighter screen
 /// that only a block left uncertain pays for, before its lanes are checked exactly.
@@ -1754,14 +1828,17 @@ fn object_link<const AVX: bool>(
         }
         hit = inside.hit.mask::<AVX>();
     }
+    let suspect = Suspect::Object {
+        object: o as u32,
+        group: g as u32,
+    };
     match verdict.add(near, hit, close) {
-        None => true,
+        None => {
+            scratch.last_hit = Some(suspect);
+            true
+        }
         Some(0) => false,
         Some(lanes) => {
-            let suspect = Suspect::Object {
-                object: o as u32,
-                group: g as u32,
-            };
             scratch.suspects.push((suspect, lanes));
             false
         }
@@ -1830,7 +1907,10 @@ fn link_pair<const AVX: bool>(
         (hit, close)
     };
     match verdict.add(near, hit, close) {
-        None => true,
+        None => {
+            scratch.last_hit = Some(Suspect::Pair(k as u32));
+            true
+        }
         Some(0) => false,
         Some(lanes) => {
             scratch.suspects.push((Suspect::Pair(k as u32), lanes));
@@ -1984,6 +2064,9 @@ impl Contact {
 /// What the screen's walk makes of each group of pairs' contacts: a [`Verdict`] (stops at the
 /// first certain collision) or a [`Tally`] (counts every colliding pair).
 trait Outcome {
+    /// Whether the walk ends at the first certain collision (then the pair the last walk
+    /// ended at is tested first).
+    const STOPS_AT_FIRST: bool;
     /// Adds the contacts of a group of pairs in the lanes of `lanes`: `hit`, the lanes certainly
     /// colliding (for bodies screened through enclosing spheres, those touching a sphere inside
     /// them), and `close`, those within the margin of contact. `None` when the walk may stop,
@@ -1998,6 +2081,7 @@ trait Outcome {
 }
 
 impl Outcome for Verdict {
+    const STOPS_AT_FIRST: bool = true;
     #[inline(always)]
     fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask> {
         let hit = lanes & hit;
@@ -2018,6 +2102,7 @@ impl Outcome for Verdict {
 }
 
 impl Outcome for Tally {
+    const STOPS_AT_FIRST: bool = false;
     #[inline(always)]
     fn add(&mut self, lanes: LaneMask, hit: LaneMask, close: LaneMask) -> Option<LaneMask> {
         let hit = lanes & hit;
@@ -2047,6 +2132,25 @@ impl Outcome for Tally {
 }
 
 impl Object {
+    /// Centre and radius of a sphere around the object.
+    fn bounding_sphere(&self) -> ([f32; 3], f32) {
+        match *self {
+            Object::Round { a, b, radius } => {
+                let center = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+                let half = std::array::from_fn(|k| 0.5 * (b[k] - a[k]));
+                (center, norm(half) as f32 + radius)
+            }
+            Object::Box { center, half, .. } => (center, norm(half) as f32),
+            Object::Cylinder {
+                center,
+                radius,
+                half,
+                ..
+            } => (center, radius.hypot(half)),
+            Object::Bounded { center, radius } => (center, radius),
+        }
+    }
+
     /// The reach of a sphere of radius `r` from the object's own geometry: the sum of the radii
     /// for round objects (and a bounded object's sphere), `r` for the others.
     #[inline(always)]
