@@ -1639,42 +1639,48 @@ fn walk<const AVX: bool, O: Outcome>(
         return;
     }
     let m = world.margin;
-    // the world first: in a planner's queries most collisions are with the world. Each object
-    // against each link's bounding sphere, then its spheres; for a model of many links,
-    // against the culling spheres of the kinematic tree's subtrees first
-    for (&o, object) in world.original.iter().zip(&world.objects) {
-        let o = o as usize;
-        if !model.culls {
-            for g in 0..model.groups.len() {
+    // the world first: in a planner's queries most collisions are with the world, and the
+    // objects nearest the robot first. A model of few links: link by link, the links last in
+    // the tree first (the hand and the forearm sweep the most space: most collisions are
+    // theirs), each link's bounding sphere against each object, then its spheres. A model of
+    // many links: each object against the culling spheres of the kinematic tree's subtrees
+    // first
+    if !model.culls {
+        for g in (0..model.groups.len()).rev() {
+            for (&o, object) in world.original.iter().zip(&world.objects) {
+                let o = o as usize;
                 if object_link::<AVX>(model, o, object, g, live, world, scratch, verdict) {
                     return;
                 }
             }
-            continue;
         }
-        let steps = &model.world_steps;
-        let mut nest = Nest::<MAX_NESTING>::new();
-        let (mut mask, mut i) = (live, 0);
-        while i < steps.len() {
-            mask = nest.close(i, mask, live);
-            match steps[i] {
-                WorldStep::Cull { ball, radius, end } => {
-                    let c = &scratch.bounds[ball as usize];
-                    let near = mask & object.near::<AVX>(c, radius + m);
-                    if near == 0 {
-                        i = end as usize;
-                        continue;
+    } else {
+        for (&o, object) in world.original.iter().zip(&world.objects) {
+            let o = o as usize;
+            let steps = &model.world_steps;
+            let mut nest = Nest::<MAX_NESTING>::new();
+            let (mut mask, mut i) = (live, 0);
+            while i < steps.len() {
+                mask = nest.close(i, mask, live);
+                match steps[i] {
+                    WorldStep::Cull { ball, radius, end } => {
+                        let c = &scratch.bounds[ball as usize];
+                        let near = mask & object.near::<AVX>(c, radius + m);
+                        if near == 0 {
+                            i = end as usize;
+                            continue;
+                        }
+                        mask = nest.open(end, mask, near);
                     }
-                    mask = nest.open(end, mask, near);
-                }
-                WorldStep::Link(g) => {
-                    let g = g as usize;
-                    if object_link::<AVX>(model, o, object, g, mask, world, scratch, verdict) {
-                        return;
+                    WorldStep::Link(g) => {
+                        let g = g as usize;
+                        if object_link::<AVX>(model, o, object, g, mask, world, scratch, verdict) {
+                            return;
+                        }
                     }
                 }
+                i += 1;
             }
-            i += 1;
         }
     }
     verdict.enter_self();
