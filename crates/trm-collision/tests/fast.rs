@@ -301,3 +301,47 @@ fn nan_is_never_free_and_bad_input_is_an_error() {
         .unwrap();
     assert_eq!([own[0], objects[0]], [own[1], objects[1]]);
 }
+
+/// One checker over worlds that shrink and grow between checks: the pair a check stopped at is
+/// tested first by the next (the last object of a larger world, then an object the next world
+/// does not have), and every answer is still the exact model's.
+#[test]
+fn a_checker_moves_between_worlds_of_any_size() {
+    let (robot, collision) = panda("panda-mbm/panda_spherized.ron");
+    let active = robot.all_active();
+    let d = active.len();
+    let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let qs: Vec<f64> = (0..400).flat_map(|_| active.random(&mut rng)).collect();
+    let (mut poses, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+    let mut table_only = World::new();
+    table_only
+        .add(
+            "table",
+            Shape::Box {
+                size: [0.8, 1.2, 0.05],
+            },
+            pose([0.5, 0.0, 0.1], [0.0, 0.0, 0.3]),
+        )
+        .unwrap();
+    let worlds = [cluttered([0.0; 3]), table_only, World::new()];
+    let mut seen = [0usize; 2];
+    for round in 0..6 {
+        let world = &worlds[round % worlds.len()];
+        let fast_world = checker.model().world(world);
+        for (k, block) in qs.chunks(d * FAST_LANES).enumerate() {
+            let expected = block.chunks(d).all(|q| {
+                active.forward(q, &mut poses).unwrap();
+                collision.place(&poses, &mut placed);
+                !collision.is_colliding(&placed, world)
+            });
+            seen[usize::from(expected)] += 1;
+            assert_eq!(
+                checker.all_free(block, world, &fast_world).unwrap(),
+                expected,
+                "round {round}, block {k}"
+            );
+        }
+    }
+    assert!(seen[0] > 10 && seen[1] > 10, "{seen:?}: both answers");
+}
