@@ -185,7 +185,12 @@ fn exchange(
     let mut scratch = timed.scratch();
     let mut fast = FastChecker::new(timed.collision(), timed.active().clone()).ok();
     let fast_world = fast.as_ref().map(|f| f.model().world(world));
-    let mut fast_exact = FastChecker::for_model(exact.collision(), exact.active(), world);
+    let mut fast_exact = FastChecker::new(exact.collision(), exact.active().clone())
+        .ok()
+        .map(|checker| {
+            let fast_world = checker.model().world(world);
+            (checker, fast_world)
+        });
     let mut run = || -> Result<Exchanged, String> {
         to_vamp.write_all(input.as_bytes()).map_err(lost)?;
         to_vamp.flush().map_err(lost)?;

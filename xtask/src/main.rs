@@ -41,7 +41,6 @@ enum Command {
 
 fn main() {
     trm::quiet_on_closed_pipes();
-    trm_taskmap::register();
     use clap::CommandFactory;
     let help = format!(
         "Commands of the trm tool (`cargo xtask COMMAND` runs `trm COMMAND`):\n{}",

@@ -48,7 +48,7 @@ fn marks(points: usize) -> Vec<usize> {
 
 /// Runs the build and the measurements, prints and writes the table.
 pub fn run(args: &Args) -> Result<()> {
-    let problem = Problem::load(&args.spec)?;
+    let problem = Problem::load_with(&args.spec, &trm_taskmap::loaders())?;
     let pool = trm::thread_pool(args.threads)?;
     let marks = marks(args.points);
     let mut reached: Vec<Option<(f64, Option<f64>)>> = vec![None; marks.len()];
@@ -132,7 +132,7 @@ pub fn run(args: &Args) -> Result<()> {
         let loaded = Roadmap::load(&scratch_file)?;
         let load_ms = started.elapsed().as_secs_f64() * 1e3;
         loaded
-            .problem()
+            .problem_with(&trm_taskmap::loaders())
             .context("verifying the map against its spec")?;
         let verify_ms = started.elapsed().as_secs_f64() * 1e3;
         let step = (seconds - previous.1) * 1e3 / (n - previous.0).max(1) as f64;

@@ -129,7 +129,7 @@ pub fn run(args: &Args) -> Result<()> {
             "--threads {t}: this machine has {cores} cores; more threads than cores only time oversubscription\n  fix: give thread counts from 1 to {cores}"
         );
     }
-    let problem = Problem::load(&args.spec)?;
+    let problem = Problem::load_with(&args.spec, &trm_taskmap::loaders())?;
     let mut md = format!(
         "Time to reach each map size ({}, seed {}) on {cores} available cores.\n\nP from the spec, on 1, 2, … threads:\n\n",
         args.spec.display(),

@@ -37,10 +37,16 @@
 //! model's; mesh hulls go through spheres that enclose them exactly
 //! ([`fit::fit_convex_spheres`]), the lanes they leave uncertain decided by the hulls pair by
 //! pair (the planner uses it for both).
+//!
+//! [`WorldChecker`] is what planners use: it checks configurations and straight edges
+//! ([`edge`]) of one robot in one world, on the screen where the model compiles to it and
+//! through the exact model otherwise, and counts what it checked.
 
 mod acm;
 mod batch;
+mod checker;
 mod cull;
+pub mod edge;
 mod error;
 pub mod fast;
 pub mod fit;
@@ -53,6 +59,7 @@ mod world;
 
 pub use acm::AllowedCollisionMatrix;
 pub use batch::PlacedBatch;
+pub use checker::WorldChecker;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};
 pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};

@@ -12,7 +12,7 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
-use crate::rrt::{Checker, EdgeCheck, RrtOptions, path_length, rrt_connect, shortcut};
+use crate::rrt::{EdgeCheck, RrtOptions, path_length, rrt_connect, shortcut};
 
 /// One problem of a set.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -288,7 +288,7 @@ pub fn solve(
     let (collision, notes) = scene_collision(collision, scene)?;
     let (objective, active, mut start) = problem_objective(robot, &collision, &world, request)?;
     let mut goal = request.goal.positions.clone();
-    let mut checker = Checker::new(&objective, &world);
+    let mut checker = objective.world_checker(&world)?;
     let mut outcome = Outcome {
         note: notes.join("; "),
         ..Default::default()
@@ -525,7 +525,7 @@ pub fn solve_with_experience(
                             // through experience: shortcut greedily, and checked at half the
                             // resolution as RRT-Connect's paths are; RRT-Connect where that fails
                             let world = planner.world().clone();
-                            let mut checker = Checker::new(&objective, &world);
+                            let mut checker = objective.world_checker(&world)?;
                             let mut path = planned.waypoints;
                             let mut rng =
                                 <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(
@@ -593,7 +593,7 @@ pub fn solve_with_experience(
 /// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
 /// configuration at a time in `f64` from one end to the other (an independent check of a
 /// planner's raked, batched, single-precision edge checks): at the points a planner checking
-/// at `2 × resolution` and then at the midpoints visits ([`crate::rrt::edge_steps`]), no more
+/// at `2 × resolution` and then at the midpoints visits ([`trm_collision::edge::edge_steps`]), no more
 /// than `resolution` apart.
 pub fn path_is_free(
     robot: &RobotModel,
@@ -610,7 +610,7 @@ pub fn path_is_free(
     for w in path.windows(2) {
         // the points the planner's half-resolution check visits (`resolution` is that half):
         // those at the full resolution and the midpoints between them
-        let steps = 2 * crate::rrt::edge_steps(&w[0], &w[1], 2.0 * resolution);
+        let steps = 2 * trm_collision::edge::edge_steps(&w[0], &w[1], 2.0 * resolution);
         for s in 0..=steps {
             let t = s as f64 / steps as f64;
             let q: Vec<f64> = w[0]

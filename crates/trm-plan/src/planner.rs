@@ -6,10 +6,10 @@ use petgraph::graph::{NodeIndex, UnGraph};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use thiserror::Error;
-use trm_collision::World;
-use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
+use trm_collision::edge::distance;
+use trm_collision::{World, WorldChecker};
 use trm_kinematics::ActiveSet;
-use trm_roadmap::{Roadmap, distance};
+use trm_roadmap::Roadmap;
 use trm_tasks::Objective;
 
 use crate::trajectory::{Trajectory, time_parametrise};
@@ -395,17 +395,13 @@ pub const RETRIEVE_STEPS: f64 = 2.0;
 pub struct Planner<'a> {
     objective: &'a Objective,
     active: ActiveSet,
-    world: World,
     nodes: Vec<(Vec<f64>, Vec<f64>)>,
     node_state: Vec<State>,
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
     scratch: trm_tasks::Scratch,
-    /// Samples of the segment being checked.
-    samples: Vec<f64>,
-    /// The single-precision screen and the current world compiled for it (`None` for a model
-    /// the screen cannot compile).
-    fast: Option<(FastChecker, FastWorld)>,
+    /// Checks in the current world.
+    checker: WorldChecker,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
 }
@@ -455,34 +451,27 @@ impl<'a> Planner<'a> {
                 }
             }
         }
-        let fast =
-            FastChecker::for_model(objective.collision(), objective.active(), objective.world());
         Ok(Planner {
-            fast,
+            checker: objective.world_checker(objective.world())?,
             objective,
             active: objective.active().clone(),
-            world: objective.world().clone(),
             node_state: vec![State::Valid; nodes.len()],
             nodes,
             edges,
             edge_state,
             scratch: objective.scratch(),
-            samples: Vec::new(),
             kept: Vec::new(),
         })
     }
 
     /// The current world.
     pub fn world(&self) -> &World {
-        &self.world
+        self.checker.world()
     }
 
     /// Replaces the world: every node and edge will be checked again when a search wants it.
     pub fn set_world(&mut self, world: World) {
-        if let Some((checker, fast_world)) = &mut self.fast {
-            *fast_world = checker.model().world(&world);
-        }
-        self.world = world;
+        self.checker.set_world(world);
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
     }
@@ -548,52 +537,18 @@ impl<'a> Planner<'a> {
     }
 
     /// Whether `q` is collision-free in the current world.
+    ///
+    /// # Panics
+    /// If `q` does not hold one value per active motor.
     pub fn is_free(&mut self, q: &[f64]) -> bool {
-        match &mut self.fast {
-            Some((checker, fast_world)) => checker.all_free_unchecked(q, &self.world, fast_world),
-            None => self
-                .objective
-                .is_collision_free_in(q, &self.world, &mut self.scratch),
-        }
+        self.checker.free(q)
     }
 
     /// Whether the straight segment a → b is free, both ends included, at points no more than
     /// `resolution` apart (Euclidean, the rule of RRT-Connect's edges:
-    /// [`crate::rrt::edge_steps`]), visited raked ([`trm_roadmap::rake`]): [`FAST_LANES`]
-    /// points at a time on the single-precision screen (a model it cannot compile
-    /// [`LANES`](trm_kinematics::LANES) at a time in `f64`).
+    /// [`trm_collision::edge::edge_steps`]), visited raked ([`WorldChecker::segment_free`]).
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let steps = crate::rrt::edge_steps(a, b, resolution);
-        let at = |s: usize| s as f64 / steps as f64;
-        let (d, world) = (self.objective.dim(), &self.world);
-        match &mut self.fast {
-            Some(fast) => trm_roadmap::rake(
-                d,
-                a,
-                b,
-                steps + 1,
-                at,
-                FAST_LANES,
-                &mut self.samples,
-                fast,
-                |qs, (checker, fast_world)| checker.all_free_unchecked(qs, world, fast_world),
-            ),
-            None => {
-                let objective = &self.objective;
-                let width = trm_kinematics::LANES;
-                trm_roadmap::rake(
-                    d,
-                    a,
-                    b,
-                    steps + 1,
-                    at,
-                    width,
-                    &mut self.samples,
-                    &mut self.scratch,
-                    |qs, scratch| objective.all_collision_free_in(qs, world, scratch),
-                )
-            }
-        }
+        self.checker.segment_free(a, b, resolution)
     }
 
     fn task_of(&mut self, q: &[f64]) -> Vec<f64> {
@@ -616,7 +571,8 @@ impl<'a> Planner<'a> {
             (&planned, goal, &options.sampling)
         {
             let began = Instant::now();
-            let found = crate::rrt::rrt_connect(self.objective, &self.world, start, q, rrt)?;
+            let found =
+                crate::rrt::rrt_connect(self.objective, self.checker.world(), start, q, rrt)?;
             let mut stats = PlanStats {
                 sampled: Some((found.iterations, found.checks)),
                 length: crate::rrt::path_length(&found.path),
@@ -1007,7 +963,7 @@ impl<'a> Planner<'a> {
             return fallback("the path is empty".into());
         };
         let objective = match self.objective.with_task_target(t, EXACT_WEIGHT) {
-            Ok(o) => o.with_world(self.world.clone()),
+            Ok(o) => o.with_world(self.checker.world().clone()),
             Err(e) => return fallback(e.to_string()),
         };
         let solver = trm_tasks::spec::SolverSpec {

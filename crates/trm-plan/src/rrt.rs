@@ -9,10 +9,9 @@ use std::time::Instant;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use trm_collision::World;
-use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
-use trm_kinematics::LANES;
-use trm_tasks::{Objective, Scratch};
+use trm_collision::edge::distance;
+use trm_collision::{World, WorldChecker};
+use trm_tasks::Objective;
 
 use crate::PlanError;
 
@@ -247,123 +246,6 @@ pub struct RrtPath {
     pub refinements: u32,
 }
 
-/// Collision checks of configurations and edges in one world, counted: by the single-precision
-/// screen ([`FastChecker`], [`FAST_LANES`] configurations at a time, exact answers), or by the
-/// objective's batched `f64` checks for a model the screen cannot compile.
-pub struct Checker<'a> {
-    objective: &'a Objective,
-    world: &'a World,
-    scratch: Scratch,
-    fast: Option<(FastChecker, FastWorld)>,
-    batch: Vec<f64>,
-    /// Configurations checked so far.
-    pub checks: u64,
-}
-
-impl<'a> Checker<'a> {
-    /// A checker for `objective`'s robot in `world`.
-    pub fn new(objective: &'a Objective, world: &'a World) -> Self {
-        let fast = FastChecker::for_model(objective.collision(), objective.active(), world);
-        Checker {
-            objective,
-            world,
-            scratch: objective.scratch(),
-            fast,
-            batch: Vec::new(),
-            checks: 0,
-        }
-    }
-
-    /// Whether the single-precision screen checks this robot ([`FastChecker::for_model`]).
-    pub fn is_fast(&self) -> bool {
-        self.fast.is_some()
-    }
-
-    /// Whether `q` is collision-free.
-    pub fn free(&mut self, q: &[f64]) -> bool {
-        self.checks += 1;
-        self.all_free(q)
-    }
-
-    /// Whether every configuration of `qs` (at most a block's worth) is collision-free.
-    fn all_free(&mut self, qs: &[f64]) -> bool {
-        match &mut self.fast {
-            Some((checker, fast_world)) => checker.all_free_unchecked(qs, self.world, fast_world),
-            None if qs.len() == self.objective.dim() => {
-                self.objective
-                    .is_collision_free_in(qs, self.world, &mut self.scratch)
-            }
-            None => self
-                .objective
-                .all_collision_free_in(qs, self.world, &mut self.scratch),
-        }
-    }
-
-    /// Whether the straight edge a → b is free at every `resolution` (the end points not
-    /// checked again), its points visited raked: block k holds points k, k + m, k + 2m, … of
-    /// the edge's n points (m = ⌈n / lanes⌉, lanes = [`FAST_LANES`] on the screen, else
-    /// [`LANES`]).
-    pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let steps = edge_steps(a, b, resolution);
-        // interior points 1..steps (0 and steps are the checked ends)
-        self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64)
-    }
-
-    /// Whether the straight edge a → b is free at every `resolution` and at `b` (`a` is not
-    /// checked): [`Checker::edge_free`] with the end in the first block, so that a new node
-    /// costs no block of its own (a block of one configuration costs a whole block).
-    pub fn edge_and_end_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let steps = edge_steps(a, b, resolution);
-        // from b back towards a: b first, where an extension usually fails
-        self.rake(a, b, steps, |i| (steps - i) as f64 / steps as f64)
-    }
-
-    /// Whether the points halfway between those [`Checker::edge_free`] checks at `resolution`
-    /// are free (raked the same way): after `edge_free(a, b, resolution)`, the edge is then free
-    /// at every `resolution / 2`, for half the checks of `edge_free(a, b, resolution / 2)`.
-    pub fn edge_midpoints_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
-        let steps = edge_steps(a, b, resolution);
-        self.rake(a, b, steps, |i| (2 * i + 1) as f64 / (2 * steps) as f64)
-    }
-
-    /// Whether the `n` points a + s(i)·(b − a), i < n, are free, visited raked
-    /// ([`trm_roadmap::rake`]).
-    fn rake(&mut self, a: &[f64], b: &[f64], n: usize, s: impl Fn(usize) -> f64) -> bool {
-        if n == 0 {
-            return true;
-        }
-        let width = if self.fast.is_some() {
-            FAST_LANES
-        } else {
-            LANES
-        };
-        let mut batch = std::mem::take(&mut self.batch);
-        let free = trm_roadmap::rake(a.len(), a, b, n, s, width, &mut batch, self, |qs, me| {
-            me.checks += (qs.len() / a.len()) as u64;
-            me.all_free(qs)
-        });
-        self.batch = batch;
-        free
-    }
-}
-
-/// Pieces of the edge a → b no longer than `resolution` (at least 1): [`Checker::edge_free`]
-/// checks the points between them; checked "at half the resolution", an edge's points are
-/// these and the midpoints between them ([`Checker::edge_midpoints_free`]), `2 ×` this many
-/// pieces.
-pub fn edge_steps(a: &[f64], b: &[f64], resolution: f64) -> usize {
-    (distance(a, b) / resolution).ceil().max(1.0) as usize
-}
-
-/// Euclidean distance between configurations.
-pub fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
-}
-
 /// Draws of a search between two reads of the clock for its time limit.
 const CLOCK_EVERY: usize = 64;
 
@@ -489,7 +371,7 @@ fn extend(
     tree: &mut Tree,
     target: &[f64],
     options: &RrtOptions,
-    checker: &mut Checker,
+    checker: &mut WorldChecker,
     domain: bool,
 ) -> Extend {
     let (near, d) = tree.nearest(target);
@@ -537,7 +419,7 @@ fn extend(
 /// in the box of the active motors' limits, then shortcut.
 ///
 /// The shortcut path is checked again at half the resolution: the points halfway between those
-/// its edges were checked at ([`Checker::edge_midpoints_free`], raked as every edge; the pieces
+/// its edges were checked at ([`WorldChecker::edge_midpoints_free`], raked as every edge; the pieces
 /// of edges a random shortcut cut, at all their points); where an
 /// edge grazes an obstacle between the points first checked, the search runs again at that
 /// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
@@ -563,7 +445,7 @@ pub fn rrt_connect(
         // the edges checked at `resolution` (by the search: the edges it kept, or by the
         // shortcut) need only their midpoints to be checked at half that; a piece of an edge
         // a random shortcut cut needs its own points too
-        let mut checker = Checker::new(objective, world);
+        let mut checker = objective.world_checker(world)?;
         let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
             (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
                 && checker.edge_midpoints_free(&w[0], &w[1], resolution)
@@ -615,7 +497,7 @@ fn search(
             });
         }
     }
-    let mut checker = Checker::new(objective, world);
+    let mut checker = objective.world_checker(world)?;
     if !checker.free(start) {
         return Err(PlanError::InvalidStart("it collides in the world".into()));
     }
@@ -721,7 +603,7 @@ fn search(
 /// How [`shortcut`] left an edge of the path it returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EdgeCheck {
-    /// Found free by the shortcut at its resolution ([`Checker::edge_free`]'s points).
+    /// Found free by the shortcut at its resolution ([`WorldChecker::edge_free`]'s points).
     Checked,
     /// An edge of the given path, unchanged: checked however the path's maker checked it.
     Given,
@@ -736,7 +618,7 @@ pub enum EdgeCheck {
 pub fn shortcut(
     path: &mut Vec<Vec<f64>>,
     options: &RrtOptions,
-    checker: &mut Checker,
+    checker: &mut WorldChecker,
     rng: &mut impl RngExt,
 ) -> Vec<EdgeCheck> {
     // greedy: from each kept point, the farthest later waypoint it sees

@@ -28,10 +28,11 @@ use std::path::Path;
 use std::time::Instant;
 
 use serde::Deserialize;
+use trm_collision::edge::distance;
 use trm_collision::{Shape, World};
 use trm_io::SpecError;
 use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError, segment_is_collision_free};
+use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError};
 use trm_tasks::Problem;
 
 use crate::planner::{Goal, PlanError, PlanOptions, Planner};
@@ -457,7 +458,6 @@ pub fn run_scenario(
     };
     let mut q = problem.start.clone();
     let mut scratch = objective.scratch();
-    let mut samples = Vec::new();
     let mut motion: Option<Motion> = None;
     // the goal of the last planning attempt, successful or not
     let mut tried: Option<Vec<f64>> = None;
@@ -474,7 +474,10 @@ pub fn run_scenario(
         let started = Instant::now();
         let repaired = live.repair(&repair)?;
         let repair_seconds = started.elapsed().as_secs_f64();
-        let hit = !objective.is_collision_free_in(&q, &world, &mut scratch);
+        let mut checker = objective
+            .world_checker(&world)
+            .map_err(|e| ScenarioError::Roadmap(e.into()))?;
+        let hit = !checker.free(&q);
         let goal = scenario.goal_at(t).map(<[f64]>::to_vec);
         // replan when the goal changed, the rest of the motion is blocked, or it ended short
         let started = Instant::now();
@@ -491,22 +494,14 @@ pub fn run_scenario(
                     .unwrap_or(m.times.len());
                 let mut from = q.clone();
                 let blocked = m.waypoints[next..].iter().any(|w| {
-                    let free = segment_is_collision_free(
-                        objective,
-                        &world,
-                        &from,
-                        w,
-                        options.plan.resolution,
-                        &mut samples,
-                        &mut scratch,
-                    );
+                    let free = checker.span_free(&from, w, options.plan.resolution);
                     from.clone_from(w);
                     !free
                 });
                 let ended = next == m.times.len();
                 let off = |goal: &[f64]| {
                     let task = objective.task_value(&q, &mut scratch);
-                    trm_roadmap::distance(&task, goal) > options.reached
+                    distance(&task, goal) > options.reached
                 };
                 if blocked {
                     Some("the rest of the motion is blocked".to_string())
@@ -568,7 +563,7 @@ pub fn run_scenario(
         }
         let goal_error = goal.as_ref().map(|g| {
             let task = objective.task_value(&q, &mut scratch);
-            trm_roadmap::distance(&task, g)
+            distance(&task, g)
         });
         let all = live.all();
         steps.push(StepReport {

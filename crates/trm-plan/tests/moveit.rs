@@ -162,7 +162,7 @@ fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolutio
         );
         let world = trm_collision::World::new();
         assert_eq!(
-            trm_plan::rrt::Checker::new(&objective, &world).is_fast(),
+            objective.world_checker(&world).unwrap().is_screened(),
             fast,
             "{file}"
         );

@@ -411,7 +411,7 @@ fn a_point_goal_is_finished_exactly_or_falls_back_clearly() {
     let error = plan.stats.goal_error.unwrap();
     assert!(error <= 1e-3, "ends {error} from the goal");
     let end = plan.trajectory.task_path.last().unwrap();
-    let d = trm_roadmap::distance(end, &goal_t);
+    let d = trm_collision::edge::distance(end, &goal_t);
     assert!((d - error).abs() < 1e-12, "{d} vs {error}");
 
     let at_node = planner
@@ -464,7 +464,7 @@ fn a_point_goal_just_off_the_map_is_reached_through_its_nearest_node() {
     let nearest = map
         .points
         .iter()
-        .map(|m| trm_roadmap::distance(&m.t, &goal_t))
+        .map(|m| trm_collision::edge::distance(&m.t, &goal_t))
         .fold(f64::INFINITY, f64::min);
     assert!(nearest > 0.03 && nearest <= 0.06, "{nearest}");
     let goal = Goal::TaskPoint {

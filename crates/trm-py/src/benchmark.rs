@@ -32,7 +32,7 @@ pub(crate) fn compare_optimisers<'py>(
     comparison.check().map_err(err)?;
     let problems: Vec<trm_tasks::Problem> = specs
         .iter()
-        .map(|s| trm_tasks::Problem::load(s).map_err(err))
+        .map(|s| trm_tasks::Problem::load_with(s, &trm_taskmap::loaders()).map_err(err))
         .collect::<PyResult<_>>()?;
     let pairs: Vec<(&str, &trm_tasks::Problem)> =
         specs.iter().map(String::as_str).zip(&problems).collect();

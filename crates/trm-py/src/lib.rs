@@ -173,8 +173,6 @@ fn pose(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
 /// The extension module.
 #[pymodule]
 fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    // specs may name task maps (`TaskMap(file: …)` costs)
-    trm_taskmap::register();
     m.add("TrmError", m.py().get_type::<TrmError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("ALGORITHMS", trm_optim::ALGORITHMS.to_vec())?;

@@ -69,7 +69,7 @@ pub(crate) fn generate_mbm(
     tolerance: f64,
     tries: usize,
 ) -> PyResult<usize> {
-    let problem = trm_tasks::Problem::load(spec).map_err(err)?;
+    let problem = trm_tasks::Problem::load_with(spec, &trm_taskmap::loaders()).map_err(err)?;
     let defaults = trm_plan::generate::SetOptions::default();
     let options = trm_plan::generate::SetOptions {
         families: families.unwrap_or(defaults.families),

@@ -32,7 +32,10 @@ pub(crate) fn run_scenario<'py>(
         )));
     }
     let spec = trm_plan::Scenario::load(scenario).map_err(err)?;
-    let problem = roadmap.map.problem().map_err(err)?;
+    let problem = roadmap
+        .map
+        .problem_with(&trm_taskmap::loaders())
+        .map_err(err)?;
     let options = trm_plan::ScenarioOptions {
         repair_seconds: repair_evaluations.is_none().then_some(repair_ms / 1e3),
         repair_evaluations,
@@ -69,7 +72,7 @@ impl Planner {
                 .collect(),
         };
         let first = maps.first().ok_or_else(|| err("give at least one map"))?;
-        let problem = first.problem().map_err(err)?;
+        let problem = first.problem_with(&trm_taskmap::loaders()).map_err(err)?;
         Ok(Planner {
             problem,
             maps,

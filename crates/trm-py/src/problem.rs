@@ -30,7 +30,7 @@ impl Problem {
     #[staticmethod]
     fn load(path: &str) -> PyResult<Self> {
         Ok(Problem {
-            problem: trm_tasks::Problem::load(path).map_err(err)?,
+            problem: trm_tasks::Problem::load_with(path, &trm_taskmap::loaders()).map_err(err)?,
             python_costs: Vec::new(),
         })
     }

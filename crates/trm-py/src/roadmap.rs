@@ -24,7 +24,7 @@ impl Roadmap {
         searches: Option<usize>,
         edge_resolution: f64,
     ) -> PyResult<Self> {
-        let problem = trm_tasks::Problem::load(spec).map_err(err)?;
+        let problem = trm_tasks::Problem::load_with(spec, &trm_taskmap::loaders()).map_err(err)?;
         let options = trm_roadmap::BuildOptions {
             points,
             seed,
@@ -43,7 +43,10 @@ impl Roadmap {
     /// Returns `(repaired map, report)`, the report a dict: blocked, restored and added nodes
     /// and edges, lost and restored cells, why growing stopped, seconds per phase.
     fn repair(&self, py: Python<'_>, world: &PyWorld) -> PyResult<(Roadmap, Py<PyAny>)> {
-        let problem = self.map.problem().map_err(err)?;
+        let problem = self
+            .map
+            .problem_with(&trm_taskmap::loaders())
+            .map_err(err)?;
         let options = trm_roadmap::RepairOptions::default();
         let (map, report) = py
             .detach(|| trm_roadmap::repair(&self.map, &problem, &world.world, &options))

@@ -57,7 +57,7 @@ pub(crate) fn view(
         scene.set_path(v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect());
     }
     if let Some(r) = roadmap {
-        let problem = r.map.problem().map_err(err)?;
+        let problem = r.map.problem_with(&trm_taskmap::loaders()).map_err(err)?;
         scene
             .add_roadmap(&r.map, problem.objective.active())
             .map_err(err)?;

@@ -14,9 +14,10 @@ use trm_collision::{Aabb, World, WorldObject};
 use trm_kinematics::LANES;
 use trm_tasks::Objective;
 
-use crate::edges::{segment_is_collision_free, segment_point, segment_steps};
 use crate::error::{Result, RoadmapError};
 use crate::map::Roadmap;
+use trm_collision::WorldChecker;
+use trm_collision::edge::{edge_point, span_steps};
 
 /// The most edge samples a [`BlockIndex`] boxes (24 bytes per body group and sample: about
 /// 0.7 GB at the most for the iCub's 6 groups).
@@ -176,7 +177,7 @@ impl BlockIndex {
             + new_edges
                 .iter()
                 .map(|&(a, b, _)| {
-                    segment_steps(&map.points[a].q, &map.points[b].q, map.edge_resolution) + 1
+                    span_steps(&map.points[a].q, &map.points[b].q, map.edge_resolution) + 1
                 })
                 .sum::<usize>();
         if samples > MAX_SAMPLES {
@@ -222,11 +223,11 @@ impl BlockIndex {
                 || (objective.scratch(), Vec::new(), Vec::new()),
                 |(scratch, qs, boxes), &(a, b, _)| {
                     let (qa, qb) = (&map.points[a].q, &map.points[b].q);
-                    let steps = segment_steps(qa, qb, map.edge_resolution);
+                    let steps = span_steps(qa, qb, map.edge_resolution);
                     qs.clear();
                     qs.resize((steps + 1) * d, 0.0);
                     for (s, q) in qs.chunks_exact_mut(d).enumerate() {
-                        segment_point(qa, qb, s, steps, q);
+                        edge_point(qa, qb, s, steps, q);
                     }
                     let mut union = vec![Aabb::new_invalid(); groups];
                     let mut samples = Vec::with_capacity((steps + 1) * groups);
@@ -384,7 +385,7 @@ impl BlockIndex {
                         if sample.iter().any(|a| boxes.iter().any(|b| a.intersects(b))) {
                             qs.resize(qs.len() + d, 0.0);
                             let at = qs.len() - d;
-                            segment_point(qa, qb, s, steps, &mut qs[at..]);
+                            edge_point(qa, qb, s, steps, &mut qs[at..]);
                         }
                     }
                     let is = !qs.is_empty() && !objective.all_clear_of(qs, objects, scratch);
@@ -472,47 +473,30 @@ fn same(a: &WorldObject, b: &WorldObject) -> bool {
     a.name() == b.name() && a.shape() == b.shape() && a.pose() == b.pose()
 }
 
-fn edge_blocked(
-    map: &Roadmap,
-    objective: &Objective,
-    world: &World,
-    k: usize,
-    samples: &mut Vec<f64>,
-    scratch: &mut trm_tasks::Scratch,
-) -> bool {
+/// Whether edge `k` of `map` is blocked in the checker's world.
+fn edge_blocked(map: &Roadmap, checker: &mut WorldChecker, k: usize) -> bool {
     let (a, b, _) = map.edges[k];
-    !segment_is_collision_free(
-        objective,
-        world,
-        &map.points[a].q,
-        &map.points[b].q,
-        map.edge_resolution,
-        samples,
-        scratch,
-    )
+    !checker.span_free(&map.points[a].q, &map.points[b].q, map.edge_resolution)
 }
 
 /// What `world` blocks in `map`, by checking every node and every edge against the whole
 /// world: the reference [`BlockIndex::blocked`] equals.
 pub fn blocked_exhaustive(map: &Roadmap, objective: &Objective, world: &World) -> Result<Blocked> {
     check_fit(map, objective)?;
+    let checker = objective.world_checker(world)?;
     let nodes = (0..map.points.len())
         .into_par_iter()
         .map_init(
-            || objective.scratch(),
-            |scratch, i| {
-                (!objective.is_collision_free_in(&map.points[i].q, world, scratch)).then_some(i)
-            },
+            || checker.clone(),
+            |checker, i| (!checker.free(&map.points[i].q)).then_some(i),
         )
         .flatten()
         .collect();
     let edges = (0..map.edges.len())
         .into_par_iter()
         .map_init(
-            || (objective.scratch(), Vec::new()),
-            |(scratch, samples), k| {
-                edge_blocked(map, objective, world, k, samples, scratch).then_some(k)
-            },
+            || checker.clone(),
+            |checker, k| edge_blocked(map, checker, k).then_some(k),
         )
         .flatten()
         .collect();

@@ -22,11 +22,11 @@ use crate::checkpoint::{CHECKPOINT_VERSION, Checkpoint, SearchState, StreamPosit
 use trm_tasks::spec::{FailureCount, MapSpec};
 use trm_tasks::{Objective, Problem, ScratchPool};
 
-use crate::edges::distance;
 use crate::error::{Result, RoadmapError};
 use crate::index::TaskIndex;
 use crate::map::{BuildStats, FORMAT, MapPoint, Roadmap, VERSION};
 use crate::team::{Solo, Team, all_gather_f64, on_threads};
+use trm_collision::edge::distance;
 
 /// Execution settings of a build (the algorithm settings are the spec's `map`).
 #[derive(Debug, Clone)]

@@ -161,7 +161,12 @@ impl Checkpoint {
     /// The task the build is for, rebuilt from the spec the checkpoint carries (as
     /// [`crate::Roadmap::problem`] does for a map).
     pub fn problem(&self) -> Result<Problem> {
-        crate::map::problem_from_spec(&self.spec_path, &self.spec, &self.active)
+        self.problem_with(&trm_tasks::SpecLoaders::default())
+    }
+
+    /// [`Checkpoint::problem`], the spec's files read by `loaders`.
+    pub fn problem_with(&self, loaders: &trm_tasks::SpecLoaders) -> Result<Problem> {
+        crate::map::problem_from_spec(&self.spec_path, &self.spec, &self.active, loaders)
     }
 
     /// Checks that the parts fit together (sizes, indices, finite values, counts within the

@@ -36,3 +36,9 @@ impl From<trm_tasks::TaskError> for RoadmapError {
         RoadmapError::Tasks(Box::new(e))
     }
 }
+
+impl From<trm_collision::CollisionError> for RoadmapError {
+    fn from(e: trm_collision::CollisionError) -> Self {
+        RoadmapError::Tasks(Box::new(trm_tasks::TaskError::Collision(e)))
+    }
+}

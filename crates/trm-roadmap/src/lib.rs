@@ -32,10 +32,7 @@ pub use build::{
     evaluate_on_threads, resume, resume_with,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
-pub use edges::{
-    MIN_RESOLUTION, check_edge_resolution, connect, connect_with, distance, rake, segment_all,
-    segment_is_collision_free, segment_is_free,
-};
+pub use edges::{MIN_RESOLUTION, check_edge_resolution, connect, connect_with, segment_is_free};
 pub use error::{Result, RoadmapError};
 pub use index::TaskIndex;
 pub use map::{BuildStats, FORMAT, MapPoint, MapSummary, Parked, Roadmap, VERSION};

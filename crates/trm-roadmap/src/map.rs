@@ -23,6 +23,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use trm_tasks::SpecLoaders;
 use trm_tasks::spec::MapSpec;
 
 use crate::error::{Result, RoadmapError};
@@ -188,9 +189,15 @@ impl Roadmap {
 
     /// The task this map was built for, rebuilt from the spec the map carries (its model and
     /// world files are found relative to the spec's original location, `spec_path`). Fails when
-    /// the spec no longer loads or no longer has the map's active motors.
+    /// the spec no longer loads or no longer has the map's active motors, or names a file
+    /// another crate reads (a task map: [`Roadmap::problem_with`]).
     pub fn problem(&self) -> Result<trm_tasks::Problem> {
-        let mut problem = problem_from_spec(&self.spec_path, &self.spec, &self.active)?;
+        self.problem_with(&SpecLoaders::default())
+    }
+
+    /// [`Roadmap::problem`], the spec's files read by `loaders`.
+    pub fn problem_with(&self, loaders: &SpecLoaders) -> Result<trm_tasks::Problem> {
+        let mut problem = problem_from_spec(&self.spec_path, &self.spec, &self.active, loaders)?;
         if let Some(world) = &self.world {
             let world = trm_collision::World::from_spec(world, &self.spec_path).map_err(|e| {
                 RoadmapError::Unsuitable(format!(
@@ -325,14 +332,16 @@ impl Roadmap {
 }
 
 /// The task of a spec stored in a map or checkpoint (its model and world files found relative
-/// to the spec's original location `spec_path`); it must still select the `active` motors.
+/// to the spec's original location `spec_path`, other files read by `loaders`); it must still
+/// select the `active` motors.
 pub(crate) fn problem_from_spec(
     spec_path: &str,
     spec: &str,
     active: &[String],
+    loaders: &SpecLoaders,
 ) -> Result<trm_tasks::Problem> {
     let base = Path::new(spec_path).parent().unwrap_or(Path::new("."));
-    let problem = trm_tasks::Problem::from_ron(spec, spec_path, base)?;
+    let problem = trm_tasks::Problem::from_ron_with(spec, spec_path, base, loaders)?;
     let names: Vec<&str> = problem.objective.active().names().collect();
     if names != active.iter().map(String::as_str).collect::<Vec<_>>() {
         return Err(RoadmapError::Unsuitable(format!(

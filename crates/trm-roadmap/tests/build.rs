@@ -416,7 +416,7 @@ fn batched_segment_checks_agree_with_one_sample_at_a_time() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
     let mut random = || objective.active().random(&mut rng);
     let mut scratch = objective.scratch();
-    let (mut samples, mut q) = (Vec::new(), vec![0.0; objective.dim()]);
+    let mut q = vec![0.0; objective.dim()];
     let (mut free, mut blocked) = (0, 0);
     for k in 0..300 {
         let (a, b) = (random(), random());
@@ -425,15 +425,10 @@ fn batched_segment_checks_agree_with_one_sample_at_a_time() {
             let one = trm_roadmap::segment_is_free(&a, &b, resolution, &mut q, |x| {
                 objective.is_collision_free_in(x, w, &mut scratch)
             });
-            let batched = trm_roadmap::segment_is_collision_free(
-                objective,
-                w,
-                &a,
-                &b,
-                resolution,
-                &mut samples,
-                &mut scratch,
-            );
+            let batched = objective
+                .world_checker(w)
+                .unwrap()
+                .span_free(&a, &b, resolution);
             assert_eq!(one, batched, "segment {k}");
             if one { free += 1 } else { blocked += 1 }
         }

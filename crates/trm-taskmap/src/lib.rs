@@ -28,14 +28,17 @@ pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
 pub use motion::{CostWeights, Motion, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
 pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};
 
-/// Lets task specs name task maps (`TaskMap(file: …)` costs of trm-tasks, read as [`TaskMap`]
-/// files): call once before loading such a spec. The `trm` tool and the Python package do.
-pub fn register() {
-    trm_tasks::register_pose_maps(|path| {
-        TaskMap::load(path)
-            .map(|m| std::sync::Arc::new(m) as std::sync::Arc<dyn trm_tasks::PoseMap>)
-            .map_err(|e| e.to_string())
-    });
+/// The readers a task spec needs to name task maps (`TaskMap(file: …)` costs of trm-tasks, read
+/// as [`TaskMap`] files): pass them where the spec is resolved
+/// ([`trm_tasks::Problem::load_with`], `Roadmap::problem_with`).
+pub fn loaders() -> trm_tasks::SpecLoaders {
+    trm_tasks::SpecLoaders {
+        pose_maps: Some(|path| {
+            TaskMap::load(path)
+                .map(|m| std::sync::Arc::new(m) as std::sync::Arc<dyn trm_tasks::PoseMap>)
+                .map_err(|e| e.to_string())
+        }),
+    }
 }
 
 /// The file formats this crate reads and writes.

@@ -8,7 +8,7 @@ use trm_tasks::{Problem, solve};
 
 #[test]
 fn ngik_brings_the_hand_onto_a_task_map() {
-    trm_taskmap::register();
+    let loaders = trm_taskmap::loaders();
     let robot = trm_models::icub_upper_body();
     let mut poses = robot.pose_buffer();
     robot
@@ -55,7 +55,7 @@ fn ngik_brings_the_hand_onto_a_task_map() {
           solver: (max_evaluations: 20000, seed: 2))",
         stick.x, stick.y, stick.z
     );
-    let problem = Problem::from_ron(&spec, "stick.ron", &dir).unwrap();
+    let problem = Problem::from_ron_with(&spec, "stick.ron", &dir, &loaders).unwrap();
     let start_cost = problem
         .objective
         .eval(&problem.start, &mut problem.objective.scratch());
@@ -82,7 +82,7 @@ fn ngik_brings_the_hand_onto_a_task_map() {
     assert!(c_map < 1e-4, "c_map {c_map} (from {start_cost})");
     // a missing map file is a located error
     let bad = spec.replace("stick.taskmap.json", "nope.json");
-    let e = Problem::from_ron(&bad, "stick.ron", &dir)
+    let e = Problem::from_ron_with(&bad, "stick.ron", &dir, &loaders)
         .unwrap_err()
         .to_string();
     assert!(e.contains("nope.json") && e.contains("explore"), "{e}");

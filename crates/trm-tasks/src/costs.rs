@@ -2,7 +2,7 @@
 //! the paper describes). Implement [`Cost`] to add your own.
 
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use trm_kinematics::FrameId;
 use trm_kinematics::nalgebra::{Isometry3, Vector3};
@@ -423,18 +423,13 @@ pub trait PoseMap: Send + Sync + std::fmt::Debug {
 /// Reads the pose map a spec's `TaskMap(file: …)` cost names (`Err`: what is wrong with it).
 pub type PoseMapLoader = fn(&Path) -> std::result::Result<Arc<dyn PoseMap>, String>;
 
-static POSE_MAP_LOADER: OnceLock<PoseMapLoader> = OnceLock::new();
-
-/// Lets specs name pose maps (`TaskMap(file: …)` costs), read by `loader`: called once by the
-/// crate that owns the file format (`trm_taskmap::register()`, which the `trm` tool and the
-/// Python package call). Later calls keep the first loader.
-pub fn register_pose_maps(loader: PoseMapLoader) {
-    let _ = POSE_MAP_LOADER.set(loader);
-}
-
-/// The registered loader of pose maps, if any.
-pub(crate) fn pose_map_loader() -> Option<PoseMapLoader> {
-    POSE_MAP_LOADER.get().copied()
+/// Readers of the files a spec may name that other crates own, passed where a spec is
+/// resolved ([`crate::Problem::load_with`]): a spec whose costs name such a file fails with a
+/// located error when its reader is not given. `Default` gives none.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SpecLoaders {
+    /// Reads the pose maps of `TaskMap(file: …)` costs (`trm_taskmap::loaders()` gives it).
+    pub pose_maps: Option<PoseMapLoader>,
 }
 
 /// The task-map cost (Gienger et al., eq. 18–19): c_map = (x − x_map)ᵀ W (x − x_map) where x is

@@ -40,7 +40,7 @@ pub mod tasks;
 
 pub use comparison::{Comparison, ComparisonResult, ComparisonRun, ComparisonSummary};
 pub use context::{Anchor, BatchContext, Context, Frames, LaneView};
-pub use costs::{Cost, PoseMap, PoseMapLoader, TaskTarget, register_pose_maps};
+pub use costs::{Cost, PoseMap, PoseMapLoader, SpecLoaders, TaskTarget};
 pub use error::{Result, TaskError};
 pub use ngik::{Solution, solve, solve_with, solver_start};
 pub use objective::{Clearance, Objective, Scratch, TermValue};

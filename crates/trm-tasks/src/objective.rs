@@ -6,8 +6,8 @@ use std::sync::Arc;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use trm_collision::fast::{FAST_LANES, FastChecker, FastModel, FastWorld, Tally};
-use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World};
+use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld, Tally};
+use trm_collision::{CollisionModel, PlacedBatch, PlacedBodies, World, WorldChecker};
 use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
 use crate::context::{BatchContext, Context};
@@ -153,7 +153,7 @@ impl Objective {
     /// world or the terms changed).
     fn compile_screen(&mut self) {
         self.screen = (self.needs_collision && !self.needs_placed)
-            .then(|| FastModel::of(&self.collision).ok())
+            .then(|| WorldChecker::screen_model(&self.collision))
             .flatten()
             .map(|fast| fast.world(&self.world));
     }
@@ -838,6 +838,13 @@ impl Objective {
     pub fn is_collision_free_in(&self, q: &[f64], world: &World, scratch: &mut Scratch) -> bool {
         self.pose(q, scratch, true);
         !self.collision.is_colliding(&scratch.placed, world)
+    }
+
+    /// A checker of this objective's robot and active motors in `world`
+    /// ([`WorldChecker`]: configurations and edges, on the screen where the model compiles to
+    /// it): what planners check with.
+    pub fn world_checker(&self, world: &World) -> trm_collision::Result<WorldChecker> {
+        WorldChecker::new(&self.collision, &self.active, world.clone())
     }
 
     /// How close active values `q` come to collision in `world`: the closest checked pair of

@@ -258,17 +258,17 @@ fn a_rotation_relative_to_another_part_is_the_axis_in_its_frame() {
     assert_eq!(label, "rotation r_hand relative to head");
 }
 
-/// Task maps are another crate's format: without its loader registered (nothing in this test
-/// binary registers one), a spec naming a task map is a located error saying what to call.
+/// Task maps are another crate's format: without its reader given, a spec naming a task map is a
+/// located error saying what to pass.
 #[test]
-fn a_task_map_cost_without_a_registered_reader_says_what_to_call() {
+fn a_task_map_cost_without_a_reader_says_what_to_pass() {
     let e = error(
         "(model: \"icub_upper_body\", active: [\"torso\"],
           world: (objects: [(name: \"stick\", shape: Sphere(radius: 0.01))]),
           costs: [(weight: 1.0, cost: TaskMap(file: \"stick.taskmap.json\", part: \"r_hand\", object: \"stick\"))])",
     );
     assert!(
-        e.contains("trm_taskmap::register()") && e.contains("costs[0]"),
+        e.contains("trm_taskmap::loaders()") && e.contains("costs[0]"),
         "{e}"
     );
 }

@@ -110,11 +110,11 @@ pub fn run(args: &Args) -> Result<()> {
         ..Default::default()
     };
     let (problem, resumed) = match (&args.spec, &args.resume) {
-        (Some(spec), _) => (Problem::load(spec)?, None),
+        (Some(spec), _) => (Problem::load_with(spec, &trm_taskmap::loaders())?, None),
         (None, Some(file)) => {
             let checkpoint = Checkpoint::load(file)?;
             let problem = checkpoint
-                .problem()
+                .problem_with(&trm_taskmap::loaders())
                 .with_context(|| format!("the spec stored in checkpoint {}", file.display()))?;
             let target = checkpoint
                 .resume_target(options.points)
@@ -301,7 +301,7 @@ pub fn info(args: &InfoArgs) -> Result<()> {
     // the spec travels inside the map: rebuild its objective (checking every point against
     // it) for the cost breakdown
     let problem = map
-        .problem()
+        .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
     print_summary(&map);
     let mut scratch = problem.objective.scratch();

@@ -80,7 +80,10 @@ pub fn run(args: &Args) -> Result<()> {
     })?;
     let problems: Vec<Problem> = specs
         .iter()
-        .map(|p| Problem::load(p).with_context(|| format!("loading {}", p.display())))
+        .map(|p| {
+            Problem::load_with(p, &trm_taskmap::loaders())
+                .with_context(|| format!("loading {}", p.display()))
+        })
         .collect::<Result<_>>()?;
     let labels: Vec<String> = specs.iter().map(|s| s.display().to_string()).collect();
     eprintln!(

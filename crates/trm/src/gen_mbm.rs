@@ -56,7 +56,7 @@ pub fn run(args: &Args) -> Result<()> {
             .collect::<Vec<_>>()
             .join(",")
     );
-    let spec = trm_tasks::spec::Problem::load(&args.spec)?;
+    let spec = trm_tasks::spec::Problem::load_with(&args.spec, &trm_taskmap::loaders())?;
     let options = SetOptions {
         families: args.families.clone(),
         per_family: args.per_family,

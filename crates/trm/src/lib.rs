@@ -272,8 +272,6 @@ where
     T: Into<std::ffi::OsString> + Clone,
 {
     let cli: Cli = parse_args(args);
-    // specs may name task maps (`TaskMap(file: …)` costs)
-    trm_taskmap::register();
     let (files, dirs) = cli.command.outputs();
     exit_with(run_staged(&files, &dirs, || dispatch(cli.command)))
 }

@@ -92,7 +92,7 @@ pub fn run(args: &Args) -> Result<()> {
     if let (true, Some(world)) = (args.repair, &world) {
         for (map, path) in maps.iter_mut().zip(&args.maps) {
             let problem = map
-                .problem()
+                .problem_with(&trm_taskmap::loaders())
                 .with_context(|| format!("the spec stored in {}", path.display()))?;
             let options = RepairOptions {
                 refill: false,
@@ -111,7 +111,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let first = &maps[0];
     let problem = first
-        .problem()
+        .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("the spec stored in {}", args.maps[0].display()))?;
     let refs: Vec<&Roadmap> = maps.iter().collect();
     let mut planner = Planner::new(&problem.objective, &refs)?;

@@ -46,7 +46,7 @@ impl Args {
 pub fn run(args: &Args) -> Result<()> {
     let map = Roadmap::load(&args.map)?;
     let problem = map
-        .problem()
+        .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
     let world = trm_plan::moveit::load_world(&args.world)?;
     let out = args.out_path();
@@ -74,7 +74,7 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if args.compare_rebuild {
-        let mut fresh = map.problem()?;
+        let mut fresh = map.problem_with(&trm_taskmap::loaders())?;
         fresh.objective.set_world(world.clone());
         let started = Instant::now();
         let rebuilt = pool.install(|| {

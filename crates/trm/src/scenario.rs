@@ -41,7 +41,7 @@ pub fn run(args: &Args) -> Result<()> {
     let scenario = Scenario::load(&args.spec)?;
     let map = Roadmap::load(&args.map)?;
     let problem = map
-        .problem()
+        .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
     let options = match args.repair_evaluations {
         Some(n) => ScenarioOptions {
@@ -96,7 +96,7 @@ fn check_rebuilds(map: &Roadmap, run: &ScenarioRun, options: &ScenarioOptions) -
         .collect();
     let (mut could, mut total) = (0, 0);
     for k in failed {
-        let mut problem = map.problem()?;
+        let mut problem = map.problem_with(&trm_taskmap::loaders())?;
         problem.objective.set_world(run.worlds[k].clone());
         let rebuilt = trm_roadmap::build_connected(
             &problem,

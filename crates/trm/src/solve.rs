@@ -37,7 +37,7 @@ pub fn run(args: &Args) -> Result<()> {
             trm_optim::ALGORITHMS.join(", ")
         );
     }
-    let problem = Problem::load(&args.spec)?;
+    let problem = Problem::load_with(&args.spec, &trm_taskmap::loaders())?;
     let mut solver = problem.spec.solver.clone();
     if let Some(a) = &args.algo {
         solver.algo = a.clone();

@@ -88,7 +88,10 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             };
             let fields = ron_fields(&text);
             if fields.iter().any(|f| f == "costs") {
-                Ok(from_problem(Problem::load(path)?, title))
+                Ok(from_problem(
+                    Problem::load_with(path, &trm_taskmap::loaders())?,
+                    title,
+                ))
             } else if fields.iter().any(|f| f == "phases") {
                 let motion = WholeBody::load(path)?;
                 Ok(Subject {
@@ -112,7 +115,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             }
         }
         (None, Some(map)) => {
-            let p = map.problem().with_context(|| {
+            let p = map.problem_with(&trm_taskmap::loaders()).with_context(|| {
                 format!(
                     "{}: the spec stored in the map ({})",
                     args.map.as_deref().unwrap_or(Path::new("")).display(),

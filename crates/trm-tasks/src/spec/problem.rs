@@ -7,6 +7,7 @@ use trm_collision::{CollisionModel, World};
 use trm_io::closest_names;
 use trm_kinematics::{FrameSpec, RobotModel};
 
+use crate::costs::SpecLoaders;
 use crate::error::{Result, TaskError};
 use crate::objective::Objective;
 
@@ -69,24 +70,46 @@ impl Ctx<'_> {
 }
 
 impl Problem {
-    /// Reads and builds a spec file.
+    /// Reads and builds a spec file whose costs name no file another crate reads (a task map:
+    /// [`Problem::load_with`]).
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        Self::load_with(path, &SpecLoaders::default())
+    }
+
+    /// Reads and builds a spec file, its costs' files read by `loaders`.
+    pub fn load_with(path: impl AsRef<Path>, loaders: &SpecLoaders) -> Result<Self> {
         let path = path.as_ref();
         let text = trm_io::read_input(path).map_err(|source| TaskError::Io {
             path: path.to_path_buf(),
             source,
         })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Self::from_ron(&text, &path.display().to_string(), &base)
+        Self::from_ron_with(&text, &path.display().to_string(), &base, loaders)
     }
 
     /// Parses and builds spec text; `origin` names it in errors, `base` resolves relative paths.
     pub fn from_ron(text: &str, origin: &str, base: &Path) -> Result<Self> {
-        let spec: Spec = ron::from_str(text).map_err(|e| ron_error(&e, origin))?;
-        Self::build(spec, text, origin, base)
+        Self::from_ron_with(text, origin, base, &SpecLoaders::default())
     }
 
-    fn build(spec: Spec, text: &str, origin: &str, base: &Path) -> Result<Self> {
+    /// [`Problem::from_ron`], its costs' files read by `loaders`.
+    pub fn from_ron_with(
+        text: &str,
+        origin: &str,
+        base: &Path,
+        loaders: &SpecLoaders,
+    ) -> Result<Self> {
+        let spec: Spec = ron::from_str(text).map_err(|e| ron_error(&e, origin))?;
+        Self::build(spec, text, origin, base, loaders)
+    }
+
+    fn build(
+        spec: Spec,
+        text: &str,
+        origin: &str,
+        base: &Path,
+        loaders: &SpecLoaders,
+    ) -> Result<Self> {
         let ctx = Ctx { origin, text };
         let robot = load_model(&spec.model, base, &ctx)?;
         let robot = with_frames(robot, &spec.frames, &ctx)?;
@@ -155,6 +178,7 @@ impl Problem {
             world: &world,
             ctx: &ctx,
             base,
+            loaders,
         };
         let mut terms = Vec::new();
         for (k, c) in spec.costs.iter().enumerate() {

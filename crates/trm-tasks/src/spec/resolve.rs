@@ -8,6 +8,7 @@ use trm_kinematics::nalgebra::{UnitQuaternion, Vector3};
 use trm_kinematics::{ActiveSet, FrameId, RobotModel};
 
 use crate::context::Anchor;
+use crate::costs::SpecLoaders;
 use crate::costs::{
     Collision, Direction, Displacement, HomePosture, JointLimits, Orientation, Pointing, Position,
     Region, Repel,
@@ -26,6 +27,8 @@ pub(super) struct Resolver<'a> {
     pub(super) world: &'a World,
     pub(super) ctx: &'a Ctx<'a>,
     pub(super) base: &'a Path,
+    /// Readers of files other crates own.
+    pub(super) loaders: &'a SpecLoaders,
 }
 
 impl Resolver<'_> {
@@ -270,11 +273,11 @@ impl Resolver<'_> {
             }),
             CostKind::TaskMap { file, part, object } => {
                 let path = self.base.join(file);
-                let loader = crate::costs::pose_map_loader().ok_or_else(|| {
+                let loader = self.loaders.pose_maps.ok_or_else(|| {
                     self.ctx.err(
                         &format!("{field}.cost"),
-                        "task maps are read by trm-taskmap, which is not registered",
-                        "call trm_taskmap::register() once before loading the spec (the trm tool and Python do)",
+                        "task maps are read by trm-taskmap, and no reader of them was given",
+                        "load the spec with Problem::load_with(path, &trm_taskmap::loaders()) (the trm tool and Python do)",
                     )
                 })?;
                 let map = loader(&path).map_err(|e| {

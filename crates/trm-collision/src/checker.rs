@@ -1,0 +1,286 @@
+//! [`WorldChecker`]: the one place that decides how a robot's configurations and edges are
+//! checked against a world.
+
+use std::sync::Arc;
+
+use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
+
+use crate::batch::PlacedBatch;
+use crate::edge::{edge_steps, rake, span_steps};
+use crate::error::{CollisionError, Result};
+use crate::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
+use crate::model::{CollisionModel, PlacedBodies};
+use crate::world::World;
+
+/// Collision checks of one robot's configurations and straight edges in one world, counted.
+///
+/// The checker decides, once, how: by the single-precision screen ([`FastChecker`],
+/// [`FAST_LANES`] configurations at a time, exact answers) where the collision model compiles to
+/// it — every valid model does — and otherwise by batched `f64` forward kinematics and the
+/// exact model ([`CollisionModel::is_colliding`], [`LANES`] configurations at a time). Either
+/// way the answers are the exact model's. Edges are checked *raked* ([`crate::edge::rake`]).
+/// Caller-owned and allocation-free once made: make one per thread.
+///
+/// ```
+/// use trm_collision::{CollisionModel, Shape, World, WorldChecker};
+/// use trm_kinematics::nalgebra::Isometry3;
+///
+/// let robot = trm_models::icub_upper_body();
+/// let home = robot.posture("home")?.to_vec();
+/// let active = robot.active_set(&["torso_yaw", "r_shoulder_pitch", "r_elbow"], &home)?;
+/// let collision = CollisionModel::new(&robot)?;
+/// let mut world = World::new();
+/// world.add("wall", Shape::Box { size: [0.05, 2.0, 2.0] }, Isometry3::translation(-0.6, 0.0, 0.0))?;
+/// let mut checker = WorldChecker::new(&collision, &active, world)?;
+/// let start = active.from_motors(&home);
+/// assert!(checker.free(&start));
+/// let mut bent = start.clone();
+/// bent[1] -= 1.0;
+/// // three points inside the edge, a quarter of a radian apart
+/// assert!(checker.edge_free(&start, &bent, 0.25));
+/// assert_eq!(checker.checks, 1 + 3);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct WorldChecker {
+    world: World,
+    engine: Engine,
+    /// The points of the edge being checked.
+    samples: Vec<f64>,
+    /// Configurations checked so far (each point of an edge is one).
+    pub checks: u64,
+}
+
+/// How a [`WorldChecker`] checks.
+#[derive(Debug, Clone)]
+enum Engine {
+    /// The single-precision screen and the world compiled for it.
+    Screen(Box<(FastChecker, FastWorld)>),
+    /// Batched `f64` kinematics and the exact model.
+    Exact(Box<Exact>),
+}
+
+/// Buffers of the `f64` checks.
+#[derive(Debug, Clone)]
+struct Exact {
+    collision: CollisionModel,
+    active: ActiveSet,
+    /// [`LANES`] configurations, one after the other.
+    lanes: Vec<f64>,
+    batch: PoseBatch,
+    placed_batch: PlacedBatch,
+    poses: PoseBuffer,
+    placed: PlacedBodies,
+}
+
+impl WorldChecker {
+    /// A checker of `collision`'s robot, moved by `active`'s coordinates, in `world`; an error
+    /// for an active set of another robot.
+    pub fn new(collision: &CollisionModel, active: &ActiveSet, world: World) -> Result<Self> {
+        let robot = collision.robot();
+        if active.model().num_frames() != robot.num_frames()
+            || active.model().name() != robot.name()
+        {
+            return Err(CollisionError::InvalidValue {
+                what: format!("active set of `{}`", active.model().name()),
+                problem: format!("belongs to another robot than `{}`", robot.name()),
+            });
+        }
+        let engine = match Self::screen_model(collision) {
+            Some(_) => {
+                let checker = FastChecker::new(collision, active.clone())?;
+                let fast_world = checker.model().world(&world);
+                Engine::Screen(Box::new((checker, fast_world)))
+            }
+            None => Engine::Exact(Box::new(Exact {
+                collision: collision.clone(),
+                lanes: vec![0.0; LANES * active.len()],
+                active: active.clone(),
+                batch: robot.pose_batch(),
+                placed_batch: collision.placed_batch(),
+                poses: robot.pose_buffer(),
+                placed: collision.placed_bodies(),
+            })),
+        };
+        Ok(WorldChecker {
+            world,
+            engine,
+            samples: Vec::new(),
+            checks: 0,
+        })
+    }
+
+    /// The single-precision screen's compilation of `collision` where the model compiles to it
+    /// (every valid model does: `None` only for a body without enclosing spheres, which the
+    /// exact model then checks). The one place that decides between the screen and the exact
+    /// model, for this checker and for objectives that count collisions.
+    pub fn screen_model(collision: &CollisionModel) -> Option<Arc<FastModel>> {
+        FastModel::of(collision).ok()
+    }
+
+    /// The world checked against.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Replaces the world (compiled again for the screen).
+    pub fn set_world(&mut self, world: World) {
+        if let Engine::Screen(screen) = &mut self.engine {
+            let (checker, fast_world) = &mut **screen;
+            *fast_world = checker.model().world(&world);
+        }
+        self.world = world;
+    }
+
+    /// Whether the single-precision screen checks this robot.
+    pub fn is_screened(&self) -> bool {
+        matches!(self.engine, Engine::Screen(_))
+    }
+
+    /// The screen's checker, when it checks this robot (for its statistics).
+    pub fn screen(&self) -> Option<&FastChecker> {
+        match &self.engine {
+            Engine::Screen(screen) => Some(&screen.0),
+            Engine::Exact(_) => None,
+        }
+    }
+
+    /// Configurations checked at once: [`FAST_LANES`] on the screen, else [`LANES`].
+    pub fn width(&self) -> usize {
+        if self.is_screened() {
+            FAST_LANES
+        } else {
+            LANES
+        }
+    }
+
+    /// Coordinates per configuration.
+    pub fn dim(&self) -> usize {
+        match &self.engine {
+            Engine::Screen(screen) => screen.0.dim(),
+            Engine::Exact(exact) => exact.active.len(),
+        }
+    }
+
+    /// Whether `q` is free of self-collisions and of the world. A value that is not finite
+    /// counts as colliding.
+    ///
+    /// # Panics
+    /// If `q` does not hold [`WorldChecker::dim`] values.
+    pub fn free(&mut self, q: &[f64]) -> bool {
+        assert_eq!(q.len(), self.dim(), "one value per active motor");
+        self.checks += 1;
+        self.block_free(q)
+    }
+
+    /// Whether every configuration of `qs` (whole configurations, one after the other) is free,
+    /// checked [`WorldChecker::width`] at a time, stopping at the first collision.
+    ///
+    /// # Panics
+    /// If `qs` does not hold whole configurations.
+    pub fn all_free(&mut self, qs: &[f64]) -> bool {
+        let (d, width) = (self.dim(), self.width());
+        assert!(d > 0 && qs.len().is_multiple_of(d), "whole configurations");
+        self.checks += (qs.len() / d) as u64;
+        qs.chunks(width * d).all(|block| self.block_free(block))
+    }
+
+    /// Whether the straight edge a → b is free at points no more than `resolution` apart in
+    /// Euclidean distance ([`edge_steps`]), the end points not checked again.
+    pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        // interior points 1..steps (0 and steps are the checked ends)
+        self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64)
+    }
+
+    /// Whether the straight edge a → b is free at every `resolution` and at `b` (`a` is not
+    /// checked): [`WorldChecker::edge_free`] with the end in the first block, so that a new
+    /// node costs no block of its own.
+    pub fn edge_and_end_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        // from b back towards a: b first, where an extension usually fails
+        self.rake(a, b, steps, |i| (steps - i) as f64 / steps as f64)
+    }
+
+    /// Whether the points halfway between those [`WorldChecker::edge_free`] checks at
+    /// `resolution` are free: after `edge_free(a, b, resolution)`, the edge is then free at every
+    /// `resolution / 2`, for half the checks of `edge_free(a, b, resolution / 2)`.
+    pub fn edge_midpoints_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        self.rake(a, b, steps, |i| (2 * i + 1) as f64 / (2 * steps) as f64)
+    }
+
+    /// Whether the straight segment a → b is free, both ends included, at points no more than
+    /// `resolution` apart in Euclidean distance ([`edge_steps`]).
+    pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = edge_steps(a, b, resolution);
+        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64)
+    }
+
+    /// Whether the straight segment a → b is free, both ends included, at points along which no
+    /// coordinate moves more than `resolution` ([`span_steps`]: a roadmap's edges).
+    pub fn span_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
+        let steps = span_steps(a, b, resolution);
+        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64)
+    }
+
+    /// Whether the `n` points a + at(i)·(b − a), i < n, are free, visited raked.
+    fn rake(&mut self, a: &[f64], b: &[f64], n: usize, at: impl Fn(usize) -> f64) -> bool {
+        if n == 0 {
+            return true;
+        }
+        let (d, width) = (a.len(), self.width());
+        let mut samples = std::mem::take(&mut self.samples);
+        let free = rake(d, a, b, n, at, width, &mut samples, self, |qs, me| {
+            me.checks += (qs.len() / d) as u64;
+            me.block_free(qs)
+        });
+        self.samples = samples;
+        free
+    }
+
+    /// Whether every configuration of `qs` (1 to [`WorldChecker::width`] of them) is free.
+    fn block_free(&mut self, qs: &[f64]) -> bool {
+        match &mut self.engine {
+            Engine::Screen(screen) => {
+                let (checker, fast_world) = &mut **screen;
+                checker.all_free_unchecked(qs, &self.world, fast_world)
+            }
+            Engine::Exact(exact) => exact.all_free(qs, &self.world),
+        }
+    }
+}
+
+impl Exact {
+    /// Whether the 1 to [`LANES`] configurations of `qs` are free: one configuration placed
+    /// alone (through the batched kinematics, as every `f64` evaluation), several in a batch.
+    fn all_free(&mut self, qs: &[f64], world: &World) -> bool {
+        let d = self.active.len();
+        let n = qs.len() / d;
+        if n == 1 {
+            for lane in 0..LANES {
+                self.lanes[lane * d..(lane + 1) * d].copy_from_slice(qs);
+            }
+            self.active
+                .forward_batch_unchecked(&self.lanes, &mut self.batch);
+            self.batch.lane_into(0, &mut self.poses);
+            self.collision.place(&self.poses, &mut self.placed);
+            return !self.collision.is_colliding(&self.placed, world);
+        }
+        if qs.iter().any(|v| v.is_nan()) {
+            return false;
+        }
+        // a partial batch padded with its first configuration, whose answer is not used
+        self.lanes[..qs.len()].copy_from_slice(qs);
+        for l in n..LANES {
+            self.lanes.copy_within(0..d, l * d);
+        }
+        self.active
+            .forward_batch_unchecked(&self.lanes, &mut self.batch);
+        self.collision
+            .place_batch(&self.batch, n, &mut self.placed_batch);
+        !self.collision.is_colliding_batch(&self.placed_batch, world)[..n]
+            .iter()
+            .any(|&hit| hit)
+    }
+}

@@ -1,0 +1,444 @@
+use super::LaneMask;
+#[cfg(target_arch = "x86_64")]
+use super::avx;
+use super::kdop::kdop_clear;
+use super::lanes::{F, PORTABLE, distance2, inverse_transform, link_frame, transform};
+use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
+use super::outcome::{Contact, Outcome};
+use super::world::{FastWorld, Object};
+use crate::batch::Nest;
+use trm_kinematics::PoseLanes32;
+
+/// Caller-owned scratch of [`FastModel::check`] (made by [`FastModel::scratch`]): world
+/// centres of every sphere and bounding sphere in every lane. Checks do not allocate.
+#[derive(Debug, Clone)]
+pub struct FastScratch {
+    pub(super) balls: Vec<[F; 3]>,
+    pub(super) inner: Vec<[F; 3]>,
+    pub(super) bounds: Vec<[F; 3]>,
+    /// Per link group: its frame (rotation rows, translation) in every lane.
+    pub(super) frames: Vec<([F; 9], [F; 3])>,
+    /// Per link group: whether its balls are placed for the current block.
+    pub(super) placed: Vec<bool>,
+    /// What left lanes uncertain in the last check, and in which lanes.
+    pub(super) suspects: Vec<(Suspect, LaneMask)>,
+    /// The pair the last check that stopped at a collision stopped at: tested first by the
+    /// next check (consecutive blocks, such as the points of a planner's edges, mostly collide
+    /// where the last one did).
+    pub(super) last_hit: Option<Suspect>,
+}
+
+/// Most culls open at once in a walk; deeper ones test but do not narrow the lanes.
+pub(super) const MAX_NESTING: usize = 16;
+
+/// [`FastModel::check`] and [`FastModel::count`], compiled for several instruction sets with the
+/// best one chosen at run time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+pub(super) fn screen<O: Outcome + Default>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+) -> O {
+    // the AVX code paths take AVX2 and FMA: the plain-AVX clone goes without them
+    const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
+        && multiversion::target::selected_target!().supports_feature_str("fma");
+    let mut outcome = O::default();
+    walk::<AVX, _>(model, poses, live, world, scratch, &mut outcome);
+    outcome
+}
+
+/// The screen's walk: the world's objects against the links, then the link pairs, each group
+/// of spheres' contacts handed to `outcome`; ends early when the outcome says so.
+#[inline(always)]
+pub(super) fn walk<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) {
+    place::<AVX>(model, poses, scratch);
+    scratch.suspects.clear();
+    if O::STOPS_AT_FIRST && last_hit_again::<AVX, O>(model, live, world, scratch, verdict) {
+        return;
+    }
+    let m = world.margin;
+    // the world first: in a planner's queries most collisions are with the world, and the
+    // objects nearest the robot first. A model of few links: link by link, the links last in
+    // the tree first (the hand and the forearm sweep the most space: most collisions are
+    // theirs), each link's bounding sphere against each object, then its spheres. A model of
+    // many links: each object against the culling spheres of the kinematic tree's subtrees
+    // first
+    if !model.culls {
+        for g in (0..model.groups.len()).rev() {
+            for (&o, object) in world.original.iter().zip(&world.objects) {
+                let o = o as usize;
+                if object_link::<AVX>(model, o, object, g, live, world, scratch, verdict) {
+                    return;
+                }
+            }
+        }
+    } else {
+        for (&o, object) in world.original.iter().zip(&world.objects) {
+            let o = o as usize;
+            let steps = &model.world_steps;
+            let mut nest = Nest::<MAX_NESTING>::new();
+            let (mut mask, mut i) = (live, 0);
+            while i < steps.len() {
+                mask = nest.close(i, mask, live);
+                match steps[i] {
+                    WorldStep::Cull { ball, radius, end } => {
+                        let c = &scratch.bounds[ball as usize];
+                        let near = mask & object.near::<AVX>(c, radius + m);
+                        if near == 0 {
+                            i = end as usize;
+                            continue;
+                        }
+                        mask = nest.open(end, mask, near);
+                    }
+                    WorldStep::Link(g) => {
+                        let g = g as usize;
+                        if object_link::<AVX>(model, o, object, g, mask, world, scratch, verdict) {
+                            return;
+                        }
+                    }
+                }
+                i += 1;
+            }
+        }
+    }
+    verdict.enter_self();
+    // self: the culling spheres of the kinematic tree (one test clears a hand against the
+    // other hand), then each link pair's bounding spheres and spheres
+    if !model.culls {
+        for (k, gp) in model.group_pairs.iter().enumerate() {
+            if link_pair::<AVX>(model, gp, k, live, world, scratch, verdict) {
+                return;
+            }
+        }
+        clear_suspects::<AVX, _>(model, scratch, m, verdict);
+        return;
+    }
+    let steps = &model.steps;
+    let mut nest = Nest::<MAX_NESTING>::new();
+    let (mut mask, mut i) = (live, 0);
+    while i < steps.len() {
+        mask = nest.close(i, mask, live);
+        match steps[i] {
+            CullStep::Cull { a, b, reach, end } => {
+                let (ca, cb) = (&scratch.bounds[a as usize], &scratch.bounds[b as usize]);
+                let reach = reach + m;
+                let near = mask & distance2(ca, cb).within(reach * reach).mask::<AVX>();
+                if near == 0 {
+                    i = end as usize;
+                    continue;
+                }
+                mask = nest.open(end, mask, near);
+            }
+            CullStep::Pair(k) => {
+                let gp = &model.group_pairs[k as usize];
+                if link_pair::<AVX>(model, gp, k as usize, mask, world, scratch, verdict) {
+                    return;
+                }
+            }
+        }
+        i += 1;
+    }
+    clear_suspects::<AVX, _>(model, scratch, m, verdict);
+}
+
+/// Whether the pair the last stopped walk stopped at (when there is one, and its object is in
+/// `world`) certainly collides in a lane of `live`: then `verdict` says so and the walk may
+/// end. Otherwise `verdict` and the suspects are left as they were (the walk tests the pair
+/// again in its turn).
+#[inline(always)]
+pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) -> bool {
+    let (before, marked) = (*verdict.uncertain(), scratch.suspects.len());
+    let stopped = match scratch.last_hit {
+        Some(Suspect::Object { object, group }) => world
+            .compiled_of
+            .get(object as usize)
+            .and_then(|&k| world.objects.get(k as usize))
+            .is_some_and(|object_shape| {
+                object_link::<AVX>(
+                    model,
+                    object as usize,
+                    object_shape,
+                    group as usize,
+                    live,
+                    world,
+                    scratch,
+                    verdict,
+                )
+            }),
+        Some(Suspect::Pair(k)) => {
+            let gp = &model.group_pairs[k as usize];
+            link_pair::<AVX>(model, gp, k as usize, live, world, scratch, verdict)
+        }
+        None => false,
+    };
+    if !stopped {
+        *verdict.uncertain() = before;
+        scratch.suspects.truncate(marked);
+    }
+    stopped
+}
+
+/// `verdict` without the link-pair suspects' lanes in which either link's spheres all lie
+/// beyond a slab of the other's k-DOP (when both are convex hulls): a second, tighter screen
+/// that only a block left uncertain pays for, before its lanes are checked exactly.
+#[inline(always)]
+pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    scratch: &mut FastScratch,
+    m: f32,
+    verdict: &mut O,
+) {
+    if verdict.settled() || *verdict.uncertain() == 0 || model.exact {
+        return;
+    }
+    let mut suspects = std::mem::take(&mut scratch.suspects);
+    let uncertain = verdict.uncertain();
+    *uncertain = 0;
+    for (suspect, lanes) in &mut suspects {
+        if let Suspect::Pair(k) = *suspect {
+            let gp = &model.group_pairs[k as usize];
+            *lanes &= !kdop_clear::<AVX>(model, gp.a, gp.b, scratch, m);
+            if *lanes != 0 {
+                *lanes &= !kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
+            }
+        }
+        *uncertain |= *lanes;
+    }
+    suspects.retain(|&(_, lanes)| lanes != 0);
+    scratch.suspects = suspects;
+}
+
+/// Checks world object `o` against link group `g` in the lanes of `live`: the link's bounding
+/// sphere, then its spheres (and the spheres inside its bodies). True when a lane certainly
+/// collides (then `verdict` says which); lanes left uncertain are added to `verdict` and the
+/// suspects.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn object_link<const AVX: bool>(
+    model: &FastModel,
+    o: usize,
+    object: &Object,
+    g: usize,
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut impl Outcome,
+) -> bool {
+    let (m, group) = (world.margin, &model.groups[g]);
+    let near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
+    if near == 0 {
+        return false;
+    }
+    place_balls::<AVX>(model, g, scratch);
+    let mut contact = Contact::default();
+    for i in group.balls.clone() {
+        object.test::<AVX>(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
+    }
+    let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
+    if !model.exact {
+        // enclosing spheres only say "maybe"; a sphere inside a body says "certainly"
+        let mut inside = Contact::default();
+        if near & close != 0 {
+            for i in group.inner.clone() {
+                let r = model.inner[i].radius;
+                object.test::<AVX>(&mut inside, &scratch.inner[i], r, m);
+            }
+        }
+        hit = inside.hit.mask::<AVX>();
+    }
+    let suspect = Suspect::Object {
+        object: o as u32,
+        group: g as u32,
+    };
+    match verdict.add(near, hit, close) {
+        None => {
+            scratch.last_hit = Some(suspect);
+            true
+        }
+        Some(0) => false,
+        Some(lanes) => {
+            scratch.suspects.push((suspect, lanes));
+            false
+        }
+    }
+}
+
+/// Checks link pair `gp` (index `k` in [`FastModel::group_pairs`]) in the lanes of `live`:
+/// bounding spheres, then a box against the other link's spheres or the two links' spheres.
+/// True when a lane certainly collides (then `verdict` says which); lanes left uncertain are
+/// added to `verdict` and the suspects.
+#[inline(always)]
+pub(super) fn link_pair<const AVX: bool>(
+    model: &FastModel,
+    gp: &GroupPair,
+    k: usize,
+    live: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut impl Outcome,
+) -> bool {
+    let m = world.margin;
+    let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
+    let reach = ga.bound.radius + gb.bound.radius + m;
+    let near = live
+        & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
+            .within(reach * reach)
+            .mask::<AVX>();
+    if near == 0 {
+        return false;
+    }
+    let (hit, close) = if let Some((s, o)) = gp.solid {
+        // the other link's spheres in the box link's frame, against the box itself
+        place_balls::<AVX>(model, o, scratch);
+        let (box_, group, frame) = (&model.groups[s].solid, &model.groups[o], &scratch.frames[s]);
+        let Some(box_) = box_ else { return false };
+        let mut contact = Contact::default();
+        for i in group.balls.clone() {
+            let c = inverse_transform(frame, &scratch.balls[i]);
+            box_.test::<AVX>(&mut contact, &c, model.balls[i].radius, m);
+        }
+        let close = contact.close.mask::<AVX>();
+        let mut inside = Contact::default();
+        if near & close != 0 {
+            for i in group.inner.clone() {
+                let c = inverse_transform(frame, &scratch.inner[i]);
+                box_.test::<AVX>(&mut inside, &c, model.inner[i].radius, m);
+            }
+        }
+        (inside.hit.mask::<AVX>(), close)
+    } else {
+        // each sphere of link a against link b's bounding sphere, then b's spheres
+        place_balls::<AVX>(model, gp.a, scratch);
+        place_balls::<AVX>(model, gp.b, scratch);
+        let (mut hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
+        if !model.exact {
+            // enclosing spheres only say "maybe"; spheres inside the bodies say "certainly"
+            let mut inside = Contact::default();
+            if near & close != 0 {
+                for &(i, j, r) in &gp.inner {
+                    let (i, j) = (&scratch.inner[i as usize], &scratch.inner[j as usize]);
+                    inside.add(distance2(i, j), r, m);
+                }
+            }
+            hit = inside.hit.mask::<AVX>();
+        }
+        (hit, close)
+    };
+    match verdict.add(near, hit, close) {
+        None => {
+            scratch.last_hit = Some(Suspect::Pair(k as u32));
+            true
+        }
+        Some(0) => false,
+        Some(lanes) => {
+            scratch.suspects.push((Suspect::Pair(k as u32), lanes));
+            false
+        }
+    }
+}
+
+/// The lanes in which link pair `gp`'s spheres certainly collide, and those in which they come
+/// within the margin `m` of contact (or NaN): each sphere of link a against link b's bounding
+/// sphere, then b's spheres. Without a branch per pair: flags or-ed together, turned into lane
+/// masks once.
+#[inline(always)]
+pub(super) fn pair_contacts<const AVX: bool>(
+    model: &FastModel,
+    gp: &GroupPair,
+    scratch: &FastScratch,
+    world: &FastWorld,
+) -> (LaneMask, LaneMask) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::pair_contacts(model, gp, scratch, world) };
+    }
+    let m = world.margin;
+    let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+    let bound_b = model.groups[gp.b].bound.radius;
+    let mut contact = Contact::default();
+    for (a, run) in &gp.runs {
+        let ball = &balls[*a as usize];
+        let reach = model.balls[*a as usize].radius + bound_b + m;
+        if !distance2(ball, &bounds[gp.b]).any_within::<PORTABLE>(reach * reach) {
+            continue;
+        }
+        let pairs = model.pairs[run.clone()]
+            .iter()
+            .zip(&world.limits[run.clone()]);
+        for (&(_, b, _), &limits) in pairs {
+            contact.add_within(distance2(ball, &balls[b as usize]), limits);
+        }
+    }
+    (
+        contact.hit.mask::<PORTABLE>(),
+        contact.close.mask::<PORTABLE>(),
+    )
+}
+
+/// The frame and bounding-sphere centre of every link group in every lane; balls are placed
+/// later, for the groups that come near something ([`place_balls`]).
+#[inline(always)]
+pub(super) fn place<const AVX: bool>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    scratch: &mut FastScratch,
+) {
+    // the culling spheres' centres: their links' origins
+    let groups = model.groups.len();
+    for (s, &frame) in model.origins.iter().enumerate() {
+        let p = &poses[frame as usize];
+        scratch.bounds[groups + s] = [F(p[4]), F(p[5]), F(p[6])];
+    }
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::place(model, poses, scratch) };
+    }
+    for (g, group) in model.groups.iter().enumerate() {
+        let (rot, t) = link_frame(poses, group.frame);
+        scratch.bounds[g] = transform(&rot, &t, group.bound.center);
+        scratch.frames[g] = (rot, t);
+        scratch.placed[g] = false;
+    }
+}
+
+/// The centres of group `g`'s balls in every lane, placed once per block.
+#[inline(always)]
+pub(super) fn place_balls<const AVX: bool>(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+    if scratch.placed[g] {
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        return unsafe { avx::place_balls(model, g, scratch) };
+    }
+    let (rot, t) = &scratch.frames[g];
+    for i in model.groups[g].balls.clone() {
+        scratch.balls[i] = transform(rot, t, model.balls[i].center);
+    }
+    for i in model.groups[g].inner.clone() {
+        scratch.inner[i] = transform(rot, t, model.inner[i].center);
+    }
+    scratch.placed[g] = true;
+}

@@ -1,0 +1,251 @@
+use super::LaneMask;
+#[cfg(target_arch = "x86_64")]
+use super::avx;
+use super::lanes::{
+    F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, norm,
+    segment_distance2, splat, to_f32,
+};
+use super::model::FastModel;
+use super::outcome::Contact;
+use crate::shape::Shape;
+use crate::world::World;
+use nalgebra::Vector3;
+
+/// Rounding budget of the margin, m per metre of the largest coordinate per joint of the
+/// deepest chain (see [`FastWorld::margin`]).
+pub(super) const MARGIN_PER_METRE_JOINT: f64 = 1e-6;
+
+/// A world object as the single-precision checks see it.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Object {
+    /// A sphere, or a capsule's segment (`a` = `b` for a sphere).
+    Round {
+        a: [f32; 3],
+        b: [f32; 3],
+        radius: f32,
+    },
+    /// A box: centre, the rows of the transposed rotation (world → box frame) and half sizes.
+    Box {
+        center: [f32; 3],
+        axes: [[f32; 3]; 3],
+        half: [f32; 3],
+    },
+    /// A cylinder along its z axis: centre, the rows of the transposed rotation, radius and
+    /// half length.
+    Cylinder {
+        center: [f32; 3],
+        axes: [[f32; 3]; 3],
+        radius: f32,
+        half: f32,
+    },
+    /// Anything else, through its bounding sphere: near it is uncertain, never colliding.
+    Bounded { center: [f32; 3], radius: f32 },
+}
+
+/// A world compiled for a [`FastModel`] (made by [`FastModel::world`]; compile it again when
+/// the world changes).
+#[derive(Debug, Clone)]
+pub struct FastWorld {
+    /// The objects, nearest the robot's root first.
+    pub(super) objects: Vec<Object>,
+    /// The world's index of each of `objects`.
+    pub(super) original: Vec<u32>,
+    /// The index in `objects` of each of the world's objects.
+    pub(super) compiled_of: Vec<u32>,
+    pub(super) margin: f32,
+    /// Per ball pair of the model ([`FastModel::pairs`]): its [`limits`] with this margin.
+    pub(super) limits: Vec<[f32; 2]>,
+}
+
+impl FastWorld {
+    /// The band, m, around contact within which a verdict is uncertain: 1 µm per metre of the
+    /// largest coordinate involved (the robot's reach and the farthest object, plus one metre)
+    /// per joint of the deepest chain (plus two, for placing the spheres and measuring their
+    /// distance, and one more for taking spheres into a box link's frame when the model has
+    /// one). Single precision errs by a few units of 2⁻²⁴ (6e-8) of relative error per
+    /// step — under 0.5 µm per metre per joint — so the band is at least twice the worst
+    /// rounding of both spheres of a pair (25 µm on the Panda; measured FK rounding: 0.7 µm on
+    /// the 75-joint iCub).
+    pub fn margin(&self) -> f64 {
+        f64::from(self.margin)
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Whether the world has no object.
+    pub fn is_empty(&self) -> bool {
+        self.objects.is_empty()
+    }
+}
+
+impl FastModel {
+    /// `world` compiled for [`FastModel::check`], with its margin (see [`FastWorld::margin`]).
+    pub fn world(&self, world: &World) -> FastWorld {
+        let mut farthest: f64 = 0.0;
+        let objects: Vec<Object> = world
+            .objects()
+            .iter()
+            .map(|o| {
+                let pose = o.pose();
+                let bounds = o.bounding_box();
+                let (mins, maxs) = (bounds.mins, bounds.maxs);
+                farthest = farthest.max(mins.coords.amax()).max(maxs.coords.amax());
+                let t = pose.translation.vector;
+                match o.shape() {
+                    Shape::Sphere { radius } => Object::Round {
+                        a: to_f32(t),
+                        b: to_f32(t),
+                        radius: *radius as f32,
+                    },
+                    Shape::Capsule { radius, length } => {
+                        let half = pose.rotation * Vector3::new(0.0, 0.0, 0.5 * length);
+                        Object::Round {
+                            a: to_f32(t - half),
+                            b: to_f32(t + half),
+                            radius: *radius as f32,
+                        }
+                    }
+                    Shape::Box { size } => Object::Box {
+                        center: to_f32(t),
+                        axes: inverse_axes(pose),
+                        half: size.map(|s| (0.5 * s) as f32),
+                    },
+                    Shape::Cylinder { radius, length } => Object::Cylinder {
+                        center: to_f32(t),
+                        axes: inverse_axes(pose),
+                        radius: *radius as f32,
+                        half: (0.5 * length) as f32,
+                    },
+                    Shape::Convex { .. } => {
+                        let c = bounds.center();
+                        Object::Bounded {
+                            center: to_f32(c.coords),
+                            radius: (0.5 * (maxs - mins).norm()) as f32,
+                        }
+                    }
+                }
+            })
+            .collect();
+        // nearest the robot's root first (as VAMP sorts its environment): a block that collides
+        // mostly collides there, and the walk stops at its first collision
+        let mut order: Vec<u32> = (0..objects.len() as u32).collect();
+        let reach_of = |o: &Object| {
+            let (center, radius) = o.bounding_sphere();
+            norm(center) - f64::from(radius)
+        };
+        order.sort_by(|&a, &b| {
+            reach_of(&objects[a as usize]).total_cmp(&reach_of(&objects[b as usize]))
+        });
+        let mut compiled_of = vec![0; order.len()];
+        for (k, &o) in order.iter().enumerate() {
+            compiled_of[o as usize] = k as u32;
+        }
+        let objects = order.iter().map(|&o| objects[o as usize]).collect();
+        let largest = self.reach.max(farthest);
+        // placing and measuring, one more step where a sphere is taken into a box link's frame
+        let solid = (self.groups.iter()).any(|g| g.solid.is_some() || g.kdop.is_some());
+        let steps = self.depth + 2 + usize::from(solid);
+        let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
+        FastWorld {
+            objects,
+            original: order,
+            compiled_of,
+            margin,
+            limits: self
+                .pairs
+                .iter()
+                .map(|&(_, _, r)| limits(r, margin))
+                .collect(),
+        }
+    }
+}
+
+impl Object {
+    /// Centre and radius of a sphere around the object.
+    pub(super) fn bounding_sphere(&self) -> ([f32; 3], f32) {
+        match *self {
+            Object::Round { a, b, radius } => {
+                let center = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+                let half = std::array::from_fn(|k| 0.5 * (b[k] - a[k]));
+                (center, norm(half) as f32 + radius)
+            }
+            Object::Box { center, half, .. } => (center, norm(half) as f32),
+            Object::Cylinder {
+                center,
+                radius,
+                half,
+                ..
+            } => (center, radius.hypot(half)),
+            Object::Bounded { center, radius } => (center, radius),
+        }
+    }
+
+    /// The reach of a sphere of radius `r` from the object's own geometry: the sum of the radii
+    /// for round objects (and a bounded object's sphere), `r` for the others.
+    #[inline(always)]
+    pub(super) fn reach(&self, r: f32) -> f32 {
+        match *self {
+            Object::Round { radius, .. } | Object::Bounded { radius, .. } => r + radius,
+            Object::Box { .. } | Object::Cylinder { .. } => r,
+        }
+    }
+
+    /// Squared distance from the point in every lane to the object's geometry (the segment of
+    /// a round object, the centre of a bounded one; 0 inside).
+    #[inline(always)]
+    pub(super) fn distance2(&self, c: &[F; 3]) -> F {
+        match *self {
+            Object::Round { a, b, .. } => segment_distance2(c, a, b),
+            Object::Box { center, axes, half } => box_distance2(c, center, &axes, half),
+            Object::Cylinder {
+                center,
+                axes,
+                radius,
+                half,
+            } => cylinder_distance2(c, center, &axes, radius, half),
+            Object::Bounded { center, .. } => distance2(c, &splat(center)),
+        }
+    }
+
+    /// Lanes whose sphere at `c` of radius `r` may come within reach of the object (its
+    /// bounding sphere for [`Object::Bounded`]).
+    #[inline(always)]
+    pub(super) fn near<const AVX: bool>(&self, c: &[F; 3], r: f32) -> LaneMask {
+        let reach = self.reach(r);
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return unsafe { avx::near(self, c, reach * reach) };
+        }
+        self.distance2(c).within(reach * reach).mask::<PORTABLE>()
+    }
+
+    /// Adds the sphere at `c` of radius `r` against the object.
+    #[inline(always)]
+    pub(super) fn test<const AVX: bool>(&self, contact: &mut Contact, c: &[F; 3], r: f32, m: f32) {
+        let reach = self.reach(r);
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return unsafe { avx::test(self, contact, c, reach, m) };
+        }
+        let d2 = self.distance2(c);
+        match self {
+            Object::Bounded { .. } => contact.add_uncertain(d2, reach + m),
+            _ => contact.add(d2, reach, m),
+        }
+    }
+}
+
+/// The squared distances below which two spheres whose radii sum to `r` certainly collide,
+/// and beyond which they are certainly clear, with the margin `m`.
+#[inline(always)]
+pub(super) fn limits(r: f32, m: f32) -> [f32; 2] {
+    let (inner, outer) = ((r - m).max(0.0), r + m);
+    [inner * inner, outer * outer]
+}
