@@ -869,7 +869,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     ));
     cases.extend(flag_cases(&run_scenario, "--threads", &["0", "x"]));
     // MotionBenchMaker sets: missing, empty, not an archive, an unknown family, a broken scene
-    let mbm = at("crates/trm-plan/tests/fixtures/mbm")
+    let mbm = at("crates/trm-mbm/tests/fixtures/mbm")
         .to_string_lossy()
         .to_string();
     let panda = at("models/panda-mbm/panda.ron")
@@ -891,7 +891,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     std::fs::create_dir_all(dir.join("broken_set/box")).unwrap();
     std::fs::write(dir.join("broken_set/box/scene0001.yaml"), "world:\n  collision_objects:\n    - id: a\n      primitives: [{type: cone, dimensions: [1, 1]}]\n      primitive_poses: [{position: [0, 0, 0]}]\n").unwrap();
     std::fs::copy(
-        at("crates/trm-plan/tests/fixtures/mbm/box_panda/request0001.yaml"),
+        at("crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml"),
         dir.join("broken_set/box/request0001.yaml"),
     )
     .unwrap();

@@ -13,15 +13,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod generate;
-pub mod mbm;
-pub mod moveit;
 mod planner;
 pub mod pose_goal;
 pub mod rrt;
 pub mod scenario;
 mod trajectory;
-pub mod yaml;
 
 pub use planner::{
     EXACT_WEIGHT, ExactGoal, Goal, PlanError, PlanOptions, PlanStats, Planned, Planner,

@@ -55,18 +55,6 @@ pub enum PlanError {
         /// What differs.
         problem: String,
     },
-    /// A MoveIt scene or request file holds something trm cannot read.
-    #[error("{}{}: {problem}\n  fix: {fix}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
-    InvalidMoveIt {
-        /// The file.
-        path: std::path::PathBuf,
-        /// 1-based line, 0 when unknown.
-        line: usize,
-        /// What is wrong.
-        problem: String,
-        /// What to do about it.
-        fix: String,
-    },
     /// A query setting out of range.
     #[error("plan options: {what} {problem}")]
     InvalidOptions {
@@ -74,16 +62,6 @@ pub enum PlanError {
         what: String,
         /// What is wrong and what to give.
         problem: String,
-    },
-    /// A problem set could not be generated as asked.
-    #[error("generating {what}: {problem}\n  fix: {fix}")]
-    Generate {
-        /// The problem or setting.
-        what: String,
-        /// What went wrong.
-        problem: String,
-        /// What to change.
-        fix: String,
     },
     /// The start configuration collides in the current world, or has the wrong length.
     #[error("the start configuration is invalid: {0}")]

@@ -74,7 +74,7 @@ pub(crate) fn benchmark_mbm<'py>(
     sampler: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sampler: trm_plan::rrt::Sampler = sampler.parse().map_err(err)?;
-    let task_space = task_space.map(|link| trm_plan::mbm::TaskSpaceGoals {
+    let task_space = task_space.map(|link| trm_mbm::TaskSpaceGoals {
         link,
         position_tolerance,
         orientation_tolerance,
@@ -84,7 +84,7 @@ pub(crate) fn benchmark_mbm<'py>(
         package_paths.into_iter().map(Into::into).collect(),
     );
     let collision = CollisionModel::with_options(&robot, &options).map_err(err)?;
-    let mut set = trm_plan::mbm::ProblemSet::open(std::path::Path::new(path)).map_err(err)?;
+    let mut set = trm_mbm::ProblemSet::open(std::path::Path::new(path)).map_err(err)?;
     set.select(&families, per_family).map_err(err)?;
     let rrt = trm_plan::rrt::RrtOptions {
         seed,
@@ -94,7 +94,7 @@ pub(crate) fn benchmark_mbm<'py>(
     };
     let runs = py
         .detach(|| {
-            trm_plan::mbm::run_set(
+            trm_mbm::run_set(
                 &robot,
                 &collision,
                 &set.problems,
@@ -108,9 +108,9 @@ pub(crate) fn benchmark_mbm<'py>(
     let d = PyDict::new(py);
     d.set_item(
         "table",
-        trm_plan::mbm::markdown_table(runs.iter().map(|r| (r.family.as_str(), &r.outcome))),
+        trm_mbm::markdown_table(runs.iter().map(|r| (r.family.as_str(), &r.outcome))),
     )?;
-    d.set_item("csv", trm_plan::mbm::runs_csv(&runs))?;
+    d.set_item("csv", trm_mbm::runs_csv(&runs))?;
     d.set_item("runs", to_python(py, &runs)?)?;
     Ok(d)
 }

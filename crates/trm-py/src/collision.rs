@@ -21,7 +21,7 @@ impl PyWorld {
     #[staticmethod]
     fn load(path: &str) -> PyResult<Self> {
         Ok(PyWorld {
-            world: trm_plan::moveit::load_world(path).map_err(err)?,
+            world: trm_moveit::load_world(path).map_err(err)?,
         })
     }
 

@@ -70,8 +70,8 @@ pub(crate) fn generate_mbm(
     tries: usize,
 ) -> PyResult<usize> {
     let problem = trm_tasks::Problem::load_with(spec, &trm_taskmap::loaders()).map_err(err)?;
-    let defaults = trm_plan::generate::SetOptions::default();
-    let options = trm_plan::generate::SetOptions {
+    let defaults = trm_mbm::generate::SetOptions::default();
+    let options = trm_mbm::generate::SetOptions {
         families: families.unwrap_or(defaults.families),
         per_family,
         seed,
@@ -81,8 +81,8 @@ pub(crate) fn generate_mbm(
         tries,
     };
     let set = py
-        .detach(|| trm_plan::generate::generate(&problem, &options, |_, _| {}))
+        .detach(|| trm_mbm::generate::generate(&problem, &options, |_, _| {}))
         .map_err(err)?;
-    trm_plan::generate::write_set(std::path::Path::new(out), &set).map_err(err)?;
+    trm_mbm::generate::write_set(std::path::Path::new(out), &set).map_err(err)?;
     Ok(set.len())
 }

@@ -1,15 +1,15 @@
 //! `cargo xtask benchmark-mbm DIR --model MODEL [--package-path DIR] [--per-family N]`: a
 //! MotionBenchMaker set (a folder per family of `sceneNNNN.yaml` + `requestNNNN.yaml`, e.g.
 //! VAMP's `resources/panda/problems.tar.bz2` unpacked) solved problem by problem
-//! (`trm_plan::mbm::solve`, RRT-Connect); per family: valid, solved, median and p95 time, path
+//! (`trm_mbm::solve`, RRT-Connect); per family: valid, solved, median and p95 time, path
 //! length, collision checks; `results.csv`, `results.md` and `times.svg` in `--out-dir`.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use trm_plan::mbm::{Outcome, ProblemSet, path_is_free};
-use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+use trm_mbm::{Outcome, ProblemSet, path_is_free};
+use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
 /// Arguments of `benchmark-mbm`.
@@ -69,7 +69,7 @@ pub struct Args {
     /// value is OMPL's time limit per problem, s.
     #[arg(long, value_parser = crate::parse::positive, conflicts_with = "families")]
     ompl: Option<f64>,
-    /// Also solve the set with experience kept, twice (`trm_plan::mbm::solve_with_experience`:
+    /// Also solve the set with experience kept, twice (`trm_mbm::solve_with_experience`:
     /// one planner per family keeps every path RRT-Connect finds; pass 1 plans each problem
     /// through the family's earlier paths, pass 2 runs the set again), a table per pass.
     #[arg(long)]
@@ -121,7 +121,7 @@ pub fn run(args: &Args) -> Result<()> {
         ..Default::default()
     };
     let mut progress = crate::progress::Progress::new("problems", problems.len() as u64);
-    let rows = trm_plan::mbm::run_set(
+    let rows = trm_mbm::run_set(
         &robot,
         &collision,
         &problems,
@@ -129,7 +129,7 @@ pub fn run(args: &Args) -> Result<()> {
         args.verify,
         args.task_space
             .as_ref()
-            .map(|link| trm_plan::mbm::TaskSpaceGoals {
+            .map(|link| trm_mbm::TaskSpaceGoals {
                 link: link.clone(),
                 position_tolerance: args.position_tolerance,
                 orientation_tolerance: args.orientation_tolerance,
@@ -138,7 +138,7 @@ pub fn run(args: &Args) -> Result<()> {
         |k, p| progress.set(k as u64, problems.len() as u64, &p.family),
     )?;
     progress.finish();
-    let csv = trm_plan::mbm::runs_csv(&rows);
+    let csv = trm_mbm::runs_csv(&rows);
     let mut md = format!(
         "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, {} samples at most{})\n\n",
         args.dir.display(),
@@ -152,7 +152,7 @@ pub fn run(args: &Args) -> Result<()> {
         .iter()
         .map(|r| (r.family.as_str(), &r.outcome))
         .collect();
-    md.push_str(&trm_plan::mbm::markdown_table(outcomes.iter().copied()));
+    md.push_str(&trm_mbm::markdown_table(outcomes.iter().copied()));
     let mut families: Vec<&str> = rows.iter().map(|r| r.family.as_str()).collect();
     families.dedup();
     let mut all_times = Vec::new();
@@ -211,17 +211,11 @@ pub fn run(args: &Args) -> Result<()> {
         let total = 2 * problems.len() as u64;
         let mut progress = crate::progress::Progress::new("problems with experience", total);
         let mut count = 0;
-        experience = trm_plan::mbm::solve_with_experience(
-            &robot,
-            &collision,
-            &problems,
-            &options,
-            2,
-            |_, k| {
+        experience =
+            trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, k| {
                 count += 1;
                 progress.set(count, total, &problems[k].family);
-            },
-        )?;
+            })?;
         progress.finish();
         let mut text = String::new();
         for (pass, outcomes) in experience.iter_mut().enumerate() {
@@ -267,7 +261,7 @@ pub fn run(args: &Args) -> Result<()> {
                 },
                 from_experience + retrieved,
                 outcomes.iter().filter(|o| o.solved).count(),
-                trm_plan::mbm::markdown_table(pairs)
+                trm_mbm::markdown_table(pairs)
             );
             if args.verify {
                 let _ = writeln!(
@@ -288,7 +282,7 @@ pub fn run(args: &Args) -> Result<()> {
             "\nVAMP's RRT-Connect + simplifier on the same problems ({}, VAMP's sphere model of {}, Halton sampler, its range for the robot; time = planning + simplification as VAMP reports them):\n\n{}",
             binary.display(),
             robot.name(),
-            trm_plan::mbm::markdown_table(theirs.iter().copied())
+            trm_mbm::markdown_table(theirs.iter().copied())
         );
         if args.verify {
             let failed = peer
@@ -304,7 +298,7 @@ pub fn run(args: &Args) -> Result<()> {
         let _ = write!(
             text,
             "\nSide by side, on the problems both call valid (ratio = trm / VAMP):\n\n{}",
-            trm_plan::mbm::side_by_side((&outcomes, "trm"), (&theirs, "VAMP"))
+            trm_mbm::side_by_side((&outcomes, "trm"), (&theirs, "VAMP"))
         );
         if let Some(second) = experience.get(1) {
             let ours: Vec<(&str, &Outcome)> = problems
@@ -315,7 +309,7 @@ pub fn run(args: &Args) -> Result<()> {
             let _ = write!(
                 text,
                 "\ntrm with experience (pass 2) beside VAMP:\n\n{}",
-                trm_plan::mbm::side_by_side((&ours, "trm"), (&theirs, "VAMP"))
+                trm_mbm::side_by_side((&ours, "trm"), (&theirs, "VAMP"))
             );
         }
         print!("{text}");
@@ -370,7 +364,7 @@ const VAMP_FIX: &str = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR 
 /// The note of a VAMP path that collides in trm's model (`--verify`).
 const VAMP_PATH_COLLIDES: &str = "VAMP's path collides in trm's model";
 
-/// Runs VAMP's program on `problems` (exported with `trm_plan::mbm::peer_problems`); its
+/// Runs VAMP's program on `problems` (exported with `trm_mbm::peer_problems`); its
 /// outcomes in the order of `problems`, with `--verify` its paths re-checked in trm's model,
 /// and the problems as given to it.
 fn run_vamp(
@@ -379,10 +373,10 @@ fn run_vamp(
     robot: &trm_kinematics::RobotModel,
     collision: &trm_collision::CollisionModel,
     set: &ProblemSet,
-    problems: &[trm_plan::mbm::Problem],
+    problems: &[trm_mbm::Problem],
 ) -> Result<(Vec<(String, Outcome)>, String)> {
     use std::io::Write as _;
-    let input = trm_plan::mbm::peer_problems(robot.name(), problems)?;
+    let input = trm_mbm::peer_problems(robot.name(), problems)?;
     let exported = input.clone();
     println!(
         "\nrunning VAMP on {} problems of {}",
@@ -406,7 +400,7 @@ fn run_vamp(
         output.status,
         String::from_utf8_lossy(&output.stderr).trim()
     );
-    let results = trm_plan::mbm::parse_peer_results(&String::from_utf8_lossy(&output.stdout))
+    let results = trm_mbm::parse_peer_results(&String::from_utf8_lossy(&output.stdout))
         .map_err(|e| anyhow::anyhow!("--vamp: {}'s output, {e}", binary.display()))?;
     let mut ordered = Vec::new();
     for p in problems {

@@ -240,7 +240,7 @@ pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
 /// Prints what `world` blocks in `map`: through the index (built once, then timed over
 /// repeated queries) and by checking every node and edge, with both times.
 fn blocking_report(map: &Roadmap, problem: &Problem, world: &Path) -> Result<()> {
-    let world = trm_plan::moveit::load_world(world)?;
+    let world = trm_moveit::load_world(world)?;
     let objective = &problem.objective;
     let started = std::time::Instant::now();
     let index = trm_roadmap::BlockIndex::new(map, objective)?;

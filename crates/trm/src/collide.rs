@@ -29,7 +29,7 @@ pub fn run(args: &Args) -> Result<()> {
     let model = crate::load_model(args.model.as_deref())?;
     let collision = args.meshes.collision_model(&model)?;
     let world = match &args.world {
-        Some(path) => trm_plan::moveit::load_world(path)?,
+        Some(path) => trm_moveit::load_world(path)?,
         None => World::new(),
     };
     let (_, all) = args.configs.read(&model)?;

@@ -1,11 +1,11 @@
 //! `cargo xtask gen-mbm SPEC --out DIR`: a MotionBenchMaker-like problem set for the spec's
-//! robot (`trm_plan::generate`): seeded table, shelf and cage scenes in front of it, reaching
+//! robot (`trm_mbm::generate`): seeded table, shelf and cage scenes in front of it, reaching
 //! goals inside them found by NGIK, written as MoveIt scenes and requests.
 
 use std::path::PathBuf;
 
 use anyhow::Result;
-use trm_plan::generate::{FAMILIES, SetOptions, generate, write_set};
+use trm_mbm::generate::{FAMILIES, SetOptions, generate, write_set};
 
 /// Arguments of `gen-mbm`.
 #[derive(clap::Args)]

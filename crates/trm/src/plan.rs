@@ -87,7 +87,7 @@ pub fn run(args: &Args) -> Result<()> {
     let world = args
         .world
         .as_ref()
-        .map(trm_plan::moveit::load_world)
+        .map(trm_moveit::load_world)
         .transpose()?;
     if let (true, Some(world)) = (args.repair, &world) {
         for (map, path) in maps.iter_mut().zip(&args.maps) {

@@ -52,7 +52,7 @@ pub fn run(args: &Args) -> Result<()> {
         Vector3::z() * v.get(3).copied().unwrap_or(0.0),
     );
     let world = match &args.world {
-        Some(w) => trm_plan::moveit::load_world(w)?,
+        Some(w) => trm_moveit::load_world(w)?,
         None => World::new(),
     };
     let active = e.reaching_set()?;

@@ -48,7 +48,7 @@ pub fn run(args: &Args) -> Result<()> {
     let problem = map
         .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
-    let world = trm_plan::moveit::load_world(&args.world)?;
+    let world = trm_moveit::load_world(&args.world)?;
     let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
     let started = Instant::now();

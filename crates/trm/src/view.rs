@@ -220,7 +220,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let mut s = subject(args, map.as_ref())?;
     if let Some(w) = &args.world {
-        s.world = trm_plan::moveit::load_world(w)?;
+        s.world = trm_moveit::load_world(w)?;
     }
     let collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
     let mut scene = Scene::new(&s.title, &collision);

@@ -237,7 +237,7 @@ pub fn mesh(data: &[u8]) {
 /// MoveIt PlanningScene YAML: a scene that reads is written and read back with the same objects
 /// and allowed collisions; the text is also read as a MotionPlanRequest.
 pub fn moveit(text: &str) {
-    use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+    use trm_moveit::{MotionPlanRequest, PlanningScene};
     if let Ok(scene) = PlanningScene::parse(text, Path::new("fuzz.yaml")) {
         let _ = scene.to_world();
         let written = scene.to_yaml().expect("a scene that reads is written");

@@ -5,9 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use trm_plan::PlanError;
-use trm_plan::mbm::{find_problems, path_is_free, solve};
-use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+use trm_mbm::{find_problems, path_is_free, solve};
+use trm_moveit::MoveItError;
+use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
 fn fixtures() -> PathBuf {
@@ -19,9 +19,9 @@ fn fixtures() -> PathBuf {
 fn solved_and_free(
     robot: &trm_kinematics::RobotModel,
     collision: &trm_collision::CollisionModel,
-    p: &trm_plan::mbm::Problem,
+    p: &trm_mbm::Problem,
     options: &RrtOptions,
-) -> (MotionPlanRequest, trm_plan::mbm::Outcome) {
+) -> (MotionPlanRequest, trm_mbm::Outcome) {
     let scene = PlanningScene::load(&p.scene).unwrap();
     let request = MotionPlanRequest::load(&p.request).unwrap();
     let outcome = solve(robot, collision, &scene, &request, options).unwrap();
@@ -79,7 +79,7 @@ fn every_sample_scene_and_request_reads_and_scenes_round_trip() {
 
 fn scene_error(text: &str) -> String {
     match PlanningScene::parse(text, Path::new("s.yaml")).and_then(|s| s.to_world().map(|_| ())) {
-        Err(e @ PlanError::InvalidMoveIt { .. }) => e.to_string(),
+        Err(e @ MoveItError::Invalid { .. }) => e.to_string(),
         other => panic!("{text:?}: {other:?}"),
     }
 }
@@ -227,7 +227,7 @@ fn the_writer_refuses_what_the_reader_refuses() {
 
 #[test]
 fn problem_sets_open_from_folders_and_archives_and_summarise() {
-    use trm_plan::mbm::{Outcome, ProblemSet, Summary, quantile};
+    use trm_mbm::{Outcome, ProblemSet, Summary, quantile};
     assert_eq!(ProblemSet::open(&fixtures()).unwrap().problems.len(), 14);
     let archive =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/mbm/panda_problems.tar.bz2");
@@ -283,7 +283,7 @@ fn the_fetch_runs_from_its_files_only() {
 #[test]
 fn peer_problems_are_written_and_peer_results_read() {
     let problems = find_problems(&fixtures()).unwrap();
-    let text = trm_plan::mbm::peer_problems("panda", &problems).unwrap();
+    let text = trm_mbm::peer_problems("panda", &problems).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("trm-mbm-problems 1"));
     assert_eq!(lines.next(), Some("robot panda"));
@@ -330,7 +330,7 @@ fn peer_problems_are_written_and_peer_results_read() {
     assert_eq!(lines.next(), None);
 
     let answer = "result box_panda 1 1 1 150000 50000 4.5 4.0 12 2\npath 0 0\npath 1 1\n\nresult box_panda 2 0 0 0 0 0 0 0 0\n";
-    let results = trm_plan::mbm::parse_peer_results(answer).unwrap();
+    let results = trm_mbm::parse_peer_results(answer).unwrap();
     assert_eq!(results.len(), 2);
     let (family, index, first) = &results[0];
     assert_eq!((family.as_str(), *index), ("box_panda", 1));
@@ -358,7 +358,7 @@ fn peer_problems_are_written_and_peer_results_read() {
             "line 2: neither",
         ),
     ] {
-        let e = trm_plan::mbm::parse_peer_results(bad).unwrap_err();
+        let e = trm_mbm::parse_peer_results(bad).unwrap_err();
         assert!(e.contains(says), "{bad}: {e}");
     }
 }
@@ -367,7 +367,7 @@ fn peer_problems_are_written_and_peer_results_read() {
 #[test]
 fn worlds_load_from_moveit_scenes_and_ron() {
     let scene = fixtures().join("box_panda/scene0001.yaml");
-    let world = trm_plan::moveit::load_world(&scene).unwrap();
+    let world = trm_moveit::load_world(&scene).unwrap();
     assert_eq!(
         world.len(),
         PlanningScene::load(&scene)
@@ -377,9 +377,8 @@ fn worlds_load_from_moveit_scenes_and_ron() {
             .len()
     );
     let ron = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/worlds/table.ron");
-    assert!(!trm_plan::moveit::load_world(&ron).unwrap().is_empty());
-    let e =
-        trm_plan::moveit::load_world(fixtures().join("box_panda/request0001.yaml")).unwrap_err();
+    assert!(!trm_moveit::load_world(&ron).unwrap().is_empty());
+    let e = trm_moveit::load_world(fixtures().join("box_panda/request0001.yaml")).unwrap_err();
     assert!(e.to_string().contains("request0001.yaml"), "{e}");
 }
 
@@ -395,7 +394,7 @@ fn experience_answers_the_second_pass() {
     let options = RrtOptions::default();
     let mut calls = 0;
     let passes =
-        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {
+        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {
             calls += 1
         })
         .unwrap();
@@ -444,7 +443,7 @@ fn experience_answers_the_second_pass() {
         problems.len()
     );
     let again =
-        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {})
+        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {})
             .unwrap();
     for (a, b) in passes.iter().flatten().zip(again.iter().flatten()) {
         assert_eq!(a.path, b.path);
@@ -585,7 +584,7 @@ fn task_space_goals_are_read_written_and_solved() {
     let joints = MotionPlanRequest::load(dir.join("request0001.yaml")).unwrap();
     // the hand's pose at the joint goal
     let base: Vec<f64> = robot.neutral_motors();
-    let (start, _) = trm_plan::moveit::motors_from_state(&robot, &joints.start, &base);
+    let (start, _) = trm_moveit::motors_from_state(&robot, &joints.start, &base);
     let mut goal_motors = start.clone();
     for (name, v) in joints.goal.names.iter().zip(&joints.goal.positions) {
         goal_motors[robot.motor_index(name).unwrap()] = *v;
@@ -754,7 +753,7 @@ fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
     let single = solve(&robot, &collision, &scene, &request, &options).unwrap();
     assert!(!single.valid, "{}", single.note);
     let passes =
-        trm_plan::mbm::solve_with_experience(&robot, &collision, &problems, &options, 1, |_, _| {})
+        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 1, |_, _| {})
             .unwrap();
     for (p, o) in problems.iter().zip(&passes[0]) {
         assert_eq!(

@@ -3,7 +3,7 @@
 //! the reaching part at two places of the scene with obstacles between them (one compartment
 //! of the shelf and the other, above the cage and inside it, above a block and beside a can),
 //! both found by NGIK from the spec's start posture in the scene. Written as MoveIt scenes and requests in MotionBenchMaker's
-//! layout, so [`crate::mbm`] and every MotionBenchMaker tool read them.
+//! layout, so [`crate::ProblemSet`] and every MotionBenchMaker tool read them.
 //!
 //! The spec gives the robot, its active motors (the requests' goal joints), the start posture,
 //! the costs a goal minimises besides the target (collision, home posture, …), the task (the
@@ -17,8 +17,8 @@ use trm_collision::Shape;
 use trm_kinematics::nalgebra::{self, Isometry3, Translation3, UnitQuaternion, Vector3};
 use trm_tasks::spec::Problem as TaskProblem;
 
-use crate::PlanError;
-use crate::moveit::{
+use crate::error::MbmError;
+use trm_moveit::{
     CollisionObject, JointGoal, JointState, MotionPlanRequest, PlanningScene, Primitive,
 };
 
@@ -98,8 +98,8 @@ fn padded(shape: &Shape, margin: f64) -> Shape {
     }
 }
 
-fn bad(what: &str, problem: String) -> PlanError {
-    PlanError::Generate {
+fn bad(what: &str, problem: String) -> MbmError {
+    MbmError::Generate {
         what: "a set".into(),
         problem: format!("{what}: {problem}"),
         fix: "give the setting in its range".into(),
@@ -113,7 +113,7 @@ pub fn generate(
     spec: &TaskProblem,
     options: &SetOptions,
     mut progress: impl FnMut(usize, usize),
-) -> Result<Vec<Generated>, PlanError> {
+) -> Result<Vec<Generated>, MbmError> {
     if options.per_family == 0 || options.per_family > 10_000 {
         return Err(bad(
             "per_family",
@@ -237,7 +237,7 @@ pub fn generate(
                 }
                 .to_world()?;
                 // NGIK from the start posture to a point of the scene frame
-                let mut reach = |local: Vector3<f64>| -> Result<Option<Vec<f64>>, PlanError> {
+                let mut reach = |local: Vector3<f64>| -> Result<Option<Vec<f64>>, MbmError> {
                     let t = frame * nalgebra::Point3::from(local);
                     let target = [t.x, t.y, t.z];
                     let objective = objective
@@ -269,7 +269,7 @@ pub fn generate(
                 break;
             }
             let Some((scene, from, goal, target)) = found else {
-                return Err(PlanError::Generate {
+                return Err(MbmError::Generate {
                     what: format!("{family} {index}"),
                     problem: format!(
                         "NGIK found no collision-free start and goal within {} m of their targets in {} scenes ({} without a start, {} with a start but no goal)",
@@ -484,8 +484,8 @@ fn layout(family: &str, rng: &mut ChaCha8Rng) -> Layout {
 
 /// Writes `set` under `dir` in MotionBenchMaker's layout (`<family>/sceneNNNN.yaml`,
 /// `<family>/requestNNNN.yaml`), each file written whole (temporary file, then renamed).
-pub fn write_set(dir: &Path, set: &[Generated]) -> Result<(), PlanError> {
-    let io = |path: &Path, source: std::io::Error| PlanError::Io {
+pub fn write_set(dir: &Path, set: &[Generated]) -> Result<(), MbmError> {
+    let io = |path: &Path, source: std::io::Error| MbmError::Io {
         path: path.to_path_buf(),
         source,
     };

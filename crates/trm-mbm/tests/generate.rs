@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use trm_plan::generate::{SetOptions, generate, write_set};
-use trm_plan::mbm::{ProblemSet, path_is_free, solve};
-use trm_plan::moveit::{MotionPlanRequest, PlanningScene};
+use trm_mbm::generate::{SetOptions, generate, write_set};
+use trm_mbm::{ProblemSet, path_is_free, solve};
+use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
 fn spec() -> trm_tasks::spec::Problem {

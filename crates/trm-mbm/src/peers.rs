@@ -1,0 +1,149 @@
+//! The problems in the plain form peer planners (VAMP, OMPL) read, and their answers read back.
+
+use trm_moveit::{MotionPlanRequest, PlanningScene};
+
+use crate::error::MbmError;
+use crate::problems::Problem;
+use crate::solve::{Outcome, joint_goal_only};
+
+/// Writes `problems` in the plain-text format that peer planners read for trm's side-by-side
+/// benchmark (`benches/peers/vamp/mbm.cc`): a header naming `robot` and the goal's joints,
+/// then per problem its family, number, start and goal (in that joint order) and its world's
+/// primitives (`box x y z qw qx qy qz hx hy hz`, `cylinder x y z qw qx qy qz radius length`,
+/// `sphere x y z radius`), every number in its shortest exact form.
+pub fn peer_problems(robot: &str, problems: &[Problem]) -> Result<String, MbmError> {
+    use std::fmt::Write as _;
+    let mut joints: Option<Vec<String>> = None;
+    let mut body = String::new();
+    for p in problems {
+        let scene = PlanningScene::load(&p.scene)?;
+        let request = MotionPlanRequest::load(&p.request)?;
+        joint_goal_only(&request, "peer planners")?;
+        let order = joints.get_or_insert_with(|| request.goal.names.clone());
+        let mismatch = |what: &str| MbmError::Invalid {
+            path: request.origin.clone(),
+            line: 0,
+            problem: format!("the {what} does not give the joints {}", order.join(", ")),
+            fix: "give one set of problems for one robot and planning group".into(),
+        };
+        let mut sorted = request.goal.names.clone();
+        sorted.sort();
+        let mut expected = order.clone();
+        expected.sort();
+        if sorted != expected {
+            return Err(mismatch("goal"));
+        }
+        let _ = writeln!(body, "problem {} {}", p.family, p.index);
+        for (label, names, values) in [
+            ("start", &request.start.names, &request.start.positions),
+            ("goal", &request.goal.names, &request.goal.positions),
+        ] {
+            let _ = write!(body, "{label}");
+            for joint in order.iter() {
+                let i = names
+                    .iter()
+                    .position(|n| n == joint)
+                    .ok_or_else(|| mismatch(label))?;
+                let _ = write!(body, " {}", values[i]);
+            }
+            body.push('\n');
+        }
+        let primitives: Vec<_> = scene.objects.iter().flat_map(|o| &o.primitives).collect();
+        let _ = writeln!(body, "objects {}", primitives.len());
+        for primitive in primitives {
+            let t = primitive.pose.translation.vector;
+            let q = primitive.pose.rotation;
+            let pose = format!("{} {} {} {} {} {} {}", t.x, t.y, t.z, q.w, q.i, q.j, q.k);
+            let _ = match &primitive.shape {
+                trm_collision::Shape::Sphere { radius } => {
+                    writeln!(body, "sphere {} {} {} {radius}", t.x, t.y, t.z)
+                }
+                trm_collision::Shape::Box { size } => writeln!(
+                    body,
+                    "box {pose} {} {} {}",
+                    size[0] / 2.0,
+                    size[1] / 2.0,
+                    size[2] / 2.0
+                ),
+                trm_collision::Shape::Cylinder { radius, length } => {
+                    writeln!(body, "cylinder {pose} {radius} {length}")
+                }
+                other => {
+                    return Err(MbmError::Invalid {
+                        path: scene.origin.clone(),
+                        line: 0,
+                        problem: format!("a {other:?} has no peer-file form"),
+                        fix: "give boxes, spheres and cylinders (MoveIt's primitives)".into(),
+                    });
+                }
+            };
+        }
+    }
+    let joints = joints.unwrap_or_default();
+    Ok(format!(
+        "trm-mbm-problems 1\nrobot {robot}\njoints {} {}\nproblems {}\n{body}",
+        joints.len(),
+        joints.join(" "),
+        problems.len()
+    ))
+}
+
+/// One problem as a peer planner reported it (`result` lines of `benches/peers/vamp/mbm.cc`):
+/// the family, the number and the outcome (time = planning + simplification; `checks` 0: the
+/// peer does not count them).
+pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, String> {
+    let mut results: Vec<(String, u32, Outcome)> = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let at = |problem: &str| format!("line {}: {problem}: `{line}`", n + 1);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("result") => {
+                let fields: Vec<&str> = words.collect();
+                if fields.len() != 10 {
+                    return Err(at("a result has 10 fields"));
+                }
+                let number = |k: usize| -> Result<f64, String> {
+                    fields[k]
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| at("not a finite number"))
+                };
+                let index = fields[1].parse().map_err(|_| at("not a problem number"))?;
+                let valid = number(2)? != 0.0;
+                let solved = number(3)? != 0.0;
+                let outcome = Outcome {
+                    valid,
+                    solved: valid && solved,
+                    seconds: (number(4)? + number(5)?) * 1e-9,
+                    length: number(7)?,
+                    waypoints: number(9)? as usize,
+                    note: match (valid, solved) {
+                        (false, _) => "start or goal in collision for the peer".into(),
+                        (true, false) => "not solved by the peer".into(),
+                        _ => String::new(),
+                    },
+                    ..Default::default()
+                };
+                results.push((fields[0].to_string(), index, outcome));
+            }
+            Some("path") => {
+                let q: Result<Vec<f64>, String> = words
+                    .map(|w| {
+                        w.parse::<f64>()
+                            .ok()
+                            .filter(|v| v.is_finite())
+                            .ok_or_else(|| at("not a finite number"))
+                    })
+                    .collect();
+                let last = results
+                    .last_mut()
+                    .ok_or_else(|| at("a path line before any result"))?;
+                last.2.path.push(q?);
+            }
+            None => {}
+            Some(_) => return Err(at("neither `result` nor `path`")),
+        }
+    }
+    Ok(results)
+}

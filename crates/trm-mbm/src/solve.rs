@@ -1,0 +1,273 @@
+//! One problem solved by RRT-Connect on any robot model, and a path re-checked one
+//! configuration at a time.
+
+use trm_collision::CollisionModel;
+use trm_kinematics::RobotModel;
+use trm_moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
+use trm_plan::rrt::{RrtOptions, path_length, rrt_connect};
+use trm_tasks::Objective;
+
+use crate::error::MbmError;
+
+/// How far outside its joint limits a start or goal value may lie and still be taken, clamped
+/// onto the limit. URDFs round ±π to ±3.14159, so MotionBenchMaker's Fetch states at ±π lie
+/// 2.7·10⁻⁶ rad outside; MoveIt moves such starts inside (its FixStartStateBounds adapter, up
+/// to 0.05 rad) and samples joint goals within the bounds.
+pub const LIMIT_SLACK: f64 = 1e-4;
+
+/// How one problem went.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Outcome {
+    /// Start and goal are collision-free and within limits (a problem that is not valid is
+    /// left out of the solved rate, as VAMP's and OMPL's reports do).
+    pub valid: bool,
+    /// A path was found.
+    pub solved: bool,
+    /// Planning time (checks, search, shortcutting; not reading the files), s.
+    pub seconds: f64,
+    /// Path length, rad.
+    pub length: f64,
+    /// Waypoints of the path.
+    pub waypoints: usize,
+    /// Configurations checked for collision.
+    pub checks: u64,
+    /// Why it is invalid or unsolved.
+    pub note: String,
+    /// The path (start to goal, active motors).
+    pub path: Vec<Vec<f64>>,
+}
+
+/// Solves one problem for `robot` with `collision` (built once per set), by RRT-Connect;
+/// `options.max_seconds` falls back to the request's `allowed_planning_time` when absent.
+pub fn solve(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    scene: &PlanningScene,
+    request: &MotionPlanRequest,
+    options: &RrtOptions,
+) -> Result<Outcome, MbmError> {
+    options.check()?;
+    let world = scene.to_world()?;
+    let (collision, notes) = scene_collision(collision, scene)?;
+    let (objective, active, mut start) = problem_objective(robot, &collision, &world, request)?;
+    let mut goal = request.goal.positions.clone();
+    let mut checker = objective.world_checker(&world)?;
+    let mut outcome = Outcome {
+        note: notes.join("; "),
+        ..Default::default()
+    };
+    // time spent finding a goal configuration for a task-space goal (part of the answer)
+    let mut goal_seconds = 0.0;
+    if !request.pose_goal.is_empty() {
+        let root = &robot.tree().links[0].name;
+        if let Some(frame) = request.pose_goal.foreign_frame(root) {
+            return Err(MbmError::Invalid {
+                path: request.origin.clone(),
+                line: 0,
+                problem: format!("a goal constraint is given in frame `{frame}`"),
+                fix: format!("give it in the robot's root frame `{root}`"),
+            });
+        }
+        let started = std::time::Instant::now();
+        let found = request.pose_goal.solve(
+            objective.active(),
+            &start,
+            options.seed,
+            GOAL_ATTEMPTS,
+            |q| checker.free(q),
+        )?;
+        goal_seconds = started.elapsed().as_secs_f64();
+        match found {
+            Some(q) => goal = q,
+            None => {
+                outcome.valid = true;
+                outcome.note = format!(
+                    "no collision-free configuration meets the task-space goal ({GOAL_ATTEMPTS} IK starts)"
+                );
+                return Ok(outcome);
+            }
+        }
+    }
+    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| checker.free(q)) {
+        outcome.note = why.into();
+        return Ok(outcome);
+    }
+    outcome.valid = true;
+    let options = RrtOptions {
+        max_seconds: options.max_seconds.or(request.planning_time),
+        ..options.clone()
+    };
+    match rrt_connect(&objective, &world, &start, &goal, &options) {
+        Ok(found) => {
+            outcome.solved = true;
+            outcome.seconds = goal_seconds + found.seconds;
+            outcome.length = path_length(&found.path);
+            outcome.waypoints = found.path.len();
+            outcome.checks = found.checks;
+            outcome.path = found.path;
+        }
+        Err(e) => outcome.note = e.to_string(),
+    }
+    Ok(outcome)
+}
+
+/// `collision` with the scene's allowed-collision matrix applied
+/// ([`trm_moveit::AllowedCollisions::apply`]), and notes on the entries it skipped.
+pub(crate) fn scene_collision<'a>(
+    collision: &'a CollisionModel,
+    scene: &PlanningScene,
+) -> Result<(std::borrow::Cow<'a, CollisionModel>, Vec<String>), MbmError> {
+    let Some(acm) = &scene.allowed_collisions else {
+        return Ok((std::borrow::Cow::Borrowed(collision), Vec::new()));
+    };
+    let (applied, notes) = acm.apply(collision)?;
+    Ok((
+        applied.map_or(
+            std::borrow::Cow::Borrowed(collision),
+            std::borrow::Cow::Owned,
+        ),
+        notes,
+    ))
+}
+
+/// Refuses a task-space goal where only joint goals are handled (`what`).
+pub(crate) fn joint_goal_only(request: &MotionPlanRequest, what: &str) -> Result<(), MbmError> {
+    if request.pose_goal.is_empty() {
+        return Ok(());
+    }
+    Err(MbmError::Invalid {
+        path: request.origin.clone(),
+        line: 0,
+        problem: format!("a task-space goal: {what} take joint goals"),
+        fix: "give joint constraints, or solve task-space goals with mbm::solve (benchmark-mbm without --experience/--vamp)".into(),
+    })
+}
+
+/// IK starts tried for a task-space goal (the start, then seeded random configurations).
+pub const GOAL_ATTEMPTS: usize = 500;
+
+/// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
+/// and `free`). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
+pub(crate) fn invalid(
+    robot: &RobotModel,
+    active: &[usize],
+    start: &mut [f64],
+    goal: &mut [f64],
+    mut free: impl FnMut(&[f64]) -> bool,
+) -> Option<&'static str> {
+    let within = |q: &mut [f64]| {
+        active.iter().zip(q).all(|(&i, v)| {
+            let limits = &robot.motors()[i].limits;
+            let inside = (limits.lower - LIMIT_SLACK..=limits.upper + LIMIT_SLACK).contains(v);
+            *v = v.clamp(limits.lower, limits.upper);
+            inside
+        })
+    };
+    if !within(start) {
+        Some("the start is outside the joint limits")
+    } else if !free(start) {
+        Some("the start collides")
+    } else if !within(goal) {
+        Some("the goal is outside the joint limits")
+    } else if !free(goal) {
+        Some("the goal collides")
+    } else {
+        None
+    }
+}
+
+/// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
+/// configuration at a time in `f64` from one end to the other (an independent check of a
+/// planner's raked, batched, single-precision edge checks): at the points a planner checking
+/// at `2 × resolution` and then at the midpoints visits ([`trm_collision::edge::edge_steps`]), no more
+/// than `resolution` apart.
+pub fn path_is_free(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    scene: &PlanningScene,
+    request: &MotionPlanRequest,
+    path: &[Vec<f64>],
+    resolution: f64,
+) -> Result<bool, MbmError> {
+    let world = scene.to_world()?;
+    let (collision, _) = scene_collision(collision, scene)?;
+    let (objective, _, _) = problem_objective(robot, &collision, &world, request)?;
+    let mut scratch = objective.scratch();
+    for w in path.windows(2) {
+        // the points the planner's half-resolution check visits (`resolution` is that half):
+        // those at the full resolution and the midpoints between them
+        let steps = 2 * trm_collision::edge::edge_steps(&w[0], &w[1], 2.0 * resolution);
+        for s in 0..=steps {
+            let t = s as f64 / steps as f64;
+            let q: Vec<f64> = w[0]
+                .iter()
+                .zip(&w[1])
+                .map(|(a, b)| a + t * (b - a))
+                .collect();
+            if !objective.is_collision_free_in(&q, &world, &mut scratch) {
+                return Ok(false);
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// The objective of a request in `world`: the goal's joints active, every other motor where
+/// the start state puts it (clamped into its limits); with the active motors' indices and the
+/// start's active values.
+pub(crate) fn problem_objective(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    world: &trm_collision::World,
+    request: &MotionPlanRequest,
+) -> Result<(Objective, Vec<usize>, Vec<f64>), MbmError> {
+    let base: Vec<f64> = robot
+        .motors()
+        .iter()
+        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+        .collect();
+    let (start_motors, _) = motors_from_state(robot, &request.start, &base);
+    let locked: Vec<f64> = robot
+        .motors()
+        .iter()
+        .zip(&start_motors)
+        .map(|(m, v)| v.clamp(m.limits.lower, m.limits.upper))
+        .collect();
+    let mut active = Vec::new();
+    if request.goal.names.is_empty() {
+        // a task-space goal moves the request's group
+        if request.group.is_empty() {
+            return Err(MbmError::Invalid {
+                path: request.origin.clone(),
+                line: 0,
+                problem: "a task-space goal without group_name".into(),
+                fix: "give group_name: the group whose joints move".into(),
+            });
+        }
+        active = robot
+            .group(&request.group)
+            .map_err(|e| MbmError::Invalid {
+                path: request.origin.clone(),
+                line: 0,
+                problem: format!("group_name: {e}"),
+                fix: "give a group of this robot model (its description's groups)".into(),
+            })?
+            .to_vec();
+    }
+    for name in &request.goal.names {
+        let i = robot.motor_index(name).map_err(|e| MbmError::Invalid {
+            path: request.origin.clone(),
+            line: 0,
+            problem: format!("the goal constrains `{name}`: {e}"),
+            fix: "give a request for this robot model".into(),
+        })?;
+        active.push(i);
+    }
+    let start: Vec<f64> = active.iter().map(|&i| start_motors[i]).collect();
+    let active_set = trm_kinematics::ActiveSet::new(robot.clone(), active.clone(), &locked)?;
+    Ok((
+        Objective::new(active_set, collision.clone(), world.clone()),
+        active,
+        start,
+    ))
+}

@@ -1,0 +1,562 @@
+//! MoveIt's `PlanningScene`: world collision objects made of primitives, the allowed-collision
+//! matrix and the robot state; read, written and turned into a trm world.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use trm_collision::{Shape, World};
+use trm_kinematics::nalgebra::Isometry3;
+
+use crate::error::MoveItError;
+use crate::reader::{Reader, quote, read};
+use crate::request::JointState;
+use crate::yaml::Node;
+
+/// The top-level fields of a MoveIt PlanningScene message (a document naming none of them is
+/// not a scene).
+const SCENE_FIELDS: [&str; 10] = [
+    "name",
+    "robot_state",
+    "robot_model_name",
+    "fixed_frame_transforms",
+    "allowed_collision_matrix",
+    "link_padding",
+    "link_scale",
+    "object_colors",
+    "world",
+    "is_diff",
+];
+
+/// One primitive of a collision object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Primitive {
+    /// The shape (MoveIt's cylinders run along z, as trm's).
+    pub shape: Shape,
+    /// Its pose in the world frame (object pose × primitive pose).
+    pub pose: Isometry3<f64>,
+}
+
+/// A collision object of the scene's world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionObject {
+    /// Its id.
+    pub id: String,
+    /// Its primitives.
+    pub primitives: Vec<Primitive>,
+    /// Line of the object in the file.
+    pub line: usize,
+}
+
+/// The allowed-collision matrix of a scene: `entry_names` and, for each pair, whether it is
+/// allowed (not checked).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct AllowedCollisions {
+    /// Entry names (links or objects).
+    pub names: Vec<String>,
+    /// `allowed[i][j]`: the pair (names[i], names[j]) is not checked.
+    pub allowed: Vec<Vec<bool>>,
+}
+
+impl AllowedCollisions {
+    /// The allowed pairs, each once (i < j).
+    pub fn allowed_pairs(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.allowed.iter().enumerate().flat_map(move |(i, row)| {
+            row.iter()
+                .enumerate()
+                .skip(i + 1)
+                .filter(|(_, a)| **a)
+                .map(move |(j, _)| (self.names[i].as_str(), self.names[j].as_str()))
+        })
+    }
+}
+
+impl AllowedCollisions {
+    /// `collision` with this matrix applied to the robot's link pairs, as MoveIt applies a
+    /// planning scene's matrix over the SRDF's: a pair it allows is not checked, a pair it
+    /// does not allow is checked. Entries that are not links of the robot (world objects: trm
+    /// checks every body against every object) are skipped and named in the returned notes.
+    /// `None` when nothing changes.
+    pub fn apply(
+        &self,
+        collision: &trm_collision::CollisionModel,
+    ) -> Result<(Option<trm_collision::CollisionModel>, Vec<String>), MoveItError> {
+        let tree = collision.robot().tree();
+        let ids: Vec<Option<usize>> = self.names.iter().map(|n| tree.link_index(n)).collect();
+        let notes: Vec<String> = self
+            .names
+            .iter()
+            .zip(&ids)
+            .filter(|(_, id)| id.is_none())
+            .map(|(n, _)| {
+                format!("allowed_collision_matrix: `{n}` is not a link of the robot (skipped)")
+            })
+            .collect();
+        let mut acm = collision.acm().clone();
+        let mut changed = false;
+        for (i, row) in self.allowed.iter().enumerate() {
+            for (j, &allowed) in row.iter().enumerate().skip(i + 1) {
+                let (Some(a), Some(b)) = (ids[i], ids[j]) else {
+                    continue;
+                };
+                if a == b || allowed != acm.is_checked(a, b) {
+                    continue;
+                }
+                changed = true;
+                if allowed {
+                    acm.disable(a, b, trm_kinematics::DisableReason::User);
+                } else {
+                    acm.enable(a, b);
+                }
+            }
+        }
+        let applied = changed.then(|| collision.with_acm(acm)).transpose()?;
+        Ok((applied, notes))
+    }
+}
+
+/// A MoveIt `PlanningScene`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PlanningScene {
+    /// Where it came from.
+    pub origin: PathBuf,
+    /// `name`.
+    pub name: String,
+    /// `robot_model_name`.
+    pub robot_model_name: String,
+    /// `world.collision_objects`.
+    pub objects: Vec<CollisionObject>,
+    /// `allowed_collision_matrix`, when given.
+    pub allowed_collisions: Option<AllowedCollisions>,
+    /// `robot_state.joint_state`, when given.
+    pub robot_state: Option<JointState>,
+}
+
+impl Reader<'_> {
+    /// A `shape_msgs/SolidPrimitive` (box, sphere, cylinder; by name or number).
+    pub(crate) fn primitive(&self, s: &Node, here: &str) -> Result<Shape, MoveItError> {
+        let kind = self.text(self.field(s, "type", here)?, &format!("{here}.type"))?;
+        let d = self.numbers(
+            self.field(s, "dimensions", here)?,
+            &format!("{here}.dimensions"),
+        )?;
+        let need = |n: usize, names: &str| -> Result<(), MoveItError> {
+            if d.len() == n && d.iter().all(|v| *v > 0.0) {
+                Ok(())
+            } else {
+                Err(self.err(
+                    s.line,
+                    format!("{here}: a {kind} with dimensions {d:?}"),
+                    format!("give {n} positive dimensions ({names})"),
+                ))
+            }
+        };
+        // shape_msgs/SolidPrimitive: BOX = 1, SPHERE = 2, CYLINDER = 3, CONE = 4
+        let shape = match kind.to_ascii_lowercase().as_str() {
+            "box" | "1" => {
+                need(3, "x, y, z")?;
+                Shape::Box {
+                    size: [d[0], d[1], d[2]],
+                }
+            }
+            "sphere" | "2" => {
+                need(1, "radius")?;
+                Shape::Sphere { radius: d[0] }
+            }
+            "cylinder" | "3" => {
+                need(2, "height, radius")?;
+                Shape::Cylinder {
+                    radius: d[1],
+                    length: d[0],
+                }
+            }
+            _ => {
+                return Err(self.err(
+                    s.line,
+                    format!("{here} is a `{kind}`"),
+                    "use box, sphere or cylinder (cones and other primitives are not supported)",
+                ));
+            }
+        };
+        Ok(shape)
+    }
+
+    fn object(&self, node: &Node, k: usize) -> Result<CollisionObject, MoveItError> {
+        let what = format!("world.collision_objects[{k}]");
+        let id = self.text(self.field(node, "id", &what)?, &format!("{what}.id"))?;
+        if id.trim().is_empty() {
+            return Err(self.err(
+                node.line,
+                format!("{what} has an empty id"),
+                "give every object an id",
+            ));
+        }
+        let what = format!("object `{id}`");
+        if let Some(op) = node.get("operation").and_then(Node::scalar) {
+            if !matches!(op, "0" | "ADD" | "add" | "\x00") {
+                return Err(self.err(
+                    node.line,
+                    format!("{what} has operation `{op}`"),
+                    "a scene file adds objects (operation 0, ADD)",
+                ));
+            }
+        }
+        for unsupported in ["meshes", "planes", "subframe_names"] {
+            if node
+                .get(unsupported)
+                .and_then(Node::items)
+                .is_some_and(|l| !l.is_empty())
+            {
+                return Err(self.err(
+                    node.line,
+                    format!("{what} has {unsupported}"),
+                    "trm's worlds hold boxes, spheres and cylinders: replace meshes and planes by primitives",
+                ));
+            }
+        }
+        let object_pose = match node.get("pose") {
+            Some(p) => self.pose(p, &format!("{what}.pose"))?,
+            None => Isometry3::identity(),
+        };
+        let shapes = match node.get("primitives") {
+            Some(p) => self.seq(p, &format!("{what}.primitives"))?,
+            None => &[],
+        };
+        let poses = match node.get("primitive_poses") {
+            Some(p) => self.seq(p, &format!("{what}.primitive_poses"))?,
+            None => &[],
+        };
+        if shapes.is_empty() || shapes.len() != poses.len() {
+            return Err(self.err(
+                node.line,
+                format!(
+                    "{what} has {} primitives and {} primitive poses",
+                    shapes.len(),
+                    poses.len()
+                ),
+                "give at least one primitive and one pose per primitive",
+            ));
+        }
+        let mut primitives = Vec::new();
+        for (i, (s, p)) in shapes.iter().zip(poses).enumerate() {
+            let here = format!("{what}.primitives[{i}]");
+            let shape = self.primitive(s, &here)?;
+            let pose = object_pose * self.pose(p, &format!("{what}.primitive_poses[{i}]"))?;
+            primitives.push(Primitive { shape, pose });
+        }
+        Ok(CollisionObject {
+            id,
+            primitives,
+            line: node.line,
+        })
+    }
+
+    fn allowed(&self, node: &Node) -> Result<AllowedCollisions, MoveItError> {
+        let what = "allowed_collision_matrix";
+        let names: Vec<String> = match node.get("entry_names") {
+            Some(n) => self
+                .seq(n, "allowed_collision_matrix.entry_names")?
+                .iter()
+                .map(|s| self.text(s, "an entry name"))
+                .collect::<Result<_, _>>()?,
+            None => Vec::new(),
+        };
+        let rows = match node.get("entry_values") {
+            Some(v) => self.seq(v, "allowed_collision_matrix.entry_values")?,
+            None => &[],
+        };
+        if rows.len() != names.len() {
+            return Err(self.err(
+                node.line,
+                format!(
+                    "{what}: {} rows for {} entry names",
+                    rows.len(),
+                    names.len()
+                ),
+                "give one row per entry name",
+            ));
+        }
+        let mut allowed = Vec::new();
+        for (i, row) in rows.iter().enumerate() {
+            let here = format!("{what}.entry_values[{i}]");
+            let values = match row.get("enabled") {
+                Some(e) => self.seq(e, &here)?,
+                None => self.seq(row, &here)?,
+            };
+            if values.len() != names.len() {
+                return Err(self.err(
+                    row.line,
+                    format!(
+                        "{here} has {} values for {} names",
+                        values.len(),
+                        names.len()
+                    ),
+                    "give one value per entry name",
+                ));
+            }
+            let parsed: Vec<bool> = values
+                .iter()
+                .map(|v| match v.scalar() {
+                    Some("true" | "True" | "1") => Ok(true),
+                    Some("false" | "False" | "0") => Ok(false),
+                    _ => Err(self.err(
+                        v.line,
+                        format!(
+                            "{here}: `{}` is not true or false",
+                            v.scalar().unwrap_or(v.kind())
+                        ),
+                        "give true or false",
+                    )),
+                })
+                .collect::<Result<_, _>>()?;
+            allowed.push(parsed);
+        }
+        for i in 0..names.len() {
+            for j in 0..i {
+                if allowed[i][j] != allowed[j][i] {
+                    return Err(self.err(
+                        rows[i].line,
+                        format!(
+                            "{what}: ({}, {}) is {} one way and {} the other",
+                            names[i], names[j], allowed[i][j], allowed[j][i]
+                        ),
+                        "give a symmetric matrix",
+                    ));
+                }
+            }
+        }
+        Ok(AllowedCollisions { names, allowed })
+    }
+}
+
+impl PlanningScene {
+    /// Parses a scene's YAML; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, MoveItError> {
+        let r = Reader { origin };
+        let doc = r.parse(text)?;
+        if let crate::yaml::Value::Map(entries) = &doc.value {
+            if !entries.is_empty()
+                && !entries
+                    .iter()
+                    .any(|(k, _)| SCENE_FIELDS.contains(&k.as_str()))
+            {
+                let request =
+                    doc.get("goal_constraints").is_some() || doc.get("start_state").is_some();
+                return Err(r.err(
+                    doc.line,
+                    if request {
+                        "this is a motion plan request, not a planning scene".to_string()
+                    } else {
+                        format!("no planning-scene field ({})", SCENE_FIELDS.join(", "))
+                    },
+                    "give a MoveIt PlanningScene (MotionBenchMaker's sceneNNNN.yaml)",
+                ));
+            }
+        }
+        let mut scene = PlanningScene {
+            origin: origin.to_path_buf(),
+            ..Default::default()
+        };
+        if let Some(n) = doc.get("name") {
+            scene.name = r.text(n, "name")?;
+        }
+        if let Some(n) = doc.get("robot_model_name") {
+            scene.robot_model_name = r.text(n, "robot_model_name")?;
+        }
+        if let Some(world) = doc.get("world") {
+            if let Some(objects) = world.get("collision_objects") {
+                for (k, o) in r
+                    .seq(objects, "world.collision_objects")?
+                    .iter()
+                    .enumerate()
+                {
+                    let object = r.object(o, k)?;
+                    if let Some(first) = scene.objects.iter().find(|f| f.id == object.id) {
+                        return Err(r.err(
+                            o.line,
+                            format!(
+                                "object `{}` is given twice (first at line {})",
+                                object.id, first.line
+                            ),
+                            "give every object its own id",
+                        ));
+                    }
+                    scene.objects.push(object);
+                }
+            }
+        }
+        if let Some(acm) = doc.get("allowed_collision_matrix") {
+            scene.allowed_collisions = Some(r.allowed(acm)?);
+        }
+        if let Some(state) = doc.get("robot_state") {
+            if let Some(js) = state.get("joint_state") {
+                scene.robot_state = Some(r.joint_state(js, "robot_state.joint_state")?);
+            }
+            if state
+                .get("attached_collision_objects")
+                .and_then(Node::items)
+                .is_some_and(|l| !l.is_empty())
+            {
+                return Err(r.err(
+                    state.line,
+                    "the robot state has attached collision objects",
+                    "detach them into the world (trm does not carry objects with the robot yet)",
+                ));
+            }
+        }
+        Ok(scene)
+    }
+
+    /// Reads a scene file (at most [`trm_io::MAX_INPUT_BYTES`]).
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, MoveItError> {
+        let path = path.as_ref();
+        Self::parse(&read(path)?, path)
+    }
+
+    /// The world of the scene: one object per primitive (`id`, or `id/k` for an object of
+    /// several).
+    pub fn to_world(&self) -> Result<World, MoveItError> {
+        let mut world = World::new();
+        for o in &self.objects {
+            for (k, p) in o.primitives.iter().enumerate() {
+                let name = if o.primitives.len() == 1 {
+                    o.id.clone()
+                } else {
+                    format!("{}/{k}", o.id)
+                };
+                world
+                    .add(&name, p.shape.clone(), p.pose)
+                    .map_err(|e| MoveItError::Invalid {
+                        path: self.origin.clone(),
+                        line: o.line,
+                        problem: format!("object `{}`: {e}", o.id),
+                        fix: "give positive finite dimensions and finite poses, and unique ids"
+                            .into(),
+                    })?;
+            }
+        }
+        Ok(world)
+    }
+
+    /// The scene as YAML in the layout [`PlanningScene::parse`] reads (a round trip keeps every
+    /// field it reads; numbers are written in their shortest exact form). Refuses what the
+    /// reader refuses: shapes other than boxes, spheres and cylinders, invalid dimensions or
+    /// poses, repeated ids, a robot state with non-finite values or one value short, a
+    /// non-square allowed-collision matrix.
+    pub fn to_yaml(&self) -> Result<String, MoveItError> {
+        let refuse = |problem: String, fix: &str| MoveItError::Invalid {
+            path: self.origin.clone(),
+            line: 0,
+            problem: format!("not written: {problem}"),
+            fix: fix.into(),
+        };
+        self.to_world()?;
+        for o in &self.objects {
+            if o.primitives.is_empty() {
+                return Err(refuse(
+                    format!("object `{}` has no primitive", o.id),
+                    "give it one",
+                ));
+            }
+            if let Some(p) = o.primitives.iter().find(|p| {
+                !matches!(
+                    p.shape,
+                    Shape::Box { .. } | Shape::Sphere { .. } | Shape::Cylinder { .. }
+                )
+            }) {
+                return Err(refuse(
+                    format!("object `{}` holds a {:?}", o.id, p.shape),
+                    "MoveIt scenes hold boxes, spheres and cylinders",
+                ));
+            }
+        }
+        if let Some(state) = &self.robot_state {
+            if state.names.len() != state.positions.len()
+                || state.positions.iter().any(|v| !v.is_finite())
+            {
+                return Err(refuse(
+                    "the robot state's positions are not one finite value per name".into(),
+                    "give one finite position per joint name",
+                ));
+            }
+        }
+        if let Some(acm) = &self.allowed_collisions {
+            let n = acm.names.len();
+            if acm.allowed.len() != n || acm.allowed.iter().any(|r| r.len() != n) {
+                return Err(refuse(
+                    "the allowed-collision matrix is not square over its names".into(),
+                    "give one row of one value per name for every name",
+                ));
+            }
+        }
+        let mut out = String::new();
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let _ = writeln!(out, "name: {}", quote(&self.name));
+        let _ = writeln!(out, "robot_model_name: {}", quote(&self.robot_model_name));
+        if let Some(state) = &self.robot_state {
+            let names: Vec<String> = state.names.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(
+                out,
+                "robot_state:\n  joint_state:\n    name: [{}]\n    position: [{}]",
+                names.join(", "),
+                list(&state.positions)
+            );
+        }
+        if let Some(acm) = &self.allowed_collisions {
+            let names: Vec<String> = acm.names.iter().map(|n| quote(n)).collect();
+            let _ = writeln!(
+                out,
+                "allowed_collision_matrix:\n  entry_names: [{}]\n  entry_values:{}",
+                names.join(", "),
+                if acm.allowed.is_empty() { " []" } else { "" }
+            );
+            for row in &acm.allowed {
+                let _ = writeln!(
+                    out,
+                    "    - [{}]",
+                    row.iter()
+                        .map(|b| b.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+        }
+        let _ = writeln!(
+            out,
+            "world:\n  collision_objects:{}",
+            if self.objects.is_empty() { " []" } else { "" }
+        );
+        for o in &self.objects {
+            let _ = writeln!(out, "    - id: {}\n      primitives:", quote(&o.id));
+            for p in &o.primitives {
+                let (kind, d) = match &p.shape {
+                    Shape::Box { size } => ("box", size.to_vec()),
+                    Shape::Sphere { radius } => ("sphere", vec![*radius]),
+                    Shape::Cylinder { radius, length } => ("cylinder", vec![*length, *radius]),
+                    _ => unreachable!("checked above"),
+                };
+                let _ = writeln!(
+                    out,
+                    "        - type: {kind}\n          dimensions: [{}]",
+                    list(&d)
+                );
+            }
+            let _ = writeln!(out, "      primitive_poses:");
+            for p in &o.primitives {
+                let t = p.pose.translation.vector;
+                let q = p.pose.rotation.coords; // x, y, z, w
+                let _ = writeln!(
+                    out,
+                    "        - position: [{}]\n          orientation: [{}]",
+                    list(&[t.x, t.y, t.z]),
+                    list(&[q.x, q.y, q.z, q.w])
+                );
+            }
+        }
+        Ok(out)
+    }
+}
