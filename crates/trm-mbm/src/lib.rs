@@ -4,15 +4,16 @@
 //! model: the active motors are the joints the goal constrains, every other motor stays where
 //! the start state puts it (clamped into its limits).
 //!
-//! [`ProblemSet::open`] reads a set (a folder or a `.tar.bz2`), [`run_set`] solves it
-//! (plain, with a task-space form of each goal, or with experience kept:
-//! [`solve_with_experience`]), [`markdown_table`] and [`side_by_side`] report it the way the
+//! [`ProblemSet::open`] reads a set (a folder or a `.tar.bz2`), [`benchmark`] solves it
+//! (plain, with a task-space form of each goal, with experience kept:
+//! [`solve_with_experience`]; every problem read and prepared once: [`LoadedProblem`]), [`markdown_table`] and [`side_by_side`] report it the way the
 //! field does, [`peer_problems`] and [`parse_peer_results`] exchange it with VAMP and OMPL, and
 //! [`generate`](generate::generate) writes new sets for any robot from a task spec.
 
 mod error;
 mod experience;
 pub mod generate;
+mod loaded;
 mod peers;
 mod problems;
 mod report;
@@ -21,8 +22,11 @@ mod solve;
 
 pub use error::{MbmError, Result};
 pub use experience::solve_with_experience;
+pub use loaded::LoadedProblem;
 pub use peers::{parse_peer_results, peer_problems};
 pub use problems::{Problem, ProblemSet, find_problems};
 pub use report::{Summary, markdown_table, quantile, runs_csv, side_by_side};
-pub use run::{Run, TaskSpaceGoals, run_set};
-pub use solve::{GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, path_is_free, solve};
+pub use run::{Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set};
+pub use solve::{
+    GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, path_is_free, path_is_free_loaded, solve, solve_loaded,
+};

@@ -1,13 +1,18 @@
-//! A set run problem by problem, in parallel, with an optional task-space form of each goal.
+//! A set run problem by problem: plain, with a task-space form of each goal, with experience
+//! kept, every path re-checked when asked; and its report.
+
+use std::fmt::Write as _;
 
 use trm_collision::CollisionModel;
 use trm_kinematics::RobotModel;
-use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
 use crate::error::MbmError;
+use crate::experience::solve_with_experience;
+use crate::loaded::LoadedProblem;
 use crate::problems::Problem;
-use crate::solve::{Outcome, path_is_free, solve};
+use crate::report::markdown_table;
+use crate::solve::{Outcome, path_is_free_loaded, solve_loaded};
 
 /// One problem of a benchmark run and how it went.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -19,11 +24,12 @@ pub struct Run {
     /// The planner's outcome.
     pub outcome: Outcome,
     /// With verification: whether the path is free when re-checked one configuration at a time
-    /// at half the resolution ([`path_is_free`]).
+    /// at half the resolution ([`crate::path_is_free`]).
     pub verified: Option<bool>,
 }
 
-/// A set's joint goals posed as task-space goals ([`MotionPlanRequest::to_task_space`]).
+/// A set's joint goals posed as task-space goals
+/// ([`trm_moveit::MotionPlanRequest::to_task_space`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TaskSpaceGoals {
     /// The link whose pose is the goal (e.g. the hand).
@@ -34,50 +40,186 @@ pub struct TaskSpaceGoals {
     pub orientation_tolerance: f64,
 }
 
-/// Solves each problem by RRT-Connect + shortcutting ([`solve`]), re-checking solved paths
-/// when `verify`; with `task_space`, each joint goal is first turned into the task-space goal
-/// it implies. `progress(done, problem)` after each.
-pub fn run_set(
+/// How a set is run.
+#[derive(Debug, Clone, Default)]
+pub struct BenchmarkOptions {
+    /// RRT-Connect's settings (a request's `allowed_planning_time` is its time limit unless
+    /// `max_seconds` is given).
+    pub rrt: RrtOptions,
+    /// Re-check every returned path one configuration at a time at half the resolution.
+    pub verify: bool,
+    /// Pose each joint goal as the task-space goal it implies (the plain run only).
+    pub task_space: Option<TaskSpaceGoals>,
+    /// Runs of the set with experience kept after the plain one
+    /// ([`solve_with_experience`]; 0: none).
+    pub experience_passes: usize,
+}
+
+/// What a set run came to: the plain run, and each pass with experience kept.
+#[derive(Debug, Clone)]
+pub struct Benchmark {
+    /// The problems as read and prepared (for checking other planners' paths in them:
+    /// [`crate::path_is_free_loaded`]).
+    pub problems: Vec<LoadedProblem>,
+    /// The plain run, one per problem.
+    pub runs: Vec<Run>,
+    /// Each pass with experience, one run per problem.
+    pub experience: Vec<Vec<Run>>,
+    /// Whether solved paths were re-checked ([`BenchmarkOptions::verify`]).
+    pub verified: bool,
+}
+
+/// Runs `problems` as `options` say, each problem read and prepared once for every run and
+/// check; `progress(stage, done, total, problem)` after each problem (stage: `problems`, then
+/// `problems with experience`).
+pub fn benchmark(
     robot: &RobotModel,
     collision: &CollisionModel,
     problems: &[Problem],
+    options: &BenchmarkOptions,
+    mut progress: impl FnMut(&str, usize, usize, &Problem),
+) -> Result<Benchmark, MbmError> {
+    let loaded = LoadedProblem::load_all(collision, problems)?;
+    let runs = run_set(
+        robot,
+        &loaded,
+        &options.rrt,
+        options.verify,
+        options.task_space.as_ref(),
+        |k, p| progress("problems", k, problems.len(), p),
+    )?;
+    let mut experience = Vec::new();
+    if options.experience_passes > 0 {
+        let total = options.experience_passes * problems.len();
+        let mut count = 0;
+        let passes = solve_with_experience(
+            robot,
+            &loaded,
+            &options.rrt,
+            options.experience_passes,
+            |_, k| {
+                count += 1;
+                progress("problems with experience", count, total, &problems[k]);
+            },
+        )?;
+        for outcomes in passes {
+            let runs = outcomes
+                .into_iter()
+                .zip(&loaded)
+                .map(|(outcome, p)| {
+                    let verified = verify_outcome(robot, p, &outcome, options)?;
+                    Ok(Run {
+                        family: p.problem.family.clone(),
+                        index: p.problem.index,
+                        outcome,
+                        verified,
+                    })
+                })
+                .collect::<Result<_, MbmError>>()?;
+            experience.push(runs);
+        }
+    }
+    Ok(Benchmark {
+        problems: loaded,
+        runs,
+        experience,
+        verified: options.verify,
+    })
+}
+
+/// Solves each problem by RRT-Connect + shortcutting ([`crate::solve`]), re-checking solved
+/// paths when `verify`; with `task_space`, each joint goal is first turned into the task-space
+/// goal it implies. `progress(done, problem)` after each.
+pub fn run_set(
+    robot: &RobotModel,
+    problems: &[LoadedProblem],
     options: &RrtOptions,
     verify: bool,
     task_space: Option<&TaskSpaceGoals>,
     mut progress: impl FnMut(usize, &Problem),
 ) -> Result<Vec<Run>, MbmError> {
+    let checks = BenchmarkOptions {
+        rrt: options.clone(),
+        verify,
+        ..Default::default()
+    };
     let mut runs = Vec::with_capacity(problems.len());
     for (k, p) in problems.iter().enumerate() {
-        let scene = PlanningScene::load(&p.scene)?;
-        let mut request = MotionPlanRequest::load(&p.request)?;
-        if let Some(t) = task_space {
-            request = request.to_task_space(
-                robot,
-                &t.link,
-                t.position_tolerance,
-                t.orientation_tolerance,
-            )?;
-        }
-        let outcome = solve(robot, collision, &scene, &request, options)?;
-        let verified = (verify && outcome.solved)
-            .then(|| {
-                path_is_free(
-                    robot,
-                    collision,
-                    &scene,
-                    &request,
-                    &outcome.path,
-                    options.resolution / 2.0,
-                )
-            })
-            .transpose()?;
+        let posed;
+        let p = match task_space {
+            Some(t) => {
+                posed = p.with_task_space(robot, t)?;
+                &posed
+            }
+            None => p,
+        };
+        let outcome = solve_loaded(robot, p, options)?;
+        let verified = verify_outcome(robot, p, &outcome, &checks)?;
         runs.push(Run {
-            family: p.family.clone(),
-            index: p.index,
+            family: p.problem.family.clone(),
+            index: p.problem.index,
             outcome,
             verified,
         });
-        progress(k + 1, p);
+        progress(k + 1, &p.problem);
     }
     Ok(runs)
+}
+
+/// With `options.verify`, whether a solved problem's path is free at half the resolution.
+fn verify_outcome(
+    robot: &RobotModel,
+    problem: &LoadedProblem,
+    outcome: &Outcome,
+    options: &BenchmarkOptions,
+) -> Result<Option<bool>, MbmError> {
+    (options.verify && outcome.solved)
+        .then(|| path_is_free_loaded(robot, problem, &outcome.path, options.rrt.resolution / 2.0))
+        .transpose()
+}
+
+impl Benchmark {
+    /// The report in markdown: the plain run's per-family table and, for each pass with
+    /// experience, how many problems the experience answered and its table; with verification,
+    /// how many paths collide when re-checked.
+    pub fn markdown(&self) -> String {
+        let mut md = markdown_table(self.runs.iter().map(|r| (r.family.as_str(), &r.outcome)));
+        if self.verified {
+            md.push_str(&verified_line(&self.runs, "Every returned path"));
+        }
+        for (pass, runs) in self.experience.iter().enumerate() {
+            let solved = |note: Option<&str>| {
+                runs.iter()
+                    .filter(|r| r.outcome.solved && note.is_none_or(|n| r.outcome.note == n))
+                    .count()
+            };
+            let retrieved = solved(Some("retrieved"));
+            let _ = write!(
+                md,
+                "\nWith experience kept, pass {} ({}; {} of {} solved problems answered by the experience alone, {retrieved} of them by retrieving the kept path whose ends they repeat):\n\n{}",
+                pass + 1,
+                if pass == 0 {
+                    "one planner per family: each problem planned through the paths of the family's earlier problems, checked lazily in its scene, RRT-Connect where they do not reach"
+                } else {
+                    "the set again, every path of pass 1 kept, the problem's own included"
+                },
+                solved(Some("experience")) + retrieved,
+                solved(None),
+                markdown_table(runs.iter().map(|r| (r.family.as_str(), &r.outcome)))
+            );
+            if self.verified {
+                md.push_str(&verified_line(runs, "Every path"));
+            }
+        }
+        md
+    }
+}
+
+/// "`what` re-checked …: F of N collide." of verified runs.
+fn verified_line(runs: &[Run], what: &str) -> String {
+    let checked = runs.iter().filter(|r| r.verified.is_some()).count();
+    let failed = runs.iter().filter(|r| r.verified == Some(false)).count();
+    format!(
+        "\n{what} re-checked one configuration at a time at half the resolution: {failed} of {checked} collide.\n"
+    )
 }

@@ -8,6 +8,7 @@ use trm_plan::rrt::{RrtOptions, path_length, rrt_connect};
 use trm_tasks::Objective;
 
 use crate::error::MbmError;
+use crate::loaded::LoadedProblem;
 
 /// How far outside its joint limits a start or goal value may lie and still be taken, clamped
 /// onto the limit. URDFs round ±π to ±3.14159, so MotionBenchMaker's Fetch states at ±π lie
@@ -39,6 +40,8 @@ pub struct Outcome {
 
 /// Solves one problem for `robot` with `collision` (built once per set), by RRT-Connect;
 /// `options.max_seconds` falls back to the request's `allowed_planning_time` when absent.
+/// For a problem solved or checked more than once, prepare it once ([`LoadedProblem`]) and
+/// call [`solve_loaded`].
 pub fn solve(
     robot: &RobotModel,
     collision: &CollisionModel,
@@ -46,14 +49,24 @@ pub fn solve(
     request: &MotionPlanRequest,
     options: &RrtOptions,
 ) -> Result<Outcome, MbmError> {
+    let problem = LoadedProblem::new(collision, scene.clone(), request.clone())?;
+    solve_loaded(robot, &problem, options)
+}
+
+/// [`solve`] of a prepared problem.
+pub fn solve_loaded(
+    robot: &RobotModel,
+    problem: &LoadedProblem,
+    options: &RrtOptions,
+) -> Result<Outcome, MbmError> {
     options.check()?;
-    let world = scene.to_world()?;
-    let (collision, notes) = scene_collision(collision, scene)?;
-    let (objective, active, mut start) = problem_objective(robot, &collision, &world, request)?;
+    let (request, world) = (&problem.request, &problem.world);
+    let (objective, active, mut start) =
+        problem_objective(robot, &problem.collision, world, request)?;
     let mut goal = request.goal.positions.clone();
-    let mut checker = objective.world_checker(&world)?;
+    let mut checker = objective.world_checker(world)?;
     let mut outcome = Outcome {
-        note: notes.join("; "),
+        note: problem.notes.join("; "),
         ..Default::default()
     };
     // time spent finding a goal configuration for a task-space goal (part of the answer)
@@ -97,7 +110,7 @@ pub fn solve(
         max_seconds: options.max_seconds.or(request.planning_time),
         ..options.clone()
     };
-    match rrt_connect(&objective, &world, &start, &goal, &options) {
+    match rrt_connect(&objective, world, &start, &goal, &options) {
         Ok(found) => {
             outcome.solved = true;
             outcome.seconds = goal_seconds + found.seconds;
@@ -109,25 +122,6 @@ pub fn solve(
         Err(e) => outcome.note = e.to_string(),
     }
     Ok(outcome)
-}
-
-/// `collision` with the scene's allowed-collision matrix applied
-/// ([`trm_moveit::AllowedCollisions::apply`]), and notes on the entries it skipped.
-pub(crate) fn scene_collision<'a>(
-    collision: &'a CollisionModel,
-    scene: &PlanningScene,
-) -> Result<(std::borrow::Cow<'a, CollisionModel>, Vec<String>), MbmError> {
-    let Some(acm) = &scene.allowed_collisions else {
-        return Ok((std::borrow::Cow::Borrowed(collision), Vec::new()));
-    };
-    let (applied, notes) = acm.apply(collision)?;
-    Ok((
-        applied.map_or(
-            std::borrow::Cow::Borrowed(collision),
-            std::borrow::Cow::Owned,
-        ),
-        notes,
-    ))
 }
 
 /// Refuses a task-space goal where only joint goals are handled (`what`).
@@ -179,8 +173,8 @@ pub(crate) fn invalid(
 /// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
 /// configuration at a time in `f64` from one end to the other (an independent check of a
 /// planner's raked, batched, single-precision edge checks): at the points a planner checking
-/// at `2 × resolution` and then at the midpoints visits ([`trm_collision::edge::edge_steps`]), no more
-/// than `resolution` apart.
+/// at `2 × resolution` and then at the midpoints visits
+/// ([`trm_collision::edge::edge_steps`]), no more than `resolution` apart.
 pub fn path_is_free(
     robot: &RobotModel,
     collision: &CollisionModel,
@@ -189,9 +183,19 @@ pub fn path_is_free(
     path: &[Vec<f64>],
     resolution: f64,
 ) -> Result<bool, MbmError> {
-    let world = scene.to_world()?;
-    let (collision, _) = scene_collision(collision, scene)?;
-    let (objective, _, _) = problem_objective(robot, &collision, &world, request)?;
+    let problem = LoadedProblem::new(collision, scene.clone(), request.clone())?;
+    path_is_free_loaded(robot, &problem, path, resolution)
+}
+
+/// [`path_is_free`] in a prepared problem.
+pub fn path_is_free_loaded(
+    robot: &RobotModel,
+    problem: &LoadedProblem,
+    path: &[Vec<f64>],
+    resolution: f64,
+) -> Result<bool, MbmError> {
+    let world = &problem.world;
+    let (objective, _, _) = problem_objective(robot, &problem.collision, world, &problem.request)?;
     let mut scratch = objective.scratch();
     for w in path.windows(2) {
         // the points the planner's half-resolution check visits (`resolution` is that half):
@@ -204,7 +208,7 @@ pub fn path_is_free(
                 .zip(&w[1])
                 .map(|(a, b)| a + t * (b - a))
                 .collect();
-            if !objective.is_collision_free_in(&q, &world, &mut scratch) {
+            if !objective.is_collision_free_in(&q, world, &mut scratch) {
                 return Ok(false);
             }
         }

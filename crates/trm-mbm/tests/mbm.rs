@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use trm_mbm::{find_problems, path_is_free, solve};
+use trm_mbm::{LoadedProblem, find_problems, path_is_free, solve};
 use trm_moveit::MoveItError;
 use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
@@ -392,12 +392,10 @@ fn experience_answers_the_second_pass() {
     let collision = trm_collision::CollisionModel::new(&robot).unwrap();
     let problems = find_problems(&fixtures()).unwrap();
     let options = RrtOptions::default();
+    let loaded = LoadedProblem::load_all(&collision, &problems).unwrap();
     let mut calls = 0;
     let passes =
-        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {
-            calls += 1
-        })
-        .unwrap();
+        trm_mbm::solve_with_experience(&robot, &loaded, &options, 2, |_, _| calls += 1).unwrap();
     assert_eq!(calls, 2 * problems.len());
     for (pass, outcomes) in passes.iter().enumerate() {
         for (p, o) in problems.iter().zip(outcomes) {
@@ -442,9 +440,7 @@ fn experience_answers_the_second_pass() {
         "{from_experience} of {} from experience",
         problems.len()
     );
-    let again =
-        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, _| {})
-            .unwrap();
+    let again = trm_mbm::solve_with_experience(&robot, &loaded, &options, 2, |_, _| {}).unwrap();
     for (a, b) in passes.iter().flatten().zip(again.iter().flatten()) {
         assert_eq!(a.path, b.path);
     }
@@ -752,9 +748,8 @@ fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
     let request = MotionPlanRequest::load(&strict.request).unwrap();
     let single = solve(&robot, &collision, &scene, &request, &options).unwrap();
     assert!(!single.valid, "{}", single.note);
-    let passes =
-        trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 1, |_, _| {})
-            .unwrap();
+    let loaded = LoadedProblem::load_all(&collision, &problems).unwrap();
+    let passes = trm_mbm::solve_with_experience(&robot, &loaded, &options, 1, |_, _| {}).unwrap();
     for (p, o) in problems.iter().zip(&passes[0]) {
         assert_eq!(
             o.valid,

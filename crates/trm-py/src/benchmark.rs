@@ -92,25 +92,21 @@ pub(crate) fn benchmark_mbm<'py>(
         sampler,
         ..Default::default()
     };
-    let runs = py
-        .detach(|| {
-            trm_mbm::run_set(
-                &robot,
-                &collision,
-                &set.problems,
-                &rrt,
-                verify,
-                task_space.as_ref(),
-                |_, _| {},
-            )
-        })
+    let options = trm_mbm::BenchmarkOptions {
+        rrt,
+        verify,
+        task_space,
+        experience_passes: 0,
+    };
+    let bench = py
+        .detach(|| trm_mbm::benchmark(&robot, &collision, &set.problems, &options, |_, _, _, _| {}))
         .map_err(err)?;
     let d = PyDict::new(py);
     d.set_item(
         "table",
-        trm_mbm::markdown_table(runs.iter().map(|r| (r.family.as_str(), &r.outcome))),
+        trm_mbm::markdown_table(bench.runs.iter().map(|r| (r.family.as_str(), &r.outcome))),
     )?;
-    d.set_item("csv", trm_mbm::runs_csv(&runs))?;
-    d.set_item("runs", to_python(py, &runs)?)?;
+    d.set_item("csv", trm_mbm::runs_csv(&bench.runs))?;
+    d.set_item("runs", to_python(py, &bench.runs)?)?;
     Ok(d)
 }

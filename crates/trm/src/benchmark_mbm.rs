@@ -8,8 +8,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use trm_mbm::{Outcome, ProblemSet, path_is_free};
-use trm_moveit::{MotionPlanRequest, PlanningScene};
+use trm_mbm::{Outcome, ProblemSet, path_is_free_loaded};
 use trm_plan::rrt::RrtOptions;
 
 /// Arguments of `benchmark-mbm`.
@@ -120,25 +119,7 @@ pub fn run(args: &Args) -> Result<()> {
         },
         ..Default::default()
     };
-    let mut progress = crate::progress::Progress::new("problems", problems.len() as u64);
-    let rows = trm_mbm::run_set(
-        &robot,
-        &collision,
-        &problems,
-        &options,
-        args.verify,
-        args.task_space
-            .as_ref()
-            .map(|link| trm_mbm::TaskSpaceGoals {
-                link: link.clone(),
-                position_tolerance: args.position_tolerance,
-                orientation_tolerance: args.orientation_tolerance,
-            })
-            .as_ref(),
-        |k, p| progress.set(k as u64, problems.len() as u64, &p.family),
-    )?;
-    progress.finish();
-    let csv = trm_mbm::runs_csv(&rows);
+    let bench = run_benchmark(args, &robot, &collision, &problems, &options)?;
     let mut md = format!(
         "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, {} samples at most{})\n\n",
         args.dir.display(),
@@ -148,134 +129,20 @@ pub fn run(args: &Args) -> Result<()> {
         args.max_seconds
             .map_or(String::new(), |s| format!(", {s} s at most"))
     );
-    let outcomes: Vec<(&str, &Outcome)> = rows
+    md.push_str(&bench.markdown());
+    print!("{md}");
+    // every file is written at the end, once every part has run
+    let mut files = vec![
+        ("results.csv", trm_mbm::runs_csv(&bench.runs).into_bytes()),
+        ("times.svg", times_plot(&bench.runs)?.into_bytes()),
+    ];
+    let outcomes: Vec<(&str, &Outcome)> = bench
+        .runs
         .iter()
         .map(|r| (r.family.as_str(), &r.outcome))
         .collect();
-    md.push_str(&trm_mbm::markdown_table(outcomes.iter().copied()));
-    let mut families: Vec<&str> = rows.iter().map(|r| r.family.as_str()).collect();
-    families.dedup();
-    let mut all_times = Vec::new();
-    let mut series = Vec::new();
-    for f in &families {
-        let mut times: Vec<f64> = rows
-            .iter()
-            .filter(|r| r.family == *f && r.outcome.valid && r.outcome.solved)
-            .map(|r| r.outcome.seconds * 1e3)
-            .collect();
-        times.sort_by(f64::total_cmp);
-        series.push(crate::plot::Series {
-            label: f.to_string(),
-            points: times
-                .iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    (
-                        (i + 1) as f64 / times.len() as f64 * 100.0,
-                        t.max(1e-3).log10(),
-                    )
-                })
-                .collect(),
-            color: None,
-        });
-        all_times.extend(times);
-    }
-    if args.verify {
-        let checked = rows.iter().filter(|r| r.verified.is_some()).count();
-        let failed = rows.iter().filter(|r| r.verified == Some(false)).count();
-        let _ = writeln!(
-            md,
-            "\nEvery returned path re-checked one configuration at a time at half the resolution: {failed} of {checked} collide."
-        );
-    }
-    print!("{md}");
-    all_times.sort_by(f64::total_cmp);
-    let svg = crate::plot::panels(
-        (800, 420),
-        &[crate::plot::Panel {
-            title: "Planning time per solved problem, sorted".into(),
-            axes: ("problems solved (%)".into(), "time (log10 ms)".into()),
-            x: 0.0..100.0,
-            y: (all_times.first().copied().unwrap_or(0.01).max(1e-3).log10() - 0.1)
-                ..(all_times.last().copied().unwrap_or(1.0).max(1e-3).log10() + 0.1),
-            series,
-        }],
-    )?;
-    // every file is written at the end, once every part has run
-    let mut files = vec![
-        ("results.csv", csv.into_bytes()),
-        ("times.svg", svg.into_bytes()),
-    ];
-    let mut experience = Vec::new();
-    if args.experience {
-        let total = 2 * problems.len() as u64;
-        let mut progress = crate::progress::Progress::new("problems with experience", total);
-        let mut count = 0;
-        experience =
-            trm_mbm::solve_with_experience(&robot, &collision, &problems, &options, 2, |_, k| {
-                count += 1;
-                progress.set(count, total, &problems[k].family);
-            })?;
-        progress.finish();
-        let mut text = String::new();
-        for (pass, outcomes) in experience.iter_mut().enumerate() {
-            let mut failed = 0;
-            if args.verify {
-                for (o, p) in outcomes.iter_mut().zip(&problems) {
-                    if o.solved {
-                        let scene = PlanningScene::load(&p.scene)?;
-                        let request = MotionPlanRequest::load(&p.request)?;
-                        if !path_is_free(
-                            &robot,
-                            &collision,
-                            &scene,
-                            &request,
-                            &o.path,
-                            options.resolution / 2.0,
-                        )? {
-                            failed += 1;
-                        }
-                    }
-                }
-            }
-            let pairs: Vec<(&str, &Outcome)> = problems
-                .iter()
-                .map(|p| p.family.as_str())
-                .zip(outcomes.iter())
-                .collect();
-            let answered = |note: &str| {
-                outcomes
-                    .iter()
-                    .filter(|o| o.solved && o.note == note)
-                    .count()
-            };
-            let (retrieved, from_experience) = (answered("retrieved"), answered("experience"));
-            let _ = write!(
-                text,
-                "\nWith experience kept, pass {} ({}; {} of {} solved problems answered by the experience alone, {retrieved} of them by retrieving the kept path whose ends they repeat):\n\n{}",
-                pass + 1,
-                if pass == 0 {
-                    "one planner per family: each problem planned through the paths of the family's earlier problems, checked lazily in its scene, RRT-Connect where they do not reach"
-                } else {
-                    "the set again, every path of pass 1 kept, the problem's own included"
-                },
-                from_experience + retrieved,
-                outcomes.iter().filter(|o| o.solved).count(),
-                trm_mbm::markdown_table(pairs)
-            );
-            if args.verify {
-                let _ = writeln!(
-                    text,
-                    "\nEvery path re-checked one configuration at a time at half the resolution: {failed} of {} collide.",
-                    outcomes.iter().filter(|o| o.solved).count()
-                );
-            }
-        }
-        print!("{text}");
-        md.push_str(&text);
-    }
     if let Some(binary) = &args.vamp {
-        let (peer, exported) = run_vamp(args, binary, &robot, &collision, &set, &problems)?;
+        let (peer, exported) = run_vamp(args, binary, &robot, &set, &bench)?;
         files.push(("peer-problems.txt", exported.into_bytes()));
         let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
         let mut text = format!(
@@ -300,11 +167,10 @@ pub fn run(args: &Args) -> Result<()> {
             "\nSide by side, on the problems both call valid (ratio = trm / VAMP):\n\n{}",
             trm_mbm::side_by_side((&outcomes, "trm"), (&theirs, "VAMP"))
         );
-        if let Some(second) = experience.get(1) {
-            let ours: Vec<(&str, &Outcome)> = problems
+        if let Some(second) = bench.experience.get(1) {
+            let ours: Vec<(&str, &Outcome)> = second
                 .iter()
-                .map(|p| p.family.as_str())
-                .zip(second.iter())
+                .map(|r| (r.family.as_str(), &r.outcome))
                 .collect();
             let _ = write!(
                 text,
@@ -353,6 +219,97 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
+/// The set run as `args` say, with progress bars.
+fn run_benchmark(
+    args: &Args,
+    robot: &trm_kinematics::RobotModel,
+    collision: &trm_collision::CollisionModel,
+    problems: &[trm_mbm::Problem],
+    options: &RrtOptions,
+) -> Result<trm_mbm::Benchmark> {
+    let options = trm_mbm::BenchmarkOptions {
+        rrt: options.clone(),
+        verify: args.verify,
+        task_space: args
+            .task_space
+            .as_ref()
+            .map(|link| trm_mbm::TaskSpaceGoals {
+                link: link.clone(),
+                position_tolerance: args.position_tolerance,
+                orientation_tolerance: args.orientation_tolerance,
+            }),
+        experience_passes: if args.experience { 2 } else { 0 },
+    };
+    let mut bar: Option<(String, crate::progress::Progress)> = None;
+    let bench = trm_mbm::benchmark(
+        robot,
+        collision,
+        problems,
+        &options,
+        |stage, done, total, p| {
+            if bar.as_ref().is_none_or(|(s, _)| s != stage) {
+                if let Some((_, old)) = bar.take() {
+                    old.finish();
+                }
+                bar = Some((
+                    stage.to_string(),
+                    crate::progress::Progress::new(stage, total as u64),
+                ));
+            }
+            if let Some((_, b)) = &mut bar {
+                b.set(done as u64, total as u64, &p.family);
+            }
+        },
+    )?;
+    if let Some((_, b)) = bar {
+        b.finish();
+    }
+    Ok(bench)
+}
+
+/// The solved problems' planning times per family, sorted, as an SVG plot.
+fn times_plot(runs: &[trm_mbm::Run]) -> Result<String> {
+    let mut families: Vec<&str> = runs.iter().map(|r| r.family.as_str()).collect();
+    families.dedup();
+    let mut all_times = Vec::new();
+    let mut series = Vec::new();
+    for f in &families {
+        let mut times: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.family == *f && r.outcome.valid && r.outcome.solved)
+            .map(|r| r.outcome.seconds * 1e3)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        series.push(crate::plot::Series {
+            label: f.to_string(),
+            points: times
+                .iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    (
+                        (i + 1) as f64 / times.len() as f64 * 100.0,
+                        t.max(1e-3).log10(),
+                    )
+                })
+                .collect(),
+            color: None,
+        });
+        all_times.extend(times);
+    }
+    all_times.sort_by(f64::total_cmp);
+    crate::plot::panels(
+        (800, 420),
+        &[crate::plot::Panel {
+            title: "Planning time per solved problem, sorted".into(),
+            axes: ("problems solved (%)".into(), "time (log10 ms)".into()),
+            x: 0.0..100.0,
+            y: (all_times.first().copied().unwrap_or(0.01).max(1e-3).log10() - 0.1)
+                ..(all_times.last().copied().unwrap_or(1.0).max(1e-3).log10() + 0.1),
+            series,
+        }],
+    )
+}
+
 /// The OMPL side of `--ompl`, in the repository the tool was built from.
 fn ompl_script() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/python/mbm_ompl.py")
@@ -371,10 +328,12 @@ fn run_vamp(
     args: &Args,
     binary: &std::path::Path,
     robot: &trm_kinematics::RobotModel,
-    collision: &trm_collision::CollisionModel,
     set: &ProblemSet,
-    problems: &[trm_mbm::Problem],
+    bench: &trm_mbm::Benchmark,
 ) -> Result<(Vec<(String, Outcome)>, String)> {
+    let problems: Vec<trm_mbm::Problem> =
+        bench.problems.iter().map(|p| p.problem.clone()).collect();
+    let problems = &problems[..];
     use std::io::Write as _;
     let input = trm_mbm::peer_problems(robot.name(), problems)?;
     let exported = input.clone();
@@ -403,23 +362,14 @@ fn run_vamp(
     let results = trm_mbm::parse_peer_results(&String::from_utf8_lossy(&output.stdout))
         .map_err(|e| anyhow::anyhow!("--vamp: {}'s output, {e}", binary.display()))?;
     let mut ordered = Vec::new();
-    for p in problems {
+    for (p, loaded) in problems.iter().zip(&bench.problems) {
         let found = results
             .iter()
             .find(|(f, i, _)| *f == p.family && *i == p.index)
             .ok_or_else(|| anyhow::anyhow!("--vamp: no result for {} {}", p.family, p.index))?;
         let mut outcome = found.2.clone();
         if args.verify && outcome.solved {
-            let scene = PlanningScene::load(&p.scene)?;
-            let request = MotionPlanRequest::load(&p.request)?;
-            if !path_is_free(
-                robot,
-                collision,
-                &scene,
-                &request,
-                &outcome.path,
-                args.resolution / 2.0,
-            )? {
+            if !path_is_free_loaded(robot, loaded, &outcome.path, args.resolution / 2.0)? {
                 outcome.note = VAMP_PATH_COLLIDES.into();
             }
         }
