@@ -193,6 +193,10 @@ impl<'a> FamilyRun<'a> {
     }
 }
 
+/// A path, the configurations checked to find it, and how the experience answered (`None`:
+/// RRT-Connect did).
+type Answer = (Vec<Vec<f64>>, u64, Option<&'static str>);
+
 /// A path from `start` to `goal` through the planner's experience (shortcut greedily and
 /// checked at half the resolution, as RRT-Connect's paths are), or by RRT-Connect where the
 /// experience does not reach or its path grazes an obstacle: the path, the configurations
@@ -204,7 +208,7 @@ fn through_experience(
     goal: &[f64],
     options: &RrtOptions,
     rrt: &RrtOptions,
-) -> Result<(Vec<Vec<f64>>, u64, Option<&'static str>), MbmError> {
+) -> Result<Answer, MbmError> {
     let plan_options = PlanOptions {
         resolution: options.resolution,
         shortcuts: 0,
