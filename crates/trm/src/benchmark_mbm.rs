@@ -368,10 +368,11 @@ fn run_vamp(
             .find(|(f, i, _)| *f == p.family && *i == p.index)
             .ok_or_else(|| anyhow::anyhow!("--vamp: no result for {} {}", p.family, p.index))?;
         let mut outcome = found.2.clone();
-        if args.verify && outcome.solved {
-            if !path_is_free_loaded(robot, loaded, &outcome.path, args.resolution / 2.0)? {
-                outcome.note = VAMP_PATH_COLLIDES.into();
-            }
+        if args.verify
+            && outcome.solved
+            && !path_is_free_loaded(robot, loaded, &outcome.path, args.resolution / 2.0)?
+        {
+            outcome.note = VAMP_PATH_COLLIDES.into();
         }
         ordered.push((p.family.clone(), outcome));
     }
