@@ -13,15 +13,15 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod error;
 mod planner;
 pub mod pose_goal;
 pub mod rrt;
 pub mod scenario;
 mod trajectory;
 
-pub use planner::{
-    EXACT_WEIGHT, ExactGoal, Goal, PlanError, PlanOptions, PlanStats, Planned, Planner,
-};
+pub use error::PlanError;
+pub use planner::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned, Planner};
 pub use scenario::{
     Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,
 };

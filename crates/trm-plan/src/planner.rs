@@ -5,89 +5,14 @@ use std::time::Instant;
 use petgraph::graph::{NodeIndex, UnGraph};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use thiserror::Error;
 use trm_collision::edge::distance;
 use trm_collision::{World, WorldChecker};
 use trm_kinematics::ActiveSet;
 use trm_roadmap::Roadmap;
 use trm_tasks::Objective;
 
+use crate::PlanError;
 use crate::trajectory::{Trajectory, time_parametrise};
-
-/// Planning failures.
-#[derive(Debug, Error)]
-#[non_exhaustive]
-pub enum PlanError {
-    /// From the kinematics (an unknown motor name, a wrong vector length).
-    #[error(transparent)]
-    Kinematics(#[from] trm_kinematics::KinematicsError),
-    /// From the collision crate (a world file that cannot be read, an invalid object).
-    #[error(transparent)]
-    Collision(#[from] trm_collision::CollisionError),
-    /// From the task crate (an objective that cannot be built, NGIK that cannot run).
-    #[error(transparent)]
-    Tasks(Box<trm_tasks::TaskError>),
-    /// A file could not be read or written.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: std::path::PathBuf,
-        /// The operating-system error.
-        source: std::io::Error,
-    },
-    /// A trajectory file holds something invalid.
-    #[error("{}{}: {problem}\n  fix: {fix}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
-    InvalidTrajectory {
-        /// The file.
-        path: std::path::PathBuf,
-        /// 1-based line, 0 when unknown.
-        line: usize,
-        /// What is wrong.
-        problem: String,
-        /// What to do about it.
-        fix: String,
-    },
-    /// Maps that do not share the objective's configuration space.
-    #[error("map {map}: {problem}")]
-    IncompatibleMap {
-        /// Index of the map.
-        map: usize,
-        /// What differs.
-        problem: String,
-    },
-    /// A query setting out of range.
-    #[error("plan options: {what} {problem}")]
-    InvalidOptions {
-        /// The setting.
-        what: String,
-        /// What is wrong and what to give.
-        problem: String,
-    },
-    /// The start configuration collides in the current world, or has the wrong length.
-    #[error("the start configuration is invalid: {0}")]
-    InvalidStart(String),
-    /// The goal does not fit the maps' spaces (wrong dimension, non-finite values, a region
-    /// whose corners are swapped, a negative tolerance).
-    #[error("the goal is invalid: {problem}\n  fix: {fix}")]
-    InvalidGoal {
-        /// What is wrong.
-        problem: String,
-        /// What to give.
-        fix: String,
-    },
-    /// No collision-free path; `closest` is the reachable node nearest to the goal.
-    #[error(
-        "goal unreachable: {reason}{}", match closest_node { Some(n) => format!("; the closest reachable node is {n}, at task distance {closest_distance:.4}"), None => "; no map node is reachable".into() }
-    )]
-    Unreachable {
-        /// Why.
-        reason: String,
-        /// The reachable node closest to the goal (task space), if any.
-        closest_node: Option<usize>,
-        /// Its task-space distance to the goal.
-        closest_distance: f64,
-    },
-}
 
 /// A goal.
 #[derive(Debug, Clone, PartialEq)]
@@ -164,12 +89,6 @@ impl Goal {
                 }
             }
         }
-    }
-}
-
-impl From<trm_tasks::TaskError> for PlanError {
-    fn from(e: trm_tasks::TaskError) -> Self {
-        PlanError::Tasks(Box::new(e))
     }
 }
 
@@ -599,9 +518,74 @@ impl<'a> Planner<'a> {
         goal: &Goal,
         options: &PlanOptions,
     ) -> Result<Planned, PlanError> {
-        options.check()?;
         let began = Instant::now();
+        self.check_query(start, goal, options)?;
+        let n = self.nodes.len();
+        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
+        let (extra, goal_q) = self.query_edges(start, goal, options)?;
+        if let Some(q) = &goal_q {
+            if let Some(planned) = self.retrieve(start, q, options, began)? {
+                return Ok(planned);
+            }
+        }
+        let goal_t = match goal {
+            Goal::Configuration(q) => self.task_of(q),
+            Goal::TaskPoint { t, .. } => t.clone(),
+            Goal::TaskRegion { min, max } => {
+                min.iter().zip(max).map(|(a, b)| (a + b) / 2.0).collect()
+            }
+        };
+        let target = Target { goal, n };
+        if goal_q.is_none() && !(0..n).any(|i| target.holds(i, &self.nodes)) {
+            let closest = self.closest_to(0..n, &goal_t);
+            return Err(self.unreachable(
+                "no map node lies within the goal's tolerance or region",
+                closest,
+                &goal_t,
+            ));
+        }
         let mut stats = PlanStats::default();
+        let mut extra_state = vec![State::Unknown; extra.len()];
+        loop {
+            stats.searches += 1;
+            let path = match self.search(&extra, &extra_state, &target, goal_q.as_deref()) {
+                Ok(path) => path,
+                Err(reachable) => {
+                    let closest = self.closest_to(reachable.into_iter(), &goal_t);
+                    return Err(self.unreachable(
+                        "no collision-free path through the maps in the current world",
+                        closest,
+                        &goal_t,
+                    ));
+                }
+            };
+            let config = |i: usize, this: &Self| -> Vec<f64> {
+                if i < n {
+                    this.nodes[i].0.clone()
+                } else if i == n {
+                    start.to_vec()
+                } else {
+                    goal_q.clone().unwrap_or_default()
+                }
+            };
+            if !self.path_valid(&path, &extra, &mut extra_state, &mut stats, options, config) {
+                continue;
+            }
+            let node_ids: Vec<usize> = path.iter().map(|&(v, _)| v).filter(|&i| i < n).collect();
+            let waypoints: Vec<Vec<f64>> = path.iter().map(|&(v, _)| config(v, self)).collect();
+            stats.path_nodes = node_ids.len();
+            return Ok(self.finish(waypoints, node_ids, goal, options, stats, began));
+        }
+    }
+
+    /// Checks a query's options, start and goal: an error says what is wrong.
+    fn check_query(
+        &mut self,
+        start: &[f64],
+        goal: &Goal,
+        options: &PlanOptions,
+    ) -> Result<(), PlanError> {
+        options.check()?;
         if start.len() != self.active.len() {
             return Err(PlanError::InvalidStart(format!(
                 "{} values for {} active motors",
@@ -622,208 +606,195 @@ impl<'a> Planner<'a> {
                 "it collides in the current world".into(),
             ));
         }
+        Ok(())
+    }
+
+    /// The query's own edges: the start (node n) and a configuration goal (node n + 1) joined
+    /// to their nearest map nodes and to each other; and the goal configuration, if any.
+    fn query_edges(
+        &mut self,
+        start: &[f64],
+        goal: &Goal,
+        options: &PlanOptions,
+    ) -> Result<(Vec<(usize, usize, f64)>, Option<Vec<f64>>), PlanError> {
         let n = self.nodes.len();
-        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
         let mut extra: Vec<(usize, usize, f64)> = Vec::new();
-        let attach = |q: &[f64],
-                      me: usize,
-                      extra: &mut Vec<(usize, usize, f64)>,
-                      nodes: &[(Vec<f64>, Vec<f64>)]| {
-            for (l, j) in k_nearest(q, nodes, 0..nodes.len(), options.attach_neighbours) {
+        let attach = |q: &[f64], me: usize, extra: &mut Vec<(usize, usize, f64)>| {
+            for (l, j) in k_nearest(q, &self.nodes, 0..n, options.attach_neighbours) {
                 extra.push((me, j, l));
             }
         };
-        attach(start, n, &mut extra, &self.nodes);
-        let goal_q = match goal {
-            Goal::Configuration(q) => {
-                if !self.is_free(q) {
-                    return Err(PlanError::Unreachable {
-                        reason: "the goal configuration collides in the current world".into(),
-                        closest_node: None,
-                        closest_distance: f64::INFINITY,
-                    });
-                }
-                attach(q, n + 1, &mut extra, &self.nodes);
-                extra.push((n, n + 1, distance(start, q)));
-                Some(q.clone())
-            }
-            _ => None,
+        attach(start, n, &mut extra);
+        let Goal::Configuration(q) = goal else {
+            return Ok((extra, None));
         };
-        if let Some(q) = &goal_q {
-            if let Some(planned) = self.retrieve(start, q, options, began)? {
-                return Ok(planned);
-            }
-        }
-        let goal_t = match goal {
-            Goal::Configuration(q) => self.task_of(q),
-            Goal::TaskPoint { t, .. } => t.clone(),
-            Goal::TaskRegion { min, max } => {
-                min.iter().zip(max).map(|(a, b)| (a + b) / 2.0).collect()
-            }
-        };
-        let is_goal_node = |i: usize, nodes: &[(Vec<f64>, Vec<f64>)]| -> bool {
-            match goal {
-                Goal::Configuration(_) => i == n + 1,
-                Goal::TaskPoint { t, tolerance } => i < n && distance(&nodes[i].1, t) <= *tolerance,
-                Goal::TaskRegion { min, max } => {
-                    i < n
-                        && nodes[i]
-                            .1
-                            .iter()
-                            .enumerate()
-                            .all(|(k, v)| *v >= min[k] && *v <= max[k])
-                }
-            }
-        };
-        if goal_q.is_none() && !(0..n).any(|i| is_goal_node(i, &self.nodes)) {
-            let closest = (0..n).min_by(|&a, &b| {
-                distance(&self.nodes[a].1, &goal_t).total_cmp(&distance(&self.nodes[b].1, &goal_t))
-            });
+        attach(q, n + 1, &mut extra);
+        extra.push((n, n + 1, distance(start, q)));
+        if !self.is_free(q) {
             return Err(PlanError::Unreachable {
-                reason: "no map node lies within the goal's tolerance or region".into(),
-                closest_node: closest,
-                closest_distance: closest
-                    .map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, &goal_t)),
+                reason: "the goal configuration collides in the current world".into(),
+                closest_node: None,
+                closest_distance: f64::INFINITY,
             });
         }
+        Ok((extra, Some(q.clone())))
+    }
+
+    /// The map node of `candidates` nearest to the task point `t` (the first of equally near
+    /// ones).
+    fn closest_to(&self, candidates: impl Iterator<Item = usize>, t: &[f64]) -> Option<usize> {
+        candidates.min_by(|&a, &b| {
+            distance(&self.nodes[a].1, t).total_cmp(&distance(&self.nodes[b].1, t))
+        })
+    }
+
+    /// The query is unreachable, for `reason`; `closest` is the reachable node nearest to the
+    /// goal's task point `t`.
+    fn unreachable(&self, reason: &str, closest: Option<usize>, t: &[f64]) -> PlanError {
+        PlanError::Unreachable {
+            reason: reason.into(),
+            closest_node: closest,
+            closest_distance: closest.map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, t)),
+        }
+    }
+
+    /// A* from the start (node n) to a goal node over the nodes and edges not known invalid:
+    /// the path's nodes, each with the edge that reaches it (`usize::MAX` for the first; edges
+    /// past the map's are `extra`'s). Without a path, the map nodes reachable from the start.
+    fn search(
+        &self,
+        extra: &[(usize, usize, f64)],
+        extra_state: &[State],
+        target: &Target,
+        goal_q: Option<&[f64]>,
+    ) -> Result<Vec<(usize, usize)>, Vec<usize>> {
+        let n = target.n;
         let total = n + 2;
-        let mut extra_state = vec![State::Unknown; extra.len()];
-        loop {
-            stats.searches += 1;
-            let mut graph =
-                UnGraph::<(), usize>::with_capacity(total, self.edges.len() + extra.len());
-            for _ in 0..total {
-                graph.add_node(());
+        let mut graph = UnGraph::<(), usize>::with_capacity(total, self.edges.len() + extra.len());
+        for _ in 0..total {
+            graph.add_node(());
+        }
+        let node_ok = |i: usize| i >= n || self.node_state[i] != State::Invalid;
+        let states = self.edge_state.iter().chain(extra_state);
+        for (k, (&(a, b, _), state)) in self.edges.iter().chain(extra).zip(states).enumerate() {
+            if *state != State::Invalid && node_ok(a) && node_ok(b) {
+                graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
             }
-            let node_ok = |i: usize, st: &[State]| i >= n || st[i] != State::Invalid;
-            for (k, &(a, b, _)) in self.edges.iter().enumerate() {
-                if self.edge_state[k] != State::Invalid
-                    && node_ok(a, &self.node_state)
-                    && node_ok(b, &self.node_state)
-                {
-                    graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
-                }
+        }
+        let length = |k: usize| {
+            if k < self.edges.len() {
+                self.edges[k].2
+            } else {
+                extra[k - self.edges.len()].2
             }
-            for (k, &(a, b, _)) in extra.iter().enumerate() {
-                if extra_state[k] != State::Invalid
-                    && node_ok(a, &self.node_state)
-                    && node_ok(b, &self.node_state)
-                {
-                    graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), self.edges.len() + k);
-                }
+        };
+        let found = petgraph::algo::astar(
+            &graph,
+            NodeIndex::new(n),
+            |v| target.holds(v.index(), &self.nodes),
+            |e| length(*e.weight()),
+            |v| match goal_q {
+                Some(q) if v.index() < n => distance(&self.nodes[v.index()].0, q),
+                _ => 0.0,
+            },
+        );
+        let Some((_, path)) = found else {
+            let reachable =
+                petgraph::algo::dijkstra(&graph, NodeIndex::new(n), None, |e| length(*e.weight()));
+            return Err(reachable
+                .keys()
+                .map(|v| v.index())
+                .filter(|&v| v < n)
+                .collect());
+        };
+        let mut steps = vec![(path[0].index(), usize::MAX)];
+        for w in path.windows(2) {
+            let k = *graph
+                .edges_connecting(w[0], w[1])
+                .next()
+                .map(|e| e.weight())
+                .unwrap_or(&usize::MAX);
+            steps.push((w[1].index(), k));
+        }
+        Ok(steps)
+    }
+
+    /// Checks lazily the nodes, then the edges, of a path [`Planner::search`] found, recording
+    /// what it learns; whether the path is free.
+    fn path_valid(
+        &mut self,
+        path: &[(usize, usize)],
+        extra: &[(usize, usize, f64)],
+        extra_state: &mut [State],
+        stats: &mut PlanStats,
+        options: &PlanOptions,
+        config: impl Fn(usize, &Self) -> Vec<f64>,
+    ) -> bool {
+        let n = self.nodes.len();
+        let mut blocked = false;
+        for &(i, _) in path {
+            if i < n && self.node_state[i] == State::Unknown && !self.node_free(i) {
+                stats.nodes_invalid += 1;
+                blocked = true;
             }
-            let length = |k: usize| {
-                if k < self.edges.len() {
-                    self.edges[k].2
-                } else {
-                    extra[k - self.edges.len()].2
-                }
+        }
+        if blocked {
+            return false;
+        }
+        debug_assert!(extra_state.len() == extra.len());
+        for w in path.windows(2) {
+            let ((a, _), (b, k)) = (w[0], w[1]);
+            let state = if k < self.edges.len() {
+                self.edge_state[k]
+            } else {
+                extra_state[k - self.edges.len()]
             };
-            let found = petgraph::algo::astar(
-                &graph,
-                NodeIndex::new(n),
-                |v| is_goal_node(v.index(), &self.nodes),
-                |e| length(*e.weight()),
-                |v| match &goal_q {
-                    Some(q) if v.index() < n => distance(&self.nodes[v.index()].0, q),
-                    _ => 0.0,
-                },
-            );
-            let Some((_, path)) = found else {
-                // the reachable node closest to the goal in task space
-                let reachable = petgraph::algo::dijkstra(&graph, NodeIndex::new(n), None, |e| {
-                    length(*e.weight())
-                });
-                let closest = reachable
-                    .keys()
-                    .map(|v| v.index())
-                    .filter(|&v| v < n)
-                    .min_by(|&a, &b| {
-                        distance(&self.nodes[a].1, &goal_t)
-                            .total_cmp(&distance(&self.nodes[b].1, &goal_t))
-                    });
-                return Err(PlanError::Unreachable {
-                    reason: "no collision-free path through the maps in the current world".into(),
-                    closest_node: closest,
-                    closest_distance: closest
-                        .map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, &goal_t)),
-                });
-            };
-            let config = |i: usize, this: &Self| -> Vec<f64> {
-                if i < n {
-                    this.nodes[i].0.clone()
-                } else if i == n {
-                    start.to_vec()
-                } else {
-                    goal_q.clone().unwrap_or_default()
-                }
-            };
-            // lazily check nodes, then edges, along the path
-            let mut blocked = false;
-            for v in &path {
-                let i = v.index();
-                if i < n && self.node_state[i] == State::Unknown && !self.node_free(i) {
-                    stats.nodes_invalid += 1;
-                    blocked = true;
-                }
-            }
-            if blocked {
+            if state != State::Unknown {
                 continue;
             }
-            for w in path.windows(2) {
-                let (a, b) = (w[0], w[1]);
-                let k = *graph
-                    .edges_connecting(a, b)
-                    .next()
-                    .map(|e| e.weight())
-                    .unwrap_or(&usize::MAX);
-                let state = if k < self.edges.len() {
-                    self.edge_state[k]
-                } else {
-                    extra_state[k - self.edges.len()]
-                };
-                if state != State::Unknown {
-                    continue;
-                }
-                let (qa, qb) = (config(a.index(), self), config(b.index(), self));
-                stats.edges_checked += 1;
-                let ok = self.segment_free(&qa, &qb, options.resolution);
-                let new = if ok { State::Valid } else { State::Invalid };
-                if k < self.edges.len() {
-                    self.edge_state[k] = new;
-                } else {
-                    extra_state[k - self.edges.len()] = new;
-                }
-                if !ok {
-                    stats.edges_invalid += 1;
-                    blocked = true;
-                    break;
-                }
+            let (qa, qb) = (config(a, self), config(b, self));
+            stats.edges_checked += 1;
+            let ok = self.segment_free(&qa, &qb, options.resolution);
+            let new = if ok { State::Valid } else { State::Invalid };
+            if k < self.edges.len() {
+                self.edge_state[k] = new;
+            } else {
+                extra_state[k - self.edges.len()] = new;
             }
-            if blocked {
-                continue;
+            if !ok {
+                stats.edges_invalid += 1;
+                return false;
             }
-            let node_ids: Vec<usize> = path.iter().map(|v| v.index()).filter(|&i| i < n).collect();
-            let mut waypoints: Vec<Vec<f64>> =
-                path.iter().map(|v| config(v.index(), self)).collect();
-            stats.path_nodes = node_ids.len();
-            self.shortcut(&mut waypoints, options);
-            if let Goal::TaskPoint { t, .. } = goal {
-                if options.exact_goal {
-                    stats.exact = self.finish_exactly(&mut waypoints, t, options);
-                }
-                let end = waypoints.last().cloned().unwrap_or_default();
-                stats.goal_error = Some(distance(&self.task_of(&end), t));
+        }
+        true
+    }
+
+    /// A free path's waypoints shortcut, finished onto a task point when asked, timed.
+    fn finish(
+        &mut self,
+        mut waypoints: Vec<Vec<f64>>,
+        nodes: Vec<usize>,
+        goal: &Goal,
+        options: &PlanOptions,
+        mut stats: PlanStats,
+        began: Instant,
+    ) -> Planned {
+        self.shortcut(&mut waypoints, options);
+        if let Goal::TaskPoint { t, .. } = goal {
+            if options.exact_goal {
+                stats.exact = self.finish_exactly(&mut waypoints, t, options);
             }
-            stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-            let trajectory = self.timed(&waypoints, options);
-            stats.seconds = began.elapsed().as_secs_f64();
-            return Ok(Planned {
-                trajectory,
-                nodes: node_ids,
-                waypoints,
-                stats,
-            });
+            let end = waypoints.last().cloned().unwrap_or_default();
+            stats.goal_error = Some(distance(&self.task_of(&end), t));
+        }
+        stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
+        let trajectory = self.timed(&waypoints, options);
+        stats.seconds = began.elapsed().as_secs_f64();
+        Planned {
+            trajectory,
+            nodes,
+            waypoints,
+            stats,
         }
     }
 
@@ -1049,6 +1020,34 @@ impl<'a> Planner<'a> {
 
 /// The `k` nodes of `candidates` nearest to `q` in configuration space, as (distance, index),
 /// nearest first and ties by index (the order of a stable sort): a selection, then a sort of
+/// Which nodes a query ends at: the goal configuration's node (n + 1), or the map nodes
+/// within a task point's tolerance or a task region.
+struct Target<'g> {
+    goal: &'g Goal,
+    /// Number of map nodes.
+    n: usize,
+}
+
+impl Target<'_> {
+    /// Whether node `i` is a goal node.
+    fn holds(&self, i: usize, nodes: &[(Vec<f64>, Vec<f64>)]) -> bool {
+        match self.goal {
+            Goal::Configuration(_) => i == self.n + 1,
+            Goal::TaskPoint { t, tolerance } => {
+                i < self.n && distance(&nodes[i].1, t) <= *tolerance
+            }
+            Goal::TaskRegion { min, max } => {
+                i < self.n
+                    && nodes[i]
+                        .1
+                        .iter()
+                        .enumerate()
+                        .all(|(k, v)| *v >= min[k] && *v <= max[k])
+            }
+        }
+    }
+}
+
 /// `k` — not a sort of every node (experience graphs hold thousands).
 fn k_nearest(
     q: &[f64],

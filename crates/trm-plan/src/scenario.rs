@@ -35,7 +35,8 @@ use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError};
 use trm_tasks::Problem;
 
-use crate::planner::{Goal, PlanError, PlanOptions, Planner};
+use crate::PlanError;
+use crate::planner::{Goal, PlanOptions, Planner};
 use crate::trajectory::Trajectory;
 
 /// What can go wrong with a scenario.
