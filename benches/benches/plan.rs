@@ -7,20 +7,20 @@ use std::hint::black_box;
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
 use trm_plan::{Goal, PlanOptions, Planner};
-use trm_roadmap::{BuildOptions, build, connect};
+use trm_roadmap::{BuildOptions, Builder, connect};
 use trm_tasks::Problem;
 
 fn plan(c: &mut Criterion) {
     let path = format!("{}/../specs/reach.ron", env!("CARGO_MANIFEST_DIR"));
     let problem = Problem::load(&path).expect("shipped spec");
-    let mut map = build(
+    let mut map = Builder::new(
         &problem,
         &BuildOptions {
             points: Some(400),
             ..Default::default()
         },
-        |_| {},
     )
+    .run(|_| {})
     .expect("map");
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let goals: Vec<Goal> = (0..16)

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use rand::{RngExt, SeedableRng};
-use trm_roadmap::{BuildOptions, Roadmap, TaskIndex, build, connect};
+use trm_roadmap::{BuildOptions, Builder, Roadmap, TaskIndex, connect};
 use trm_tasks::Problem;
 
 /// Arguments of `map-scaling`.
@@ -58,7 +58,7 @@ pub fn run(args: &Args) -> Result<()> {
         ..Default::default()
     };
     let (map, edge_seconds) = pool.install(|| -> Result<(Roadmap, f64)> {
-        let mut map = build(&problem, &options, |p| {
+        let mut map = Builder::new(&problem, &options).run(|p| {
             progress.set(p.points as u64, p.target as u64, "");
             for (k, &m) in marks.iter().enumerate() {
                 if p.points >= m && reached[k].is_none() {

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use plotters::prelude::{BLACK, Color};
-use trm_roadmap::{BuildOptions, Progress, build};
+use trm_roadmap::{BuildOptions, Builder, Progress};
 use trm_tasks::Problem;
 
 /// Arguments of `speedup`.
@@ -49,7 +49,7 @@ fn timed(
     let mut times = vec![f64::NAN; marks.len()];
     let mut last = None;
     pool.install(|| {
-        build(
+        Builder::new(
             problem,
             &BuildOptions {
                 points: Some(target),
@@ -57,15 +57,15 @@ fn timed(
                 seed: Some(seed),
                 ..Default::default()
             },
-            |p| {
-                for (k, &m) in marks.iter().enumerate() {
-                    if p.points >= m && times[k].is_nan() {
-                        times[k] = p.seconds;
-                    }
-                }
-                last = Some(*p);
-            },
         )
+        .run(|p| {
+            for (k, &m) in marks.iter().enumerate() {
+                if p.points >= m && times[k].is_nan() {
+                    times[k] = p.seconds;
+                }
+            }
+            last = Some(*p);
+        })
     })?;
     let last = last.ok_or_else(|| anyhow::anyhow!("the build reported no progress"))?;
     Ok((times, last))

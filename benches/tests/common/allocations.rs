@@ -99,14 +99,14 @@ fn a_map_build() -> (f64, f64) {
     let problem = spec("reach.ron");
     let build = |points: usize| {
         let before = allocations();
-        let map = trm_roadmap::build(
+        let map = trm_roadmap::Builder::new(
             &problem,
             &trm_roadmap::BuildOptions {
                 points: Some(points),
                 ..Default::default()
             },
-            |_| {},
         )
+        .run(|_| {})
         .unwrap();
         let allocations = allocations() - before;
         (

@@ -616,10 +616,10 @@ impl<'a> Planner<'a> {
         start: &[f64],
         goal: &Goal,
         options: &PlanOptions,
-    ) -> Result<(Vec<(usize, usize, f64)>, Option<Vec<f64>>), PlanError> {
+    ) -> Result<(Vec<Edge>, Option<Vec<f64>>), PlanError> {
         let n = self.nodes.len();
-        let mut extra: Vec<(usize, usize, f64)> = Vec::new();
-        let attach = |q: &[f64], me: usize, extra: &mut Vec<(usize, usize, f64)>| {
+        let mut extra: Vec<Edge> = Vec::new();
+        let attach = |q: &[f64], me: usize, extra: &mut Vec<Edge>| {
             for (l, j) in k_nearest(q, &self.nodes, 0..n, options.attach_neighbours) {
                 extra.push((me, j, l));
             }
@@ -1020,6 +1020,9 @@ impl<'a> Planner<'a> {
 
 /// The `k` nodes of `candidates` nearest to `q` in configuration space, as (distance, index),
 /// nearest first and ties by index (the order of a stable sort): a selection, then a sort of
+/// An edge of the planner's graph: its two nodes and its length.
+type Edge = (usize, usize, f64);
+
 /// Which nodes a query ends at: the goal configuration's node (n + 1), or the map nodes
 /// within a task point's tolerance or a task region.
 struct Target<'g> {

@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
 use trm_plan::{ExactGoal, Goal, PlanError, PlanOptions, Planner};
-use trm_roadmap::{BuildOptions, Roadmap, build, connect};
+use trm_roadmap::{BuildOptions, Builder, Roadmap, connect};
 use trm_tasks::Problem;
 
 fn problem() -> &'static Problem {
@@ -22,14 +22,14 @@ fn map() -> &'static Roadmap {
     static M: OnceLock<Roadmap> = OnceLock::new();
     M.get_or_init(|| {
         let p = problem();
-        let mut map = build(
+        let mut map = Builder::new(
             p,
             &BuildOptions {
                 points: Some(120),
                 ..Default::default()
             },
-            |_| {},
         )
+        .run(|_| {})
         .unwrap();
         connect(&mut map, &p.objective, 8, 0.05).unwrap();
         map

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
-use trm_roadmap::{BuildOptions, build, connect};
+use trm_roadmap::{BuildOptions, Builder, connect};
 use trm_tasks::Problem;
 
 /// Builds `points` of `spec`'s map (`dim` active motors), plans to just off node `node` and
@@ -23,14 +23,14 @@ fn builds_a_map_and_plans_through_it(
         .join(spec);
     let problem = Problem::load(&spec).unwrap();
     assert_eq!(problem.objective.dim(), dim, "the SRDF's group");
-    let mut map = build(
+    let mut map = Builder::new(
         &problem,
         &BuildOptions {
             points: Some(points),
             ..Default::default()
         },
-        |_| {},
     )
+    .run(|_| {})
     .unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     assert!(map.points.len() >= points);

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use trm_plan::{Action, Scenario, ScenarioError, ScenarioOptions, run_scenario};
-use trm_roadmap::{BuildOptions, blocked_exhaustive, build, connect};
+use trm_roadmap::{BuildOptions, Builder, blocked_exhaustive, connect};
 use trm_tasks::Problem;
 
 fn root() -> &'static Path {
@@ -102,14 +102,14 @@ fn objects_follow_their_keyframes_and_goals_switch() {
 #[test]
 fn a_scenario_run_keeps_the_map_valid_reaches_goals_and_is_reproducible() {
     let problem = Problem::load(root().join("specs/reach.ron")).unwrap();
-    let mut map = build(
+    let mut map = Builder::new(
         &problem,
         &BuildOptions {
             points: Some(120),
             ..Default::default()
         },
-        |_| {},
     )
+    .run(|_| {})
     .unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let scenario = Scenario::load(root().join("specs/scenarios/sliding_box.ron")).unwrap();

@@ -33,7 +33,11 @@ impl Roadmap {
             ..Default::default()
         };
         let map = py
-            .detach(|| trm_roadmap::build_connected(&problem, &options, |_| {}))
+            .detach(|| {
+                trm_roadmap::Builder::new(&problem, &options)
+                    .connected()
+                    .run(|_| {})
+            })
             .map_err(err)?;
         Ok(Roadmap { map })
     }

@@ -22,9 +22,9 @@ fn main() -> Result<(), RoadmapError> {
         .unwrap_or_else(|| "target/small.map.json".into());
     let problem = trm_tasks::Problem::from_ron(SPEC, "<example>", std::path::Path::new("."))?;
     // built, then connected (the spec's 6 neighbours, edges checked every 0.05 rad)
-    let map = trm_roadmap::build_connected(&problem, &BuildOptions::default(), |p| {
-        eprint!("\r{} / {} points", p.points, p.target)
-    })?;
+    let map = trm_roadmap::Builder::new(&problem, &BuildOptions::default())
+        .connected()
+        .run(|p| eprint!("\r{} / {} points", p.points, p.target))?;
     eprintln!();
     map.save(&out)?;
     let back = Roadmap::load(&out)?;

@@ -43,7 +43,7 @@ pub struct BuildOptions {
     pub repel_weight: f64,
     /// Write a [`Checkpoint`] while building (and once at the end), to resume a killed build.
     pub checkpoint: Option<CheckpointOptions>,
-    /// The joint step (rad) at which [`build_connected`] checks edges.
+    /// The joint step (rad) at which a connected build ([`Builder::connected`]) checks edges.
     pub edge_resolution: f64,
 }
 
@@ -57,6 +57,24 @@ pub struct CheckpointOptions {
     pub path: PathBuf,
     /// Write one each time the map has grown by this many points.
     pub every: usize,
+}
+
+impl BuildOptions {
+    /// The options that build `map` again (in another world, say): its size, P, seed and edge
+    /// step.
+    pub fn like(map: &Roadmap) -> Self {
+        BuildOptions {
+            points: Some(map.points.len()),
+            searches: Some(map.searches),
+            seed: Some(map.seed),
+            edge_resolution: if map.edge_resolution > 0.0 {
+                map.edge_resolution
+            } else {
+                DEFAULT_EDGE_RESOLUTION
+            },
+            ..Default::default()
+        }
+    }
 }
 
 impl Default for BuildOptions {
@@ -508,23 +526,6 @@ fn active_names(problem: &Problem) -> Vec<String> {
         .collect()
 }
 
-/// Builds the map of a spec (it needs a task function and `map` settings, or their defaults)
-/// on the current rayon pool's threads. Zero or absurd point and search counts are errors.
-///
-/// When P is a multiple of T > 1 threads the build runs as a team of T threads
-/// ([`on_threads`]), each owning P / T searches (asks, evaluations, h_map, tells) and
-/// exchanging once per generation, rather than forking and joining every step of every
-/// generation: the same map, faster (reach map on 2 threads: see the book's Roadmaps page).
-pub fn build(
-    problem: &Problem,
-    options: &BuildOptions,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    on_pool(searches_of(problem, options), progress, |team, progress| {
-        build_with(problem, options, team, progress)
-    })
-}
-
 /// P of a build of `problem` with `options` (before it is checked).
 fn searches_of(problem: &Problem, options: &BuildOptions) -> usize {
     options.searches.unwrap_or_else(|| {
@@ -552,98 +553,120 @@ fn on_pool(
     Ok(map)
 }
 
-/// [`build`] shared among the processes of `team` (e.g. the ranks of an MPI job: every one
-/// calls it with the same problem and options, and every one returns the map): the same map as
-/// [`build`].
-pub fn build_with(
-    problem: &Problem,
-    options: &BuildOptions,
-    team: &mut dyn Team,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    let mut setup = Setup::new(problem, options.points, options.searches, options.seed)?;
-    setup.max_generations = options.max_generations;
-    setup.repel_weight = options.repel_weight;
-    let state = State::fresh(&setup);
-    run(&setup, state, options.checkpoint.as_ref(), team, progress)
-}
-
-/// A map ready to plan with: built ([`build`]) and connected ([`connect`](crate::connect): each point to the
-/// spec's `edge_neighbours` nearest, edges checked every `options.edge_resolution`, which is
-/// checked before any building). Save it with [`Roadmap::save`].
-pub fn build_connected(
-    problem: &Problem,
-    options: &BuildOptions,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    build_connected_on_threads(problem, options, None, progress)
-}
-
-/// [`build_connected`], finishing a killed build from its checkpoint when `resumed` is given
-/// ([`resume`]), on the current rayon pool's threads as [`build`] uses them.
-pub fn build_connected_on_threads(
-    problem: &Problem,
-    options: &BuildOptions,
+/// A map build: the spec's problem built with [`BuildOptions`], optionally connected
+/// (edges to each point's `edge_neighbours` nearest, checked every
+/// [`BuildOptions::edge_resolution`]) and optionally finishing a killed build from its
+/// [`Checkpoint`]; run on the current rayon pool's threads ([`Builder::run`]) or shared
+/// among the processes of a [`Team`] ([`Builder::run_with`]). Save the map with
+/// [`Roadmap::save`].
+///
+/// ```no_run
+/// use trm_roadmap::{BuildOptions, Builder};
+/// let problem = trm_tasks::Problem::load("specs/reach.ron")?;
+/// let map = Builder::new(&problem, &BuildOptions::default())
+///     .connected()
+///     .run(|p| eprintln!("{} points", p.points))?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Builder<'p> {
+    problem: &'p Problem,
+    options: &'p BuildOptions,
     resumed: Option<Checkpoint>,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    let searches = resumed
-        .as_ref()
-        .map_or_else(|| searches_of(problem, options), |c| c.searches);
-    on_pool(searches, progress, |team, progress| {
-        build_connected_with(problem, options, resumed.clone(), team, progress)
-    })
+    connect: bool,
 }
 
-/// [`build_connected`] finishing a killed build from its checkpoint when `resumed` is given
-/// ([`resume_with`]), shared among `team` as [`build_with`] shares a build (the edges too).
-pub fn build_connected_with(
-    problem: &Problem,
-    options: &BuildOptions,
-    resumed: Option<Checkpoint>,
-    team: &mut dyn Team,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    crate::edges::check_edge_resolution(options.edge_resolution)?;
-    let mut map = match resumed {
-        Some(checkpoint) => resume_with(problem, checkpoint, options, team, progress)?,
-        None => build_with(problem, options, team, progress)?,
-    };
-    let neighbours = map.settings.edge_neighbours;
-    crate::edges::connect_with(
-        &mut map,
-        &problem.objective,
-        neighbours,
-        options.edge_resolution,
-        team,
-    )?;
-    Ok(map)
+impl<'p> Builder<'p> {
+    /// A build of `problem`'s map (it needs a task function and `map` settings, or their
+    /// defaults) with `options`. Zero or absurd point and search counts are errors.
+    pub fn new(problem: &'p Problem, options: &'p BuildOptions) -> Self {
+        Builder {
+            problem,
+            options,
+            resumed: None,
+            connect: false,
+        }
+    }
+
+    /// Connects the map once built: each point to the spec's `edge_neighbours` nearest, edges
+    /// checked every `options.edge_resolution` (checked before any building).
+    pub fn connected(mut self) -> Self {
+        self.connect = true;
+        self
+    }
+
+    /// Finishes a build from its [`Checkpoint`] with exactly the map the uninterrupted build
+    /// gives (timing statistics aside). The problem must be [`Checkpoint::problem`]'s. The
+    /// seed, P and the search settings are the checkpoint's: a `seed` or `searches` option
+    /// that differs is an error; `points` may set another target (the build goes on as if it
+    /// had been started with it), and `checkpoint` keeps writing checkpoints.
+    pub fn resume(self, checkpoint: Checkpoint) -> Self {
+        self.resuming(Some(checkpoint))
+    }
+
+    /// [`Builder::resume`] when `checkpoint` is given.
+    pub fn resuming(mut self, checkpoint: Option<Checkpoint>) -> Self {
+        self.resumed = checkpoint;
+        self
+    }
+
+    /// Runs the build on the current rayon pool's threads. When P is a multiple of T > 1
+    /// threads it runs as a team of T threads ([`on_threads`]), each owning P / T searches
+    /// (asks, evaluations, h_map, tells) and exchanging once per generation, rather than
+    /// forking and joining every step of every generation: the same map, faster (reach map on
+    /// 2 threads: see the book's Roadmaps page).
+    pub fn run(self, progress: impl FnMut(&Progress)) -> Result<Roadmap> {
+        let searches = self
+            .resumed
+            .as_ref()
+            .map_or_else(|| searches_of(self.problem, self.options), |c| c.searches);
+        on_pool(searches, progress, |team, progress| {
+            self.clone().run_with(team, progress)
+        })
+    }
+
+    /// Runs the build shared among the processes of `team` (e.g. the ranks of an MPI job:
+    /// every one runs it with the same problem, options and checkpoint, and every one returns
+    /// the map): the same map as [`Builder::run`], the edges shared too.
+    pub fn run_with(self, team: &mut dyn Team, progress: impl FnMut(&Progress)) -> Result<Roadmap> {
+        let (problem, options) = (self.problem, self.options);
+        if self.connect {
+            crate::edges::check_edge_resolution(options.edge_resolution)?;
+        }
+        let (setup, state) = match self.resumed {
+            Some(checkpoint) => resumed_setup(problem, checkpoint, options, team)?,
+            None => {
+                let mut setup =
+                    Setup::new(problem, options.points, options.searches, options.seed)?;
+                setup.max_generations = options.max_generations;
+                setup.repel_weight = options.repel_weight;
+                let state = State::fresh(&setup);
+                (setup, state)
+            }
+        };
+        let mut map = run(&setup, state, options.checkpoint.as_ref(), team, progress)?;
+        if self.connect {
+            let neighbours = map.settings.edge_neighbours;
+            crate::edges::connect_with(
+                &mut map,
+                &problem.objective,
+                neighbours,
+                options.edge_resolution,
+                team,
+            )?;
+        }
+        Ok(map)
+    }
 }
 
-/// Finishes a build from its [`Checkpoint`] with exactly the map the uninterrupted build gives
-/// (timing statistics aside). `problem` is [`Checkpoint::problem`]. The seed, P and the search
-/// settings are the checkpoint's: a `seed` or `searches` option that differs is an error;
-/// `points` may set another target (the build goes on as if it had been started with it), and
-/// `checkpoint` keeps writing checkpoints.
-pub fn resume(
-    problem: &Problem,
+/// The setup and state of a build resumed from `checkpoint`, refused when the options or the
+/// problem are not the checkpoint's.
+fn resumed_setup<'p>(
+    problem: &'p Problem,
     checkpoint: Checkpoint,
     options: &BuildOptions,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
-    on_pool(checkpoint.searches, progress, |team, progress| {
-        resume_with(problem, checkpoint.clone(), options, team, progress)
-    })
-}
-
-/// [`resume`] shared among `team`, as [`build_with`] (every process gives it the checkpoint).
-pub fn resume_with(
-    problem: &Problem,
-    checkpoint: Checkpoint,
-    options: &BuildOptions,
     team: &mut dyn Team,
-    progress: impl FnMut(&Progress),
-) -> Result<Roadmap> {
+) -> Result<(Setup<'p>, State)> {
     for (what, given, stored) in [
         ("seed", options.seed, checkpoint.seed),
         (
@@ -674,7 +697,7 @@ pub fn resume_with(
     setup.max_generations = checkpoint.max_generations;
     setup.repel_weight = checkpoint.repel_weight;
     let state = State::restore(&setup, checkpoint, team)?;
-    run(&setup, state, options.checkpoint.as_ref(), team, progress)
+    Ok((setup, state))
 }
 
 /// Algorithm 2 from `state` on; see the module documentation.

@@ -249,7 +249,7 @@ mod tests {
             }),
             ..Default::default()
         };
-        crate::build(&problem, &options, |_| {}).unwrap();
+        crate::Builder::new(&problem, &options).run(|_| {}).unwrap();
         let good = Checkpoint::load(&path).unwrap();
         let _ = std::fs::remove_file(&path);
         let reread = |c: &Checkpoint| {

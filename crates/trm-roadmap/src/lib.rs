@@ -8,7 +8,7 @@
 //! ```no_run
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
 //! // built and connected (the pieces: `build`, then `connect`)
-//! let map = trm_roadmap::build_connected(&problem, &Default::default(), |p| eprintln!("{} points", p.points))?;
+//! let map = trm_roadmap::Builder::new(&problem, &Default::default()).connected().run(|p| eprintln!("{} points", p.points))?;
 //! map.save("reach.map.json")?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -27,9 +27,8 @@ mod team;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
 pub use build::{
-    BuildOptions, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, MAX_POINTS, MAX_SEARCHES, Progress,
-    build, build_connected, build_connected_on_threads, build_connected_with, build_with,
-    evaluate_on_threads, resume, resume_with,
+    BuildOptions, Builder, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, MAX_POINTS, MAX_SEARCHES,
+    Progress, evaluate_on_threads,
 };
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{MIN_RESOLUTION, check_edge_resolution, connect, connect_with, segment_is_free};

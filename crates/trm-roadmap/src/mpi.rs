@@ -14,7 +14,7 @@
 //! let world = universe.world();
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
 //! let mut ranks = trm_roadmap::mpi::Ranks::new(&world);
-//! let map = trm_roadmap::build_connected_with(&problem, &Default::default(), None, &mut ranks, |_| {})?;
+//! let map = trm_roadmap::Builder::new(&problem, &Default::default()).connected().run_with(&mut ranks, |_| {})?;
 //! if world.rank() == 0 {
 //!     map.save("reach.map.json")?;
 //! }

@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use trm_roadmap::{
-    BlockIndex, BuildOptions, LiveMap, RepairOptions, blocked_exhaustive, build, connect,
+    BlockIndex, BuildOptions, Builder, LiveMap, RepairOptions, blocked_exhaustive, connect,
 };
 use trm_tasks::Problem;
 
@@ -15,14 +15,14 @@ use trm_tasks::Problem;
 fn reach_map(points: usize) -> (Problem, trm_roadmap::Roadmap) {
     let problem =
         Problem::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron")).unwrap();
-    let mut map = build(
+    let mut map = Builder::new(
         &problem,
         &BuildOptions {
             points: Some(points),
             ..Default::default()
         },
-        |_| {},
     )
+    .run(|_| {})
     .unwrap();
     connect(&mut map, &problem.objective, 6, 0.05).unwrap();
     (problem, map)
@@ -113,7 +113,7 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
         points: Some(points),
         ..Default::default()
     };
-    let mut map = build(&problem, &options, |_| {}).unwrap();
+    let mut map = Builder::new(&problem, &options).run(|_| {}).unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let world = World::load(root.join("specs/worlds/reach_with_box.ron")).unwrap();
     let (repaired, report) =
@@ -147,7 +147,9 @@ fn a_repaired_map_is_valid_in_the_new_world_and_covers_like_a_rebuild() {
     );
     let rebuilt_problem = Problem::from_ron(&text, &problem.origin, &root.join("specs")).unwrap();
     let started = std::time::Instant::now();
-    let rebuilt = build(&rebuilt_problem, &options, |_| {}).unwrap();
+    let rebuilt = Builder::new(&rebuilt_problem, &options)
+        .run(|_| {})
+        .unwrap();
     eprintln!("rebuild {:.2} s", started.elapsed().as_secs_f64());
     let (ours, theirs) = (repaired.occupied_cells(), rebuilt.occupied_cells());
     eprintln!(

@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build, build_connected,
-    build_connected_with, connect, on_threads, resume,
+    BuildOptions, Builder, Checkpoint, CheckpointOptions, Roadmap, Team, connect, on_threads,
 };
 use trm_tasks::Problem;
 
@@ -24,7 +23,7 @@ fn small(problem: &Problem, threads: usize) -> Roadmap {
         .build()
         .unwrap()
         .install(|| {
-            let mut map = build(problem, &options, |_| {}).unwrap();
+            let mut map = Builder::new(problem, &options).run(|_| {}).unwrap();
             connect(&mut map, &problem.objective, 6, 0.05).unwrap();
             map
         })
@@ -83,14 +82,14 @@ fn resumed_builds_give_the_uninterrupted_map() {
             .build()
             .unwrap()
     };
-    let whole = build(
+    let whole = Builder::new(
         &problem,
         &BuildOptions {
             points: Some(60),
             ..Default::default()
         },
-        |_| {},
     )
+    .run(|_| {})
     .unwrap();
     let path = tmp("resume.checkpoint");
     let first = BuildOptions {
@@ -104,12 +103,13 @@ fn resumed_builds_give_the_uninterrupted_map() {
     // checkpoints in the middle: seen by the progress callback after they are written
     let mut middle = None;
     pool(1).install(|| {
-        build(&problem, &first, |p| {
-            if p.points >= 20 && middle.is_none() {
-                middle = Some(Checkpoint::load(&path).unwrap());
-            }
-        })
-        .unwrap()
+        Builder::new(&problem, &first)
+            .run(|p| {
+                if p.points >= 20 && middle.is_none() {
+                    middle = Some(Checkpoint::load(&path).unwrap());
+                }
+            })
+            .unwrap()
     });
     let middle = middle.unwrap();
     assert!((10..35).contains(&middle.points()), "{}", middle.points());
@@ -122,7 +122,11 @@ fn resumed_builds_give_the_uninterrupted_map() {
             ..Default::default()
         };
         let resumed = pool(2)
-            .install(|| resume(&problem, checkpoint, &options, |_| {}))
+            .install(|| {
+                Builder::new(&problem, &options)
+                    .resume(checkpoint)
+                    .run(|_| {})
+            })
             .unwrap();
         assert_eq!(resumed.points, whole.points);
         assert_eq!(resumed.stats.evaluations, whole.stats.evaluations);
@@ -131,15 +135,15 @@ fn resumed_builds_give_the_uninterrupted_map() {
     }
     // changed settings, damaged files
     let checkpoint = Checkpoint::load(&path).unwrap();
-    let e = resume(
+    let e = Builder::new(
         &problem,
-        checkpoint.clone(),
         &BuildOptions {
             seed: Some(7),
             ..Default::default()
         },
-        |_| {},
     )
+    .resume(checkpoint.clone())
+    .run(|_| {})
     .unwrap_err()
     .to_string();
     assert!(
@@ -148,7 +152,9 @@ fn resumed_builds_give_the_uninterrupted_map() {
     );
     let specs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs");
     let other = Problem::from_ron(&format!("{} ", problem.text), &problem.origin, &specs).unwrap();
-    let e = resume(&other, checkpoint, &BuildOptions::default(), |_| {})
+    let e = Builder::new(&other, &BuildOptions::default())
+        .resume(checkpoint)
+        .run(|_| {})
         .unwrap_err()
         .to_string();
     assert!(e.contains("Checkpoint::problem"), "{e}");
@@ -205,11 +211,16 @@ fn a_build_shared_among_processes_gives_the_map_of_one() {
         points: Some(40),
         ..Default::default()
     };
-    let alone =
-        build_connected_with(&problem, &options, None, &mut trm_roadmap::Solo, |_| {}).unwrap();
+    let alone = Builder::new(&problem, &options)
+        .connected()
+        .run_with(&mut trm_roadmap::Solo, |_| {})
+        .unwrap();
     for size in [2, 3] {
         let maps = on_team(size, |team| {
-            build_connected_with(&problem, &options, None, team, |_| {}).unwrap()
+            Builder::new(&problem, &options)
+                .connected()
+                .run_with(team, |_| {})
+                .unwrap()
         });
         for (rank, map) in maps.iter().enumerate() {
             assert_eq!(map.points, alone.points, "{size} processes, rank {rank}");
@@ -228,13 +239,20 @@ fn a_build_shared_among_processes_gives_the_map_of_one() {
         ..Default::default()
     };
     on_team(3, |team| {
-        build_connected_with(&problem, &first, None, team, |_| {}).unwrap()
+        Builder::new(&problem, &first)
+            .connected()
+            .run_with(team, |_| {})
+            .unwrap()
     });
     let checkpoint = Checkpoint::load(&path).unwrap();
     assert_eq!(checkpoint.points(), 25);
     let maps = on_team(2, |team| {
         let checkpoint = checkpoint.clone();
-        build_connected_with(&problem, &options, Some(checkpoint), team, |_| {}).unwrap()
+        Builder::new(&problem, &options)
+            .connected()
+            .resume(checkpoint)
+            .run_with(team, |_| {})
+            .unwrap()
     });
     for map in maps {
         assert_eq!(map.points, alone.points);
@@ -257,7 +275,7 @@ fn a_build_shared_among_processes_gives_the_map_of_one() {
         .num_threads(2)
         .build()
         .unwrap()
-        .install(|| build_connected(&problem, &nowhere, |_| {}))
+        .install(|| Builder::new(&problem, &nowhere).connected().run(|_| {}))
         .unwrap_err()
         .to_string();
     assert!(e.contains("not-a-dir"), "{e}");
@@ -293,7 +311,8 @@ fn maps_round_trip_through_files_and_bad_files_are_clear_errors() {
 fn a_spec_without_a_task_function_cannot_make_a_map() {
     let text = "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)])";
     let problem = Problem::from_ron(text, "notask.ron", Path::new(".")).unwrap();
-    let e = build(&problem, &BuildOptions::default(), |_| {})
+    let e = Builder::new(&problem, &BuildOptions::default())
+        .run(|_| {})
         .unwrap_err()
         .to_string();
     assert!(e.contains("no task function"), "{e}");
@@ -306,7 +325,9 @@ fn a_small_map_on_the_planar_arm_covers_its_workspace() {
         task: Some(Position(part: \"tool\", mask: (true, true, false))),
         map: Some((spacing: 0.2, max_points: 40, construct_weight: 5.0, searches: 2)))";
     let problem = Problem::from_ron(text, "arm.ron", Path::new(".")).unwrap();
-    let map = build(&problem, &BuildOptions::default(), |_| {}).unwrap();
+    let map = Builder::new(&problem, &BuildOptions::default())
+        .run(|_| {})
+        .unwrap();
     assert_eq!(map.points.len(), 40);
     // grown from the stretched start (x = 2.3) along the rim of the reachable disc: over seeds
     // 1–7 the 40 points span 0.69–1.3 m in x and 1.85–2.7 m in y
@@ -329,15 +350,15 @@ fn every_fig6_spec_builds_a_non_trivial_map() {
     assert_eq!(specs.len(), 10);
     for spec in specs {
         let problem = Problem::load(&spec).unwrap();
-        let map = build(
+        let map = Builder::new(
             &problem,
             &BuildOptions {
                 points: Some(15),
                 searches: Some(2),
                 ..Default::default()
             },
-            |_| {},
         )
+        .run(|_| {})
         .unwrap();
         assert_eq!(
             map.points.len(),
@@ -376,7 +397,10 @@ fn zero_counts_and_a_zero_step_are_errors_not_hangs() {
             ..Default::default()
         },
     ] {
-        let e = build(&problem, &options, |_| {}).unwrap_err().to_string();
+        let e = Builder::new(&problem, &options)
+            .run(|_| {})
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("give 1 to"), "{e}");
     }
     let mut map = small(&problem, 1);
@@ -448,15 +472,15 @@ fn the_failure_limit_counts_all_failures_or_consecutive_ones() {
             .replace("failure_limit: 60,", setting)
             .replace("spacing: 0.025,", "spacing: 0.08,");
         let problem = Problem::from_ron(&spec, "reach.ron", &root.join("specs")).unwrap();
-        build(
+        Builder::new(
             &problem,
             &BuildOptions {
                 // a wide spacing: the workspace fills up and searches fail
                 points: Some(400),
                 ..Default::default()
             },
-            |_| {},
         )
+        .run(|_| {})
         .unwrap()
     };
     let total = with("failure_limit: 3,");
@@ -492,8 +516,11 @@ fn build_connected_is_build_then_connect_and_checks_the_resolution_first() {
         edge_resolution: 0.07,
         ..Default::default()
     };
-    let one = trm_roadmap::build_connected(&problem, &options, |_| {}).unwrap();
-    let mut two = build(&problem, &options, |_| {}).unwrap();
+    let one = trm_roadmap::Builder::new(&problem, &options)
+        .connected()
+        .run(|_| {})
+        .unwrap();
+    let mut two = Builder::new(&problem, &options).run(|_| {}).unwrap();
     let neighbours = two.settings.edge_neighbours;
     connect(&mut two, &problem.objective, neighbours, 0.07).unwrap();
     assert_eq!(one.points, two.points);
@@ -504,7 +531,10 @@ fn build_connected_is_build_then_connect_and_checks_the_resolution_first() {
         edge_resolution: f64::NAN,
         ..options
     };
-    let e = trm_roadmap::build_connected(&problem, &bad, |_| built = true).unwrap_err();
+    let e = trm_roadmap::Builder::new(&problem, &bad)
+        .connected()
+        .run(|_| built = true)
+        .unwrap_err();
     assert!(e.to_string().contains("edge resolution"), "{e}");
     assert!(!built, "the resolution is checked before building");
 }

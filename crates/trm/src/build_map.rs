@@ -5,10 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use trm_roadmap::{
-    BuildOptions, Checkpoint, CheckpointOptions, Roadmap, Team, build_connected_on_threads,
-    build_connected_with,
-};
+use trm_roadmap::{BuildOptions, Builder, Checkpoint, CheckpointOptions, Roadmap, Team};
 use trm_tasks::Problem;
 
 /// Arguments of `build-map`.
@@ -194,8 +191,14 @@ impl Job<'_> {
                 );
             };
             let map = match team {
-                Some(team) => build_connected_with(problem, options, resumed, team, report)?,
-                None => build_connected_on_threads(problem, options, resumed, report)?,
+                Some(team) => Builder::new(problem, options)
+                    .connected()
+                    .resuming(resumed)
+                    .run_with(team, report)?,
+                None => Builder::new(problem, options)
+                    .connected()
+                    .resuming(resumed)
+                    .run(report)?,
             };
             if writes {
                 progress.finish();

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use trm_roadmap::{BuildOptions, RepairOptions, RepairReport, Roadmap, build};
+use trm_roadmap::{BuildOptions, Builder, RepairOptions, RepairReport, Roadmap};
 
 /// Arguments of `repair-map`.
 #[derive(clap::Args)]
@@ -77,18 +77,8 @@ pub fn run(args: &Args) -> Result<()> {
         let mut fresh = map.problem_with(&trm_taskmap::loaders())?;
         fresh.objective.set_world(world.clone());
         let started = Instant::now();
-        let rebuilt = pool.install(|| {
-            build(
-                &fresh,
-                &BuildOptions {
-                    points: Some(map.points.len()),
-                    searches: Some(map.searches),
-                    seed: Some(map.seed),
-                    ..Default::default()
-                },
-                |_| {},
-            )
-        })?;
+        let rebuilt =
+            pool.install(|| Builder::new(&fresh, &BuildOptions::like(&map)).run(|_| {}))?;
         let rebuild_seconds = started.elapsed().as_secs_f64();
         println!(
             "rebuild in the new world: {} points, {} occupied cells in {rebuild_seconds:.2} s (edges not built); repair: {:.0} % of its coverage in {:.0} % of its time",

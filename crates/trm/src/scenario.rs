@@ -98,21 +98,10 @@ fn check_rebuilds(map: &Roadmap, run: &ScenarioRun, options: &ScenarioOptions) -
     for k in failed {
         let mut problem = map.problem_with(&trm_taskmap::loaders())?;
         problem.objective.set_world(run.worlds[k].clone());
-        let rebuilt = trm_roadmap::build_connected(
-            &problem,
-            &trm_roadmap::BuildOptions {
-                points: Some(map.points.len()),
-                searches: Some(map.searches),
-                seed: Some(map.seed),
-                edge_resolution: if map.edge_resolution > 0.0 {
-                    map.edge_resolution
-                } else {
-                    trm_roadmap::DEFAULT_EDGE_RESOLUTION
-                },
-                ..Default::default()
-            },
-            |_| {},
-        )?;
+        let like = trm_roadmap::BuildOptions::like(map);
+        let rebuilt = trm_roadmap::Builder::new(&problem, &like)
+            .connected()
+            .run(|_| {})?;
         let active = problem.objective.active();
         let q = active.from_motors(&run.motion.positions[k]);
         let Some(goal) = run.steps[k].goal.clone() else {

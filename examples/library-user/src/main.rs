@@ -16,7 +16,7 @@ use rand::{Rng, RngExt, SeedableRng};
 use trm_kinematics::{FrameId, PostureFile};
 use trm_optim::{OptimError, Optimizer, Population, Start, State};
 use trm_plan::{Goal, PlanOptions, Planner, Trajectory};
-use trm_roadmap::{BuildOptions, Roadmap};
+use trm_roadmap::{BuildOptions, Builder, Roadmap};
 use trm_tasks::{Comparison, Context, Cost, Problem};
 
 /// Our own cost: squared height of a frame below a plane, zero above it.
@@ -117,7 +117,7 @@ fn main() -> Result<(), Box<dyn Error>> {
 
     // 1. build a map from our spec
     let problem = Problem::load(&spec)?;
-    let map = trm_roadmap::build_connected(&problem, &BuildOptions::default(), |_| {})?;
+    let map = trm_roadmap::Builder::new(&problem, &BuildOptions::default()).connected().run(|_| {})?;
     let map_file = out.join("right_hand.map.json");
     map.save(&map_file)?;
     let summary = map.summary();
