@@ -80,6 +80,26 @@ pub struct RepairReport {
     pub seconds: [f64; 3],
 }
 
+impl std::fmt::Display for RepairReport {
+    /// One line: what was blocked, restored and grown, and the coverage lost and regained.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let report = self;
+        write!(
+            f,
+            "blocked: {} nodes, {} edges parked; restored from the parked ones: {} nodes, {} edges; grown: {} nodes, {} edges ({}); lost cells of side d: {}, {} hold a point again",
+            report.blocked_nodes,
+            report.blocked_edges,
+            report.restored_nodes,
+            report.restored_edges,
+            report.added_nodes,
+            report.added_edges,
+            report.stopped_because,
+            report.lost_cells,
+            report.restored_cells
+        )
+    }
+}
+
 /// A map kept valid in a changing world; see the module documentation.
 pub struct LiveMap<'p> {
     problem: &'p Problem,

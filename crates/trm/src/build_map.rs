@@ -211,33 +211,16 @@ impl Job<'_> {
         crate::write_atomic(out, map.to_json(out)?.as_bytes())?;
         print_summary(&map);
         let svg = out.with_extension("svg");
-        crate::write_atomic(&svg, scatter(&map, None)?.as_bytes())?;
+        crate::write_atomic(&svg, crate::plot::map_scatter(&map, None)?.as_bytes())?;
         println!("wrote {} and {}", out.display(), svg.display());
         if args.view {
             let mut scene =
                 trm_view::Scene::of_problem(problem, &format!("map of {}", problem.origin))?;
             scene.add_roadmap(&map, problem.objective.active())?;
-            crate::view::write_scene(&scene, &crate::view::scene_path(out))?;
+            crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(out))?;
         }
         Ok(())
     }
-}
-
-/// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
-/// coloured by task cost, like Fig. 3 of the parallel paper; with `path`, the task-space path
-/// is drawn over them.
-pub fn scatter(map: &Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
-    let at = |t: &[f64], i: usize| t.get(i).copied().unwrap_or(0.0);
-    let points: Vec<[f64; 3]> = map
-        .points
-        .iter()
-        .map(|p| [at(&p.t, 0), at(&p.t, 1), at(&p.t, 2)])
-        .collect();
-    let costs: Vec<f64> = map.points.iter().map(|p| p.cost).collect();
-    let path: Option<Vec<[f64; 3]>> =
-        path.map(|p| p.iter().map(|t| [at(t, 0), at(t, 1), at(t, 2)]).collect());
-    let title = format!("{} points, task `{}`", map.points.len(), map.task);
-    crate::plot::scatter_points(&title, &points, &costs, path.as_deref())
 }
 
 /// Prints what `world` blocks in `map`: through the index (built once, then timed over

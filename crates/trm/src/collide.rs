@@ -13,7 +13,7 @@ pub struct Args {
     /// A .urdf file or a .ron model description; the embedded iCub upper body when absent.
     model: Option<PathBuf>,
     #[command(flatten)]
-    configs: crate::fk::ConfigsArgs,
+    configs: crate::support::configs::ConfigsArgs,
     /// World objects (RON: crates/trm-collision/docs/world.md; or a MoveIt planning scene .yaml), checked as well.
     #[arg(long)]
     world: Option<PathBuf>,
@@ -154,7 +154,7 @@ mod tests {
         let out = dir.join("out.json");
         run(&Args {
             model: None,
-            configs: crate::fk::ConfigsArgs {
+            configs: crate::support::configs::ConfigsArgs {
                 path: input,
                 outside_limits: false,
             },

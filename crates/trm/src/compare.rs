@@ -131,7 +131,7 @@ pub fn run(args: &Args) -> Result<()> {
                 }
             }
             let page = args.out_dir.join(format!("posture{}.scene.html", p + 1));
-            crate::view::write_scene(&scene, &page)?;
+            crate::support::scene::write_scene(&scene, &page)?;
         }
     }
     Ok(())

@@ -5,9 +5,9 @@
 
 use std::path::PathBuf;
 
+use crate::support::taskmap::explore_spec;
 use anyhow::Result;
 pub use trm_taskmap::Explored;
-use trm_taskmap::TaskMapSpec;
 
 /// Arguments of `explore-task-map`.
 #[derive(clap::Args)]
@@ -17,16 +17,6 @@ pub struct Args {
     /// Output file (default: target/taskmaps/<spec name>.taskmap.json; an .svg goes beside it).
     #[arg(long)]
     out: Option<PathBuf>,
-}
-
-/// Reads a task-map spec, finds the first grasp if needed and explores the map.
-pub fn explore_spec(path: &std::path::Path) -> Result<Explored> {
-    let loaded = TaskMapSpec::load(path)?;
-    let explored = loaded.explore()?;
-    if loaded.spec.start.is_none() {
-        eprintln!("first grasp found by search: {:?}", explored.start);
-    }
-    Ok(explored)
 }
 
 impl Args {

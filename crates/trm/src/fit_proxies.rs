@@ -271,8 +271,12 @@ mod committed {
         );
         let description = dir.join(format!("{name}.ron"));
         // the steps after fitting read the fitted URDF just written (the same bytes)
-        crate::model_info::write_srdf_description(&fitted, &robot.join(srdf), &description)
-            .unwrap();
+        crate::support::description::write_srdf_description(
+            &fitted,
+            &robot.join(srdf),
+            &description,
+        )
+        .unwrap();
         if let Some((posture, samples)) = acm {
             use clap::Parser;
             let path = description.to_str().unwrap();
@@ -289,10 +293,7 @@ mod committed {
                 path,
             ])
             .unwrap();
-            let crate::Command::GenAcm(args) = cli.command else {
-                unreachable!("parsed as gen-acm")
-            };
-            crate::gen_acm::run(&args).unwrap();
+            crate::dispatch(cli.command).unwrap();
         }
         // the written `urdf` field is relative to the output: compare the rest
         let body = |text: String| -> String {

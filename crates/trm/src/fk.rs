@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
+use crate::support::configs::ConfigsArgs;
 use anyhow::{Context, Result};
 use serde_json::{Map, Value, json};
-use trm_kinematics::ConfigurationsFile;
 
 /// Arguments of `fk`.
 #[derive(clap::Args)]
@@ -26,43 +26,6 @@ fn pose_json(p: &nalgebra::Isometry3<f64>) -> Value {
         "p": [p.translation.x, p.translation.y, p.translation.z],
         "R": [[m[(0, 0)], m[(0, 1)], m[(0, 2)]], [m[(1, 0)], m[(1, 1)], m[(1, 2)]], [m[(2, 0)], m[(2, 1)], m[(2, 2)]]],
     })
-}
-
-/// The configurations a command reads (`fk`, `collide`).
-#[derive(clap::Args)]
-pub struct ConfigsArgs {
-    /// Input: {"joint_names": [...], "samples": [{"q": [...]}, ...]} (URDF joint names, radians).
-    #[arg(long = "configs")]
-    pub path: PathBuf,
-    /// Accept joint values outside the URDF limits (refused by default).
-    #[arg(long)]
-    pub outside_limits: bool,
-}
-
-impl ConfigsArgs {
-    /// The parsed file and, per sample, the full joint vector (joints not named are 0; mimic
-    /// joints not named follow their leader).
-    pub fn read(
-        &self,
-        model: &trm_kinematics::RobotModel,
-    ) -> Result<(ConfigurationsFile, Vec<Vec<f64>>)> {
-        let path = &self.path;
-        let configs = ConfigurationsFile::load(path)?;
-        let missing = configs.missing_joints(model);
-        if !missing.is_empty() {
-            eprintln!(
-                "note: {} joints not in joint_names are set to 0 (mimic joints follow their leader): {}",
-                missing.len(),
-                missing.join(", ")
-            );
-        }
-        let all = if self.outside_limits {
-            configs.joint_vectors_outside_limits(model, path)?
-        } else {
-            configs.joint_vectors(model, path)?
-        };
-        Ok((configs, all))
-    }
 }
 
 /// Computes and writes the poses.

@@ -25,6 +25,7 @@ mod repair_map;
 mod scenario;
 mod solve;
 mod stand_up;
+mod support;
 mod view;
 
 use std::path::{Path, PathBuf};

@@ -57,7 +57,7 @@ pub struct Args {
 
 fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
     let active = problem.objective.active();
-    let motors = crate::view::posture_motors(
+    let motors = crate::support::scene::posture_motors(
         path,
         &problem.robot,
         Some(active),
@@ -105,7 +105,7 @@ pub fn run(args: &Args) -> Result<()> {
                 path.display(),
                 started.elapsed().as_secs_f64()
             );
-            crate::repair_map::print_report(&report);
+            println!("{report}");
             *map = repaired;
         }
     }
@@ -210,7 +210,7 @@ pub fn run(args: &Args) -> Result<()> {
         let svg = out.with_extension("svg");
         crate::write_atomic(
             &svg,
-            crate::build_map::scatter(first, Some(&plan.trajectory.task_path))?.as_bytes(),
+            crate::plot::map_scatter(first, Some(&plan.trajectory.task_path))?.as_bytes(),
         )?;
         println!(
             "wrote {}, {}, {} (ROS 2 JointTrajectory) and {}",
@@ -239,7 +239,7 @@ pub fn run(args: &Args) -> Result<()> {
             .out
             .clone()
             .unwrap_or_else(|| PathBuf::from("target/plan.csv"));
-        crate::view::write_scene(&scene, &crate::view::scene_path(&out))?;
+        crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))?;
     }
     Ok(())
 }

@@ -180,6 +180,23 @@ pub fn scatter_points(
     Ok(svg)
 }
 
+/// A 3-D scatter of the task points (the first three task dimensions; fewer are padded with 0)
+/// coloured by task cost, like Fig. 3 of the parallel paper; with `path`, the task-space path
+/// is drawn over them.
+pub fn map_scatter(map: &trm_roadmap::Roadmap, path: Option<&[Vec<f64>]>) -> Result<String> {
+    let at = |t: &[f64], i: usize| t.get(i).copied().unwrap_or(0.0);
+    let points: Vec<[f64; 3]> = map
+        .points
+        .iter()
+        .map(|p| [at(&p.t, 0), at(&p.t, 1), at(&p.t, 2)])
+        .collect();
+    let costs: Vec<f64> = map.points.iter().map(|p| p.cost).collect();
+    let path: Option<Vec<[f64; 3]>> =
+        path.map(|p| p.iter().map(|t| [at(t, 0), at(t, 1), at(t, 2)]).collect());
+    let title = format!("{} points, task `{}`", map.points.len(), map.task);
+    scatter_points(&title, &points, &costs, path.as_deref())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,7 +13,7 @@ use trm_kinematics::nalgebra::{Isometry3, Vector3};
 use trm_plan::{Trajectory, time_parametrise};
 use trm_taskmap::MotionGoal;
 
-use crate::explore_task_map::explore_spec;
+use crate::support::taskmap::explore_spec;
 
 /// Arguments of `reach-grasp`.
 #[derive(clap::Args)]

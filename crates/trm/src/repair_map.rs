@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use trm_roadmap::{BuildOptions, Builder, RepairOptions, RepairReport, Roadmap};
+use trm_roadmap::{BuildOptions, Builder, RepairOptions, Roadmap};
 
 /// Arguments of `repair-map`.
 #[derive(clap::Args)]
@@ -55,7 +55,7 @@ pub fn run(args: &Args) -> Result<()> {
     let (repaired, report) =
         pool.install(|| trm_roadmap::repair(&map, &problem, &world, &RepairOptions::default()))?;
     let seconds = started.elapsed().as_secs_f64();
-    print_report(&report);
+    println!("{report}");
     println!(
         "repaired in {seconds:.2} s (finding what is blocked {:.3} s, growing {:.2} s, connecting {:.2} s); {} points, {} edges, {} occupied cells (before: {})",
         report.seconds[0],
@@ -91,20 +91,4 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&out, repaired.to_json(&out)?.as_bytes())?;
     println!("wrote {}", out.display());
     Ok(())
-}
-
-/// Prints what a repair did (also for `plan --repair`).
-pub fn print_report(report: &RepairReport) {
-    println!(
-        "blocked: {} nodes, {} edges parked; restored from the parked ones: {} nodes, {} edges; grown: {} nodes, {} edges ({}); lost cells of side d: {}, {} hold a point again",
-        report.blocked_nodes,
-        report.blocked_edges,
-        report.restored_nodes,
-        report.restored_edges,
-        report.added_nodes,
-        report.added_edges,
-        report.stopped_because,
-        report.lost_cells,
-        report.restored_cells
-    );
 }

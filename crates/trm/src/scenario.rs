@@ -80,7 +80,7 @@ pub fn run(args: &Args) -> Result<()> {
         run.motion.to_ros_yaml(&problem.robot, &ros)?.as_bytes(),
     )?;
     let scene = trm_view::Scene::of_scenario(&problem, &run)?;
-    crate::view::write_scene(&scene, &dir.join("scenario.scene.html"))?;
+    crate::support::scene::write_scene(&scene, &dir.join("scenario.scene.html"))?;
     println!(
         "wrote steps.md, steps.csv, motion.csv (+ .json, .ros.yaml) in {}",
         dir.display()

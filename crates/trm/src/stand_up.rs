@@ -377,7 +377,7 @@ fn write_view(problem: &WholeBody, s: &Comparison, path: &Path) -> Result<()> {
         scene.add_frame_at(r.times[i], &r.q[i], &problem.root_pose(&r.q[i]))?;
     }
     scene.set_path(r.com.clone());
-    crate::view::write_scene(&scene, path)
+    crate::support::scene::write_scene(&scene, path)
 }
 
 /// The optimised motion as CSV ([`trm_wholebody::Rollout::to_csv`]) and, beside it, as a ROS 2

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::support::scene::{posture_motors, write_scene};
 use anyhow::{Context, Result};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::nalgebra::Isometry3;
@@ -145,17 +146,6 @@ fn home(robot: &RobotModel) -> Vec<f64> {
         .unwrap_or_else(|_| robot.neutral_motors())
 }
 
-/// Motor values from a posture file: "motors": {name: value} over `start`, or "q": [active
-/// values] when `active` is known.
-pub fn posture_motors(
-    path: &Path,
-    robot: &RobotModel,
-    active: Option<&ActiveSet>,
-    start: &[f64],
-) -> Result<Vec<f64>> {
-    Ok(trm_kinematics::PostureFile::load(path)?.to_motors(robot, active, start, path)?)
-}
-
 /// Timed postures (time, motor values).
 type Frames = Vec<(f64, Vec<f64>)>;
 
@@ -169,47 +159,6 @@ fn trajectory(path: &Path, robot: &RobotModel, start: &[f64]) -> Result<(Frames,
         frames,
         t.task_path.iter().map(|p| trm_view::point3(p)).collect(),
     ))
-}
-
-/// Where a command's `--view` page goes: beside `out`, named `<stem>.scene.html`.
-pub fn scene_path(out: &Path) -> PathBuf {
-    let stem = out
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().to_string());
-    out.with_file_name(format!("{stem}.scene.html"))
-}
-
-/// Writes `out` (.html) and the scene beside it (.json); the page inlines the viewer bundle when
-/// `viewer/dist/viewer.js` exists, else it loads three.js from a CDN.
-pub fn write_scene(scene: &Scene, out: &Path) -> Result<()> {
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let repo = crate::models_dir().join("..");
-    let bundle = trm_view::find_bundle(&repo)?;
-    crate::write_atomic(&out.with_extension("json"), scene.to_json()?.as_bytes())?;
-    crate::write_atomic(out, scene.to_html(bundle.as_deref())?.as_bytes())?;
-    let how = if bundle.is_some() {
-        "three.js inlined, works offline".to_string()
-    } else {
-        format!(
-            "loads three.js {} from a CDN; `npm ci && npm run build` in viewer/ makes it offline",
-            trm_view::THREE_VERSION
-        )
-    };
-    eprintln!(
-        "wrote {} ({how}) and {}: {} bodies, {} frames{}",
-        out.display(),
-        out.with_extension("json").display(),
-        scene.bodies.len(),
-        scene.frames.len(),
-        scene
-            .map
-            .as_ref()
-            .map(|m| format!(", {} map points, {} edges", m.points.len(), m.edges.len()))
-            .unwrap_or_default()
-    );
-    Ok(())
 }
 
 /// Runs the command.
