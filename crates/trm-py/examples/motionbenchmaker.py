@@ -11,7 +11,7 @@ import trm
 ROOT = Path(__file__).resolve().parents[3]
 
 result = trm.benchmark_mbm(
-    str(ROOT / "crates" / "trm-plan" / "tests" / "fixtures" / "mbm"),
+    str(ROOT / "crates" / "trm-mbm" / "tests" / "fixtures" / "mbm"),
     str(ROOT / "models" / "panda-mbm" / "panda.ron"),
     per_family=1,
     verify=True,

@@ -331,10 +331,10 @@ def test_an_optimiser_refuses_values_for_other_candidates():
 
 
 def test_worlds_load_from_moveit_scenes(tmp_path):
-    scene = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/scene0001.yaml"
+    scene = ROOT / "crates/trm-mbm/tests/fixtures/mbm/box_panda/scene0001.yaml"
     world = trm.World.load(str(scene))
     assert len(world.names) == 7
-    request = ROOT / "crates/trm-plan/tests/fixtures/mbm/box_panda/request0001.yaml"
+    request = ROOT / "crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml"
     with pytest.raises(trm.TrmError, match="request0001.yaml"):
         trm.World.load(str(request))
 
@@ -355,7 +355,7 @@ def test_table_iii_from_python_is_seeded_and_complete():
 
 
 def test_motionbenchmaker_from_python_solves_and_verifies():
-    fixtures = ROOT / "crates" / "trm-plan" / "tests" / "fixtures" / "mbm"
+    fixtures = ROOT / "crates" / "trm-mbm" / "tests" / "fixtures" / "mbm"
     model = str(ROOT / "models" / "panda-mbm" / "panda.ron")
     r = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True)
     assert len(r["runs"]) == 2 and all(run["family"] == "box_panda" for run in r["runs"])
