@@ -16,12 +16,14 @@
 mod error;
 mod planner;
 pub mod pose_goal;
+mod query;
 pub mod rrt;
 pub mod scenario;
 mod trajectory;
 
 pub use error::PlanError;
-pub use planner::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned, Planner};
+pub use planner::{Planner, RETRIEVE_STEPS};
+pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{
     Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,
 };

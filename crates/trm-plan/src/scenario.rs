@@ -36,7 +36,8 @@ use trm_roadmap::{LiveMap, RepairOptions, Roadmap, RoadmapError};
 use trm_tasks::Problem;
 
 use crate::PlanError;
-use crate::planner::{Goal, PlanOptions, Planner};
+use crate::planner::Planner;
+use crate::query::{Goal, PlanOptions};
 use crate::trajectory::Trajectory;
 
 /// What can go wrong with a scenario.

@@ -15,6 +15,7 @@
 
 mod blocked;
 mod build;
+mod builder;
 mod checkpoint;
 mod edges;
 mod error;
@@ -26,10 +27,8 @@ mod repair;
 mod team;
 
 pub use blocked::{BlockIndex, Blocked, Changes, blocked_exhaustive};
-pub use build::{
-    BuildOptions, Builder, CheckpointOptions, DEFAULT_EDGE_RESOLUTION, MAX_POINTS, MAX_SEARCHES,
-    Progress, evaluate_on_threads,
-};
+pub use build::{MAX_POINTS, MAX_SEARCHES, Progress, evaluate_on_threads};
+pub use builder::{BuildOptions, Builder, CheckpointOptions, DEFAULT_EDGE_RESOLUTION};
 pub use checkpoint::{CHECKPOINT_FORMAT, CHECKPOINT_VERSION, Checkpoint};
 pub use edges::{MIN_RESOLUTION, check_edge_resolution, connect, connect_with, segment_is_free};
 pub use error::{Result, RoadmapError};
