@@ -53,7 +53,7 @@ pub struct CollisionObject {
 pub struct AllowedCollisions {
     /// Entry names (links or objects).
     pub names: Vec<String>,
-    /// `allowed[i][j]`: the pair (names[i], names[j]) is not checked.
+    /// `allowed[i][j]`: the pair (`names[i]`, `names[j]`) is not checked.
     pub allowed: Vec<Vec<bool>>,
 }
 

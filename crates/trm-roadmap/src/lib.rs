@@ -1,13 +1,13 @@
 //! Task-relevant roadmaps: maps of postures that evenly cover a task space while satisfying a
 //! task's costs (Stollenga et al., IROS 2013; parallel E-TRM of Stollenga, Schmidhuber and
-//! Gomez). [`build`] grows a map with P concurrent xNES searches (writing [`Checkpoint`]s that
-//! [`resume`] finishes exactly; [`build_with`] shares a build among processes, e.g. the ranks
-//! of an MPI job with the `mpi` feature's `trm_roadmap::mpi`), [`connect`] adds
+//! Gomez). [`Builder`] grows a map with P concurrent xNES searches (writing [`Checkpoint`]s that
+//! [`Builder::resume`] finishes exactly; [`Builder::run_with`] shares a build among processes,
+//! e.g. the ranks of an MPI job with the `mpi` feature's `trm_roadmap::mpi`), [`connect`] adds
 //! configuration-space edges, and [`Roadmap`] saves and loads map files.
 //!
 //! ```no_run
 //! let problem = trm_tasks::Problem::load("specs/reach.ron")?;
-//! // built and connected (the pieces: `build`, then `connect`)
+//! // built and connected (the pieces: `Builder::run`, then `connect`)
 //! let map = trm_roadmap::Builder::new(&problem, &Default::default()).connected().run(|p| eprintln!("{} points", p.points))?;
 //! map.save("reach.map.json")?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())

@@ -14,7 +14,7 @@ use crate::error::{Result, RoadmapError};
 /// they exchange the searches' centres and outcomes. Every evaluation gives the same bits
 /// wherever it runs and the map changes only between generations, in search order, so a seed
 /// and P give the same map on any number of processes × threads. [`Solo`] is this process
-/// alone, [`on_threads`] makes threads of this process a team (what [`crate::build`] does on
+/// alone, [`on_threads`] makes threads of this process a team (what [`crate::Builder::run`] does on
 /// several threads), the `mpi` feature's `trm_roadmap::mpi::Ranks` are the ranks of an MPI
 /// communicator.
 pub trait Team {

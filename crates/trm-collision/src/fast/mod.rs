@@ -13,16 +13,16 @@
 //! anything between is *uncertain*. A lane with an uncertain pair and no certain collision is
 //! handed back ([`Verdict::uncertain`]) for the exact `f64` check, so a caller that checks those
 //! lanes exactly answers as the `f64` path does, configuration by configuration (tested on
-//! random configurations of the Panda against [`CollisionModel::is_colliding`]).
+//! random configurations of the Panda against [`CollisionModel::is_colliding`](crate::CollisionModel::is_colliding)).
 //! [`FastChecker`] checks them pair by pair: only the link pairs and (link, object) pairs that
 //! left the lane uncertain, each body placed alone.
 //!
 //! Robot bodies that are spheres (a spherized URDF, or one written by
 //! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)) are the model itself; other bodies
-//! are *screened* through the spheres enclosing them ([`CollisionModel::enclosing_spheres`]: a
+//! are *screened* through the spheres enclosing them ([`CollisionModel::enclosing_spheres`](crate::CollisionModel::enclosing_spheres): a
 //! mesh's convex hull cut into cells, each enclosed exactly; a capsule's caps and pieces of its
 //! cylinder), so that contact is only a reason to look exactly, and through spheres inside them
-//! ([`Shape::inscribed_spheres`]), whose contact is a certain collision. A link that is one box
+//! ([`Shape::inscribed_spheres`](crate::Shape::inscribed_spheres)), whose contact is a certain collision. A link that is one box
 //! is tested as that box: the other link's spheres are taken into its frame. A block whose
 //! lanes are left uncertain by two links of convex hulls gets a second, tighter screen before
 //! the exact checks: each link's spheres against the other's 18-sided bounding polytope

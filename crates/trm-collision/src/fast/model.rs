@@ -104,7 +104,7 @@ pub(super) enum Suspect {
     Object { object: u32, group: u32 },
 }
 
-/// A collision model compiled for single-precision checks of [`FAST_LANES`] configurations at
+/// A collision model compiled for single-precision checks of [`FAST_LANES`](super::FAST_LANES) configurations at
 /// once (made by [`FastModel::new`]): its spheres, or the spheres enclosing its bodies.
 #[derive(Debug, Clone)]
 pub struct FastModel {
@@ -220,7 +220,7 @@ impl FastModel {
     }
 
     /// Checks the configurations of a block against themselves and `world`: `poses` holds their
-    /// link poses ([`PoseBlock::lanes`] of the collision model's robot), `live` the lanes in
+    /// link poses ([`PoseBlock::lanes`](trm_kinematics::PoseBlock::lanes) of the collision model's robot), `live` the lanes in
     /// use. Stops at the first certain collision.
     ///
     /// # Panics
@@ -237,7 +237,7 @@ impl FastModel {
 
     /// Counts, in the configurations of a block (as [`FastModel::check`] takes them), the link
     /// pairs and (link, object) pairs that certainly collide; the pairs left uncertain are
-    /// kept in `scratch` for an exact check ([`FastChecker::count_unchecked`] does both).
+    /// kept in `scratch` for an exact check ([`FastChecker::count_unchecked`](crate::fast::FastChecker::count_unchecked) does both).
     ///
     /// # Panics
     /// If the poses or the scratch belong to another model.

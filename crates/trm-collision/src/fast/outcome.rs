@@ -13,7 +13,7 @@ pub struct Verdict {
     pub uncertain: LaneMask,
 }
 
-/// What a block's count found ([`FastModel::count`]): per lane, the link pairs and the (link,
+/// What a block's count found ([`FastModel::count`](crate::fast::FastModel::count)): per lane, the link pairs and the (link,
 /// world object) pairs certainly colliding, and the lanes with pairs left uncertain (the
 /// suspects), whose counts are complete only once those are checked exactly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
