@@ -13,7 +13,8 @@ use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vect
 use trm_kinematics::{LANES, PoseBatch, PoseLanes};
 
 use crate::cull::{Ball, Step};
-use crate::model::{CollisionModel, PlacedBodies};
+use crate::model::CollisionModel;
+use crate::placed::PlacedBodies;
 use crate::query::CollisionCount;
 use crate::shape::{
     Compiled, Geometry, Placed, PointLanes, intersects, segment_distance_squared_lanes,

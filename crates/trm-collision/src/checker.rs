@@ -9,7 +9,8 @@ use crate::batch::PlacedBatch;
 use crate::edge::{edge_steps, rake, span_steps};
 use crate::error::{CollisionError, Result};
 use crate::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
-use crate::model::{CollisionModel, PlacedBodies};
+use crate::model::CollisionModel;
+use crate::placed::PlacedBodies;
 use crate::world::World;
 
 /// Collision checks of one robot's configurations and straight edges in one world, counted.

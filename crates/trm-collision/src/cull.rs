@@ -13,7 +13,7 @@
 use nalgebra::Point3;
 use trm_kinematics::{JointKind, Tree};
 
-use crate::model::{BodyPair, PlacedBodies};
+use crate::placed::{BodyPair, PlacedBodies};
 use crate::shape::Compiled;
 
 /// A sphere that encloses some bodies.

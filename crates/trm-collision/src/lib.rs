@@ -53,6 +53,7 @@ pub mod fit;
 mod generate;
 pub mod mesh;
 mod model;
+mod placed;
 mod query;
 mod shape;
 mod world;
@@ -62,10 +63,11 @@ pub use batch::PlacedBatch;
 pub use checker::WorldChecker;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};
-pub use model::{Body, CollisionModel, CollisionOptions, PlacedBodies};
+pub use model::{Body, CollisionModel, CollisionOptions};
 /// Axis-aligned boxes (parry's), as [`PlacedBodies::bounding_box`] and
 /// [`WorldObject::bounding_box`] return them.
 pub use parry3d_f64::bounding_volume::Aabb;
+pub use placed::PlacedBodies;
 pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
 pub use shape::{CONVEX_SPHERES, Shape, ShapeProblem, Sphere};
 pub use trm_kinematics::DisableReason;

@@ -1,7 +1,7 @@
 //! The collision model of a robot: one body per URDF `<collision>` element, the allowed-collision
 //! matrix, and the flat list of body pairs the queries walk.
 
-use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
+use parry3d_f64::bounding_volume::Aabb;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
@@ -12,6 +12,7 @@ use crate::acm::AllowedCollisionMatrix;
 use crate::cull::Culling;
 use crate::error::{CollisionError, Result, unknown};
 use crate::mesh::{convex_hull_of_mesh, resolve_mesh};
+use crate::placed::{BodyPair, PlacedBodies};
 use crate::shape::{Compiled, Placed, Shape, from_urdf};
 
 /// How to turn a URDF's `<collision>` elements into bodies.
@@ -52,14 +53,6 @@ pub struct Body {
     pub local: Isometry3<f64>,
 }
 
-/// Two bodies to test, and where the next link pair starts (so a link pair is counted once).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct BodyPair {
-    pub a: u32,
-    pub b: u32,
-    pub next: u32,
-}
-
 #[derive(Debug)]
 struct Inner {
     robot: RobotModel,
@@ -90,41 +83,6 @@ struct SphereSets {
 #[derive(Debug, Clone)]
 pub struct CollisionModel {
     inner: Arc<Inner>,
-}
-
-/// World-frame geometry of every body for one configuration (a reusable scratch buffer).
-#[derive(Debug, Clone)]
-pub struct PlacedBodies {
-    pub(crate) placed: Vec<Placed>,
-    /// World origins of the links the culling spheres are centred on.
-    pub(crate) origins: Vec<Point3<f64>>,
-}
-
-impl PlacedBodies {
-    /// Number of bodies.
-    pub fn len(&self) -> usize {
-        self.placed.len()
-    }
-
-    /// True for a robot without collision geometry.
-    pub fn is_empty(&self) -> bool {
-        self.placed.is_empty()
-    }
-
-    /// Axis-aligned boxes enclosing each placed body (through its bounding sphere), in body
-    /// order.
-    pub fn body_boxes(&self) -> impl Iterator<Item = Aabb> + '_ {
-        self.placed.iter().map(Placed::bounding_box)
-    }
-
-    /// An axis-aligned box enclosing every placed body (through their bounding spheres);
-    /// `None` without bodies.
-    pub fn bounding_box(&self) -> Option<Aabb> {
-        self.placed
-            .iter()
-            .map(Placed::bounding_box)
-            .reduce(|a, b| a.merged(&b))
-    }
 }
 
 fn link_dir(origin: &str) -> Option<PathBuf> {

@@ -1,7 +1,8 @@
 //! Queries on placed bodies: colliding-pair counts, early-exit checks, pair lists, distances.
 
 use crate::cull::Step;
-use crate::model::{CollisionModel, PlacedBodies};
+use crate::model::CollisionModel;
+use crate::placed::PlacedBodies;
 use nalgebra::{Point3, Vector3};
 
 use crate::shape::{Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart};

@@ -6,7 +6,7 @@ use super::{ALL_LANES, FAST_LANES, LaneMask};
 use crate::error::CollisionError;
 use crate::error::Result;
 use crate::model::CollisionModel;
-use crate::model::PlacedBodies;
+use crate::placed::PlacedBodies;
 use crate::world::World;
 use std::sync::Arc;
 use trm_kinematics::ActiveSet;
