@@ -79,7 +79,7 @@ pub fn run(args: &Args) -> Result<()> {
         &ros,
         run.motion.to_ros_yaml(&problem.robot, &ros)?.as_bytes(),
     )?;
-    let scene = trm_view::Scene::of_scenario(&problem, &run)?;
+    let scene = crate::support::scene::scenario_scene(&problem, &run)?;
     crate::support::scene::write_scene(&scene, &dir.join("scenario.scene.html"))?;
     println!(
         "wrote steps.md, steps.csv, motion.csv (+ .json, .ros.yaml) in {}",

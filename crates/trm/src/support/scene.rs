@@ -4,6 +4,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_kinematics::{ActiveSet, RobotModel};
+use trm_plan::ScenarioRun;
+use trm_tasks::Problem;
 use trm_view::Scene;
 
 /// Motor values from a posture file: "motors": {name: value} over `start`, or "q": [active
@@ -56,4 +58,64 @@ pub fn write_scene(scene: &Scene, out: &Path) -> Result<()> {
             .unwrap_or_default()
     );
     Ok(())
+}
+
+/// A scenario run (`trm_plan::run_scenario` on `problem`'s map): the robot's motion, every
+/// object that ever appears posed per frame (absent while it is not there), the map with the
+/// nodes and edges parked at each step, and the task-space path.
+pub fn scenario_scene(problem: &Problem, run: &ScenarioRun) -> trm_view::Result<Scene> {
+    let mut scene = Scene::of_problem(problem, "scenario")?;
+    scene.frames.clear();
+    for (t, q) in run.motion.times.iter().zip(&run.motion.positions) {
+        scene.add_frame(*t, q)?;
+    }
+    let mut all = run
+        .worlds
+        .last()
+        .cloned()
+        .unwrap_or_else(|| problem.objective.world().clone());
+    for w in &run.worlds {
+        for o in w.objects() {
+            if all.object(o.name()).is_err() {
+                all.add(o.name(), o.shape().clone(), *o.pose())
+                    .map_err(|e| trm_view::ViewError::Invalid {
+                        what: format!("scenario object `{}`", o.name()),
+                        problem: e.to_string(),
+                    })?;
+            }
+        }
+    }
+    scene.set_world(&all);
+    scene.add_roadmap(&run.map, problem.objective.active())?;
+    for (frame, (step, world)) in scene
+        .frames
+        .iter_mut()
+        .zip(run.steps.iter().zip(&run.worlds))
+    {
+        frame.world = Some(
+            all.objects()
+                .iter()
+                .map(|o| {
+                    world
+                        .object(o.name())
+                        .ok()
+                        .map(|p| trm_view::pose(p.pose()))
+                })
+                .collect(),
+        );
+        frame.map = Some(trm_view::FrameMap {
+            nodes: step.nodes,
+            edges: step.edges,
+            blocked: step.parked_nodes.clone(),
+            blocked_edges: step.parked_edges.clone(),
+        });
+    }
+    scene.set_path(
+        run.motion
+            .task_path
+            .iter()
+            .map(|p| trm_view::point3(p))
+            .collect(),
+    );
+    Ok(scene)
 }
