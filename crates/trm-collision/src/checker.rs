@@ -7,7 +7,7 @@ use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
 use crate::batch::PlacedBatch;
 use crate::edge::{edge_steps, rake, span_steps};
-use crate::error::{CollisionError, Result};
+use crate::error::Result;
 use crate::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
 use crate::model::CollisionModel;
 use crate::placed::PlacedBodies;
@@ -78,15 +78,8 @@ impl WorldChecker {
     /// A checker of `collision`'s robot, moved by `active`'s coordinates, in `world`; an error
     /// for an active set of another robot.
     pub fn new(collision: &CollisionModel, active: &ActiveSet, world: World) -> Result<Self> {
+        collision.check_active(active)?;
         let robot = collision.robot();
-        if active.model().num_frames() != robot.num_frames()
-            || active.model().name() != robot.name()
-        {
-            return Err(CollisionError::InvalidValue {
-                what: format!("active set of `{}`", active.model().name()),
-                problem: format!("belongs to another robot than `{}`", robot.name()),
-            });
-        }
         let engine = match Self::screen_model(collision) {
             Some(_) => {
                 let checker = FastChecker::new(collision, active.clone())?;
@@ -283,5 +276,29 @@ impl Exact {
         !self.collision.is_colliding_batch(&self.placed_batch, world)[..n]
             .iter()
             .any(|&hit| hit)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A checker of one robot moved by another robot's motors is an error naming both.
+    #[test]
+    fn an_active_set_of_another_robot_is_refused() {
+        let upper = trm_models::icub_upper_body();
+        let sagittal = trm_models::icub_sagittal();
+        let collision = CollisionModel::new(&upper).unwrap();
+        let e = WorldChecker::new(&collision, &sagittal.all_active(), World::new())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(sagittal.name()) && e.contains(upper.name()),
+            "{e}"
+        );
+        let mut checker = WorldChecker::new(&collision, &upper.all_active(), World::new()).unwrap();
+        assert!(checker.is_screened());
+        let home = upper.posture("home").unwrap().to_vec();
+        assert!(checker.free(&upper.all_active().from_motors(&home)));
     }
 }

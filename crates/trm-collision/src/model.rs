@@ -350,6 +350,20 @@ impl CollisionModel {
         self.inner.compiled[body].place(&poses.poses()[b.link], &mut out.placed[body]);
     }
 
+    /// Whether `active` moves this model's robot (an error naming both robots otherwise).
+    pub fn check_active(&self, active: &trm_kinematics::ActiveSet) -> Result<()> {
+        let robot = self.robot();
+        if active.model().num_frames() != robot.num_frames()
+            || active.model().name() != robot.name()
+        {
+            return Err(CollisionError::InvalidValue {
+                what: format!("active set of `{}`", active.model().name()),
+                problem: format!("belongs to another robot than `{}`", robot.name()),
+            });
+        }
+        Ok(())
+    }
+
     /// Where [`crate::fast::FastModel::of`] keeps this model's compilation.
     pub(crate) fn fast_cell(&self) -> &OnceLock<Arc<crate::fast::FastModel>> {
         &self.inner.fast

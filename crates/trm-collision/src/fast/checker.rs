@@ -37,15 +37,8 @@ impl FastChecker {
     /// set of another robot.
     pub fn new(collision: &CollisionModel, active: ActiveSet) -> Result<Self> {
         let fast = FastModel::of(collision)?;
+        collision.check_active(&active)?;
         let robot = collision.robot();
-        if active.model().num_frames() != robot.num_frames()
-            || active.model().name() != robot.name()
-        {
-            return Err(CollisionError::InvalidValue {
-                what: format!("active set of `{}`", active.model().name()),
-                problem: format!("belongs to another robot than `{}`", robot.name()),
-            });
-        }
         // forward kinematics of the links the checks read only (bodies' links and the culling
         // spheres' centres), not of frames and links without geometry
         let links = (collision.bodies().iter().map(|b| b.link))
