@@ -93,7 +93,7 @@ pub fn joint_trajectory_yaml(
 
 /// A float as YAML 1.1 reads it: plain decimal digits with a point, no exponent (Rust's
 /// `Display` of f64 never writes one and round-trips exactly).
-fn yaml_float(v: f64) -> String {
+pub fn yaml_float(v: f64) -> String {
     let text = format!("{v}");
     if text.contains('.') {
         text

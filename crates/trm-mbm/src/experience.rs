@@ -2,8 +2,8 @@
 //! finds, and later problems plan through them.
 
 use trm_kinematics::RobotModel;
-use trm_plan::rrt::{EdgeCheck, RrtOptions, path_length, rrt_connect, shortcut};
-use trm_plan::{Goal, PlanError, PlanOptions, Planner};
+use trm_plan::rrt::{RrtOptions, path_length};
+use trm_plan::{Planner, Source};
 use trm_tasks::Objective;
 
 use crate::error::MbmError;
@@ -133,27 +133,27 @@ impl<'a> FamilyRun<'a> {
             return Ok(outcome);
         }
         outcome.valid = true;
-        let began = std::time::Instant::now();
         let rrt = RrtOptions {
             max_seconds: options.max_seconds.or(problem.request.planning_time),
             ..options.clone()
         };
-        match through_experience(planner, objective, &start, &goal, options, &rrt) {
-            Ok((path, checks, answered)) => {
+        match planner.connect(&start, &goal, &rrt) {
+            Ok(found) => {
                 outcome.solved = true;
-                outcome.seconds = began.elapsed().as_secs_f64();
-                outcome.length = path_length(&path);
-                outcome.waypoints = path.len();
-                outcome.checks = checks;
-                outcome.note = match answered {
-                    Some(how) => how.into(),
-                    None => {
-                        planner.add_path(&path)?;
-                        self.kept.push(path.clone());
+                outcome.seconds = found.seconds;
+                outcome.length = path_length(&found.path);
+                outcome.waypoints = found.path.len();
+                outcome.checks = found.checks;
+                outcome.note = match found.source {
+                    Source::Sampled => {
+                        planner.add_path(&found.path)?;
+                        self.kept.push(found.path.clone());
                         "RRT-Connect (path kept)".into()
                     }
+                    Source::Graph => "experience".into(),
+                    other => other.name().into(),
                 };
-                outcome.path = path;
+                outcome.path = found.path;
             }
             Err(e) => outcome.note = e.to_string(),
         }
@@ -190,64 +190,5 @@ impl<'a> FamilyRun<'a> {
             });
         }
         Ok((start, request.goal.positions.clone()))
-    }
-}
-
-/// A path, the configurations checked to find it, and how the experience answered (`None`:
-/// RRT-Connect did).
-type Answer = (Vec<Vec<f64>>, u64, Option<&'static str>);
-
-/// A path from `start` to `goal` through the planner's experience (shortcut greedily and
-/// checked at half the resolution, as RRT-Connect's paths are), or by RRT-Connect where the
-/// experience does not reach or its path grazes an obstacle: the path, the configurations
-/// checked, and how the experience answered (`None`: RRT-Connect did).
-fn through_experience(
-    planner: &mut Planner,
-    objective: &Objective,
-    start: &[f64],
-    goal: &[f64],
-    options: &RrtOptions,
-    rrt: &RrtOptions,
-) -> Result<Answer, MbmError> {
-    let plan_options = PlanOptions {
-        resolution: options.resolution,
-        shortcuts: 0,
-        seed: options.seed,
-        exact_goal: false,
-        sampling: Some(rrt.clone()),
-        ..Default::default()
-    };
-    let planned = planner.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options)?;
-    if let Some((_, checks)) = planned.stats.sampled {
-        return Ok((planned.waypoints, checks, None));
-    }
-    let world = planner.world().clone();
-    let mut checker = objective.world_checker(&world)?;
-    let mut path = planned.waypoints;
-    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(options.seed);
-    let greedy = RrtOptions {
-        shortcuts: 0,
-        ..options.clone()
-    };
-    let edges = shortcut(&mut path, &greedy, &mut checker, &mut rng);
-    let how = if planned.stats.retrieved {
-        "retrieved"
-    } else if planned.nodes.is_empty() {
-        "straight"
-    } else {
-        "experience"
-    };
-    // at half the resolution: the edges the shortcut found free and the planner's own (checked
-    // at the same points, `Planner::segment_free`) need only their midpoints
-    let r = options.resolution;
-    if path.windows(2).zip(&edges).all(|(w, e)| {
-        (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
-            && checker.edge_midpoints_free(&w[0], &w[1], r)
-    }) {
-        Ok((path, checker.checks, Some(how)))
-    } else {
-        let found: Result<_, PlanError> = rrt_connect(objective, &world, start, goal, rrt);
-        let found = found?;
-        Ok((found.path, checker.checks + found.checks, None))
     }
 }

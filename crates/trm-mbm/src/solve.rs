@@ -4,17 +4,14 @@
 use trm_collision::CollisionModel;
 use trm_kinematics::RobotModel;
 use trm_moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
-use trm_plan::rrt::{RrtOptions, path_length, rrt_connect};
+use trm_plan::Planner;
+use trm_plan::rrt::{RrtOptions, path_length};
 use trm_tasks::Objective;
 
 use crate::error::MbmError;
 use crate::loaded::LoadedProblem;
 
-/// How far outside its joint limits a start or goal value may lie and still be taken, clamped
-/// onto the limit. URDFs round ±π to ±3.14159, so MotionBenchMaker's Fetch states at ±π lie
-/// 2.7·10⁻⁶ rad outside; MoveIt moves such starts inside (its FixStartStateBounds adapter, up
-/// to 0.05 rad) and samples joint goals within the bounds.
-pub const LIMIT_SLACK: f64 = 1e-4;
+pub use trm_moveit::LIMIT_SLACK;
 
 /// How one problem went.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
@@ -64,7 +61,9 @@ pub fn solve_loaded(
     let (objective, active, mut start) =
         problem_objective(robot, &problem.collision, world, request)?;
     let mut goal = request.goal.positions.clone();
-    let mut checker = objective.world_checker(world)?;
+    // the planner every door uses: compiled here once, for the IK of a task-space goal, the
+    // validity checks and the search
+    let mut planner = Planner::new(&objective, &[])?;
     let mut outcome = Outcome {
         note: problem.notes.join("; "),
         ..Default::default()
@@ -87,7 +86,7 @@ pub fn solve_loaded(
             &start,
             options.seed,
             GOAL_ATTEMPTS,
-            |q| checker.free(q),
+            |q| planner.is_free(q),
         )?;
         goal_seconds = started.elapsed().as_secs_f64();
         match found {
@@ -101,7 +100,9 @@ pub fn solve_loaded(
             }
         }
     }
-    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| checker.free(q)) {
+    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| {
+        planner.is_free(q)
+    }) {
         outcome.note = why.into();
         return Ok(outcome);
     }
@@ -110,7 +111,7 @@ pub fn solve_loaded(
         max_seconds: options.max_seconds.or(request.planning_time),
         ..options.clone()
     };
-    match rrt_connect(&objective, world, &start, &goal, &options) {
+    match planner.connect(&start, &goal, &options) {
         Ok(found) => {
             outcome.solved = true;
             outcome.seconds = goal_seconds + found.seconds;

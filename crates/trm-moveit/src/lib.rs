@@ -24,15 +24,17 @@
 mod error;
 mod reader;
 mod request;
+mod response;
 mod scene;
 pub mod yaml;
 
 use std::path::Path;
 
-use trm_collision::World;
+use trm_collision::{AllowedCollisionMatrix, CollisionModel, World};
 
 pub use error::{MoveItError, Result};
-pub use request::{JointGoal, JointState, MotionPlanRequest, motors_from_state};
+pub use request::{JointGoal, JointState, LIMIT_SLACK, MotionPlanRequest, motors_from_state};
+pub use response::motion_plan_response_yaml;
 pub use scene::{AllowedCollisions, CollisionObject, PlanningScene, Primitive};
 
 /// A world from a file: a MoveIt planning scene (`.yaml`/`.yml`, its collision objects) or
@@ -42,5 +44,50 @@ pub fn load_world(path: impl AsRef<Path>) -> Result<World, MoveItError> {
     match path.extension().and_then(|e| e.to_str()) {
         Some("yaml" | "yml") => PlanningScene::load(path)?.to_world(),
         _ => Ok(World::load(path)?),
+    }
+}
+
+/// A world file read for a robot: its objects and the allowed-collision matrix to check them
+/// with.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The objects.
+    pub world: World,
+    /// A MoveIt scene's matrix applied over the collision model's own
+    /// ([`AllowedCollisions::over`]); the model's own for a scene without one and a RON world.
+    pub acm: AllowedCollisionMatrix,
+    /// The scene's matrix entries that are not links of the robot (skipped).
+    pub notes: Vec<String>,
+}
+
+/// A world file (RON, or a MoveIt planning scene `.yaml`) read for `collision`'s robot: the
+/// world and matrix a planner takes (`trm_plan::Planner::set_world` and `set_acm`).
+pub fn load_scene(
+    path: impl AsRef<Path>,
+    collision: &CollisionModel,
+) -> Result<Scene, MoveItError> {
+    let path = path.as_ref();
+    let own = || collision.acm().clone();
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("yaml" | "yml") => {
+            let scene = PlanningScene::load(path)?;
+            let (acm, notes) = match &scene.allowed_collisions {
+                Some(allowed) => {
+                    let (acm, notes) = allowed.over(collision);
+                    (acm.unwrap_or_else(own), notes)
+                }
+                None => (own(), Vec::new()),
+            };
+            Ok(Scene {
+                world: scene.to_world()?,
+                acm,
+                notes,
+            })
+        }
+        _ => Ok(Scene {
+            world: World::load(path)?,
+            acm: own(),
+            notes: Vec::new(),
+        }),
     }
 }

@@ -43,6 +43,12 @@ pub struct JointGoal {
     pub tolerances: Vec<(f64, f64)>,
 }
 
+/// How far outside its joint limits a start or goal value may lie and still be taken, clamped
+/// onto the limit. URDFs round ±π to ±3.14159, so MotionBenchMaker's Fetch states at ±π lie
+/// 2.7·10⁻⁶ rad outside; MoveIt moves such starts inside (its FixStartStateBounds adapter, up
+/// to 0.05 rad) and samples joint goals within the bounds.
+pub const LIMIT_SLACK: f64 = 1e-4;
+
 /// A MoveIt `MotionPlanRequest` with a joint-space goal.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct MotionPlanRequest {
@@ -513,6 +519,94 @@ impl MotionPlanRequest {
             }],
         };
         Ok(out)
+    }
+
+    /// The request's start and joint goal in `active`'s coordinates (a planner's): the start
+    /// state's values of the active motors, the goal's by name. An error names what does not
+    /// fit: a task-space goal, a goal that constrains a motor the set does not move or leaves
+    /// one of them out, a start that misses an active motor or puts one the set holds fixed
+    /// elsewhere (by more than 1e-9).
+    pub fn joint_query(
+        &self,
+        active: &trm_kinematics::ActiveSet,
+    ) -> Result<(Vec<f64>, Vec<f64>), MoveItError> {
+        let invalid = |problem: String, fix: &str| MoveItError::Invalid {
+            path: self.origin.clone(),
+            line: 0,
+            problem,
+            fix: fix.into(),
+        };
+        let names: Vec<&str> = active.names().collect();
+        let moved = names.join(", ");
+        if self.goal.names.is_empty() {
+            return Err(invalid(
+                "a task-space goal, where joint goals are taken".into(),
+                "give joint_constraints for the planner's motors",
+            ));
+        }
+        let mut goal = vec![f64::NAN; names.len()];
+        for (name, value) in self.goal.names.iter().zip(&self.goal.positions) {
+            let k = names.iter().position(|n| n == name).ok_or_else(|| {
+                invalid(
+                    format!("the goal constrains `{name}`, which the planner does not move (it moves {moved})"),
+                    "give a planner that moves the request's goal joints",
+                )
+            })?;
+            goal[k] = *value;
+        }
+        if let Some(k) = goal.iter().position(|v| v.is_nan()) {
+            return Err(invalid(
+                format!("the goal leaves `{}` out", names[k]),
+                "constrain every motor the planner moves",
+            ));
+        }
+        let fixed = active.to_motors(&vec![0.0; names.len()]);
+        let robot = active.model();
+        let (motors, _) = motors_from_state(robot, &self.start, &fixed);
+        let moving = active.motor_indices();
+        for (i, (m, (&held, &given))) in robot
+            .motors()
+            .iter()
+            .zip(fixed.iter().zip(&motors))
+            .enumerate()
+        {
+            if moving.contains(&i) {
+                if !self.start.names.contains(&m.name) {
+                    return Err(invalid(
+                        format!(
+                            "the start state does not give `{}`, which the planner moves",
+                            m.name
+                        ),
+                        "give every moving joint in start_state.joint_state",
+                    ));
+                }
+            } else if (held - given).abs() > 1e-9 {
+                return Err(invalid(
+                    format!(
+                        "the start state puts `{}` at {given}; the planner holds it at {held}",
+                        m.name
+                    ),
+                    "make the planner with this start state's values for the motors it does not move",
+                ));
+            }
+        }
+        let mut start = active.from_motors(&motors);
+        for (what, q) in [("start", &mut start), ("goal", &mut goal)] {
+            for (v, &i) in q.iter_mut().zip(moving) {
+                let (m, limits) = (&robot.motors()[i], &robot.motors()[i].limits);
+                if !(limits.lower - LIMIT_SLACK..=limits.upper + LIMIT_SLACK).contains(v) {
+                    return Err(invalid(
+                        format!(
+                            "the {what} puts `{}` at {v}, outside its limits [{}, {}]",
+                            m.name, limits.lower, limits.upper
+                        ),
+                        "give values within the joint limits",
+                    ));
+                }
+                *v = v.clamp(limits.lower, limits.upper);
+            }
+        }
+        Ok((start, goal))
     }
 
     /// Reads a request file (at most [`trm_io::MAX_INPUT_BYTES`]).

@@ -80,6 +80,17 @@ impl AllowedCollisions {
         &self,
         collision: &trm_collision::CollisionModel,
     ) -> Result<(Option<trm_collision::CollisionModel>, Vec<String>), MoveItError> {
+        let (acm, notes) = self.over(collision);
+        let applied = acm.map(|acm| collision.with_acm(acm)).transpose()?;
+        Ok((applied, notes))
+    }
+
+    /// The matrix [`AllowedCollisions::apply`] gives `collision` (`None` when nothing changes),
+    /// and its notes.
+    pub fn over(
+        &self,
+        collision: &trm_collision::CollisionModel,
+    ) -> (Option<trm_collision::AllowedCollisionMatrix>, Vec<String>) {
         let tree = collision.robot().tree();
         let ids: Vec<Option<usize>> = self.names.iter().map(|n| tree.link_index(n)).collect();
         let notes: Vec<String> = self
@@ -109,8 +120,7 @@ impl AllowedCollisions {
                 }
             }
         }
-        let applied = changed.then(|| collision.with_acm(acm)).transpose()?;
-        Ok((applied, notes))
+        (changed.then_some(acm), notes)
     }
 }
 

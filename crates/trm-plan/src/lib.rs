@@ -22,7 +22,7 @@ pub mod scenario;
 mod trajectory;
 
 pub use error::PlanError;
-pub use planner::{Planner, RETRIEVE_STEPS};
+pub use planner::{Connection, Planner, RETRIEVE_STEPS, Source};
 pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{
     Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,

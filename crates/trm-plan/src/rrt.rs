@@ -432,8 +432,29 @@ pub fn rrt_connect(
     options: &RrtOptions,
 ) -> Result<RrtPath, PlanError> {
     options.check()?;
+    let mut checker = objective.world_checker(world)?;
+    rrt_connect_in(
+        &mut checker,
+        &objective.active().bounds(),
+        start,
+        goal,
+        options,
+    )
+}
+
+/// [`rrt_connect`] with a checker already made for the robot and the world (a planner's, kept
+/// between queries: nothing is compiled per query), sampling within `bounds` (lower and upper
+/// limits of the checker's coordinates). [`RrtPath::checks`] counts this query's checks only.
+pub fn rrt_connect_in(
+    checker: &mut WorldChecker,
+    bounds: &(Vec<f64>, Vec<f64>),
+    start: &[f64],
+    goal: &[f64],
+    options: &RrtOptions,
+) -> Result<RrtPath, PlanError> {
+    options.check()?;
     let began = Instant::now();
-    let mut checks = 0;
+    let before = checker.checks;
     let mut iterations = 0;
     for refinement in 0..3 {
         let resolution = options.resolution / f64::from(1u32 << refinement);
@@ -441,11 +462,10 @@ pub fn rrt_connect(
             resolution,
             ..options.clone()
         };
-        let (mut found, edges) = search(objective, world, start, goal, &attempt, began)?;
+        let (mut found, edges) = search(checker, bounds, start, goal, &attempt, began)?;
         // the edges checked at `resolution` (by the search: the edges it kept, or by the
         // shortcut) need only their midpoints to be checked at half that; a piece of an edge
         // a random shortcut cut needs its own points too
-        let mut checker = objective.world_checker(world)?;
         let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
             (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
                 && checker.edge_midpoints_free(&w[0], &w[1], resolution)
@@ -456,10 +476,9 @@ pub fn rrt_connect(
                     || checker.edge_free(&w[0], &w[1], options.resolution)
                         && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
         });
-        checks += found.checks + checker.checks;
         iterations += found.iterations;
         if free {
-            found.checks = checks;
+            found.checks = checker.checks - before;
             found.iterations = iterations;
             found.refinements = refinement;
             found.seconds = began.elapsed().as_secs_f64();
@@ -478,14 +497,14 @@ pub fn rrt_connect(
 
 /// One RRT-Connect search at `options.resolution`, its time counted from `began`.
 fn search(
-    objective: &Objective,
-    world: &World,
+    checker: &mut WorldChecker,
+    (lower, upper): &(Vec<f64>, Vec<f64>),
     start: &[f64],
     goal: &[f64],
     options: &RrtOptions,
     began: Instant,
 ) -> Result<(RrtPath, Vec<EdgeCheck>), PlanError> {
-    let dim = objective.dim();
+    let dim = checker.dim();
     for (what, q) in [("start", start), ("goal", goal)] {
         if q.len() != dim || q.iter().any(|v| !v.is_finite()) {
             return Err(PlanError::InvalidGoal {
@@ -497,7 +516,7 @@ fn search(
             });
         }
     }
-    let mut checker = objective.world_checker(world)?;
+    let before = checker.checks;
     if !checker.free(start) {
         return Err(PlanError::InvalidStart("it collides in the world".into()));
     }
@@ -508,7 +527,6 @@ fn search(
             closest_distance: f64::INFINITY,
         });
     }
-    let (lower, upper) = objective.active().bounds();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut samples = Samples::new(options.sampler, options.seed, dim);
     let mut result = RrtPath::default();
@@ -535,14 +553,8 @@ fn search(
         if draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
             break;
         }
-        samples.next(&lower, &upper, &mut sample);
-        let new = match extend(
-            &mut a,
-            &sample,
-            options,
-            &mut checker,
-            options.dynamic_domain,
-        ) {
+        samples.next(lower, upper, &mut sample);
+        let new = match extend(&mut a, &sample, options, checker, options.dynamic_domain) {
             // outside the dynamic domain: drawn again, not counted as a sample
             Extend::Outside => continue,
             Extend::Trapped => None,
@@ -552,7 +564,7 @@ fn search(
         if let Some(i) = new {
             let target = a.node(i).to_vec();
             loop {
-                match extend(&mut b, &target, options, &mut checker, false) {
+                match extend(&mut b, &target, options, checker, false) {
                     Extend::Advanced(_) => continue,
                     Extend::Trapped | Extend::Outside => break,
                     Extend::Reached(j) => {
@@ -580,7 +592,7 @@ fn search(
     }
     result.nodes = a.len() + b.len();
     let Some(mut path) = raw else {
-        result.checks = checker.checks;
+        result.checks = checker.checks - before;
         return Err(PlanError::Unreachable {
             reason: format!(
                 "RRT-Connect found no path in {} samples ({} nodes, {:.3} s)",
@@ -593,9 +605,9 @@ fn search(
         });
     };
     result.raw_waypoints = path.len();
-    let edges = shortcut(&mut path, options, &mut checker, &mut rng);
+    let edges = shortcut(&mut path, options, checker, &mut rng);
     result.path = path;
-    result.checks = checker.checks;
+    result.checks = checker.checks - before;
     result.seconds = began.elapsed().as_secs_f64();
     Ok((result, edges))
 }

@@ -2,13 +2,19 @@
 
 use crate::*;
 
-/// A planner over one or several maps of the same robot and active motors, checked against a
-/// world.
+/// A planner for one robot, compiled once (`trm_plan::Planner`): worlds and planning scenes
+/// are set on it, maps and kept paths are optional, queries go without rebuilding anything.
 #[pyclass(module = "trm")]
 pub(crate) struct Planner {
-    pub(crate) maps: Vec<trm_roadmap::Roadmap>,
-    pub(crate) problem: trm_tasks::Problem,
-    pub(crate) world: Option<World>,
+    planner: trm_plan::Planner,
+    /// The collision model the planner was made with (a scene's matrix applies over its own).
+    own: CollisionModel,
+    /// The maps' spec start (map planners), the default start.
+    start: Option<Vec<f64>>,
+    /// The maps' task space has this many dimensions (0: no maps).
+    task_dim: usize,
+    /// Keep every path RRT-Connect finds as experience.
+    experience: bool,
 }
 
 /// Runs a scenario (RON: objects that move, appear and vanish, goals that change; see
@@ -59,76 +65,248 @@ pub(crate) fn run_scenario<'py>(
 
 #[pymethods]
 impl Planner {
-    /// A planner over `maps` (a Roadmap or a list of them), in `world` (none: the maps' own).
+    /// A planner for `source`: a `Robot` (no maps; RRT-Connect and kept paths answer), or a
+    /// `Roadmap` or list of them (their spec's robot, motors, costs and task space), in `world`
+    /// (none: empty, or the maps' own). For a robot, `joints` are the motors it moves (their
+    /// names, or a group's name; all motors when absent), `posture` holds the others (every
+    /// motor's value; the `home` posture, else 0 within the limits, when absent), `collision`
+    /// its collision model (the robot's own when absent). With `experience=True` every path
+    /// RRT-Connect finds is kept and later queries plan through them.
     #[new]
-    #[pyo3(signature = (maps, world = None))]
-    fn new(maps: &Bound<'_, PyAny>, world: Option<&PyWorld>) -> PyResult<Self> {
-        let maps: Vec<trm_roadmap::Roadmap> = match maps.extract::<PyRef<'_, Roadmap>>() {
+    #[pyo3(signature = (source, world = None, *, joints = None, posture = None, collision = None, experience = false))]
+    fn new(
+        source: &Bound<'_, PyAny>,
+        world: Option<&PyWorld>,
+        joints: Option<&Bound<'_, PyAny>>,
+        posture: Option<&Bound<'_, PyAny>>,
+        collision: Option<PyRef<'_, Collision>>,
+        experience: bool,
+    ) -> PyResult<Self> {
+        if let Ok(robot) = source.extract::<PyRef<'_, Robot>>() {
+            let model = &robot.model;
+            let names: Vec<String> = match joints {
+                None => model.motors().iter().map(|m| m.name.clone()).collect(),
+                Some(j) => match j.extract::<String>() {
+                    Ok(group) => {
+                        let ids = model.group(&group).map_err(err)?;
+                        ids.iter()
+                            .map(|&i| model.motors()[i].name.clone())
+                            .collect()
+                    }
+                    Err(_) => j
+                        .extract::<Vec<String>>()
+                        .map_err(|_| err("joints: give a list of motor names or a group's name"))?,
+                },
+            };
+            let fixed = match posture {
+                Some(p) => configurations(p, model.motors().len(), "posture")?.0,
+                None => match model.posture("home") {
+                    Ok(home) => home.to_vec(),
+                    Err(_) => model
+                        .motors()
+                        .iter()
+                        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+                        .collect(),
+                },
+            };
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            let active = model.active_set(&refs, &fixed).map_err(err)?;
+            let collision = match collision {
+                Some(c) => c.model.clone(),
+                None => CollisionModel::new(model).map_err(err)?,
+            };
+            let world = world.map(|w| w.world.clone()).unwrap_or_default();
+            let objective = trm_tasks::Objective::new(active, collision, world);
+            return Ok(Planner {
+                planner: trm_plan::Planner::new(&objective, &[]).map_err(err)?,
+                own: objective.collision().clone(),
+                start: None,
+                task_dim: 0,
+                experience,
+            });
+        }
+        if joints.is_some() || posture.is_some() || collision.is_some() {
+            return Err(err(
+                "joints, posture and collision are a robot planner's: a map planner takes its maps' spec",
+            ));
+        }
+        let maps: Vec<trm_roadmap::Roadmap> = match source.extract::<PyRef<'_, Roadmap>>() {
             Ok(m) => vec![m.map.clone()],
-            Err(_) => maps
-                .extract::<Vec<PyRef<'_, Roadmap>>>()?
+            Err(_) => source
+                .extract::<Vec<PyRef<'_, Roadmap>>>()
+                .map_err(|_| err("give a Robot, a Roadmap or a list of Roadmaps"))?
                 .iter()
                 .map(|m| m.map.clone())
                 .collect(),
         };
         let first = maps.first().ok_or_else(|| err("give at least one map"))?;
         let problem = first.problem_with(&trm_taskmap::loaders()).map_err(err)?;
+        let refs: Vec<&trm_roadmap::Roadmap> = maps.iter().collect();
+        let mut planner = trm_plan::Planner::new(&problem.objective, &refs).map_err(err)?;
+        if let Some(w) = world {
+            planner.set_world(w.world.clone());
+        }
         Ok(Planner {
-            problem,
-            maps,
-            world: world.map(|w| w.world.clone()),
+            own: problem.objective.collision().clone(),
+            planner,
+            start: Some(problem.start.clone()),
+            task_dim: problem.objective.task().map_or(0, |t| t.dim()),
+            experience,
         })
     }
 
-    /// Plans from `start` (active values; the spec's start when absent) to a task point `to`
-    /// (a map node within `tolerance`, then, with `exact`, NGIK to the point itself) or, with
-    /// `posture=True`, to a posture (active values). Returns a dict: `times (T,)`,
-    /// `positions (T, motors)`, `motor_names`, `task_path`, `length` (rad), `seconds`.
-    #[pyo3(signature = (to, start = None, tolerance = 0.03, posture = false, exact = true, seed = 0))]
+    /// The current world (a copy: set it again after changing it).
+    #[getter]
+    fn get_world(&self) -> PyWorld {
+        PyWorld {
+            world: self.planner.world().clone(),
+        }
+    }
+
+    /// Replaces the world; the robot is not compiled again, kept paths are checked again
+    /// lazily.
+    #[setter]
+    fn set_world(&mut self, world: &PyWorld) {
+        self.planner.set_world(world.world.clone());
+    }
+
+    /// Sets a world file as the current world: RON, or a MoveIt planning scene (`.yaml`), whose
+    /// allowed-collision matrix then applies over the planner's own (the collision checks are
+    /// made again only when the matrix changes). Returns notes on the matrix's entries that are
+    /// not links of the robot.
+    fn load_scene(&mut self, py: Python<'_>, path: &str) -> PyResult<Vec<String>> {
+        let scene = trm_moveit::load_scene(path, &self.own).map_err(err)?;
+        let planner = &mut self.planner;
+        py.detach(|| -> Result<(), trm_plan::PlanError> {
+            planner.set_world(scene.world);
+            planner.set_acm(scene.acm)?;
+            Ok(())
+        })
+        .map_err(err)?;
+        Ok(scene.notes)
+    }
+
+    /// The names of the motors the planner moves (the order of its configurations' values).
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.planner.active().names().map(str::to_string).collect()
+    }
+
+    /// Nodes of the planner's graph: map nodes and kept waypoints.
+    #[getter]
+    fn num_nodes(&self) -> usize {
+        self.planner.num_nodes()
+    }
+
+    /// Whether the configuration `q` (the moved motors' values) is collision-free in the
+    /// current world.
+    fn is_free(&mut self, q: &Bound<'_, PyAny>) -> PyResult<bool> {
+        let q = configurations(q, self.planner.active().len(), "q")?.0;
+        Ok(self.planner.is_free(&q))
+    }
+
+    /// Keeps a path (an `(W, joints)` array, free in the current world) as experience: later
+    /// queries plan through it. Returns the number of nodes added.
+    fn add_path(&mut self, path: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let n = self.planner.active().len();
+        let (values, _) = configurations(path, n, "path")?;
+        let rows: Vec<Vec<f64>> = values.chunks(n.max(1)).map(<[f64]>::to_vec).collect();
+        self.planner.add_path(&rows).map_err(err)
+    }
+
+    /// Plans from `start` (the moved motors' values; a map planner's spec start when absent)
+    /// to `to`: a posture (the moved motors' values; RRT-Connect through the kept paths, within
+    /// `max_seconds` and `max_samples`, edges checked every `resolution` rad) or, for a map
+    /// planner, a task point (a map node within `tolerance`, then with `exact` NGIK to the
+    /// point itself). `posture` says which; by default a posture for a robot planner and a
+    /// task point for a map planner. The GIL is released while planning.
+    ///
+    /// Returns a dict: `times (T,)` and `positions (T, motors)` (every motor, stopping at each
+    /// waypoint), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
+    /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
+    /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = 1.0 / 32.0))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
-        &self,
+        &mut self,
         py: Python<'py>,
         to: &Bound<'py, PyAny>,
         start: Option<&Bound<'py, PyAny>>,
         tolerance: f64,
-        posture: bool,
+        posture: Option<bool>,
         exact: bool,
         seed: u64,
+        max_seconds: Option<f64>,
+        max_samples: usize,
+        resolution: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = &self.problem.objective;
-        let from = match start {
-            Some(s) => configurations(s, o.dim(), "start")?.0,
-            None => self.problem.start.clone(),
+        let dim = self.planner.active().len();
+        let from = match (start, &self.start) {
+            (Some(s), _) => configurations(s, dim, "start")?.0,
+            (None, Some(home)) => home.clone(),
+            (None, None) => return Err(err("start: give the moved motors' values to start from")),
         };
         let target = float_array(to)?.as_slice().map_err(err)?.to_vec();
-        let goal = if posture {
-            trm_plan::Goal::Configuration(target)
-        } else {
-            trm_plan::Goal::TaskPoint {
-                t: target,
-                tolerance,
-            }
-        };
+        let posture = posture.unwrap_or(self.task_dim == 0);
+        if !posture && self.task_dim == 0 {
+            return Err(err(
+                "to: a task point needs a map planner (its task space); give a posture (posture=True)",
+            ));
+        }
+        let d = PyDict::new(py);
         let options = trm_plan::PlanOptions {
             seed,
             exact_goal: exact,
             ..Default::default()
         };
-        let planned = py
-            .detach(|| -> Result<trm_plan::Planned, String> {
-                let refs: Vec<&trm_roadmap::Roadmap> = self.maps.iter().collect();
-                let mut planner = trm_plan::Planner::new(o, &refs).map_err(|e| e.to_string())?;
-                if let Some(w) = &self.world {
-                    planner.set_world(w.clone());
-                }
-                planner
-                    .plan(&from, &goal, &options)
-                    .map_err(|e| e.to_string())
-            })
-            .map_err(err)?;
-        let t = &planned.trajectory;
-        let d = PyDict::new(py);
+        let planned = if posture {
+            if target.len() != dim {
+                return Err(err(format!(
+                    "to: {} values; the planner moves {dim} motors ({})",
+                    target.len(),
+                    self.joint_names().join(", ")
+                )));
+            }
+            let rrt = trm_plan::rrt::RrtOptions {
+                seed,
+                max_seconds,
+                max_iterations: max_samples,
+                resolution,
+                ..Default::default()
+            };
+            let (experience, planner) = (self.experience, &mut self.planner);
+            let (found, trajectory) = py
+                .detach(|| -> Result<_, trm_plan::PlanError> {
+                    let found = planner.connect(&from, &target, &rrt)?;
+                    if experience && found.source == trm_plan::Source::Sampled {
+                        planner.add_path(&found.path)?;
+                    }
+                    let trajectory = planner.trajectory(&found.path, &options);
+                    Ok((found, trajectory))
+                })
+                .map_err(err)?;
+            d.set_item("source", found.source.name())?;
+            d.set_item("checks", found.checks)?;
+            d.set_item("samples", found.iterations)?;
+            let length = trm_plan::rrt::path_length(&found.path);
+            (trajectory, found.path, length, found.seconds)
+        } else {
+            let goal = trm_plan::Goal::TaskPoint {
+                t: target,
+                tolerance,
+            };
+            let planner = &mut self.planner;
+            let planned = py
+                .detach(|| planner.plan(&from, &goal, &options))
+                .map_err(err)?;
+            (
+                planned.trajectory,
+                planned.waypoints,
+                planned.stats.length,
+                planned.stats.seconds,
+            )
+        };
+        let (t, waypoints, length, seconds) = planned;
         d.set_item(
             "times",
             shaped(py, None, &[t.times.len()], t.times.clone())?,
@@ -140,14 +318,61 @@ impl Planner {
             shaped(py, None, &[t.positions.len(), motors], flat)?,
         )?;
         d.set_item("motor_names", t.names.clone())?;
-        let dim = t.task_path.first().map_or(0, Vec::len);
-        let tasks: Vec<f64> = t.task_path.iter().flatten().copied().collect();
+        let rows = waypoints.len();
         d.set_item(
-            "task_path",
-            shaped(py, None, &[t.task_path.len(), dim], tasks)?,
+            "waypoints",
+            shaped(py, None, &[rows, dim], waypoints.concat())?,
         )?;
-        d.set_item("length", planned.stats.length)?;
-        d.set_item("seconds", planned.stats.seconds)?;
+        if self.task_dim > 0 {
+            let tasks: Vec<f64> = t.task_path.iter().flatten().copied().collect();
+            d.set_item(
+                "task_path",
+                shaped(py, None, &[t.task_path.len(), self.task_dim], tasks)?,
+            )?;
+        }
+        d.set_item("length", length)?;
+        d.set_item("seconds", seconds)?;
         Ok(d)
+    }
+
+    /// Plans a MoveIt motion plan request (`.yaml`: its start state and joint goal, for the
+    /// motors the planner moves; its `allowed_planning_time` as the budget unless
+    /// `max_seconds`), in the current world; load its scene first (`load_scene`). Returns what
+    /// `plan` returns.
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = 1.0 / 32.0))]
+    fn plan_request<'py>(
+        &mut self,
+        py: Python<'py>,
+        request: &str,
+        seed: u64,
+        max_seconds: Option<f64>,
+        max_samples: usize,
+        resolution: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let request = trm_moveit::MotionPlanRequest::load(request).map_err(err)?;
+        let (start, goal) = request.joint_query(self.planner.active()).map_err(err)?;
+        let to = shaped(py, None, &[goal.len()], goal)?;
+        let from = shaped(py, None, &[start.len()], start)?;
+        self.plan(
+            py,
+            to.as_any(),
+            Some(from.as_any()),
+            0.0,
+            Some(true),
+            false,
+            seed,
+            max_seconds.or(request.planning_time),
+            max_samples,
+            resolution,
+        )
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Planner(moves {} motors, {} graph nodes, {} world objects)",
+            self.planner.active().len(),
+            self.planner.num_nodes(),
+            self.planner.world().len()
+        )
     }
 }

@@ -194,6 +194,16 @@ impl Objective {
         self.compile_screen();
     }
 
+    /// Replaces the collision model's allowed-collision matrix (a planning scene's, say): the
+    /// pairs it allows are not checked. Scratches made before are made again when next used.
+    /// An error for a matrix of another link count.
+    pub fn set_acm(&mut self, acm: trm_collision::AllowedCollisionMatrix) -> Result<()> {
+        self.collision = self.collision.with_acm(acm)?;
+        self.key = NEXT_KEY.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.compile_screen();
+        Ok(())
+    }
+
     /// Adds a term `weight · cost` (weight finite and ≥ 0).
     pub fn add(&mut self, weight: f64, cost: Box<dyn Cost>) -> Result<()> {
         if !(weight.is_finite() && weight >= 0.0) {

@@ -1,34 +1,55 @@
-//! `cargo xtask plan --map FILE [--map FILE2 …] [--world WORLD.ron] --from home|q.json
-//! [--repair] --to "x,y,z"|q.json [--out traj.csv]`.
+//! `trm plan`: through maps (`--map FILE [--map FILE2 …] [--world WORLD] --from home|q.json
+//! [--repair] --to "x,y,z"|q.json`), or without them for a robot (`--model MODEL --world
+//! scene.yaml --request request.yaml`, or `--joints … --from q.json --to q.json`), writing the
+//! trajectory with `--out traj.csv`.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use trm_plan::{ExactGoal, Goal, PlanOptions, Planner};
+use trm_plan::rrt::RrtOptions;
+use trm_plan::{ExactGoal, Goal, PlanOptions, Planner, Trajectory};
 use trm_roadmap::{RepairOptions, Roadmap};
 use trm_tasks::Problem;
 
 /// Arguments of `plan`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Map files (repeatable); they must share the first map's active motors.
-    #[arg(long = "map", required = true)]
+    /// Map files (repeatable); they must share the first map's active motors. Without maps,
+    /// `--model` plans by RRT-Connect (MoveIt's query: a start and a goal posture).
+    #[arg(long = "map", conflicts_with_all = ["model", "joints", "request"])]
     maps: Vec<PathBuf>,
-    /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps were built in.
+    /// Without maps: the robot (.urdf or .ron model description; the embedded iCub upper body
+    /// when absent).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    #[command(flatten)]
+    meshes: crate::MeshArgs,
+    /// Without maps: the motors that move (comma-separated names, or a group's name; the
+    /// request's goal joints with --request, else every motor).
+    #[arg(long)]
+    joints: Option<String>,
+    /// Without maps: a MoveIt motion plan request (.yaml): its start state and joint goal, its
+    /// allowed_planning_time as the budget (instead of --from and --to).
+    #[arg(long, conflicts_with = "to")]
+    request: Option<PathBuf>,
+    /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps
+    /// were built in. Without maps, a scene's allowed-collision matrix applies over the
+    /// model's own.
     #[arg(long)]
     world: Option<PathBuf>,
     /// Repair the maps for --world before planning: park what it blocks, bring back parked
     /// nodes it frees, grow points where coverage was lost (`repair-map` without its refill).
-    #[arg(long, requires = "world")]
+    #[arg(long, requires_all = ["world", "maps"])]
     repair: bool,
-    /// Start: `home` (the spec's start posture) or a JSON file with "motors": {name: value}
-    /// (as `solve --out` writes) or "q": [active values].
+    /// Start: `home` (the spec's start posture; without maps the model's `home` posture, else
+    /// 0 within the limits) or a JSON file with "motors": {name: value} (as `solve --out`
+    /// writes) or "q": [active values].
     #[arg(long, default_value = "home")]
     from: String,
     /// Goal: a task-space point "x,y,z" (through a map node within --tolerance, then to the
-    /// point itself) or a JSON posture file.
-    #[arg(long, allow_hyphen_values = true)]
-    to: String,
+    /// point itself) or a JSON posture file (the only goal without maps).
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "request")]
+    to: Option<String>,
     /// Task-space tolerance for the map node a point goal's path goes through.
     #[arg(long, default_value_t = 0.03)]
     tolerance: f64,
@@ -39,11 +60,21 @@ pub struct Args {
     /// Task error the exact finish must reach (metres for positions).
     #[arg(long, default_value_t = 1e-3, value_parser = crate::parse::positive)]
     exact_tolerance: f64,
-    /// Trajectory output (CSV; beside it a .json with the task-space path, a .ros.yaml ROS 2
-    /// JointTrajectory and an .svg of the path over the map).
+    /// Without maps: time budget, s (default: the request's allowed_planning_time, else none).
+    #[arg(long, value_parser = crate::parse::positive)]
+    max_seconds: Option<f64>,
+    /// Without maps: sample budget of RRT-Connect.
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::parse::count(1, 100_000_000))]
+    max_samples: usize,
+    /// Without maps: largest gap between checked points of an edge, rad.
+    #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]
+    resolution: f64,
+    /// Trajectory output (CSV; beside it a .json, a .ros.yaml ROS 2 JointTrajectory, a
+    /// .response.yaml MoveIt MotionPlanResponse and, with maps, an .svg of the path over the
+    /// first map).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Seed of the shortcutting.
+    /// Seed of the shortcutting (and of RRT-Connect's samples).
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Also write a 3-D view (maps, world, the motion and its task-space path) beside --out
@@ -79,6 +110,10 @@ pub fn run(args: &Args) -> Result<()> {
         "--tolerance {}: give a finite positive task-space distance",
         args.tolerance
     );
+    if args.maps.is_empty() {
+        return run_without_maps(args);
+    }
+    let to = args.to.as_deref().unwrap_or_default();
     let mut maps: Vec<Roadmap> = args
         .maps
         .iter()
@@ -123,15 +158,15 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         posture(Path::new(&args.from), &problem)?
     };
-    let goal = if Path::new(&args.to).is_file() {
-        Goal::Configuration(posture(Path::new(&args.to), &problem)?)
+    let goal = if Path::new(to).is_file() {
+        Goal::Configuration(posture(Path::new(to), &problem)?)
     } else {
-        let t = crate::numbers("--to", &args.to, "\"x,y,z\" or a posture file")?;
+        let t = crate::numbers("--to", to, "\"x,y,z\" or a posture file")?;
         let dim = first.points.first().map_or(t.len(), |p| p.t.len());
         if t.len() != dim {
             anyhow::bail!(
                 "--to `{}`: {} values for the map's {dim}-dimensional task space",
-                args.to,
+                to,
                 t.len()
             );
         }
@@ -201,24 +236,19 @@ pub fn run(args: &Args) -> Result<()> {
         _ => {}
     }
     if let Some(out) = &args.out {
-        crate::write_atomic(out, plan.trajectory.to_csv(out)?.as_bytes())?;
-        let json = out.with_extension("json");
-        crate::write_atomic(&json, plan.trajectory.to_json(&json)?.as_bytes())?;
-        let ros = out.with_extension("ros.yaml");
-        let yaml = plan.trajectory.to_ros_yaml(&problem.robot, &ros)?;
-        crate::write_atomic(&ros, yaml.as_bytes())?;
+        let group = problem
+            .objective
+            .active()
+            .names()
+            .collect::<Vec<_>>()
+            .join(",");
+        let written = write_trajectory(&plan.trajectory, &problem.robot, &group, s.seconds, out)?;
         let svg = out.with_extension("svg");
         crate::write_atomic(
             &svg,
             crate::plot::map_scatter(first, Some(&plan.trajectory.task_path))?.as_bytes(),
         )?;
-        println!(
-            "wrote {}, {}, {} (ROS 2 JointTrajectory) and {}",
-            out.display(),
-            json.display(),
-            ros.display(),
-            svg.display()
-        );
+        println!("wrote {written} and {}", svg.display());
     }
     if args.view {
         let mut scene = trm_view::Scene::of_problem(&problem, "planned motion")?;
@@ -235,6 +265,167 @@ pub fn run(args: &Args) -> Result<()> {
         );
         scene.set_world(planner.world());
         scene.add_roadmap(first, problem.objective.active())?;
+        let out = args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("target/plan.csv"));
+        crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))?;
+    }
+    Ok(())
+}
+
+/// Writes `trajectory` to `out` (CSV) and beside it as JSON, a ROS 2 JointTrajectory
+/// (`.ros.yaml`) and a MoveIt MotionPlanResponse (`.response.yaml`, for `group`, planned in
+/// `seconds`); each file written whole or not at all. Returns the files' names, for the report.
+fn write_trajectory(
+    trajectory: &Trajectory,
+    robot: &trm_kinematics::RobotModel,
+    group: &str,
+    seconds: f64,
+    out: &Path,
+) -> Result<String> {
+    crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;
+    let json = out.with_extension("json");
+    crate::write_atomic(&json, trajectory.to_json(&json)?.as_bytes())?;
+    let ros = out.with_extension("ros.yaml");
+    crate::write_atomic(&ros, trajectory.to_ros_yaml(robot, &ros)?.as_bytes())?;
+    let response = out.with_extension("response.yaml");
+    let yaml = trm_moveit::motion_plan_response_yaml(trajectory, robot, group, seconds, &response)?;
+    crate::write_atomic(&response, yaml.as_bytes())?;
+    Ok(format!(
+        "{}, {}, {} (ROS 2 JointTrajectory), {} (MoveIt MotionPlanResponse)",
+        out.display(),
+        json.display(),
+        ros.display(),
+        response.display()
+    ))
+}
+
+/// `plan` without maps: one planner for the robot, the world (and a scene's matrix) set on it,
+/// a start and a goal posture (or a MoveIt request's), RRT-Connect.
+fn run_without_maps(args: &Args) -> Result<()> {
+    let robot = crate::load_model(args.model.as_deref())?;
+    let collision = args.meshes.collision_model(&robot)?;
+    let request = args
+        .request
+        .as_ref()
+        .map(trm_moveit::MotionPlanRequest::load)
+        .transpose()?;
+    let names: Vec<String> = match (&args.joints, &request) {
+        (Some(j), _) if !j.contains(',') && robot.group(j).is_ok() => robot
+            .group(j)?
+            .iter()
+            .map(|&i| robot.motors()[i].name.clone())
+            .collect(),
+        (Some(j), _) => j.split(',').map(|n| n.trim().to_string()).collect(),
+        (None, Some(r)) => r.goal.names.clone(),
+        (None, None) => robot.motors().iter().map(|m| m.name.clone()).collect(),
+    };
+    let home: Vec<f64> = match robot.posture("home") {
+        Ok(home) => home.to_vec(),
+        Err(_) => robot
+            .motors()
+            .iter()
+            .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+            .collect(),
+    };
+    // the motors that do not move: where the request's start state puts them, else home
+    let fixed = match &request {
+        Some(r) => trm_moveit::motors_from_state(&robot, &r.start, &home).0,
+        None => home.clone(),
+    };
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let active = robot
+        .active_set(&refs, &fixed)
+        .context("--joints: give motor names of the model, or a group's name")?;
+    let mut planner = Planner::new(
+        &trm_tasks::Objective::new(active.clone(), collision.clone(), Default::default()),
+        &[],
+    )?;
+    if let Some(world) = &args.world {
+        let scene = trm_moveit::load_scene(world, &collision)?;
+        for note in &scene.notes {
+            eprintln!("{}: {note}", world.display());
+        }
+        planner.set_world(scene.world);
+        planner.set_acm(scene.acm)?;
+    }
+    let configuration = |text: &str, what: &str| -> Result<Vec<f64>> {
+        if text == "home" {
+            return Ok(active.from_motors(&fixed));
+        }
+        let motors =
+            crate::support::scene::posture_motors(Path::new(text), &robot, Some(&active), &fixed)
+                .with_context(|| format!("{what} {text}: give `home` or a posture file"))?;
+        Ok(active.from_motors(&motors))
+    };
+    let (start, goal) = match &request {
+        Some(r) => r.joint_query(&active)?,
+        None => (
+            configuration(&args.from, "--from")?,
+            configuration(args.to.as_deref().unwrap_or_default(), "--to")?,
+        ),
+    };
+    let options = RrtOptions {
+        seed: args.seed,
+        max_seconds: args
+            .max_seconds
+            .or(request.as_ref().and_then(|r| r.planning_time)),
+        max_iterations: args.max_samples,
+        resolution: args.resolution,
+        ..Default::default()
+    };
+    for (what, q) in [("start", &start), ("goal", &goal)] {
+        if !planner.is_free(q) {
+            anyhow::bail!(
+                "the {what} collides{}\n  fix: give a collision-free {what} (`trm collide` names the pairs)",
+                args.world
+                    .as_ref()
+                    .map_or(String::new(), |w| format!(" in {}", w.display()))
+            );
+        }
+    }
+    let found = planner.connect(&start, &goal, &options)?;
+    let timing = PlanOptions {
+        default_velocity: args.velocity,
+        ..Default::default()
+    };
+    let trajectory = planner.trajectory(&found.path, &timing);
+    println!(
+        "{}: {} of {} motors move; world: {} objects",
+        robot.name(),
+        active.len(),
+        robot.motors().len(),
+        planner.world().len()
+    );
+    println!(
+        "path: {} waypoints ({}), joint-space length {:.3} rad, duration {:.2} s",
+        found.path.len(),
+        found.source.name(),
+        trm_plan::rrt::path_length(&found.path),
+        trajectory.times.last().copied().unwrap_or(0.0)
+    );
+    println!(
+        "planning: {:.2} ms, {} samples, {} configurations checked",
+        found.seconds * 1e3,
+        found.iterations,
+        found.checks
+    );
+    if let Some(out) = &args.out {
+        let group = request
+            .as_ref()
+            .map_or_else(|| names.join(","), |r| r.group.clone());
+        println!(
+            "wrote {}",
+            write_trajectory(&trajectory, &robot, &group, found.seconds, out)?
+        );
+    }
+    if args.view {
+        let mut scene = trm_view::Scene::new("planned motion", &collision);
+        for (t, q) in trajectory.times.iter().zip(&trajectory.positions) {
+            scene.add_frame(*t, q)?;
+        }
+        scene.set_world(planner.world());
         let out = args
             .out
             .clone()

@@ -15,6 +15,9 @@ use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 use crate::trajectory::{Trajectory, time_parametrise};
 
+mod connect;
+pub use connect::{Connection, Source};
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum State {
     Unknown,
@@ -27,11 +30,45 @@ enum State {
 /// planned before.
 pub const RETRIEVE_STEPS: f64 = 2.0;
 
-/// The roadmap graph with lazily checked states, for one robot and a current world.
-#[derive(Debug)]
-pub struct Planner<'a> {
-    objective: &'a Objective,
+/// A planner for one robot, compiled once: its collision checks in a current world (set and
+/// replaced without recompiling the robot), an optional graph of maps and kept paths
+/// (experience) whose nodes and edges are checked lazily in that world, and RRT-Connect for
+/// what the graph does not answer.
+///
+/// Two kinds of query: [`Planner::connect`] joins two configurations (the graph when it has
+/// nodes, else or where it fails RRT-Connect; the query MotionBenchMaker and MoveIt ask), and
+/// [`Planner::plan`] reaches task-space goals through the maps (and configuration goals, with
+/// a timed trajectory).
+///
+/// ```
+/// use trm_collision::{CollisionModel, Shape, World};
+/// use trm_kinematics::nalgebra::Isometry3;
+/// use trm_plan::Planner;
+/// use trm_plan::rrt::RrtOptions;
+///
+/// let robot = trm_models::icub_upper_body();
+/// let home = robot.posture("home")?.to_vec();
+/// let active = robot.active_set(&["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"], &home)?;
+/// let mut world = World::new();
+/// world.add("pole", Shape::Box { size: [0.04, 0.04, 2.0] }, Isometry3::translation(-0.25, 0.2, 0.0))?;
+/// let objective = trm_tasks::Objective::new(active, CollisionModel::new(&robot)?, world);
+/// let mut planner = Planner::new(&objective, &[])?;
+/// let start = objective.active().from_motors(&home);
+/// let goal = vec![start[0] - 1.2, start[1] + 0.6, start[2] + 0.5];
+/// let motion = planner.connect(&start, &goal, &RrtOptions::default())?;
+/// assert_eq!(motion.path.first(), Some(&start));
+/// assert_eq!(motion.path.last(), Some(&goal));
+/// // the world moves: the robot is not compiled again
+/// planner.set_world(World::new());
+/// assert!(planner.is_free(&goal));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct Planner {
+    objective: Objective,
     active: ActiveSet,
+    /// The active motors' lower and upper limits (RRT-Connect's sampling box).
+    bounds: (Vec<f64>, Vec<f64>),
     nodes: Vec<(Vec<f64>, Vec<f64>)>,
     node_state: Vec<State>,
     edges: Vec<(usize, usize, f64)>,
@@ -43,12 +80,12 @@ pub struct Planner<'a> {
     kept: Vec<(Vec<usize>, Vec<usize>)>,
 }
 
-impl<'a> Planner<'a> {
+impl Planner {
     /// A planner over `maps` (built for the same active motors as `objective`), in the world the
     /// objective was built with. Map nodes and edges are trusted until the world changes; maps
     /// are joined by edges from each node to its nearest nodes of every other map (checked when
     /// A* first wants them).
-    pub fn new(objective: &'a Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
+    pub fn new(objective: &Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
         let names: Vec<&str> = objective.active().names().collect();
         let mut nodes = Vec::new();
         let mut edges = Vec::new();
@@ -90,8 +127,9 @@ impl<'a> Planner<'a> {
         }
         Ok(Planner {
             checker: objective.world_checker(objective.world())?,
-            objective,
+            objective: objective.clone(),
             active: objective.active().clone(),
+            bounds: objective.active().bounds(),
             node_state: vec![State::Valid; nodes.len()],
             nodes,
             edges,
@@ -111,6 +149,37 @@ impl<'a> Planner<'a> {
         self.checker.set_world(world);
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
+    }
+
+    /// Replaces the allowed-collision matrix (a planning scene's, applied over the robot's own:
+    /// see `trm_moveit::PlanningScene::world_and_acm`): when it differs from the current one, the
+    /// checks are made again for it (the robot's compiled screen is reused where its pairs
+    /// allow) and every node and edge will be checked again. Whether it differed.
+    pub fn set_acm(
+        &mut self,
+        acm: trm_collision::AllowedCollisionMatrix,
+    ) -> Result<bool, PlanError> {
+        if *self.objective.collision().acm() == acm {
+            return Ok(false);
+        }
+        self.objective.set_acm(acm)?;
+        let world = self.checker.world().clone();
+        let checks = self.checker.checks;
+        self.checker = self.objective.world_checker(&world)?;
+        self.checker.checks = checks;
+        self.node_state.fill(State::Unknown);
+        self.edge_state.fill(State::Unknown);
+        Ok(true)
+    }
+
+    /// The active motors the planner moves (its configurations' coordinates).
+    pub fn active(&self) -> &ActiveSet {
+        &self.active
+    }
+
+    /// The objective the planner was made with (its robot, collision model and maps' costs).
+    pub fn objective(&self) -> &Objective {
+        &self.objective
     }
 
     /// Keeps a path (active values, free in the current world, e.g. one RRT-Connect found) as
@@ -208,14 +277,13 @@ impl<'a> Planner<'a> {
             (&planned, goal, &options.sampling)
         {
             let began = Instant::now();
-            let found =
-                crate::rrt::rrt_connect(self.objective, self.checker.world(), start, q, rrt)?;
+            let found = crate::rrt::rrt_connect_in(&mut self.checker, &self.bounds, start, q, rrt)?;
             let mut stats = PlanStats {
                 sampled: Some((found.iterations, found.checks)),
                 length: crate::rrt::path_length(&found.path),
                 ..Default::default()
             };
-            let trajectory = self.timed(&found.path, options);
+            let trajectory = self.trajectory(&found.path, options);
             stats.seconds = began.elapsed().as_secs_f64();
             return Ok(Planned {
                 trajectory,
@@ -528,7 +596,7 @@ impl<'a> Planner<'a> {
             stats.goal_error = Some(distance(&self.task_of(&end), t));
         }
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.timed(&waypoints, options);
+        let trajectory = self.trajectory(&waypoints, options);
         stats.seconds = began.elapsed().as_secs_f64();
         Planned {
             trajectory,
@@ -614,7 +682,7 @@ impl<'a> Planner<'a> {
         stats.retrieved = true;
         self.shortcut(&mut waypoints, options);
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.timed(&waypoints, options);
+        let trajectory = self.trajectory(&waypoints, options);
         stats.seconds = began.elapsed().as_secs_f64();
         Ok(Some(Planned {
             trajectory,
@@ -730,7 +798,10 @@ impl<'a> Planner<'a> {
         }
     }
 
-    fn timed(&mut self, waypoints: &[Vec<f64>], options: &PlanOptions) -> Trajectory {
+    /// A path (active values) timed within the motors' velocity limits (and `options`'
+    /// acceleration): stopping at every waypoint, [`time_parametrise`]; with its task-space
+    /// path where the planner has a task.
+    pub fn trajectory(&mut self, waypoints: &[Vec<f64>], options: &PlanOptions) -> Trajectory {
         let task_path = waypoints.iter().map(|q| self.task_of(q)).collect();
         let model = self.active.model();
         let velocity: Vec<f64> = self
@@ -758,8 +829,6 @@ impl<'a> Planner<'a> {
     }
 }
 
-/// The `k` nodes of `candidates` nearest to `q` in configuration space, as (distance, index),
-/// nearest first and ties by index (the order of a stable sort): a selection, then a sort of
 /// An edge of the planner's graph: its two nodes and its length.
 type Edge = (usize, usize, f64);
 
@@ -791,6 +860,8 @@ impl Target<'_> {
     }
 }
 
+/// The `k` nodes of `candidates` nearest to `q` in configuration space, as (distance, index),
+/// nearest first and ties by index (the order of a stable sort): a selection, then a sort of
 /// `k` — not a sort of every node (experience graphs hold thousands).
 fn k_nearest(
     q: &[f64],

@@ -1,0 +1,154 @@
+//! [`Planner::connect`]: a path between two configurations, the query MotionBenchMaker and
+//! MoveIt ask.
+
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::Planner;
+use crate::PlanError;
+use crate::query::{Goal, PlanOptions};
+use crate::rrt::{EdgeCheck, RrtOptions, rrt_connect_in, shortcut};
+
+/// Where the path of a [`Planner::connect`] query came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Source {
+    /// The straight segment from the start to the goal.
+    Straight,
+    /// A search through the maps and kept paths.
+    Graph,
+    /// A kept path whose ends repeat the query's (see [`crate::RETRIEVE_STEPS`]).
+    Retrieved,
+    /// RRT-Connect.
+    Sampled,
+}
+
+impl Source {
+    /// A short lowercase name: `straight`, `graph`, `retrieved` or `sampled`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Straight => "straight",
+            Source::Graph => "graph",
+            Source::Retrieved => "retrieved",
+            Source::Sampled => "sampled",
+        }
+    }
+}
+
+/// A collision-free path [`Planner::connect`] found, and what it cost.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Connection {
+    /// Waypoints (active values) from the start to the goal, shortcut.
+    pub path: Vec<Vec<f64>>,
+    /// Where the path came from.
+    pub source: Source,
+    /// Configurations checked for collision by this query (the graph's lazy checks excluded
+    /// when RRT-Connect answered).
+    pub checks: u64,
+    /// RRT-Connect's samples (0 when the graph answered).
+    pub iterations: usize,
+    /// Wall time, s.
+    pub seconds: f64,
+}
+
+impl Planner {
+    /// A collision-free path from `start` to `goal` (active values), found with `options`'
+    /// resolution, seed and budget:
+    /// - without maps or kept paths, by RRT-Connect ([`crate::rrt::rrt_connect`]: the straight
+    ///   segment first, the path shortcut and checked again at half the resolution);
+    /// - with them, through the graph first ([`Planner::plan`] to a configuration goal: a kept
+    ///   path repeating the query is retrieved, else A* with lazy checks), the path shortcut
+    ///   greedily and checked at half the resolution as RRT-Connect's paths are; where the
+    ///   graph does not join the two or its path grazes an obstacle, by RRT-Connect.
+    ///
+    /// Nothing is kept: a caller keeping experience adds the path ([`Planner::add_path`]) when
+    /// [`Connection::source`] is [`Source::Sampled`].
+    pub fn connect(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+    ) -> Result<Connection, PlanError> {
+        options.check()?;
+        let began = Instant::now();
+        if self.nodes.is_empty() {
+            return self.sample(start, goal, options, began, 0);
+        }
+        let plan_options = PlanOptions {
+            resolution: options.resolution,
+            shortcuts: 0,
+            seed: options.seed,
+            exact_goal: false,
+            sampling: Some(options.clone()),
+            ..Default::default()
+        };
+        let planned = self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options)?;
+        if let Some((iterations, checks)) = planned.stats.sampled {
+            return Ok(Connection {
+                path: planned.waypoints,
+                source: Source::Sampled,
+                checks,
+                iterations,
+                seconds: began.elapsed().as_secs_f64(),
+            });
+        }
+        let before = self.checker.checks;
+        let mut path = planned.waypoints;
+        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        let greedy = RrtOptions {
+            shortcuts: 0,
+            ..options.clone()
+        };
+        let edges = shortcut(&mut path, &greedy, &mut self.checker, &mut rng);
+        let source = if planned.stats.retrieved {
+            Source::Retrieved
+        } else if planned.nodes.is_empty() {
+            Source::Straight
+        } else {
+            Source::Graph
+        };
+        // at half the resolution: the edges the shortcut found free and the graph's own
+        // (checked at the same points, `WorldChecker::segment_free`) need only their midpoints
+        let r = options.resolution;
+        let checker = &mut self.checker;
+        let free = path.windows(2).zip(&edges).all(|(w, e)| {
+            (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
+                && checker.edge_midpoints_free(&w[0], &w[1], r)
+        });
+        let checks = self.checker.checks - before;
+        if free {
+            return Ok(Connection {
+                path,
+                source,
+                checks,
+                iterations: 0,
+                seconds: began.elapsed().as_secs_f64(),
+            });
+        }
+        self.sample(start, goal, options, began, checks)
+    }
+
+    /// RRT-Connect from `start` to `goal` with the planner's checker; `checks` already spent.
+    fn sample(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+        began: Instant,
+        checks: u64,
+    ) -> Result<Connection, PlanError> {
+        let found = rrt_connect_in(&mut self.checker, &self.bounds, start, goal, options)?;
+        Ok(Connection {
+            source: if found.iterations == 0 {
+                Source::Straight
+            } else {
+                Source::Sampled
+            },
+            path: found.path,
+            checks: checks + found.checks,
+            iterations: found.iterations,
+            seconds: began.elapsed().as_secs_f64(),
+        })
+    }
+}
