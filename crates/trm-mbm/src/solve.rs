@@ -231,45 +231,10 @@ pub(crate) fn problem_objective(
         .iter()
         .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
         .collect();
+    let active_set = request.active_set(robot, &base)?;
+    let active = active_set.motor_indices().to_vec();
     let (start_motors, _) = motors_from_state(robot, &request.start, &base);
-    let locked: Vec<f64> = robot
-        .motors()
-        .iter()
-        .zip(&start_motors)
-        .map(|(m, v)| v.clamp(m.limits.lower, m.limits.upper))
-        .collect();
-    let mut active = Vec::new();
-    if request.goal.names.is_empty() {
-        // a task-space goal moves the request's group
-        if request.group.is_empty() {
-            return Err(MbmError::Invalid {
-                path: request.origin.clone(),
-                line: 0,
-                problem: "a task-space goal without group_name".into(),
-                fix: "give group_name: the group whose joints move".into(),
-            });
-        }
-        active = robot
-            .group(&request.group)
-            .map_err(|e| MbmError::Invalid {
-                path: request.origin.clone(),
-                line: 0,
-                problem: format!("group_name: {e}"),
-                fix: "give a group of this robot model (its description's groups)".into(),
-            })?
-            .to_vec();
-    }
-    for name in &request.goal.names {
-        let i = robot.motor_index(name).map_err(|e| MbmError::Invalid {
-            path: request.origin.clone(),
-            line: 0,
-            problem: format!("the goal constrains `{name}`: {e}"),
-            fix: "give a request for this robot model".into(),
-        })?;
-        active.push(i);
-    }
     let start: Vec<f64> = active.iter().map(|&i| start_motors[i]).collect();
-    let active_set = trm_kinematics::ActiveSet::new(robot.clone(), active.clone(), &locked)?;
     Ok((
         Objective::new(active_set, collision.clone(), world.clone()),
         active,

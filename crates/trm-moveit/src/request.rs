@@ -521,6 +521,63 @@ impl MotionPlanRequest {
         Ok(out)
     }
 
+    /// The motors a planner for this request moves — the goal's joints, or for a task-space
+    /// goal the request's group — and the others held where the start state puts them (`base`,
+    /// one value per motor, where it is silent), clamped into their limits: the active set a
+    /// planner for this request is made with (see [`MotionPlanRequest::joint_query`]).
+    pub fn active_set(
+        &self,
+        robot: &trm_kinematics::RobotModel,
+        base: &[f64],
+    ) -> Result<trm_kinematics::ActiveSet, MoveItError> {
+        let invalid = |problem: String, fix: &str| MoveItError::Invalid {
+            path: self.origin.clone(),
+            line: 0,
+            problem,
+            fix: fix.into(),
+        };
+        let (start, _) = motors_from_state(robot, &self.start, base);
+        let held: Vec<f64> = robot
+            .motors()
+            .iter()
+            .zip(&start)
+            .map(|(m, v)| v.clamp(m.limits.lower, m.limits.upper))
+            .collect();
+        let mut moving = Vec::new();
+        if self.goal.names.is_empty() {
+            // a task-space goal moves the request's group
+            if self.group.is_empty() {
+                return Err(invalid(
+                    "a task-space goal without group_name".into(),
+                    "give group_name: the group whose joints move",
+                ));
+            }
+            moving = robot
+                .group(&self.group)
+                .map_err(|e| {
+                    invalid(
+                        format!("group_name: {e}"),
+                        "give a group of this robot model (its description's groups)",
+                    )
+                })?
+                .to_vec();
+        }
+        for name in &self.goal.names {
+            let i = robot.motor_index(name).map_err(|e| {
+                invalid(
+                    format!("the goal constrains `{name}`: {e}"),
+                    "give a request for this robot model",
+                )
+            })?;
+            moving.push(i);
+        }
+        Ok(trm_kinematics::ActiveSet::new(
+            robot.clone(),
+            moving,
+            &held,
+        )?)
+    }
+
     /// The request's start and joint goal in `active`'s coordinates (a planner's): the start
     /// state's values of the active motors, the goal's by name. An error names what does not
     /// fit: a task-space goal, a goal that constrains a motor the set does not move or leaves

@@ -70,20 +70,29 @@ impl Planner {
     /// (none: empty, or the maps' own). For a robot, `joints` are the motors it moves (their
     /// names, or a group's name; all motors when absent), `posture` holds the others (every
     /// motor's value; the `home` posture, else 0 within the limits, when absent), `collision`
-    /// its collision model (the robot's own when absent). With `experience=True` every path
-    /// RRT-Connect finds is kept and later queries plan through them.
+    /// its collision model (the robot's own when absent); or `request`, a MoveIt motion plan
+    /// request (`.yaml`), says both: its goal's joints move, the other motors stay where its
+    /// start state puts them. With `experience=True` every path RRT-Connect finds is kept and
+    /// later queries plan through them.
     #[new]
-    #[pyo3(signature = (source, world = None, *, joints = None, posture = None, collision = None, experience = false))]
+    #[pyo3(signature = (source, world = None, *, joints = None, posture = None, request = None, collision = None, experience = false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         source: &Bound<'_, PyAny>,
         world: Option<&PyWorld>,
         joints: Option<&Bound<'_, PyAny>>,
         posture: Option<&Bound<'_, PyAny>>,
+        request: Option<&str>,
         collision: Option<PyRef<'_, Collision>>,
         experience: bool,
     ) -> PyResult<Self> {
         if let Ok(robot) = source.extract::<PyRef<'_, Robot>>() {
             let model = &robot.model;
+            if request.is_some() && (joints.is_some() || posture.is_some()) {
+                return Err(err(
+                    "request: give it alone, or joints and posture (a request says both)",
+                ));
+            }
             let names: Vec<String> = match joints {
                 None => model.motors().iter().map(|m| m.name.clone()).collect(),
                 Some(j) => match j.extract::<String>() {
@@ -109,8 +118,15 @@ impl Planner {
                         .collect(),
                 },
             };
-            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-            let active = model.active_set(&refs, &fixed).map_err(err)?;
+            let active = match request {
+                Some(path) => trm_moveit::MotionPlanRequest::load(path)
+                    .and_then(|r| r.active_set(model, &fixed))
+                    .map_err(err)?,
+                None => {
+                    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+                    model.active_set(&refs, &fixed).map_err(err)?
+                }
+            };
             let collision = match collision {
                 Some(c) => c.model.clone(),
                 None => CollisionModel::new(model).map_err(err)?,
@@ -125,9 +141,9 @@ impl Planner {
                 experience,
             });
         }
-        if joints.is_some() || posture.is_some() || collision.is_some() {
+        if joints.is_some() || posture.is_some() || request.is_some() || collision.is_some() {
             return Err(err(
-                "joints, posture and collision are a robot planner's: a map planner takes its maps' spec",
+                "joints, posture, request and collision are a robot planner's: a map planner takes its maps' spec",
             ));
         }
         let maps: Vec<trm_roadmap::Roadmap> = match source.extract::<PyRef<'_, Roadmap>>() {
@@ -262,7 +278,7 @@ impl Planner {
         let planned = if posture {
             if target.len() != dim {
                 return Err(err(format!(
-                    "to: {} values; the planner moves {dim} motors ({})",
+                    "to: the goal configuration has {} values; the planner moves {dim} motors ({})",
                     target.len(),
                     self.joint_names().join(", ")
                 )));

@@ -311,16 +311,6 @@ fn run_without_maps(args: &Args) -> Result<()> {
         .as_ref()
         .map(trm_moveit::MotionPlanRequest::load)
         .transpose()?;
-    let names: Vec<String> = match (&args.joints, &request) {
-        (Some(j), _) if !j.contains(',') && robot.group(j).is_ok() => robot
-            .group(j)?
-            .iter()
-            .map(|&i| robot.motors()[i].name.clone())
-            .collect(),
-        (Some(j), _) => j.split(',').map(|n| n.trim().to_string()).collect(),
-        (None, Some(r)) => r.goal.names.clone(),
-        (None, None) => robot.motors().iter().map(|m| m.name.clone()).collect(),
-    };
     let home: Vec<f64> = match robot.posture("home") {
         Ok(home) => home.to_vec(),
         Err(_) => robot
@@ -329,15 +319,32 @@ fn run_without_maps(args: &Args) -> Result<()> {
             .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
             .collect(),
     };
-    // the motors that do not move: where the request's start state puts them, else home
-    let fixed = match &request {
-        Some(r) => trm_moveit::motors_from_state(&robot, &r.start, &home).0,
-        None => home.clone(),
+    let active = match (&args.joints, &request) {
+        // the request's goal joints move, the other motors stay where its start puts them
+        (None, Some(r)) => r.active_set(&robot, &home)?,
+        (joints, _) => {
+            let names: Vec<String> = match joints {
+                Some(j) if !j.contains(',') && robot.group(j).is_ok() => robot
+                    .group(j)?
+                    .iter()
+                    .map(|&i| robot.motors()[i].name.clone())
+                    .collect(),
+                Some(j) => j.split(',').map(|n| n.trim().to_string()).collect(),
+                None => robot.motors().iter().map(|m| m.name.clone()).collect(),
+            };
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            let fixed = match &request {
+                Some(r) => trm_moveit::motors_from_state(&robot, &r.start, &home).0,
+                None => home,
+            };
+            robot
+                .active_set(&refs, &fixed)
+                .context("--joints: give motor names of the model, or a group's name")?
+        }
     };
-    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let active = robot
-        .active_set(&refs, &fixed)
-        .context("--joints: give motor names of the model, or a group's name")?;
+    // the motors that do not move, where the planner holds them
+    let fixed = active.to_motors(&vec![0.0; active.len()]);
+    let names: Vec<String> = active.names().map(str::to_string).collect();
     let mut planner = Planner::new(
         &trm_tasks::Objective::new(active.clone(), collision.clone(), Default::default()),
         &[],

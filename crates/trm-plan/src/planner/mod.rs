@@ -50,7 +50,7 @@ pub const RETRIEVE_STEPS: f64 = 2.0;
 /// let home = robot.posture("home")?.to_vec();
 /// let active = robot.active_set(&["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"], &home)?;
 /// let mut world = World::new();
-/// world.add("pole", Shape::Box { size: [0.04, 0.04, 2.0] }, Isometry3::translation(-0.25, 0.2, 0.0))?;
+/// world.add("pole", Shape::Box { size: [0.04, 0.04, 2.0] }, Isometry3::translation(-0.25, 0.3, 0.0))?;
 /// let objective = trm_tasks::Objective::new(active, CollisionModel::new(&robot)?, world);
 /// let mut planner = Planner::new(&objective, &[])?;
 /// let start = objective.active().from_motors(&home);

@@ -260,6 +260,63 @@ def test_a_map_builds_saves_loads_and_plans(tmp_path):
     assert str(page).endswith("plan.html")
 
 
+MBM = ROOT / "crates" / "trm-mbm" / "tests" / "fixtures" / "mbm"
+PANDA = str(ROOT / "models" / "panda-mbm" / "panda_spherized.ron")
+
+
+def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
+    robot = trm.Robot.load(PANDA)
+    requests = sorted(MBM.glob("*/request*.yaml"))
+    planner = trm.Planner(robot, request=str(requests[0]))
+    assert planner.joint_names == [f"panda_joint{k}" for k in range(1, 8)]
+    bench = trm.benchmark_mbm(str(MBM), PANDA)
+    expected = {(r["family"], r["index"]): r["outcome"] for r in bench["runs"]}
+    for request in requests:
+        number = request.stem[len("request"):]
+        assert planner.load_scene(str(request.with_name(f"scene{number}.yaml"))) == []
+        r = planner.plan_request(str(request))
+        same = expected[(request.parent.name, int(number))]
+        # the same planner object: the same path, found with the same checks
+        assert same["solved"] and r["checks"] == same["checks"], request
+        np.testing.assert_array_equal(r["waypoints"], np.array(same["path"]))
+        assert r["positions"].shape == (len(r["waypoints"]), 7)
+        assert r["times"][0] == 0.0 and np.all(np.diff(r["times"]) > 0)
+        assert r["source"] in ("straight", "sampled")
+    assert "7 motors" in repr(planner)
+
+
+def test_a_robot_planner_keeps_experience_across_worlds(robot):
+    joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
+    planner = trm.Planner(robot, joints=joints, experience=True)
+    home = robot.posture("home")
+    start = np.array([home[robot.motor_names.index(j)] for j in joints])
+    goal = start + np.array([-1.2, 0.6, 0.5])
+    world = trm.World()
+    world.add_box("pole", [0.04, 0.04, 2.0], [-0.25, 0.3, 0.0])
+    planner.world = world
+    assert len(planner.world) == 1
+    first = planner.plan(goal, start=start, seed=3, max_seconds=10.0)
+    assert np.allclose(first["waypoints"][0], start) and np.allclose(first["waypoints"][-1], goal)
+    again = planner.plan(goal, start=start, seed=4)
+    if first["source"] == "sampled":
+        assert planner.num_nodes > 0 and again["source"] == "retrieved"
+    # a new world: the kept path is checked again, never trusted
+    planner.world = trm.World()
+    assert planner.plan(goal, start=start)["source"] in ("straight", "retrieved", "graph")
+    with pytest.raises(trm.TrmError, match="start: give"):
+        planner.plan(goal)
+    with pytest.raises(trm.TrmError, match="a task point needs a map planner"):
+        planner.plan(goal, start=start, posture=False)
+    with pytest.raises(trm.TrmError, match="max_seconds"):
+        planner.plan(goal, start=start, max_seconds=-1.0)
+    with pytest.raises(trm.TrmError, match="joints, posture, request and collision"):
+        trm.Planner([], joints=joints)
+    with pytest.raises(trm.TrmError, match="nope"):
+        trm.Planner(robot, joints=["nope"])
+    with pytest.raises(trm.TrmError, match="the goal constrains `panda_joint1`"):
+        planner.plan_request(str(sorted(MBM.glob("*/request*.yaml"))[0]))
+
+
 def test_errors_are_located_trm_errors(robot, tmp_path):
     with pytest.raises(trm.TrmError, match="nope.urdf"):
         trm.Robot.load("nope.urdf")

@@ -120,8 +120,50 @@ class Roadmap:
     def __len__(self) -> int: ...
 
 class Planner:
-    def __init__(self, maps: Roadmap | Sequence[Roadmap], world: World | None = None) -> None: ...
-    def plan(self, to: ArrayLike, start: ArrayLike | None = None, tolerance: float = 0.03, posture: bool = False, exact: bool = True, seed: int = 0) -> dict: ...
+    def __init__(
+        self,
+        source: Robot | Roadmap | Sequence[Roadmap],
+        world: World | None = None,
+        *,
+        joints: str | Sequence[str] | None = None,
+        posture: ArrayLike | None = None,
+        request: str | None = None,
+        collision: CollisionModel | None = None,
+        experience: bool = False,
+    ) -> None: ...
+    @property
+    def world(self) -> World: ...
+    @world.setter
+    def world(self, world: World) -> None: ...
+    @property
+    def joint_names(self) -> list[str]: ...
+    @property
+    def num_nodes(self) -> int: ...
+    def load_scene(self, path: str) -> list[str]: ...
+    def is_free(self, q: ArrayLike) -> bool: ...
+    def add_path(self, path: ArrayLike) -> int: ...
+    def plan(
+        self,
+        to: ArrayLike,
+        start: ArrayLike | None = None,
+        *,
+        tolerance: float = 0.03,
+        posture: bool | None = None,
+        exact: bool = True,
+        seed: int = 0,
+        max_seconds: float | None = None,
+        max_samples: int = 1_000_000,
+        resolution: float = 1.0 / 32.0,
+    ) -> dict: ...
+    def plan_request(
+        self,
+        request: str,
+        *,
+        seed: int = 0,
+        max_seconds: float | None = None,
+        max_samples: int = 1_000_000,
+        resolution: float = 1.0 / 32.0,
+    ) -> dict: ...
 
 class TaskMap:
     @staticmethod

@@ -1,0 +1,128 @@
+"""MotionBenchMaker problems through Python's door: one `trm.Planner` for the robot, each
+problem's scene set on it (`load_scene`: world and allowed-collision matrix) and its request
+planned (`plan_request`), as a Python user plans MoveIt queries. Prints, per family: valid,
+solved, the planner's median and p95 time (what `trm benchmark-mbm` reports for the same
+problems and seed), and the median wall time of the Python call, without and with reading the
+scene. Compare with `trm benchmark-mbm SET --model MODEL` on the same set: the same planner
+object answers both, so solved counts and path lengths agree problem by problem.
+
+Run (the wheel installed: `python3 -m maturin build --release -m crates/trm-py/Cargo.toml`
+and `pip install` the wheel it writes):
+    python3 benches/python/mbm_planner.py SET_DIR --model models/panda-mbm/panda_spherized.ron
+where SET_DIR holds one folder per family (unpack benches/mbm/panda_problems.tar.bz2), or a
+.tar.bz2 of one. `--csv FILE` writes one row per problem.
+"""
+
+import argparse
+import statistics
+import sys
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+import trm
+
+
+def percentile(values, p):
+    """The p-th percentile (linear between order statistics, as numpy's default)."""
+    if not values:
+        return float("nan")
+    s = sorted(values)
+    k = (len(s) - 1) * p / 100.0
+    lo = int(k)
+    hi = min(lo + 1, len(s) - 1)
+    return s[lo] + (s[hi] - s[lo]) * (k - lo)
+
+
+def problems(root):
+    """(family, number, scene, request) of every problem, families and numbers in order."""
+    for family in sorted(p for p in root.iterdir() if p.is_dir()):
+        for request in sorted(family.glob("request*.yaml")):
+            number = request.stem[len("request"):]
+            scene = family / f"scene{number}.yaml"
+            if scene.is_file():
+                yield family.name, int(number), scene, request
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("set", type=Path)
+    ap.add_argument("--model", required=True)
+    ap.add_argument("--per-family", type=int)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--max-samples", type=int, default=1_000_000)
+    ap.add_argument("--csv", type=Path)
+    args = ap.parse_args()
+
+    root = args.set
+    if root.suffix == ".bz2":
+        tmp = tempfile.TemporaryDirectory()
+        with tarfile.open(root) as t:
+            t.extractall(tmp.name, filter="data")
+        root = Path(tmp.name)
+        inner = [p for p in root.iterdir() if p.is_dir()]
+        if len(inner) == 1 and not any(inner[0].glob("request*.yaml")):
+            root = inner[0]
+
+    robot = trm.Robot.load(args.model)
+    all_problems = list(problems(root))
+    if not all_problems:
+        sys.exit(f"{args.set}: no family folders with sceneNNNN.yaml and requestNNNN.yaml")
+    # one planner for the set: the first request's goal joints move, the other motors stay where
+    # its start puts them (every later request is checked against that by plan_request)
+    made = time.perf_counter()
+    planner = trm.Planner(robot, request=str(all_problems[0][3]))
+    made = time.perf_counter() - made
+
+    rows = []
+    counts = {}
+    for family, number, scene, request in all_problems:
+        seen = counts.setdefault(family, 0)
+        if args.per_family is not None and seen >= args.per_family:
+            continue
+        counts[family] = seen + 1
+        t0 = time.perf_counter()
+        planner.load_scene(str(scene))
+        t1 = time.perf_counter()
+        row = {"family": family, "problem": number, "valid": True, "solved": False}
+        try:
+            r = planner.plan_request(str(request), seed=args.seed, max_samples=args.max_samples)
+            row.update(solved=True, seconds=r["seconds"], length=r["length"],
+                       waypoints=len(r["waypoints"]), checks=r["checks"], note=r["source"])
+        except trm.TrmError as e:
+            message = str(e)
+            row["valid"] = "collides" not in message and "outside its limits" not in message
+            row["note"] = message.splitlines()[0]
+        t2 = time.perf_counter()
+        row["call"] = t2 - t1
+        row["with_scene"] = t2 - t0
+        rows.append(row)
+
+    print(f"trm.Planner({Path(args.model).name}) made in {made * 1e3:.2f} ms")
+    print("| family | valid | solved | median ms | p95 ms | median call ms | median call + scene ms | median length (rad) |")
+    print("|---|---|---|---|---|---|---|---|")
+    families = sorted({r["family"] for r in rows})
+    for family in families + ["all"]:
+        sel = [r for r in rows if family in ("all", r["family"])]
+        valid = [r for r in sel if r["valid"]]
+        solved = [r for r in valid if r["solved"]]
+        ms = [1e3 * r["seconds"] for r in solved]
+        call = [1e3 * r["call"] for r in solved]
+        scene = [1e3 * r["with_scene"] for r in solved]
+        length = [r["length"] for r in solved]
+        med = lambda v: statistics.median(v) if v else float("nan")
+        print(f"| {family} | {len(valid)}/{len(sel)} | {len(solved)}/{len(valid)} | "
+              f"{med(ms):.2f} | {percentile(ms, 95):.2f} | {med(call):.2f} | {med(scene):.2f} | "
+              f"{med(length):.2f} |")
+    if args.csv:
+        keys = ["family", "problem", "valid", "solved", "seconds", "call", "with_scene",
+                "length", "waypoints", "checks", "note"]
+        with open(args.csv, "w") as f:
+            f.write(",".join(keys) + "\n")
+            for r in rows:
+                f.write(",".join(str(r.get(k, "")).replace(",", ";") for k in keys) + "\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,267 @@
+//! One planner, every door: a `trm_plan::Planner` made once for the robot, each MotionBenchMaker
+//! scene set on it (world and allowed-collision matrix) and each request asked of it, answers
+//! exactly as the benchmark's solve does; requests that do not fit the planner are named; the
+//! MoveIt response a plan is written as reads back.
+
+use std::path::{Path, PathBuf};
+
+use trm_collision::CollisionModel;
+use trm_kinematics::RobotModel;
+use trm_mbm::{LoadedProblem, find_problems, solve_loaded};
+use trm_moveit::{MotionPlanRequest, load_scene, motion_plan_response_yaml};
+use trm_plan::rrt::RrtOptions;
+use trm_plan::{PlanOptions, Planner, Source};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mbm")
+}
+
+fn panda() -> (RobotModel, CollisionModel) {
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda_spherized.ron");
+    let robot = RobotModel::load(&model).unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    (robot, collision)
+}
+
+/// A planner for the first request's robot and motors.
+fn planner_for(robot: &RobotModel, collision: &CollisionModel, request: &Path) -> Planner {
+    let request = MotionPlanRequest::load(request).unwrap();
+    let home = vec![0.0; robot.motors().len()];
+    let active = request.active_set(robot, &home).unwrap();
+    let objective = trm_tasks::Objective::new(active, collision.clone(), Default::default());
+    Planner::new(&objective, &[]).unwrap()
+}
+
+#[test]
+fn one_planner_answers_every_problem_as_the_benchmark_does() {
+    let (robot, collision) = panda();
+    let problems = find_problems(&fixtures()).unwrap();
+    let mut planner = planner_for(&robot, &collision, &problems[0].request);
+    let options = RrtOptions::default();
+    let mut matrices_set = 0;
+    for p in &problems {
+        let expected = solve_loaded(
+            &robot,
+            &LoadedProblem::load(&collision, p).unwrap(),
+            &options,
+        )
+        .unwrap();
+        let scene = load_scene(&p.scene, &collision).unwrap();
+        planner.set_world(scene.world);
+        matrices_set += usize::from(planner.set_acm(scene.acm).unwrap());
+        let request = MotionPlanRequest::load(&p.request).unwrap();
+        let (start, goal) = request.joint_query(planner.active()).unwrap();
+        let found = planner.connect(&start, &goal, &options).unwrap();
+        let what = format!("{} {}", p.family, p.index);
+        assert!(expected.solved, "{what}: {}", expected.note);
+        assert_eq!(found.path, expected.path, "{what}");
+        assert_eq!(found.checks, expected.checks, "{what}");
+        assert_eq!(
+            found.source == Source::Straight,
+            found.path.len() == 2,
+            "{what}"
+        );
+    }
+    // every sample scene carries a matrix, the model's own: nothing is compiled again
+    assert_eq!(matrices_set, 0);
+}
+
+#[test]
+fn experience_kept_on_the_planner_answers_a_repeated_query() {
+    let (robot, collision) = panda();
+    let problems = find_problems(&fixtures()).unwrap();
+    let p = problems
+        .iter()
+        .find(|p| p.family == "cage_panda")
+        .expect("a cage problem");
+    let mut planner = planner_for(&robot, &collision, &p.request);
+    let scene = load_scene(&p.scene, &collision).unwrap();
+    planner.set_world(scene.world);
+    planner.set_acm(scene.acm).unwrap();
+    let (start, goal) = MotionPlanRequest::load(&p.request)
+        .unwrap()
+        .joint_query(planner.active())
+        .unwrap();
+    let options = RrtOptions::default();
+    let first = planner.connect(&start, &goal, &options).unwrap();
+    assert_eq!(first.source, Source::Sampled);
+    assert!(planner.add_path(&first.path).unwrap() > 0);
+    let again = planner.connect(&start, &goal, &options).unwrap();
+    assert_eq!(again.source, Source::Retrieved);
+    assert_eq!(again.iterations, 0);
+    assert!(
+        again.checks < first.checks,
+        "{} {}",
+        again.checks,
+        first.checks
+    );
+    // timed within the motors' limits, every waypoint reached
+    let trajectory = planner.trajectory(&again.path, &PlanOptions::default());
+    assert_eq!(trajectory.positions.len(), again.path.len());
+    assert!(trajectory.times.windows(2).all(|w| w[1] > w[0]));
+}
+
+/// The first sample request with `edit` applied to its text, asked of a planner moving
+/// `joints` (the request's when empty) with the other motors held at `held`.
+fn request_error(edit: &dyn Fn(&str) -> String, joints: &[&str], held: f64) -> String {
+    let (robot, collision) = panda();
+    let path = find_problems(&fixtures()).unwrap()[0].request.clone();
+    let planner = if joints.is_empty() {
+        planner_for(&robot, &collision, &path)
+    } else {
+        let active = robot
+            .active_set(joints, &vec![held; robot.motors().len()])
+            .unwrap();
+        let objective = trm_tasks::Objective::new(active, collision, Default::default());
+        Planner::new(&objective, &[]).unwrap()
+    };
+    let text = edit(&std::fs::read_to_string(&path).unwrap());
+    let request = MotionPlanRequest::parse(&text, &path).unwrap();
+    request
+        .joint_query(planner.active())
+        .err()
+        .unwrap_or_else(|| panic!("not refused: {text}"))
+        .to_string()
+}
+
+#[test]
+fn requests_that_do_not_fit_the_planner_are_named() {
+    let six = [
+        "panda_joint1",
+        "panda_joint2",
+        "panda_joint3",
+        "panda_joint4",
+        "panda_joint5",
+        "panda_joint6",
+    ];
+    let without_joint7 = |t: &str| {
+        t.replace(
+            "      - joint_name: panda_joint7\n        position: 1.06196398075046\n",
+            "",
+        )
+    };
+    let cases: [(&dyn Fn(&str) -> String, &[&str], &str); 5] = [
+        (
+            &|t| {
+                t.replacen(
+                    "joint_name: panda_joint1",
+                    "joint_name: panda_finger_joint1",
+                    1,
+                )
+            },
+            &[],
+            "the goal constrains `panda_finger_joint1`, which the planner does not move",
+        ),
+        (
+            &|t| t.replace("panda_joint7, panda_finger", "panda_jointX, panda_finger"),
+            &[],
+            "the start state does not give `panda_joint7`, which the planner moves",
+        ),
+        (
+            &without_joint7,
+            &six,
+            "the start state puts `panda_joint7` at 0.785; the planner holds it at 0.5",
+        ),
+        (
+            &|t| t.replace("[0, -0.785, 0, -2.356", "[9, -0.785, 0, -2.356"),
+            &[],
+            "the start puts `panda_joint1` at 9, outside its limits",
+        ),
+        (
+            &|t| t.to_string(),
+            &six,
+            "the goal constrains `panda_joint7`, which the planner does not move",
+        ),
+    ];
+    for (edit, joints, expected) in cases {
+        let message = request_error(edit, joints, 0.5);
+        assert!(message.contains(expected), "{message}");
+        assert!(
+            message.contains("request0001.yaml") && message.contains("fix:"),
+            "{message}"
+        );
+    }
+}
+
+#[test]
+fn a_scene_matrix_that_allows_a_colliding_pair_frees_the_configuration() {
+    let (robot, collision) = panda();
+    let path = &find_problems(&fixtures()).unwrap()[0].request;
+    let mut planner = planner_for(&robot, &collision, path);
+    // a self-colliding configuration, drawn with a fixed seed
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
+    let active = planner.active().clone();
+    let colliding = (0..10_000)
+        .map(|_| active.random(&mut rng))
+        .find(|q| !planner.is_free(q))
+        .expect("a self-colliding configuration");
+    let own = collision.acm().clone();
+    let mut everything = own.clone();
+    let links = robot.tree().links.len();
+    for a in 0..links {
+        for b in a + 1..links {
+            everything.disable(a, b, trm_kinematics::DisableReason::User);
+        }
+    }
+    assert!(planner.set_acm(everything.clone()).unwrap());
+    assert!(planner.is_free(&colliding));
+    assert!(
+        !planner.set_acm(everything).unwrap(),
+        "the same matrix again"
+    );
+    assert!(planner.set_acm(own).unwrap());
+    assert!(!planner.is_free(&colliding));
+}
+
+#[test]
+fn a_plan_written_as_a_moveit_response_reads_back() {
+    let (robot, collision) = panda();
+    let p = &find_problems(&fixtures()).unwrap()[0];
+    let mut planner = planner_for(&robot, &collision, &p.request);
+    let scene = load_scene(&p.scene, &collision).unwrap();
+    planner.set_world(scene.world);
+    planner.set_acm(scene.acm).unwrap();
+    let (start, goal) = MotionPlanRequest::load(&p.request)
+        .unwrap()
+        .joint_query(planner.active())
+        .unwrap();
+    let found = planner
+        .connect(&start, &goal, &RrtOptions::default())
+        .unwrap();
+    let trajectory = planner.trajectory(&found.path, &PlanOptions::default());
+    let out = Path::new("plan.response.yaml");
+    let text = motion_plan_response_yaml(&trajectory, &robot, "panda_arm", 0.25, out).unwrap();
+    let doc = trm_moveit::yaml::parse(&text).unwrap();
+    assert_eq!(doc.get("group_name").unwrap().scalar(), Some("panda_arm"));
+    assert_eq!(doc.get("planning_time").unwrap().scalar(), Some("0.25"));
+    let code = doc.get("error_code").unwrap().get("val").unwrap();
+    assert_eq!(code.scalar(), Some("1"));
+    let points = doc
+        .get("trajectory")
+        .and_then(|t| t.get("joint_trajectory"))
+        .and_then(|t| t.get("points"))
+        .and_then(|p| p.items())
+        .unwrap();
+    assert_eq!(points.len(), found.path.len());
+    let last: Vec<f64> = points[points.len() - 1]
+        .get("positions")
+        .and_then(|p| p.items())
+        .unwrap()
+        .iter()
+        .map(|v| v.scalar().unwrap().parse().unwrap())
+        .collect();
+    // the arm's 7 joints end at the goal (the fingers are not in the trajectory's motors)
+    for (k, g) in goal.iter().enumerate() {
+        assert!((last[k] - g).abs() < 1e-12, "joint {k}: {} vs {g}", last[k]);
+    }
+    let start_state = doc
+        .get("trajectory_start")
+        .unwrap()
+        .get("joint_state")
+        .unwrap();
+    assert_eq!(
+        start_state.get("name").unwrap().items().unwrap().len(),
+        last.len()
+    );
+}
