@@ -14,7 +14,7 @@ where SET_DIR holds one folder per family (unpack benches/mbm/panda_problems.tar
 """
 
 import argparse
-import statistics
+import math
 import sys
 import tarfile
 import tempfile
@@ -24,15 +24,13 @@ from pathlib import Path
 import trm
 
 
-def percentile(values, p):
-    """The p-th percentile (linear between order statistics, as numpy's default)."""
+def quantile(values, q):
+    """The q-quantile (nearest rank), as `trm benchmark-mbm` reports it."""
     if not values:
         return float("nan")
     s = sorted(values)
-    k = (len(s) - 1) * p / 100.0
-    lo = int(k)
-    hi = min(lo + 1, len(s) - 1)
-    return s[lo] + (s[hi] - s[lo]) * (k - lo)
+    k = min(max(math.ceil(q * len(s)), 1), len(s))
+    return s[k - 1]
 
 
 def problems(root):
@@ -111,9 +109,9 @@ def main():
         call = [1e3 * r["call"] for r in solved]
         scene = [1e3 * r["with_scene"] for r in solved]
         length = [r["length"] for r in solved]
-        med = lambda v: statistics.median(v) if v else float("nan")
+        med = lambda v: quantile(v, 0.5)
         print(f"| {family} | {len(valid)}/{len(sel)} | {len(solved)}/{len(valid)} | "
-              f"{med(ms):.2f} | {percentile(ms, 95):.2f} | {med(call):.2f} | {med(scene):.2f} | "
+              f"{med(ms):.2f} | {quantile(ms, 0.95):.2f} | {med(call):.2f} | {med(scene):.2f} | "
               f"{med(length):.2f} |")
     if args.csv:
         keys = ["family", "problem", "valid", "solved", "seconds", "call", "with_scene",

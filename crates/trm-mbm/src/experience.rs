@@ -92,11 +92,12 @@ impl<'a> FamilyRun<'a> {
             let acm = self.problems[self.members[next]].collision.acm().clone();
             let (objective, _, _) = problem_objective(
                 self.robot,
-                &self.problems[self.members[next]].collision,
+                &self.problems[self.members[next]].own,
                 &trm_collision::World::new(),
                 &first.request,
             )?;
             let mut planner = Planner::new(&objective, &[])?;
+            planner.set_collision(&self.problems[self.members[next]].collision)?;
             for path in &self.kept {
                 planner.add_path(path)?;
             }
@@ -126,10 +127,8 @@ impl<'a> FamilyRun<'a> {
         let (mut start, mut goal) = self.start_and_goal(problem, objective)?;
         planner.set_world(problem.world.clone());
         let mut outcome = Outcome::default();
-        if let Some(why) = invalid(self.robot, &self.active, &mut start, &mut goal, |q| {
-            planner.is_free(q)
-        }) {
-            outcome.note = why.into();
+        if let Some(why) = invalid(self.robot, &self.active, &mut start, &mut goal, planner) {
+            outcome.note = why;
             return Ok(outcome);
         }
         outcome.valid = true;

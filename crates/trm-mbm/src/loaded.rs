@@ -26,6 +26,9 @@ pub struct LoadedProblem {
     /// The robot's collision model with the scene's matrix applied
     /// ([`trm_moveit::AllowedCollisions::apply`]).
     pub collision: CollisionModel,
+    /// The robot's collision model as given, before the scene's matrix (a planner is made
+    /// with it, then takes the problem's: so that it can say which matrix checks a pair).
+    pub own: CollisionModel,
     /// The scene's matrix entries that are not links of the robot (skipped).
     pub notes: Vec<String>,
 }
@@ -38,7 +41,7 @@ impl LoadedProblem {
         request: MotionPlanRequest,
     ) -> Result<Self, MbmError> {
         let world = scene.to_world()?;
-        let (collision, notes) = match &scene.allowed_collisions {
+        let (applied, notes) = match &scene.allowed_collisions {
             Some(acm) => {
                 let (applied, notes) = acm.apply(collision)?;
                 (applied.unwrap_or_else(|| collision.clone()), notes)
@@ -55,7 +58,8 @@ impl LoadedProblem {
             scene,
             request,
             world,
-            collision,
+            own: collision.clone(),
+            collision: applied,
             notes,
         })
     }

@@ -58,12 +58,12 @@ pub fn solve_loaded(
 ) -> Result<Outcome, MbmError> {
     options.check()?;
     let (request, world) = (&problem.request, &problem.world);
-    let (objective, active, mut start) =
-        problem_objective(robot, &problem.collision, world, request)?;
+    let (objective, active, mut start) = problem_objective(robot, &problem.own, world, request)?;
     let mut goal = request.goal.positions.clone();
     // the planner every door uses: compiled here once, for the IK of a task-space goal, the
     // validity checks and the search
     let mut planner = Planner::new(&objective, &[])?;
+    planner.set_collision(&problem.collision)?;
     let mut outcome = Outcome {
         note: problem.notes.join("; "),
         ..Default::default()
@@ -100,10 +100,8 @@ pub fn solve_loaded(
             }
         }
     }
-    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, |q| {
-        planner.is_free(q)
-    }) {
-        outcome.note = why.into();
+    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, &mut planner) {
+        outcome.note = why;
         return Ok(outcome);
     }
     outcome.valid = true;
@@ -142,14 +140,15 @@ pub(crate) fn joint_goal_only(request: &MotionPlanRequest, what: &str) -> Result
 pub const GOAL_ATTEMPTS: usize = 500;
 
 /// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
-/// and `free`). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
+/// and free for `planner`); a colliding start or goal names its pairs
+/// ([`Planner::collisions`]). Values within [`LIMIT_SLACK`] outside a limit are clamped onto it.
 pub(crate) fn invalid(
     robot: &RobotModel,
     active: &[usize],
     start: &mut [f64],
     goal: &mut [f64],
-    mut free: impl FnMut(&[f64]) -> bool,
-) -> Option<&'static str> {
+    planner: &mut Planner,
+) -> Option<String> {
     let within = |q: &mut [f64]| {
         active.iter().zip(q).all(|(&i, v)| {
             let limits = &robot.motors()[i].limits;
@@ -158,16 +157,18 @@ pub(crate) fn invalid(
             inside
         })
     };
+    let mut collides = |what: &str, q: &[f64]| {
+        (!planner.is_free(q))
+            .then(|| format!("the {what} collides: {}", planner.collisions(q).join("; ")))
+    };
     if !within(start) {
-        Some("the start is outside the joint limits")
-    } else if !free(start) {
-        Some("the start collides")
+        Some("the start is outside the joint limits".into())
+    } else if let Some(why) = collides("start", start) {
+        Some(why)
     } else if !within(goal) {
-        Some("the goal is outside the joint limits")
-    } else if !free(goal) {
-        Some("the goal collides")
+        Some("the goal is outside the joint limits".into())
     } else {
-        None
+        collides("goal", goal)
     }
 }
 

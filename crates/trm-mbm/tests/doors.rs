@@ -265,3 +265,75 @@ fn a_plan_written_as_a_moveit_response_reads_back() {
         last.len()
     );
 }
+
+#[test]
+fn a_colliding_start_or_goal_names_its_pairs_and_the_matrix_that_checks_them() {
+    let (robot, collision) = panda();
+    let p = &find_problems(&fixtures()).unwrap()[0];
+    let mut planner = planner_for(&robot, &collision, &p.request);
+    let (start, goal) = MotionPlanRequest::load(&p.request)
+        .unwrap()
+        .joint_query(planner.active())
+        .unwrap();
+    // a box around the robot's base: the start collides with it
+    let mut world = trm_collision::World::new();
+    world
+        .add(
+            "crate",
+            trm_collision::Shape::Box {
+                size: [0.4, 0.4, 0.4],
+            },
+            trm_kinematics::nalgebra::Isometry3::identity(),
+        )
+        .unwrap();
+    planner.set_world(world);
+    let message = planner
+        .connect(&start, &goal, &RrtOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("collides: link `panda_link0` and object `crate`"),
+        "{message}"
+    );
+    planner.set_world(trm_collision::World::new());
+    // every pair checked, the adjacent ones the model disables included: the goal's named
+    // pairs say which matrix checks them
+    let links = robot.tree().links.len();
+    assert!(
+        planner
+            .set_acm(trm_collision::AllowedCollisionMatrix::all_checked(links))
+            .unwrap()
+    );
+    let pairs = planner.collisions(&goal);
+    assert!(!pairs.is_empty());
+    assert!(
+        pairs.iter().all(|p| p.contains(
+            "checked by the matrix set on the planner (a scene's); the model's own disables it ("
+        )),
+        "{pairs:?}"
+    );
+    let message = planner
+        .connect(&start, &goal, &RrtOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("collides: links `"), "{message}");
+    // the benchmark's note says the same
+    let mut loaded = LoadedProblem::load(&collision, p).unwrap();
+    loaded.collision = collision
+        .with_acm(trm_collision::AllowedCollisionMatrix::all_checked(links))
+        .unwrap();
+    let outcome = solve_loaded(&robot, &loaded, &RrtOptions::default()).unwrap();
+    assert!(!outcome.valid);
+    assert!(
+        outcome.note.starts_with("the start collides: links `"),
+        "{}",
+        outcome.note
+    );
+    assert!(
+        outcome
+            .note
+            .contains("the model's own disables it (adjacent)"),
+        "{}",
+        outcome.note
+    );
+}

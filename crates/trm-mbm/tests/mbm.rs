@@ -682,6 +682,13 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
     );
     m.allowed[a][b] = true;
     m.allowed[b][a] = true;
+    // and check two adjacent links: a fact of the model's geometry, the pair stays disabled
+    let (c, d) = (
+        m.names.iter().position(|n| n == "panda_link1").unwrap(),
+        m.names.iter().position(|n| n == "panda_link2").unwrap(),
+    );
+    m.allowed[c][d] = false;
+    m.allowed[d][c] = false;
     m.names.push("table".into());
     for row in &mut m.allowed {
         row.push(true);
@@ -699,17 +706,27 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
             .acm()
             .is_checked(id("panda_hand"), id("panda_link2"))
     );
-    assert_eq!(notes.len(), 1);
+    assert_eq!(notes.len(), 2);
     assert!(notes[0].contains("`table`"), "{notes:?}");
-    // every pair the scene lists ends as the scene says
+    assert!(
+        notes[1].contains("1 pairs it checks stay disabled")
+            && notes[1].contains("`panda_link1`–`panda_link2` (adjacent)"),
+        "{notes:?}"
+    );
+    // every pair the scene lists ends as the scene says, but for the pairs the model's own
+    // geometry disables
     for (i, row) in m.allowed.iter().enumerate() {
         for (j, &allowed) in row.iter().enumerate() {
             if let (Some(x), Some(y)) = (tree.link_index(&m.names[i]), tree.link_index(&m.names[j]))
             {
+                let geometric = collision.acm().reason(x, y).is_some_and(|r| {
+                    use trm_kinematics::DisableReason::{Adjacent, Always, Default};
+                    matches!(r, Adjacent | Always | Default)
+                });
                 if x != y {
                     assert_eq!(
                         applied.acm().is_checked(x, y),
-                        !allowed,
+                        !allowed && !geometric,
                         "{} {}",
                         m.names[i],
                         m.names[j]
@@ -721,13 +738,23 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
 }
 
 /// Experience runs plan each problem with its own scene's allowed-collision matrix, as single
-/// runs do: a scene that forbids a pair the model skips (adjacent links that touch: links 1
-/// and 2) makes its problem invalid in both, and the family's other problems are still solved.
+/// runs do: a scene that forbids a pair the model skips (links 1 and 2, which touch; disabled
+/// by hand here, as a scene cannot enable a pair the model disables as adjacent) makes its
+/// problem invalid in both, and the family's other problems are still solved.
 #[test]
 fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
     let robot = trm_kinematics::RobotModel::load(&model).unwrap();
     let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let tree = robot.tree();
+    let (l1, l2) = (
+        tree.link_index("panda_link1").unwrap(),
+        tree.link_index("panda_link2").unwrap(),
+    );
+    let mut own = collision.acm().clone();
+    own.enable(l1, l2);
+    own.disable(l1, l2, trm_kinematics::DisableReason::User);
+    let collision = collision.with_acm(own).unwrap();
     let dir = std::env::temp_dir().join(format!("trm-acm-experience-{}", std::process::id()));
     let family = dir.join("box_panda");
     std::fs::create_dir_all(&family).unwrap();

@@ -70,6 +70,12 @@ impl AllowedCollisions {
     }
 }
 
+/// Whether the model disables a pair with this reason for a fact of its own geometry.
+fn geometric(reason: trm_kinematics::DisableReason) -> bool {
+    use trm_kinematics::DisableReason::{Adjacent, Always, Default};
+    matches!(reason, Adjacent | Always | Default)
+}
+
 impl AllowedCollisions {
     /// `collision` with this matrix applied to the robot's link pairs, as MoveIt applies a
     /// planning scene's matrix over the SRDF's: a pair it allows is not checked, a pair it
@@ -87,13 +93,21 @@ impl AllowedCollisions {
 
     /// The matrix [`AllowedCollisions::apply`] gives `collision` (`None` when nothing changes),
     /// and its notes.
+    ///
+    /// The rule, for a matrix written for other geometry than the model's (a scene made for a
+    /// robot's meshes, applied to its sphere model): a pair the scene allows is not checked; a
+    /// pair it checks is checked, except where the model's own matrix disables it for a fact
+    /// of the model's own geometry — adjacent links, links colliding at the default posture
+    /// or in (almost) every sample — which the scene's author could not know; those stay
+    /// disabled and a note counts them. Pairs the model disables by hand or as never
+    /// colliding are checked as the scene asks.
     pub fn over(
         &self,
         collision: &trm_collision::CollisionModel,
     ) -> (Option<trm_collision::AllowedCollisionMatrix>, Vec<String>) {
         let tree = collision.robot().tree();
         let ids: Vec<Option<usize>> = self.names.iter().map(|n| tree.link_index(n)).collect();
-        let notes: Vec<String> = self
+        let mut notes: Vec<String> = self
             .names
             .iter()
             .zip(&ids)
@@ -104,6 +118,7 @@ impl AllowedCollisions {
             .collect();
         let mut acm = collision.acm().clone();
         let mut changed = false;
+        let mut kept = Vec::new();
         for (i, row) in self.allowed.iter().enumerate() {
             for (j, &allowed) in row.iter().enumerate().skip(i + 1) {
                 let (Some(a), Some(b)) = (ids[i], ids[j]) else {
@@ -112,13 +127,30 @@ impl AllowedCollisions {
                 if a == b || allowed != acm.is_checked(a, b) {
                     continue;
                 }
-                changed = true;
                 if allowed {
                     acm.disable(a, b, trm_kinematics::DisableReason::User);
+                } else if let Some(reason) = acm.reason(a, b).filter(|r| geometric(*r)) {
+                    kept.push(format!(
+                        "`{}`–`{}` ({})",
+                        self.names[i],
+                        self.names[j],
+                        reason.as_str()
+                    ));
+                    continue;
                 } else {
                     acm.enable(a, b);
                 }
+                changed = true;
             }
+        }
+        if !kept.is_empty() {
+            let shown = kept.len().min(3);
+            notes.push(format!(
+                "allowed_collision_matrix: {} pairs it checks stay disabled, as this model's own geometry disables them: {}{}",
+                kept.len(),
+                kept[..shown].join(", "),
+                if kept.len() > shown { ", …" } else { "" }
+            ));
         }
         (changed.then_some(acm), notes)
     }

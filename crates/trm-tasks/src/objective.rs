@@ -194,11 +194,23 @@ impl Objective {
         self.compile_screen();
     }
 
-    /// Replaces the collision model's allowed-collision matrix (a planning scene's, say): the
-    /// pairs it allows are not checked. Scratches made before are made again when next used.
-    /// An error for a matrix of another link count.
-    pub fn set_acm(&mut self, acm: trm_collision::AllowedCollisionMatrix) -> Result<()> {
-        self.collision = self.collision.with_acm(acm)?;
+    /// Replaces the collision model by another of the same robot and bodies — the same model
+    /// with another allowed-collision matrix (a planning scene's, say) — keeping its compiled
+    /// screen when it has one. Scratches made before are made again when next used. An error
+    /// for a model of another robot or other bodies.
+    pub fn set_collision(&mut self, collision: CollisionModel) -> Result<()> {
+        collision.check_active(&self.active)?;
+        if collision.bodies().len() != self.collision.bodies().len() {
+            return Err(TaskError::Invalid {
+                what: "collision model".into(),
+                problem: format!(
+                    "{} bodies where the objective's model has {}",
+                    collision.bodies().len(),
+                    self.collision.bodies().len()
+                ),
+            });
+        }
+        self.collision = collision;
         self.key = NEXT_KEY.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.compile_screen();
         Ok(())

@@ -83,7 +83,10 @@ impl Planner {
             sampling: Some(options.clone()),
             ..Default::default()
         };
-        let planned = self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options)?;
+        let planned = match self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options) {
+            Ok(planned) => planned,
+            Err(e) => return Err(self.name_collisions(e, start, goal)),
+        };
         if let Some((iterations, checks)) = planned.stats.sampled {
             return Ok(Connection {
                 path: planned.waypoints,
@@ -138,7 +141,10 @@ impl Planner {
         began: Instant,
         checks: u64,
     ) -> Result<Connection, PlanError> {
-        let found = rrt_connect_in(&mut self.checker, &self.bounds, start, goal, options)?;
+        let found = match rrt_connect_in(&mut self.checker, &self.bounds, start, goal, options) {
+            Ok(found) => found,
+            Err(e) => return Err(self.name_collisions(e, start, goal)),
+        };
         Ok(Connection {
             source: if found.iterations == 0 {
                 Source::Straight
@@ -152,3 +158,91 @@ impl Planner {
         })
     }
 }
+
+impl Planner {
+    /// What makes `q` (active values) collide in the current world, one line per colliding
+    /// pair, nearest to contact last: the robot's links and the world's objects by name, and for
+    /// a pair of links which allowed-collision matrix has it checked — the model's own, or a
+    /// matrix set since ([`Planner::set_acm`], a planning scene's) that checks a pair the
+    /// model's own disables (and why the model disables it). Empty when `q` is free.
+    ///
+    /// # Panics
+    /// If `q` does not hold one value per active motor.
+    pub fn collisions(&mut self, q: &[f64]) -> Vec<String> {
+        let collision = self.objective.collision();
+        let robot = collision.robot();
+        let mut poses = robot.pose_buffer();
+        if robot
+            .forward_motors(&self.active.to_motors(q), &mut poses)
+            .is_err()
+        {
+            return vec!["the configuration is not finite".into()];
+        }
+        let mut placed = collision.placed_bodies();
+        collision.place(&poses, &mut placed);
+        let mut pairs = collision.colliding_pairs(&placed, self.checker.world());
+        pairs.sort_by(|a, b| b.distance.total_cmp(&a.distance));
+        let link = |body: usize| collision.bodies()[body].link;
+        let name = |l: usize| robot.tree().links[l].name.as_str();
+        pairs
+            .iter()
+            .map(|p| {
+                let depth = format!("{:.1} mm deep", -1e3 * p.distance);
+                match &p.other {
+                    trm_collision::Other::Object(object) => {
+                        format!("link `{}` and object `{object}`, {depth}", name(link(p.body_index)))
+                    }
+                    trm_collision::Other::Body(_) => {
+                        let (a, b) = (link(p.body_index), link(p.other_index));
+                        let why = match self.own_acm.reason(a, b) {
+                            Some(reason) => format!(
+                                "checked by the matrix set on the planner (a scene's); the model's own disables it ({})",
+                                reason.as_str()
+                            ),
+                            None => "checked by the model's own matrix".into(),
+                        };
+                        format!("links `{}` and `{}`, {depth}: {why}", name(a), name(b))
+                    }
+                }
+            })
+            .collect()
+    }
+
+    /// `error` with the colliding pairs of the start or goal it is about named.
+    pub(super) fn name_collisions(
+        &mut self,
+        error: PlanError,
+        start: &[f64],
+        goal: &[f64],
+    ) -> PlanError {
+        let named = |pairs: Vec<String>| {
+            let mut text = String::new();
+            for p in pairs.iter().take(MAX_NAMED) {
+                text.push_str("\n  collides: ");
+                text.push_str(p);
+            }
+            if pairs.len() > MAX_NAMED {
+                text.push_str(&format!("\n  … and {} more pairs", pairs.len() - MAX_NAMED));
+            }
+            text
+        };
+        match error {
+            PlanError::InvalidStart(why) => {
+                PlanError::InvalidStart(format!("{why}{}", named(self.collisions(start))))
+            }
+            PlanError::Unreachable {
+                reason,
+                closest_node,
+                closest_distance,
+            } if reason.starts_with("the goal configuration collides") => PlanError::Unreachable {
+                reason: format!("{reason}{}", named(self.collisions(goal))),
+                closest_node,
+                closest_distance,
+            },
+            other => other,
+        }
+    }
+}
+
+/// Colliding pairs an error names (the deepest first); the rest are counted.
+const MAX_NAMED: usize = 5;

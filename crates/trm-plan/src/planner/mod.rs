@@ -69,6 +69,8 @@ pub struct Planner {
     active: ActiveSet,
     /// The active motors' lower and upper limits (RRT-Connect's sampling box).
     bounds: (Vec<f64>, Vec<f64>),
+    /// The allowed-collision matrix the planner was made with (before [`Planner::set_acm`]).
+    own_acm: trm_collision::AllowedCollisionMatrix,
     nodes: Vec<(Vec<f64>, Vec<f64>)>,
     node_state: Vec<State>,
     edges: Vec<(usize, usize, f64)>,
@@ -130,6 +132,7 @@ impl Planner {
             objective: objective.clone(),
             active: objective.active().clone(),
             bounds: objective.active().bounds(),
+            own_acm: objective.collision().acm().clone(),
             node_state: vec![State::Valid; nodes.len()],
             nodes,
             edges,
@@ -152,9 +155,8 @@ impl Planner {
     }
 
     /// Replaces the allowed-collision matrix (a planning scene's, applied over the robot's own:
-    /// see `trm_moveit::PlanningScene::world_and_acm`): when it differs from the current one, the
-    /// checks are made again for it (the robot's compiled screen is reused where its pairs
-    /// allow) and every node and edge will be checked again. Whether it differed.
+    /// see `trm_moveit::load_scene`): when it differs from the current one, the checks are made
+    /// again for it and every node and edge will be checked again. Whether it differed.
     pub fn set_acm(
         &mut self,
         acm: trm_collision::AllowedCollisionMatrix,
@@ -162,7 +164,21 @@ impl Planner {
         if *self.objective.collision().acm() == acm {
             return Ok(false);
         }
-        self.objective.set_acm(acm)?;
+        let collision = self.objective.collision().with_acm(acm)?;
+        self.set_collision(&collision)
+    }
+
+    /// Replaces the collision model by the same robot's with another allowed-collision matrix
+    /// (a problem's, prepared once: its compiled screen is shared, not compiled again), as
+    /// [`Planner::set_acm`] does. Whether the matrix differed.
+    pub fn set_collision(
+        &mut self,
+        collision: &trm_collision::CollisionModel,
+    ) -> Result<bool, PlanError> {
+        if self.objective.collision().acm() == collision.acm() {
+            return Ok(false);
+        }
+        self.objective.set_collision(collision.clone())?;
         let world = self.checker.world().clone();
         let checks = self.checker.checks;
         self.checker = self.objective.world_checker(&world)?;

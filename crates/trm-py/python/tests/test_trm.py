@@ -285,6 +285,18 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
     assert "7 motors" in repr(planner)
 
 
+def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
+    import runpy
+    import sys
+
+    csv = tmp_path / "doors.csv"
+    monkeypatch.setattr(sys, "argv", ["mbm_planner.py", str(MBM), "--model", PANDA, "--csv", str(csv)])
+    runpy.run_path(str(ROOT / "benches" / "python" / "mbm_planner.py"), run_name="__main__")
+    out = capsys.readouterr().out
+    assert "| all | 14/14 | 14/14 |" in out, out
+    assert len(csv.read_text().splitlines()) == 15
+
+
 def test_a_robot_planner_keeps_experience_across_worlds(robot):
     joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
     planner = trm.Planner(robot, joints=joints, experience=True)
