@@ -102,9 +102,12 @@ fn experience_kept_on_the_planner_answers_a_repeated_query() {
     assert!(trajectory.times.windows(2).all(|w| w[1] > w[0]));
 }
 
+/// An edit of a request's text.
+type Edit = dyn Fn(&str) -> String;
+
 /// The first sample request with `edit` applied to its text, asked of a planner moving
 /// `joints` (the request's when empty) with the other motors held at `held`.
-fn request_error(edit: &dyn Fn(&str) -> String, joints: &[&str], held: f64) -> String {
+fn request_error(edit: &Edit, joints: &[&str], held: f64) -> String {
     let (robot, collision) = panda();
     let path = find_problems(&fixtures()).unwrap()[0].request.clone();
     let planner = if joints.is_empty() {
@@ -141,7 +144,7 @@ fn requests_that_do_not_fit_the_planner_are_named() {
             "",
         )
     };
-    let cases: [(&dyn Fn(&str) -> String, &[&str], &str); 5] = [
+    let cases: [(&Edit, &[&str], &str); 5] = [
         (
             &|t| {
                 t.replacen(
