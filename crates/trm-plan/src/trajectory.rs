@@ -210,7 +210,7 @@ impl Trajectory {
         Ok(())
     }
 
-    /// Reads a CSV trajectory of `robot` (format in the [module docs](self)); `origin` names the
+    /// Reads a CSV trajectory of `robot` (as [`Trajectory::to_csv`] writes it); `origin` names the
     /// text in errors, with line numbers. The task path is empty.
     ///
     /// ```
