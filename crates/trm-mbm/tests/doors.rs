@@ -33,6 +33,24 @@ fn planner_for(robot: &RobotModel, collision: &CollisionModel, request: &Path) -
     Planner::new(&objective, &[]).unwrap()
 }
 
+/// A planner for problem `p`'s robot and motors, its scene set on it; the problem's start and
+/// goal.
+fn planner_in(
+    robot: &RobotModel,
+    collision: &CollisionModel,
+    p: &trm_mbm::Problem,
+) -> (Planner, Vec<f64>, Vec<f64>) {
+    let mut planner = planner_for(robot, collision, &p.request);
+    let scene = load_scene(&p.scene, collision).unwrap();
+    planner.set_world(scene.world);
+    planner.set_acm(scene.acm).unwrap();
+    let (start, goal) = MotionPlanRequest::load(&p.request)
+        .unwrap()
+        .joint_query(planner.active())
+        .unwrap();
+    (planner, start, goal)
+}
+
 #[test]
 fn one_planner_answers_every_problem_as_the_benchmark_does() {
     let (robot, collision) = panda();
@@ -75,14 +93,7 @@ fn experience_kept_on_the_planner_answers_a_repeated_query() {
         .iter()
         .find(|p| p.family == "cage_panda")
         .expect("a cage problem");
-    let mut planner = planner_for(&robot, &collision, &p.request);
-    let scene = load_scene(&p.scene, &collision).unwrap();
-    planner.set_world(scene.world);
-    planner.set_acm(scene.acm).unwrap();
-    let (start, goal) = MotionPlanRequest::load(&p.request)
-        .unwrap()
-        .joint_query(planner.active())
-        .unwrap();
+    let (mut planner, start, goal) = planner_in(&robot, &collision, p);
     let options = RrtOptions::default();
     let first = planner.connect(&start, &goal, &options).unwrap();
     assert_eq!(first.source, Source::Sampled);
@@ -221,14 +232,7 @@ fn a_scene_matrix_that_allows_a_colliding_pair_frees_the_configuration() {
 fn a_plan_written_as_a_moveit_response_reads_back() {
     let (robot, collision) = panda();
     let p = &find_problems(&fixtures()).unwrap()[0];
-    let mut planner = planner_for(&robot, &collision, &p.request);
-    let scene = load_scene(&p.scene, &collision).unwrap();
-    planner.set_world(scene.world);
-    planner.set_acm(scene.acm).unwrap();
-    let (start, goal) = MotionPlanRequest::load(&p.request)
-        .unwrap()
-        .joint_query(planner.active())
-        .unwrap();
+    let (mut planner, start, goal) = planner_in(&robot, &collision, p);
     let found = planner
         .connect(&start, &goal, &RrtOptions::default())
         .unwrap();

@@ -65,7 +65,7 @@ pub enum PlanError {
     },
     /// No collision-free path; `closest` is the reachable node nearest to the goal.
     #[error(
-        "goal unreachable: {reason}{}", match closest_node { Some(n) => format!("; the closest reachable node is {n}, at task distance {closest_distance:.4}"), None => "; no map node is reachable".into() }
+        "goal unreachable: {reason}{}", match closest_node { Some(n) => format!("; the closest reachable node is {n}, at task distance {closest_distance:.4}"), None => String::new() }
     )]
     Unreachable {
         /// Why.

@@ -263,15 +263,22 @@ pub fn run(args: &Args) -> Result<()> {
                 .map(|p| trm_view::point3(p))
                 .collect(),
         );
-        scene.set_world(planner.world());
         scene.add_roadmap(first, problem.objective.active())?;
-        let out = args
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("target/plan.csv"));
-        crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))?;
+        write_view(scene, planner.world(), args.out.as_deref())?;
     }
     Ok(())
+}
+
+/// Writes the 3-D view of a plan, `scene` in `world`, beside `out` (or as
+/// target/plan.scene.html).
+fn write_view(
+    mut scene: trm_view::Scene,
+    world: &trm_collision::World,
+    out: Option<&Path>,
+) -> Result<()> {
+    scene.set_world(world);
+    let out = out.map_or_else(|| PathBuf::from("target/plan.csv"), Path::to_path_buf);
+    crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))
 }
 
 /// Writes `trajectory` to `out` (CSV) and beside it as JSON, a ROS 2 JointTrajectory
@@ -392,7 +399,14 @@ fn run_without_maps(args: &Args) -> Result<()> {
             );
         }
     }
-    let found = planner.connect(&start, &goal, &options)?;
+    let found = match planner.connect(&start, &goal, &options) {
+        Ok(found) => found,
+        Err(e @ trm_plan::PlanError::Unreachable { .. }) => anyhow::bail!(
+            "{e}\n  fix: a larger budget (--max-samples {}, --max-seconds), or a goal the robot can reach in this world",
+            args.max_samples
+        ),
+        Err(e) => return Err(e.into()),
+    };
     let timing = PlanOptions {
         default_velocity: args.velocity,
         ..Default::default()
@@ -432,12 +446,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         for (t, q) in trajectory.times.iter().zip(&trajectory.positions) {
             scene.add_frame(*t, q)?;
         }
-        scene.set_world(planner.world());
-        let out = args
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("target/plan.csv"));
-        crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))?;
+        write_view(scene, planner.world(), args.out.as_deref())?;
     }
     Ok(())
 }

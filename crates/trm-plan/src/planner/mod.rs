@@ -476,7 +476,10 @@ impl Planner {
     /// goal's task point `t`.
     fn unreachable(&self, reason: &str, closest: Option<usize>, t: &[f64]) -> PlanError {
         PlanError::Unreachable {
-            reason: reason.into(),
+            reason: match closest {
+                Some(_) => reason.into(),
+                None => format!("{reason}; no map node is reachable"),
+            },
             closest_node: closest,
             closest_distance: closest.map_or(f64::INFINITY, |c| distance(&self.nodes[c].1, t)),
         }
