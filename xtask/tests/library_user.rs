@@ -7,12 +7,12 @@ use std::path::Path;
 use std::process::Command;
 
 #[test]
-#[ignore = "slow (a cargo build of its own workspace, and a map build); CI runs it with --ignored"]
+#[ignore = "slow (builds the library crates again for the example's own profile); CI runs it with --ignored"]
 fn a_crate_outside_the_workspace_uses_the_library_end_to_end() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let manifest = root.join("examples/library-user/Cargo.toml");
-    // the workspace's target directory: the example's lock file and profile are the workspace's
-    // test profile, so the crates built for the tests serve it (only the program itself builds)
+    // the workspace's target directory: the example's lock file and profile for dependencies are
+    // the workspace's, so the dependencies built for the tests serve it (only trm's crates build)
     let target =
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), Into::into);
     let out = std::env::temp_dir().join(format!("trm-library-user-{}", std::process::id()));
