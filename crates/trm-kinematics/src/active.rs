@@ -66,6 +66,12 @@ impl ActiveSet {
         }
         let mut position = vec![None; motors.len()];
         for (k, &m) in active.iter().enumerate() {
+            if position[m].is_some() {
+                return Err(KinematicsError::OutOfRange {
+                    what: "active motors".into(),
+                    problem: format!("`{}` is given twice; give each motor once", motors[m].name),
+                });
+            }
             position[m] = Some(k);
         }
         // Per joint: locked motors folded into the constant, active terms by active index.

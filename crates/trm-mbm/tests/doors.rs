@@ -344,3 +344,28 @@ fn a_colliding_start_or_goal_names_its_pairs_and_the_matrix_that_checks_them() {
         outcome.note
     );
 }
+
+#[test]
+fn a_joint_given_twice_is_refused_where_it_is_given() {
+    let (robot, _) = panda();
+    let path = find_problems(&fixtures()).unwrap()[0].request.clone();
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("joint_name: panda_joint2", "joint_name: panda_joint1");
+    let message = MotionPlanRequest::parse(&text, &path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("request0001.yaml:14: joint `panda_joint1` is constrained twice"),
+        "{message}"
+    );
+    // and an active set of motor indices that repeats one
+    let home = vec![0.0; robot.motors().len()];
+    let message = trm_kinematics::ActiveSet::new(robot.clone(), vec![0, 1, 0], &home)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("`panda_joint1` is given twice"),
+        "{message}"
+    );
+}

@@ -392,10 +392,16 @@ fn run_without_maps(args: &Args) -> Result<()> {
     for (what, q) in [("start", &start), ("goal", &goal)] {
         if !planner.is_free(q) {
             anyhow::bail!(
-                "the {what} collides{}\n  fix: give a collision-free {what} (`trm collide` names the pairs)",
+                "the {what} collides{}: {}\n  fix: give a collision-free {what}",
                 args.world
                     .as_ref()
-                    .map_or(String::new(), |w| format!(" in {}", w.display()))
+                    .map_or(String::new(), |w| format!(" in {}", w.display())),
+                planner
+                    .collisions(q)
+                    .into_iter()
+                    .take(5)
+                    .collect::<Vec<_>>()
+                    .join("; ")
             );
         }
     }

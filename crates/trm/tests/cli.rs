@@ -166,12 +166,31 @@ fn plan_without_maps_refuses_what_does_not_fit_and_writes_nothing() {
             ],
             "start.json",
         ),
+        // the model's zero posture folds the arm onto itself: the pair is named
+        (
+            vec!["--joints", "panda_arm", "--to", "home"],
+            "the start collides: links `panda_link5` and `panda_hand`",
+        ),
+        (
+            vec!["--request", request, "--max-samples", "0"],
+            "--max-samples",
+        ),
+        (
+            vec!["--request", request, "--resolution", "NaN"],
+            "--resolution",
+        ),
+        (
+            vec!["--request", request, "--max-seconds", "-1"],
+            "--max-seconds",
+        ),
     ] {
         let mut full = vec!["plan", "--model", model, "--out", "traj.csv"];
         full.extend(args);
         let failed = trm(&full, &dir);
         let stderr = String::from_utf8_lossy(&failed.stderr);
-        assert_eq!(failed.status.code(), Some(1), "{full:?}: {stderr}");
+        // a flag's value out of range is clap's error (2), the rest trm's (1)
+        let code = if expected.starts_with("--") { 2 } else { 1 };
+        assert_eq!(failed.status.code(), Some(code), "{full:?}: {stderr}");
         assert!(stderr.contains(expected), "{full:?}: {stderr}");
         assert!(!dir.join("traj.csv").exists(), "{full:?}");
     }

@@ -161,7 +161,7 @@ impl Planner {
 
 impl Planner {
     /// What makes `q` (active values) collide in the current world, one line per colliding
-    /// pair, nearest to contact last: the robot's links and the world's objects by name, and for
+    /// pair of links (or link and object) at its deepest contact, deepest first: the robot's links and the world's objects by name, and for
     /// a pair of links which allowed-collision matrix has it checked — the model's own, or a
     /// matrix set since ([`Planner::set_acm`], a planning scene's) that checks a pair the
     /// model's own disables (and why the model disables it). Empty when `q` is free.
@@ -180,10 +180,17 @@ impl Planner {
         }
         let mut placed = collision.placed_bodies();
         collision.place(&poses, &mut placed);
-        let mut pairs = collision.colliding_pairs(&placed, self.checker.world());
-        pairs.sort_by(|a, b| b.distance.total_cmp(&a.distance));
         let link = |body: usize| collision.bodies()[body].link;
         let name = |l: usize| robot.tree().links[l].name.as_str();
+        // one line per pair of links (or link and object), its deepest contact, deepest first
+        let mut pairs = collision.colliding_pairs(&placed, self.checker.world());
+        let key = |p: &trm_collision::CollidingPair| match p.other {
+            trm_collision::Other::Body(_) => (link(p.body_index), link(p.other_index), false),
+            trm_collision::Other::Object(_) => (link(p.body_index), p.other_index, true),
+        };
+        pairs.sort_by(|a, b| key(a).cmp(&key(b)).then(a.distance.total_cmp(&b.distance)));
+        pairs.dedup_by(|b, a| key(a) == key(b));
+        pairs.sort_by(|a, b| a.distance.total_cmp(&b.distance));
         pairs
             .iter()
             .map(|p| {
