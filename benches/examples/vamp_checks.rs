@@ -10,7 +10,9 @@
 //!
 //! Arguments: the model timed (VAMP's spheres), the exact model (mesh hulls) whose verdicts
 //! are the reference, VAMP's program, the number of configurations (seed 0, uniform within
-//! the joint limits), and optionally the rounds (default 7). Both sides check blocks of
+//! the joint limits), and optionally the rounds (default 7) and the joints moved (a group or
+//! comma-separated motors of both models, the others held at their neutral values: VAMP's
+//! joints, e.g. `arm` for the project's fitted Panda, whose fingers are a motor). Both sides check blocks of
 //! configurations (trm [`trm_kinematics::LANES`], VAMP its float lanes), stopping a block at
 //! its first collision, in an empty world.
 
@@ -24,10 +26,21 @@ use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
 use trm_tasks::Objective;
 
-fn objective(path: &str) -> Result<Objective, String> {
+/// The model at `path`, moving `joints` (a group or comma-separated motors; the others held at
+/// their neutral values) or every motor.
+fn objective(path: &str, joints: Option<&str>) -> Result<Objective, String> {
     let robot = RobotModel::load(path).map_err(|e| e.to_string())?;
     let collision = CollisionModel::new(&robot).map_err(|e| e.to_string())?;
-    Ok(Objective::new(robot.all_active(), collision, World::new()))
+    let active = match joints {
+        Some(list) => {
+            let names: Vec<&str> = list.split(',').collect();
+            robot
+                .active_set(&names, &robot.neutral_motors())
+                .map_err(|e| format!("{path}: {e}"))?
+        }
+        None => robot.all_active(),
+    };
+    Ok(Objective::new(active, collision, World::new()))
 }
 
 /// trm's `f64` batch, trm's single-precision screen of the timed model and of the exact model
@@ -45,10 +58,12 @@ fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 4 {
         return Err(
-            "usage: vamp_checks TIMED_MODEL EXACT_MODEL VAMP_PROGRAM COUNT [ROUNDS]".into(),
+            "usage: vamp_checks TIMED_MODEL EXACT_MODEL VAMP_PROGRAM COUNT [ROUNDS [JOINTS]]"
+                .into(),
         );
     }
-    let (timed, exact) = (objective(&args[0])?, objective(&args[1])?);
+    let joints = args.get(5).map(String::as_str);
+    let (timed, exact) = (objective(&args[0], joints)?, objective(&args[1], joints)?);
     let count = |text: &str, what: &str| match text.parse::<usize>() {
         Ok(v) if v > 0 => Ok(v),
         _ => Err(format!("{what}: `{text}` is not a positive whole number")),

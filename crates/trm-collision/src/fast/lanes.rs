@@ -28,6 +28,7 @@ macro_rules! lane_wise {
 lane_wise!(Add, add, +);
 lane_wise!(Sub, sub, -);
 lane_wise!(Mul, mul, *);
+lane_wise!(Div, div, /);
 
 impl F {
     /// `x` in every lane.

@@ -18,17 +18,24 @@
 //! left the lane uncertain, each body placed alone.
 //!
 //! Robot bodies that are spheres (a spherized URDF, or one written by
-//! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)) are the model itself; other bodies
-//! are *screened* through the spheres enclosing them ([`CollisionModel::enclosing_spheres`](crate::CollisionModel::enclosing_spheres): a
-//! mesh's convex hull cut into cells, each enclosed exactly; a capsule's caps and pieces of its
-//! cylinder), so that contact is only a reason to look exactly, and through spheres inside them
-//! ([`Shape::inscribed_spheres`](crate::Shape::inscribed_spheres)), whose contact is a certain collision. A link that is one box
-//! is tested as that box: the other link's spheres are taken into its frame. A block whose
-//! lanes are left uncertain by two links of convex hulls gets a second, tighter screen before
-//! the exact checks: each link's spheres against the other's 18-sided bounding polytope
-//! (k-DOP). World objects of every shape are taken: spheres, capsules and boxes are checked
-//! in single precision, cylinders and convex hulls through their bounding spheres (a lane near
-//! one is uncertain).
+//! [`fit::urdf_with_spheres`](crate::fit::urdf_with_spheres)) are the model itself. In other
+//! models, a link whose bodies are all boxes, capsules or spheres (a model fitted by
+//! `fit-proxies`, the iCub's capsules and boxes) is tested **as those bodies** against other
+//! such links and against spheres, capsules and boxes in the world: boxes by their separating
+//! axes, capsules by the closest points of their segments, a capsule against a box by
+//! projections and bisection along its segment, each with the same exactness contract (a
+//! tolerance of the margin scaled by the bodies' size; see `solid.rs`). Other bodies (mesh
+//! hulls, cylinders) are *screened* through the spheres enclosing them
+//! ([`CollisionModel::enclosing_spheres`](crate::CollisionModel::enclosing_spheres): a mesh's
+//! convex hull cut into cells, each enclosed exactly), so that contact is only a reason to look
+//! exactly, and through spheres inside them ([`Shape::inscribed_spheres`](crate::Shape::inscribed_spheres)),
+//! whose contact is a certain collision. A link that is one box, against a link screened
+//! through spheres, is tested as that box: the other link's spheres are taken into its frame. A
+//! block whose lanes are left uncertain by two links of convex hulls gets a second, tighter
+//! screen before the exact checks: each link's spheres against the other's 18-sided bounding
+//! polytope (k-DOP). World objects of every shape are taken: spheres, capsules and boxes are
+//! checked in single precision, cylinders and convex hulls through their bounding spheres (a
+//! lane near one is uncertain).
 
 // Lane loops index several arrays at once, the form the vectoriser turns into one instruction;
 // `!(x > limit)` is the NaN-inclusive test on purpose.
@@ -42,6 +49,7 @@ mod kdop;
 mod lanes;
 mod model;
 mod outcome;
+mod solid;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
 mod walk;

@@ -2,6 +2,7 @@ use super::LaneMask;
 use super::kdop::{KDOP, kdop_of};
 use super::lanes::{F, inverse_axes, norm, to_f32};
 use super::outcome::{Tally, Verdict};
+use super::solid::{SLOTS, Solid, SolidPair};
 use super::walk::{FastScratch, screen};
 use super::world::{FastWorld, Object};
 use crate::error::CollisionError;
@@ -42,6 +43,10 @@ pub(super) struct Group {
     /// [`KDOP`] directions in the link frame, `[lowest, highest]` per direction. A sphere
     /// beyond one of its slabs is clear of the link's bodies.
     pub(super) kdop: Option<[[f32; 2]; KDOP.len()]>,
+    /// When every body of the link is a box, a capsule or a sphere (and the model is not a
+    /// sphere model): the bodies as solids, in the order of `bodies` (indices into
+    /// [`FastModel::solids`]), tested as themselves against other such links.
+    pub(super) solids: Option<std::ops::Range<usize>>,
 }
 
 /// Two balls (indices into [`FastModel::balls`]) and the sum of their radii.
@@ -67,6 +72,9 @@ pub(super) struct GroupPair {
     /// the other: the other's spheres are tested against the box in its link's frame instead
     /// of the sphere pairs.
     pub(super) solid: Option<(usize, usize)>,
+    /// When both links are solids ([`Group::solids`]): their checked body pairs as solids,
+    /// tested instead of the spheres.
+    pub(super) solid_pairs: Vec<SolidPair>,
 }
 
 /// One step of the self-collision walk, in the order of [`crate::cull`]'s steps.
@@ -111,6 +119,8 @@ pub struct FastModel {
     pub(super) balls: Vec<Ball>,
     /// Spheres inside the bodies ([`Shape::inscribed_spheres`]), grouped by link.
     pub(super) inner: Vec<Ball>,
+    /// Bodies tested as themselves ([`Group::solids`]), grouped by link.
+    pub(super) solids: Vec<Solid>,
     /// For each ball, the index of the body it came from.
     pub(super) bodies: Vec<usize>,
     pub(super) groups: Vec<Group>,
@@ -152,6 +162,7 @@ impl FastModel {
             depth,
             balls: spheres.balls,
             inner: spheres.inner,
+            solids: spheres.solids,
             bodies: spheres.ball_bodies,
             groups: spheres.groups,
             group_pairs,
@@ -206,6 +217,8 @@ impl FastModel {
         FastScratch {
             balls: vec![[F::default(); 3]; self.balls.len()],
             inner: vec![[F::default(); 3]; self.inner.len()],
+            solids: vec![[[F::default(); 3]; SLOTS]; self.solids.len()],
+            solid_placed: vec![false; self.groups.len()],
             bounds: vec![[F::default(); 3]; self.groups.len() + self.origins.len()],
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
@@ -264,6 +277,9 @@ struct Spheres {
     ball_bodies: Vec<usize>,
     groups: Vec<Group>,
     inner: Vec<Ball>,
+    solids: Vec<Solid>,
+    /// Per body: its solid (when its link's bodies are solids).
+    solid_of_body: Vec<Option<usize>>,
     /// Per body: its spheres inside it, its group, its balls.
     inner_of_body: Vec<std::ops::Range<usize>>,
     group_of_body: Vec<usize>,
@@ -284,6 +300,7 @@ impl Spheres {
         let mut inner_of_body = vec![0..0; bodies.len()];
         let mut group_of_body = vec![usize::MAX; bodies.len()];
         let mut balls_of_body = vec![0..0; bodies.len()];
+        let (mut solids, mut solid_of_body) = (Vec::new(), vec![None; bodies.len()]);
         for (&link, members) in &by_link {
             let (start, inner_start) = (balls.len(), inner.len());
             let mut spheres: Vec<(Point3<f64>, f64)> = Vec::new();
@@ -328,6 +345,18 @@ impl Spheres {
             let kdop = (!exact)
                 .then(|| kdop_of(members.iter().map(|&i| &bodies[i])))
                 .flatten();
+            // a sphere model's spheres stay on the sphere kernels, tuned for them
+            let as_solids: Option<Vec<Solid>> = (!exact)
+                .then(|| members.iter().map(|&i| Solid::of(&bodies[i])).collect())
+                .flatten();
+            let group_solids = as_solids.map(|list| {
+                let first = solids.len();
+                for (&i, solid) in members.iter().zip(list) {
+                    solid_of_body[i] = Some(solids.len());
+                    solids.push(solid);
+                }
+                first..solids.len()
+            });
             groups.push(Group {
                 frame: link,
                 bound: bounding_ball(&spheres),
@@ -336,9 +365,12 @@ impl Spheres {
                 bodies: members.iter().map(|&i| i as u32).collect(),
                 solid,
                 kdop,
+                solids: group_solids,
             });
         }
         Ok(Spheres {
+            solids,
+            solid_of_body,
             balls,
             ball_bodies,
             groups,
@@ -359,6 +391,8 @@ impl Spheres {
             inner_of_body,
             group_of_body,
             balls_of_body,
+            solids,
+            solid_of_body,
             ..
         } = self;
         // the model's checked body pairs as ball pairs, grouped by link pair
@@ -404,7 +438,16 @@ impl Spheres {
                     .then_some((s, o))
             };
             let solid = against(a, b).or_else(|| against(b, a));
+            let solid_pairs = bodies
+                .iter()
+                .map(|&(x, y)| {
+                    let (x, y) = (solid_of_body[x as usize]?, solid_of_body[y as usize]?);
+                    Some(SolidPair::new(solids, x, y))
+                })
+                .collect::<Option<Vec<_>>>()
+                .unwrap_or_default();
             group_pairs.push(GroupPair {
+                solid_pairs,
                 a,
                 b,
                 runs,

@@ -2,9 +2,10 @@ use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
 use super::kdop::kdop_clear;
-use super::lanes::{F, PORTABLE, distance2, inverse_transform, link_frame, transform};
+use super::lanes::{F, PORTABLE, distance2, inverse_transform, link_frame, splat, transform};
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
+use super::solid::{Placed, Solid, box_box, rotate, round_box, round_round};
 use super::world::{FastWorld, Object};
 use crate::batch::Nest;
 use trm_kinematics::PoseLanes32;
@@ -15,6 +16,10 @@ use trm_kinematics::PoseLanes32;
 pub struct FastScratch {
     pub(super) balls: Vec<[F; 3]>,
     pub(super) inner: Vec<[F; 3]>,
+    /// Every solid ([`FastModel::solids`]) placed: a box's centre and axes, a capsule's ends.
+    pub(super) solids: Vec<Placed>,
+    /// Per link group: whether its solids are placed for the current block.
+    pub(super) solid_placed: Vec<bool>,
     pub(super) bounds: Vec<[F; 3]>,
     /// Per link group: its frame (rotation rows, translation) in every lane.
     pub(super) frames: Vec<([F; 9], [F; 3])>,
@@ -245,6 +250,101 @@ pub(super) fn object_link<const AVX: bool>(
     if near == 0 {
         return false;
     }
+    let (hit, close) = if let Some(contacts) = object_solids::<AVX>(model, object, g, scratch, m) {
+        contacts
+    } else {
+        object_balls::<AVX>(model, object, g, near, scratch, m)
+    };
+    let suspect = Suspect::Object {
+        object: o as u32,
+        group: g as u32,
+    };
+    match verdict.add(near, hit, close) {
+        None => {
+            scratch.last_hit = Some(suspect);
+            true
+        }
+        Some(0) => false,
+        Some(lanes) => {
+            scratch.suspects.push((suspect, lanes));
+            false
+        }
+    }
+}
+
+/// The lanes in which a world object certainly collides with link group `g`'s solids, and
+/// those within their tolerance of contact: `None` unless the link is solids
+/// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box.
+#[inline(always)]
+fn object_solids<const AVX: bool>(
+    model: &FastModel,
+    object: &Object,
+    g: usize,
+    scratch: &mut FastScratch,
+    m: f32,
+) -> Option<(LaneMask, LaneMask)> {
+    let range = model.groups[g].solids.clone()?;
+    let (placed, extent) = match *object {
+        Object::Round { a, b, radius } => {
+            let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let half = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            ([splat(a), splat(b), splat(a), splat(a)], half + radius)
+        }
+        Object::Box { center, axes, half } => (
+            [
+                splat(center),
+                splat(axes[0]),
+                splat(axes[1]),
+                splat(axes[2]),
+            ],
+            (half[0] * half[0] + half[1] * half[1] + half[2] * half[2]).sqrt(),
+        ),
+        Object::Cylinder { .. } | Object::Bounded { .. } => return None,
+    };
+    place_solids(model, g, scratch);
+    let mut contact = Contact::default();
+    for k in range {
+        let solid = model.solids[k];
+        let tol = m * (1.0 + extent + solid.extent());
+        let p = &scratch.solids[k];
+        let (hit, close) = match (solid, *object) {
+            (
+                Solid::Round { a, b, radius },
+                Object::Round {
+                    a: c,
+                    b: d,
+                    radius: r,
+                },
+            ) => round_round(p, (a, b, radius), &placed, (c, d, r), tol),
+            (Solid::Round { a, b, radius }, Object::Box { half, .. }) => {
+                round_box(p, (a, b, radius), &placed, half, tol)
+            }
+            (Solid::Box { half, .. }, Object::Round { a, b, radius }) => {
+                round_box(&placed, (a, b, radius), p, half, tol)
+            }
+            (Solid::Box { half, .. }, Object::Box { half: other, .. }) => {
+                box_box::<AVX>(p, half, &placed, other, tol)
+            }
+            _ => return None,
+        };
+        contact.hit = contact.hit | hit;
+        contact.close = contact.close | close;
+    }
+    Some((contact.hit.mask::<AVX>(), contact.close.mask::<AVX>()))
+}
+
+/// The lanes in which a world object certainly collides with link group `g`'s spheres (the
+/// spheres inside its bodies, when they enclose them), and those within the margin of contact.
+#[inline(always)]
+fn object_balls<const AVX: bool>(
+    model: &FastModel,
+    object: &Object,
+    g: usize,
+    near: LaneMask,
+    scratch: &mut FastScratch,
+    m: f32,
+) -> (LaneMask, LaneMask) {
+    let group = &model.groups[g];
     place_balls::<AVX>(model, g, scratch);
     let mut contact = Contact::default();
     for i in group.balls.clone() {
@@ -262,21 +362,7 @@ pub(super) fn object_link<const AVX: bool>(
         }
         hit = inside.hit.mask::<AVX>();
     }
-    let suspect = Suspect::Object {
-        object: o as u32,
-        group: g as u32,
-    };
-    match verdict.add(near, hit, close) {
-        None => {
-            scratch.last_hit = Some(suspect);
-            true
-        }
-        Some(0) => false,
-        Some(lanes) => {
-            scratch.suspects.push((suspect, lanes));
-            false
-        }
-    }
+    (hit, close)
 }
 
 /// Checks link pair `gp` (index `k` in [`FastModel::group_pairs`]) in the lanes of `live`:
@@ -303,7 +389,12 @@ pub(super) fn link_pair<const AVX: bool>(
     if near == 0 {
         return false;
     }
-    let (hit, close) = if let Some((s, o)) = gp.solid {
+    let (hit, close) = if !gp.solid_pairs.is_empty() {
+        // the bodies themselves
+        place_solids(model, gp.a, scratch);
+        place_solids(model, gp.b, scratch);
+        solid_contacts::<AVX>(model, gp, scratch, m)
+    } else if let Some((s, o)) = gp.solid {
         // the other link's spheres in the box link's frame, against the box itself
         place_balls::<AVX>(model, o, scratch);
         let (box_, group, frame) = (&model.groups[s].solid, &model.groups[o], &scratch.frames[s]);
@@ -351,6 +442,80 @@ pub(super) fn link_pair<const AVX: bool>(
             false
         }
     }
+}
+
+/// The lanes in which link pair `gp`'s solids ([`GroupPair::solid_pairs`], placed) certainly
+/// collide, and those in which they come within their tolerance of contact (or NaN).
+#[inline(always)]
+pub(super) fn solid_contacts<const AVX: bool>(
+    model: &FastModel,
+    gp: &GroupPair,
+    scratch: &FastScratch,
+    m: f32,
+) -> (LaneMask, LaneMask) {
+    let mut contact = Contact::default();
+    let several = gp.solid_pairs.len() > 1;
+    for pair in &gp.solid_pairs {
+        let (a, b) = (pair.a as usize, pair.b as usize);
+        let (pa, pb) = (&scratch.solids[a], &scratch.solids[b]);
+        let tol = m * pair.scale;
+        // the spheres around the two solids first, when the links hold several: most of
+        // their pairs near enough for the links' bounding spheres are not near enough for
+        // their own
+        let reach = pair.reach + tol;
+        if several && !distance2(&pa[0], &pb[0]).any_within::<AVX>(reach * reach) {
+            continue;
+        }
+        let (hit, close) = match (model.solids[a], model.solids[b]) {
+            (
+                Solid::Round { a, b, radius },
+                Solid::Round {
+                    a: c,
+                    b: d,
+                    radius: r,
+                },
+            ) => round_round(pa, (a, b, radius), pb, (c, d, r), tol),
+            (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
+                round_box(pa, (a, b, radius), pb, half, tol)
+            }
+            (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
+                box_box::<AVX>(pa, half, pb, other, tol)
+            }
+            // pairs are made round first
+            (Solid::Box { .. }, Solid::Round { .. }) => unreachable!("a solid pair is round first"),
+        };
+        contact.hit = contact.hit | hit;
+        contact.close = contact.close | close;
+    }
+    (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>())
+}
+
+/// The solids of group `g` in every lane, placed once per block.
+#[inline(always)]
+pub(super) fn place_solids(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+    if scratch.solid_placed[g] {
+        return;
+    }
+    let Some(range) = model.groups[g].solids.clone() else {
+        return;
+    };
+    let (rot, t) = &scratch.frames[g];
+    for k in range {
+        let placed = &mut scratch.solids[k];
+        match model.solids[k] {
+            Solid::Box { center, axes, .. } => {
+                placed[0] = transform(rot, t, center);
+                placed[1] = rotate(rot, axes[0]);
+                placed[2] = rotate(rot, axes[1]);
+                placed[3] = rotate(rot, axes[2]);
+            }
+            Solid::Round { a, b, .. } => {
+                placed[0] = transform(rot, t, a);
+                placed[1] = transform(rot, t, b);
+            }
+        }
+    }
+    scratch.solid_placed[g] = true;
 }
 
 /// The lanes in which link pair `gp`'s spheres certainly collide, and those in which they come
@@ -403,6 +568,7 @@ pub(super) fn place<const AVX: bool>(
 ) {
     // the culling spheres' centres: their links' origins
     let groups = model.groups.len();
+    scratch.solid_placed.fill(false);
     for (s, &frame) in model.origins.iter().enumerate() {
         let p = &poses[frame as usize];
         scratch.bounds[groups + s] = [F(p[4]), F(p[5]), F(p[6])];
