@@ -121,6 +121,8 @@ pub struct FastModel {
     pub(super) inner: Vec<Ball>,
     /// Bodies tested as themselves ([`Group::solids`]), grouped by link.
     pub(super) solids: Vec<Solid>,
+    /// Each solid's [`Solid::extent`], for the tolerances of its tests against world objects.
+    pub(super) solid_extents: Vec<f32>,
     /// For each ball, the index of the body it came from.
     pub(super) bodies: Vec<usize>,
     pub(super) groups: Vec<Group>,
@@ -162,6 +164,7 @@ impl FastModel {
             depth,
             balls: spheres.balls,
             inner: spheres.inner,
+            solid_extents: spheres.solids.iter().map(Solid::extent).collect(),
             solids: spheres.solids,
             bodies: spheres.ball_bodies,
             groups: spheres.groups,

@@ -110,8 +110,8 @@ impl Solid {
     }
 }
 
-/// Two solids (indices into [`super::FastModel::solids`]) whose bodies are a checked pair; a box
-/// is `b` whenever the other is round.
+/// Two solids (indices into [`super::FastModel::solids`]) whose bodies are a checked pair, the
+/// round one first where one is round (the walk takes either order).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SolidPair {
     pub(super) a: u32,

@@ -305,7 +305,7 @@ fn object_solids<const AVX: bool>(
     let mut contact = Contact::default();
     for k in range {
         let solid = model.solids[k];
-        let tol = m * (1.0 + extent + solid.extent());
+        let tol = m * (1.0 + extent + model.solid_extents[k]);
         let p = &scratch.solids[k];
         let (hit, close) = match (solid, *object) {
             (
@@ -478,11 +478,12 @@ pub(super) fn solid_contacts<const AVX: bool>(
             (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
                 round_box(pa, (a, b, radius), pb, half, tol)
             }
+            (Solid::Box { half, .. }, Solid::Round { a, b, radius }) => {
+                round_box(pb, (a, b, radius), pa, half, tol)
+            }
             (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
                 box_box::<AVX>(pa, half, pb, other, tol)
             }
-            // pairs are made round first
-            (Solid::Box { .. }, Solid::Round { .. }) => unreachable!("a solid pair is round first"),
         };
         contact.hit = contact.hit | hit;
         contact.close = contact.close | close;
