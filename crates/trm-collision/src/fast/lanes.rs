@@ -97,6 +97,35 @@ impl F {
     }
 }
 
+/// `fn name<const AVX: bool>(args) -> ret`, calling `body::<AVX>(args)` compiled once for AVX2
+/// and FMA (when `AVX`) and once portably, each out of line. For kernels too large to inline
+/// into every clone of the screen at every call site: that made this crate's build take ten
+/// times longer. Costs one call.
+macro_rules! compiled_per_isa {
+    ($(#[$doc:meta])* $name:ident => $body:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty) => {
+        $(#[$doc])*
+        #[inline(always)]
+        pub(super) fn $name<const AVX: bool>($($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            if AVX {
+                #[target_feature(enable = "avx2,fma")]
+                fn avx2($($arg: $ty),*) -> $ret {
+                    $body::<true>($($arg),*)
+                }
+                // SAFETY: as in `F::any_within`
+                #[allow(unsafe_code)]
+                return unsafe { avx2($($arg),*) };
+            }
+            #[inline(never)]
+            fn portable($($arg: $ty),*) -> $ret {
+                $body::<false>($($arg),*)
+            }
+            portable($($arg),*)
+        }
+    };
+}
+pub(super) use compiled_per_isa;
+
 /// [`Flags::mask`]'s lane-by-lane form: the world's tests keep it, as they vectorise worse
 /// around the AVX one (measured: 0.40 → 0.60 ms median on the MBM Panda with mesh hulls).
 pub(super) const PORTABLE: bool = false;

@@ -26,7 +26,7 @@
 //!   is an upper bound, and the same convexity step turns it into a lower bound. A sphere
 //!   against a box is the exact point–box distance.
 
-use super::lanes::{F, Flags, to_f32};
+use super::lanes::{F, Flags, compiled_per_isa, to_f32};
 use crate::model::Body;
 use crate::shape::Shape;
 
@@ -229,14 +229,22 @@ fn not(flags: Flags) -> Flags {
     Flags(out)
 }
 
-/// Two capsules (or spheres) `(a, ends, radius)` in every lane: certainly colliding lanes and
-/// lanes within the tolerance of contact (or NaN).
+/// A capsule (or sphere): its two ends and radius in its link's frame.
+pub(super) type Round = ([f32; 3], [f32; 3], f32);
+
+compiled_per_isa! {
+    /// Two capsules (or spheres) in every lane (placed, and as in their links): certainly
+    /// colliding lanes and lanes within the tolerance of contact (or NaN).
+    round_round => round_round_in(p: &Placed, a: Round, q: &Placed, b: Round, tol: f32)
+        -> (Flags, Flags)
+}
+
 #[inline(always)]
-pub(super) fn round_round(
+fn round_round_in<const AVX: bool>(
     p: &Placed,
-    (pa, pb, pr): ([f32; 3], [f32; 3], f32),
+    (pa, pb, pr): Round,
     q: &Placed,
-    (qa, qb, qr): ([f32; 3], [f32; 3], f32),
+    (qa, qb, qr): Round,
     tol: f32,
 ) -> (Flags, Flags) {
     let len2 = |a: [f32; 3], b: [f32; 3]| {
@@ -291,12 +299,17 @@ fn in_box(c: &[F; 3], b: &Placed) -> [F; 3] {
     [dot(&d, &b[1]), dot(&d, &b[2]), dot(&d, &b[3])]
 }
 
-/// A capsule (or sphere) against a box, in every lane: certainly colliding lanes and lanes
-/// within the tolerance of contact (or NaN).
+compiled_per_isa! {
+    /// A capsule (or sphere) against a box of half sizes `half`, in every lane: certainly
+    /// colliding lanes and lanes within the tolerance of contact (or NaN).
+    round_box => round_box_in(p: &Placed, round: Round, b: &Placed, half: [f32; 3], tol: f32)
+        -> (Flags, Flags)
+}
+
 #[inline(always)]
-pub(super) fn round_box(
+fn round_box_in<const AVX: bool>(
     p: &Placed,
-    (pa, pb, r): ([f32; 3], [f32; 3], f32),
+    (pa, pb, r): Round,
     b: &Placed,
     half: [f32; 3],
     tol: f32,
@@ -434,20 +447,33 @@ fn beyond(p: &[F; 3], h: &[F; 3]) -> [F; 3] {
     ]
 }
 
-/// `x` clamped to `[−h, h]` in every lane.
+/// `x` clamped to `[−h, h]` in every lane (NaN stays NaN). Comparisons, not `f32::clamp`,
+/// whose check of its bounds is a branch per lane that keeps the loop from vectorising.
 #[inline(always)]
 fn clamp_abs(x: F, h: F) -> F {
     let mut out = x.0;
     for l in 0..out.len() {
-        out[l] = out[l].clamp(-h.0[l], h.0[l]);
+        let (v, h) = (out[l], h.0[l]);
+        out[l] = if v < -h {
+            -h
+        } else if v > h {
+            h
+        } else {
+            v
+        };
     }
     F(out)
 }
 
-/// Two boxes in every lane: certainly colliding lanes and lanes within the tolerance of
-/// contact (or NaN), by the separating-axis theorem.
+compiled_per_isa! {
+    /// Two boxes (placed, and their half sizes) in every lane: certainly colliding lanes and
+    /// lanes within the tolerance of contact (or NaN), by the separating-axis theorem.
+    box_box => box_box_in(a: &Placed, ha: [f32; 3], b: &Placed, hb: [f32; 3], tol: f32)
+        -> (Flags, Flags)
+}
+
 #[inline(always)]
-pub(super) fn box_box<const AVX: bool>(
+fn box_box_in<const AVX: bool>(
     a: &Placed,
     ha: [f32; 3],
     b: &Placed,

@@ -214,10 +214,13 @@ fn kdop_slabs_hold_the_hulls_and_clear_only_what_is_clear() {
 /// other).
 #[test]
 fn solid_kernels_are_sound_at_contact() {
+    use super::lanes::Flags;
     use super::solid::{Placed, Solid, SolidPair, box_box, round_box, round_round};
     use crate::model::Body;
     use nalgebra::{Isometry3, Translation3, UnitQuaternion, UnitVector3};
     use parry3d_f64::query;
+
+    let avx2 = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
 
     let shapes = [
         Shape::Sphere { radius: 0.05 },
@@ -373,6 +376,38 @@ fn solid_kernels_are_sound_at_contact() {
                         .unwrap()
                         .map_or(0.0, |c| c.dist)
                 };
+                fn kernel<const AVX: bool>(
+                    (first, second): (&Solid, &Solid),
+                    pa: &Placed,
+                    pb: &Placed,
+                    tol: f32,
+                ) -> (Flags, Flags) {
+                    match (first, second) {
+                        (
+                            Solid::Round { a, b, radius },
+                            Solid::Round {
+                                a: c,
+                                b: d,
+                                radius: r,
+                            },
+                        ) => round_round::<AVX>(pa, (*a, *b, *radius), pb, (*c, *d, *r), tol),
+                        (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
+                            round_box::<AVX>(pa, (*a, *b, *radius), pb, *half, tol)
+                        }
+                        (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
+                            box_box::<AVX>(pa, *half, pb, *other, tol)
+                        }
+                        _ => unreachable!(),
+                    }
+                }
+                let kernel = |avx: bool, pa: &Placed, pb: &Placed| {
+                    let solids = (&solids[pair.a as usize], &solids[pair.b as usize]);
+                    if avx {
+                        kernel::<true>(solids, pa, pb, tol)
+                    } else {
+                        kernel::<false>(solids, pa, pb, tol)
+                    }
+                };
                 let (mut pa, mut pb): (Placed, Placed) = Default::default();
                 let (mut apart, mut depth) = ([false; FAST_LANES], [0.0; FAST_LANES]);
                 for (l, &o) in offsets.iter().enumerate() {
@@ -383,23 +418,16 @@ fn solid_kernels_are_sound_at_contact() {
                     apart[l] = distance(lambda) > 0.0;
                     depth[l] = signed(lambda);
                 }
-                let (hit, close) = match (&solids[pair.a as usize], &solids[pair.b as usize]) {
-                    (
-                        Solid::Round { a, b, radius },
-                        Solid::Round {
-                            a: c,
-                            b: d,
-                            radius: r,
-                        },
-                    ) => round_round(&pa, (*a, *b, *radius), &pb, (*c, *d, *r), tol),
-                    (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
-                        round_box(&pa, (*a, *b, *radius), &pb, *half, tol)
-                    }
-                    (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
-                        box_box::<false>(&pa, *half, &pb, *other, tol)
-                    }
-                    _ => unreachable!(),
-                };
+                let (hit, close) = kernel(false, &pa, &pb);
+                if avx2 {
+                    // the AVX2 compilation answers as the portable one
+                    let (avx_hit, avx_close) = kernel(true, &pa, &pb);
+                    assert_eq!(
+                        (avx_hit.0, avx_close.0),
+                        (hit.0, close.0),
+                        "AVX2 and portable"
+                    );
+                }
                 for l in 0..FAST_LANES {
                     let what = format!(
                         "{} and {}, trial {trial}, offset {}",

@@ -2,7 +2,9 @@ use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
 use super::kdop::kdop_clear;
-use super::lanes::{F, PORTABLE, distance2, inverse_transform, link_frame, splat, transform};
+use super::lanes::{
+    F, PORTABLE, compiled_per_isa, distance2, inverse_transform, link_frame, splat, transform,
+};
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
 use super::solid::{Placed, Solid, box_box, rotate, round_box, round_round};
@@ -272,11 +274,21 @@ pub(super) fn object_link<const AVX: bool>(
     }
 }
 
-/// The lanes in which a world object certainly collides with link group `g`'s solids, and
-/// those within their tolerance of contact: `None` unless the link is solids
-/// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box.
+compiled_per_isa! {
+    /// The lanes in which a world object certainly collides with link group `g`'s solids, and
+    /// those within their tolerance of contact: `None` unless the link is solids
+    /// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box.
+    object_solids => object_solids_in(
+        model: &FastModel,
+        object: &Object,
+        g: usize,
+        scratch: &mut FastScratch,
+        m: f32,
+    ) -> Option<(LaneMask, LaneMask)>
+}
+
 #[inline(always)]
-fn object_solids<const AVX: bool>(
+fn object_solids_in<const AVX: bool>(
     model: &FastModel,
     object: &Object,
     g: usize,
@@ -315,12 +327,12 @@ fn object_solids<const AVX: bool>(
                     b: d,
                     radius: r,
                 },
-            ) => round_round(p, (a, b, radius), &placed, (c, d, r), tol),
+            ) => round_round::<AVX>(p, (a, b, radius), &placed, (c, d, r), tol),
             (Solid::Round { a, b, radius }, Object::Box { half, .. }) => {
-                round_box(p, (a, b, radius), &placed, half, tol)
+                round_box::<AVX>(p, (a, b, radius), &placed, half, tol)
             }
             (Solid::Box { half, .. }, Object::Round { a, b, radius }) => {
-                round_box(&placed, (a, b, radius), p, half, tol)
+                round_box::<AVX>(&placed, (a, b, radius), p, half, tol)
             }
             (Solid::Box { half, .. }, Object::Box { half: other, .. }) => {
                 box_box::<AVX>(p, half, &placed, other, tol)
@@ -391,8 +403,6 @@ pub(super) fn link_pair<const AVX: bool>(
     }
     let (hit, close) = if !gp.solid_pairs.is_empty() {
         // the bodies themselves
-        place_solids(model, gp.a, scratch);
-        place_solids(model, gp.b, scratch);
         solid_contacts::<AVX>(model, gp, scratch, m)
     } else if let Some((s, o)) = gp.solid {
         // the other link's spheres in the box link's frame, against the box itself
@@ -444,15 +454,27 @@ pub(super) fn link_pair<const AVX: bool>(
     }
 }
 
-/// The lanes in which link pair `gp`'s solids ([`GroupPair::solid_pairs`], placed) certainly
-/// collide, and those in which they come within their tolerance of contact (or NaN).
+compiled_per_isa! {
+    /// The lanes in which link pair `gp`'s solids ([`GroupPair::solid_pairs`]) certainly
+    /// collide (placing them first), and those in which they come within their tolerance of
+    /// contact (or NaN).
+    solid_contacts => solid_contacts_in(
+        model: &FastModel,
+        gp: &GroupPair,
+        scratch: &mut FastScratch,
+        m: f32,
+    ) -> (LaneMask, LaneMask)
+}
+
 #[inline(always)]
-pub(super) fn solid_contacts<const AVX: bool>(
+fn solid_contacts_in<const AVX: bool>(
     model: &FastModel,
     gp: &GroupPair,
-    scratch: &FastScratch,
+    scratch: &mut FastScratch,
     m: f32,
 ) -> (LaneMask, LaneMask) {
+    place_solids(model, gp.a, scratch);
+    place_solids(model, gp.b, scratch);
     let mut contact = Contact::default();
     let several = gp.solid_pairs.len() > 1;
     for pair in &gp.solid_pairs {
@@ -474,12 +496,12 @@ pub(super) fn solid_contacts<const AVX: bool>(
                     b: d,
                     radius: r,
                 },
-            ) => round_round(pa, (a, b, radius), pb, (c, d, r), tol),
+            ) => round_round::<AVX>(pa, (a, b, radius), pb, (c, d, r), tol),
             (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
-                round_box(pa, (a, b, radius), pb, half, tol)
+                round_box::<AVX>(pa, (a, b, radius), pb, half, tol)
             }
             (Solid::Box { half, .. }, Solid::Round { a, b, radius }) => {
-                round_box(pb, (a, b, radius), pa, half, tol)
+                round_box::<AVX>(pb, (a, b, radius), pa, half, tol)
             }
             (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
                 box_box::<AVX>(pa, half, pb, other, tol)
