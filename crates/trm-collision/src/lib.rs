@@ -51,6 +51,7 @@ mod error;
 pub mod fast;
 pub mod fit;
 mod generate;
+mod levers;
 pub mod mesh;
 mod model;
 mod placed;
@@ -63,6 +64,7 @@ pub use batch::PlacedBatch;
 pub use checker::WorldChecker;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};
+pub use levers::Levers;
 pub use model::{Body, CollisionModel, CollisionOptions};
 /// Axis-aligned boxes (parry's), as [`PlacedBodies::bounding_box`] and
 /// [`WorldObject::bounding_box`] return them.

@@ -51,6 +51,30 @@ pub struct ModelDescription {
     /// (adjacency included).
     #[serde(default)]
     pub enabled_collisions: Vec<(String, String)>,
+    /// Sampling planners' settings for this robot where the ones sized by its lever arms do
+    /// not suit it (e.g. `planning: (range: Some(0.5))`).
+    #[serde(default, skip_serializing_if = "PlanningSpec::is_empty")]
+    pub planning: PlanningSpec,
+}
+
+/// A robot's own settings for sampling planners; each one absent is sized by the robot's
+/// lever arms (`trm_plan::rrt::RrtOptions::for_robot`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanningSpec {
+    /// RRT-Connect's longest step, rad (Euclidean in the planned motors' values).
+    #[serde(default)]
+    pub range: Option<f64>,
+    /// Largest gap between checked points of an edge, rad.
+    #[serde(default)]
+    pub resolution: Option<f64>,
+}
+
+impl PlanningSpec {
+    /// Whether no setting is given.
+    pub fn is_empty(&self) -> bool {
+        self.range.is_none() && self.resolution.is_none()
+    }
 }
 
 /// Why a link pair is left out of collision checking (the reasons of MoveIt's setup assistant).

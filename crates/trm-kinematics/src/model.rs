@@ -11,7 +11,7 @@ use crate::error::{KinematicsError, NameKind, Result, unknown};
 use crate::fk::{AffineRow, FrameId, Plan, PoseBuffer, affine};
 use crate::resolve::{
     DescCtx, resolve_collision_pairs, resolve_frames, resolve_groups, resolve_motors,
-    resolve_postures,
+    resolve_planning, resolve_postures,
 };
 use crate::tree::{Ctx, Limits, Tree};
 
@@ -66,6 +66,8 @@ struct ModelData {
     enabled_collisions: Vec<[usize; 2]>,
     /// Directories searched for `package://` meshes (the description's, resolved).
     package_paths: Vec<PathBuf>,
+    /// The description's settings for sampling planners.
+    planning: crate::PlanningSpec,
     /// FK over joint values.
     joint_plan: Plan,
     /// FK over motor values.
@@ -252,10 +254,12 @@ impl RobotModel {
         let postures = resolve_postures(&motors, desc, &dctx)?;
         let (disabled_collisions, enabled_collisions) =
             resolve_collision_pairs(&tree, desc, &dctx)?;
+        let planning = resolve_planning(desc, &dctx)?;
         let (joint_plan, motor_plan) = compile_plans(&tree, &frames, &couplings);
         Ok(RobotModel {
             data: Arc::new(ModelData {
                 package_paths: desc.package_paths.clone(),
+                planning,
                 origin: origin.to_string(),
                 tree,
                 motors,
@@ -282,6 +286,7 @@ impl RobotModel {
         Ok(RobotModel {
             data: Arc::new(ModelData {
                 package_paths: d.package_paths.clone(),
+                planning: d.planning,
                 origin: d.origin.clone(),
                 tree: d.tree.clone(),
                 motors: d.motors.clone(),
@@ -301,6 +306,11 @@ impl RobotModel {
     /// description's directory; empty for a bare URDF).
     pub fn package_paths(&self) -> &[PathBuf] {
         &self.data.package_paths
+    }
+
+    /// The description's settings for sampling planners (empty for a bare URDF).
+    pub fn planning(&self) -> &crate::PlanningSpec {
+        &self.data.planning
     }
 
     /// Where the model was loaded from (the URDF file name, or `<string>`).

@@ -514,6 +514,27 @@ pub(crate) fn resolve_collision_pairs(
     Ok((disabled, enabled))
 }
 
+/// The description's planning settings, each a positive finite number of radians.
+pub(crate) fn resolve_planning(
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<crate::PlanningSpec> {
+    let p = desc.planning;
+    for (what, value) in [("range", p.range), ("resolution", p.resolution)] {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(ctx.invalid(
+                format!("planning.{what}"),
+                what,
+                format!("{v} is not a positive finite number of radians"),
+                format!(
+                    "give a positive {what} in radians, or leave it out to size it by the robot"
+                ),
+            ));
+        }
+    }
+    Ok(p)
+}
+
 pub(crate) fn resolve_postures(
     motors: &[Motor],
     desc: &ModelDescription,

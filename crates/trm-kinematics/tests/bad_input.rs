@@ -248,6 +248,15 @@ fn other_description_mistakes_are_errors() {
             "(urdf: \"x\", postures: [(name: \"p\", values: {\"j9\": 0.0})])",
             "which is no motor",
         ),
+        (
+            "(urdf: \"x\",\n planning: (range: Some(-0.5)))",
+            "-0.5 is not a positive finite number of radians",
+        ),
+        (
+            "(urdf: \"x\",\n planning: (resolution: Some(0.0)))",
+            "planning.resolution",
+        ),
+        ("(urdf: \"x\", planning: (step: Some(1.0)))", "step"),
     ] {
         let message = description_error(ron);
         assert!(message.contains(needle), "{ron}: {message}");
@@ -305,4 +314,10 @@ fn a_namespace_the_xml_layer_chokes_on_is_an_error_not_a_panic() {
     );
     // and the model loads as before afterwards
     assert!(RobotModel::from_urdf_str(&urdf(r#"<link name="a"/>"#), "ok.urdf").is_ok());
+}
+
+#[test]
+fn a_bad_planning_setting_is_located() {
+    let message = description_error("(urdf: \"x\",\n planning: (range: Some(-0.5)))");
+    assert!(message.contains("model.ron:2"), "{message}");
 }

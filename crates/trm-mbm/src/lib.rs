@@ -24,7 +24,7 @@ pub use error::{MbmError, Result};
 pub use experience::solve_with_experience;
 pub use loaded::LoadedProblem;
 pub use peers::{parse_peer_results, peer_problems};
-pub use problems::{Problem, ProblemSet, find_problems};
+pub use problems::{Problem, ProblemSet, find_problems, rrt_options_for};
 pub use report::{Summary, markdown_table, quantile, runs_csv, side_by_side};
 pub use run::{Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set};
 pub use solve::{

@@ -229,3 +229,20 @@ impl ProblemSet {
         Ok(())
     }
 }
+
+/// RRT-Connect's settings for a set: the robot's
+/// ([`RrtOptions::for_robot`](trm_plan::rrt::RrtOptions::for_robot): its description's, else
+/// sized by its lever arms) for the motors the set's first request plans for (the defaults
+/// for an empty set).
+pub fn rrt_options_for(
+    robot: &trm_kinematics::RobotModel,
+    collision: &trm_collision::CollisionModel,
+    problems: &[Problem],
+) -> Result<trm_plan::rrt::RrtOptions, MbmError> {
+    let Some(first) = problems.first() else {
+        return Ok(trm_plan::rrt::RrtOptions::default());
+    };
+    let request = trm_moveit::MotionPlanRequest::load(&first.request)?;
+    let active = request.active_set(robot, &robot.neutral_motors())?;
+    Ok(trm_plan::rrt::RrtOptions::for_robot(collision, &active)?)
+}

@@ -86,3 +86,38 @@ fn the_talos_humanoid_builds_a_map_and_plans_through_it() {
     // torso and right arm (the SRDF's r_arm_torso), the rest in the half-sitting posture
     builds_a_map_and_plans_through_it("talos_reach.ron", 9, 80, 40, "arm_right_7_joint");
 }
+
+/// RRT-Connect's settings sized by the robot: VAMP's hand-tuned 1 rad and 1/32 rad on its
+/// Panda; the iCub upper body (shorter levers, 41 motors) checks less densely and steps shorter;
+/// a robot's own description overrides them.
+#[test]
+fn planner_settings_are_sized_by_the_robot() {
+    use trm_collision::CollisionModel;
+    use trm_kinematics::RobotModel;
+    use trm_plan::rrt::RrtOptions;
+
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models");
+    let sized = |robot: &RobotModel, group: &[&str]| {
+        let collision = CollisionModel::new(robot).unwrap();
+        let active = robot.active_set(group, &robot.neutral_motors()).unwrap();
+        RrtOptions::for_robot(&collision, &active).unwrap()
+    };
+    let panda = RobotModel::load(models.join("panda-mbm/panda_spherized.ron")).unwrap();
+    let options = sized(&panda, &["panda_arm"]);
+    assert!((options.range - 1.0).abs() < 0.02, "{options:?}");
+    assert!((1.0 / options.resolution - 32.0).abs() < 0.7, "{options:?}");
+
+    let icub = trm_models::icub_upper_body();
+    let all: Vec<&str> = icub.motors().iter().map(|m| m.name.as_str()).collect();
+    let icub_options = sized(&icub, &all);
+    assert!(icub_options.resolution > options.resolution, "{icub_options:?}");
+    assert!(icub_options.range < options.range, "{icub_options:?}");
+
+    // the description's own settings win, each on its own
+    let mut description = trm_kinematics::ModelDescription::default();
+    description.planning.range = Some(0.5);
+    let own = panda.with_description(&description, None).unwrap();
+    let own_options = sized(&own, &["panda_joint1", "panda_joint2"]);
+    assert_eq!(own_options.range, 0.5);
+    assert!(own_options.resolution > 0.0 && own_options.resolution != 0.5);
+}

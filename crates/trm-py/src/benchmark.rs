@@ -86,11 +86,12 @@ pub(crate) fn benchmark_mbm<'py>(
     let collision = CollisionModel::with_options(&robot, &options).map_err(err)?;
     let mut set = trm_mbm::ProblemSet::open(std::path::Path::new(path)).map_err(err)?;
     set.select(&families, per_family).map_err(err)?;
+    let sized = trm_mbm::rrt_options_for(&robot, &collision, &set.problems).map_err(err)?;
     let rrt = trm_plan::rrt::RrtOptions {
         seed,
         max_iterations,
         sampler,
-        ..Default::default()
+        ..sized
     };
     let options = trm_mbm::BenchmarkOptions {
         rrt,

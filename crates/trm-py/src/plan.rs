@@ -232,7 +232,8 @@ impl Planner {
 
     /// Plans from `start` (the moved motors' values; a map planner's spec start when absent)
     /// to `to`: a posture (the moved motors' values; RRT-Connect through the kept paths, within
-    /// `max_seconds` and `max_samples`, edges checked every `resolution` rad) or, for a map
+    /// `max_seconds` and `max_samples`, steps of at most `range` rad, edges checked every
+    /// `resolution` rad; both sized by the robot's lever arms unless given) or, for a map
     /// planner, a task point (a map node within `tolerance`, then with `exact` NGIK to the
     /// point itself). `posture` says which; by default a posture for a robot planner and a
     /// task point for a map planner. The GIL is released while planning.
@@ -241,7 +242,7 @@ impl Planner {
     /// waypoint), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
     /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
     /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
-    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = 1.0 / 32.0))]
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &mut self,
@@ -254,7 +255,8 @@ impl Planner {
         seed: u64,
         max_seconds: Option<f64>,
         max_samples: usize,
-        resolution: f64,
+        resolution: Option<f64>,
+        range: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let dim = self.planner.active().len();
         let from = match (start, &self.start) {
@@ -283,12 +285,14 @@ impl Planner {
                     self.joint_names().join(", ")
                 )));
             }
+            let sized = self.planner.rrt_options().map_err(err)?;
             let rrt = trm_plan::rrt::RrtOptions {
                 seed,
                 max_seconds,
                 max_iterations: max_samples,
-                resolution,
-                ..Default::default()
+                resolution: resolution.unwrap_or(sized.resolution),
+                range: range.unwrap_or(sized.range),
+                ..sized
             };
             let (experience, planner) = (self.experience, &mut self.planner);
             let (found, trajectory) = py
@@ -355,7 +359,8 @@ impl Planner {
     /// motors the planner moves; its `allowed_planning_time` as the budget unless
     /// `max_seconds`), in the current world; load its scene first (`load_scene`). Returns what
     /// `plan` returns.
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = 1.0 / 32.0))]
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
+    #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
         &mut self,
         py: Python<'py>,
@@ -363,7 +368,8 @@ impl Planner {
         seed: u64,
         max_seconds: Option<f64>,
         max_samples: usize,
-        resolution: f64,
+        resolution: Option<f64>,
+        range: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let request = trm_moveit::MotionPlanRequest::load(request).map_err(err)?;
         let (start, goal) = request.joint_query(self.planner.active()).map_err(err)?;
@@ -380,6 +386,7 @@ impl Planner {
             max_seconds.or(request.planning_time),
             max_samples,
             resolution,
+            range,
         )
     }
 

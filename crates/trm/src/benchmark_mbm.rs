@@ -37,9 +37,14 @@ pub struct Args {
     /// Sample budget per problem (VAMP's evaluate_mbm.py gives its RRT-Connect 10⁶).
     #[arg(long, default_value_t = 1_000_000, value_parser = crate::parse::count(1, 100_000_000))]
     max_iterations: usize,
-    /// Largest gap between checked points of an edge, rad.
-    #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]
-    resolution: f64,
+    /// Largest gap between checked points of an edge, rad (default: sized by the robot's lever
+    /// arms, `trm_plan::rrt::RrtOptions::for_robot`; 1/32 rad on the Panda).
+    #[arg(long, value_parser = crate::parse::positive)]
+    resolution: Option<f64>,
+    /// RRT-Connect's longest step, rad (default: sized by the robot's lever arms; 1 rad on
+    /// the Panda).
+    #[arg(long, value_parser = crate::parse::positive)]
+    range: Option<f64>,
     /// Where RRT-Connect's samples come from: `uniform` (independent seeded draws) or `halton`
     /// (low discrepancy, shifted by the seed; VAMP's sampler).
     #[arg(long, value_enum, default_value_t = SamplerArg::Uniform)]
@@ -107,11 +112,13 @@ pub fn run(args: &Args) -> Result<()> {
     set.select(&args.families, args.per_family)
         .with_context(|| format!("--families/--per-family with {}", args.dir.display()))?;
     let problems = set.problems.clone();
+    let sized = trm_mbm::rrt_options_for(&robot, &collision, &problems)?;
     let options = RrtOptions {
         seed: args.seed,
         max_iterations: args.max_iterations,
         max_seconds: args.max_seconds,
-        resolution: args.resolution,
+        resolution: args.resolution.unwrap_or(sized.resolution),
+        range: args.range.unwrap_or(sized.range),
         shortcuts: args.shortcuts,
         sampler: match args.sampler {
             SamplerArg::Halton => trm_plan::rrt::Sampler::Halton,
@@ -121,10 +128,17 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let bench = run_benchmark(args, &robot, &collision, &problems, &options)?;
     let mut md = format!(
-        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, {} samples at most{})\n\n",
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{})\n\n",
         args.dir.display(),
         args.model.display(),
         args.seed,
+        options.range,
+        1.0 / options.resolution,
+        if args.range.is_none() || args.resolution.is_none() {
+            " (sized by the robot's lever arms where not given)"
+        } else {
+            ""
+        },
         args.max_iterations,
         args.max_seconds
             .map_or(String::new(), |s| format!(", {s} s at most"))
@@ -142,7 +156,7 @@ pub fn run(args: &Args) -> Result<()> {
         .map(|r| (r.family.as_str(), &r.outcome))
         .collect();
     if let Some(binary) = &args.vamp {
-        let (peer, exported) = run_vamp(args, binary, &robot, &set, &bench)?;
+        let (peer, exported) = run_vamp(args, binary, &robot, &set, &bench, options.resolution)?;
         files.push(("peer-problems.txt", exported.into_bytes()));
         let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
         let mut text = format!(
@@ -330,6 +344,7 @@ fn run_vamp(
     robot: &trm_kinematics::RobotModel,
     set: &ProblemSet,
     bench: &trm_mbm::Benchmark,
+    resolution: f64,
 ) -> Result<(Vec<(String, Outcome)>, String)> {
     let problems: Vec<trm_mbm::Problem> =
         bench.problems.iter().map(|p| p.problem.clone()).collect();
@@ -370,7 +385,7 @@ fn run_vamp(
         let mut outcome = found.2.clone();
         if args.verify
             && outcome.solved
-            && !path_is_free_loaded(robot, loaded, &outcome.path, args.resolution / 2.0)?
+            && !path_is_free_loaded(robot, loaded, &outcome.path, resolution / 2.0)?
         {
             outcome.note = VAMP_PATH_COLLIDES.into();
         }

@@ -66,9 +66,14 @@ pub struct Args {
     /// Without maps: sample budget of RRT-Connect.
     #[arg(long, default_value_t = 1_000_000, value_parser = crate::parse::count(1, 100_000_000))]
     max_samples: usize,
-    /// Without maps: largest gap between checked points of an edge, rad.
-    #[arg(long, default_value_t = 1.0 / 32.0, value_parser = crate::parse::positive)]
-    resolution: f64,
+    /// Without maps: largest gap between checked points of an edge, rad (default: sized by the
+    /// robot's lever arms; 1/32 rad on the Panda).
+    #[arg(long, value_parser = crate::parse::positive)]
+    resolution: Option<f64>,
+    /// Without maps: RRT-Connect's longest step, rad (default: sized by the robot's lever
+    /// arms; 1 rad on the Panda).
+    #[arg(long, value_parser = crate::parse::positive)]
+    range: Option<f64>,
     /// Trajectory output (CSV; beside it a .json, a .ros.yaml ROS 2 JointTrajectory, a
     /// .response.yaml MoveIt MotionPlanResponse and, with maps, an .svg of the path over the
     /// first map).
@@ -380,14 +385,16 @@ fn run_without_maps(args: &Args) -> Result<()> {
             configuration(args.to.as_deref().unwrap_or_default(), "--to")?,
         ),
     };
+    let sized = planner.rrt_options()?;
     let options = RrtOptions {
         seed: args.seed,
         max_seconds: args
             .max_seconds
             .or(request.as_ref().and_then(|r| r.planning_time)),
         max_iterations: args.max_samples,
-        resolution: args.resolution,
-        ..Default::default()
+        resolution: args.resolution.unwrap_or(sized.resolution),
+        range: args.range.unwrap_or(sized.range),
+        ..sized
     };
     for (what, q) in [("start", &start), ("goal", &goal)] {
         if !planner.is_free(q) {

@@ -183,6 +183,7 @@ fn plan_without_maps_refuses_what_does_not_fit_and_writes_nothing() {
             vec!["--request", request, "--max-seconds", "-1"],
             "--max-seconds",
         ),
+        (vec!["--request", request, "--range", "0"], "--range"),
     ] {
         let mut full = vec!["plan", "--model", model, "--out", "traj.csv"];
         full.extend(args);

@@ -13,6 +13,7 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
+use crate::rrt::RrtOptions;
 use crate::trajectory::{Trajectory, time_parametrise};
 
 mod connect;
@@ -186,6 +187,13 @@ impl Planner {
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
         Ok(true)
+    }
+
+    /// RRT-Connect's settings for this robot and these active motors
+    /// ([`RrtOptions::for_robot`]: the model description's, else sized by the bodies' lever
+    /// arms). Callers override what their user set.
+    pub fn rrt_options(&self) -> Result<RrtOptions, PlanError> {
+        RrtOptions::for_robot(self.objective.collision(), &self.active)
     }
 
     /// The active motors the planner moves (its configurations' coordinates).

@@ -153,7 +153,8 @@ class Planner:
         seed: int = 0,
         max_seconds: float | None = None,
         max_samples: int = 1_000_000,
-        resolution: float = 1.0 / 32.0,
+        resolution: float | None = None,
+        range: float | None = None,
     ) -> dict: ...
     def plan_request(
         self,
@@ -162,7 +163,8 @@ class Planner:
         seed: int = 0,
         max_seconds: float | None = None,
         max_samples: int = 1_000_000,
-        resolution: float = 1.0 / 32.0,
+        resolution: float | None = None,
+        range: float | None = None,
     ) -> dict: ...
 
 class TaskMap:
