@@ -31,15 +31,13 @@ impl Levers {
         // the joints' values are affine in the active coordinates: their slopes, exactly
         let (n, joints) = (active.len(), robot.num_joints());
         let (mut at_zero, mut moved) = (vec![0.0; joints], vec![0.0; joints]);
-        let mut q = vec![0.0; n];
-        active.joint_values_unchecked(&q, &mut at_zero);
+        active.joint_values_unchecked(&vec![0.0; n], &mut at_zero);
         let mut slopes = vec![vec![0.0; n]; joints];
         for i in 0..n {
-            q[i] = 1.0;
-            active.joint_values_unchecked(&q, &mut moved);
-            q[i] = 0.0;
-            for (c, row) in slopes.iter_mut().enumerate() {
-                row[i] = (moved[c] - at_zero[c]).abs();
+            let unit: Vec<f64> = (0..n).map(|k| f64::from(u8::from(k == i))).collect();
+            active.joint_values_unchecked(&unit, &mut moved);
+            for (row, (m, z)) in slopes.iter_mut().zip(moved.iter().zip(&at_zero)) {
+                row[i] = (m - z).abs();
             }
         }
         // each link's farthest body point from its origin

@@ -110,7 +110,10 @@ fn planner_settings_are_sized_by_the_robot() {
     let icub = trm_models::icub_upper_body();
     let all: Vec<&str> = icub.motors().iter().map(|m| m.name.as_str()).collect();
     let icub_options = sized(&icub, &all);
-    assert!(icub_options.resolution > options.resolution, "{icub_options:?}");
+    assert!(
+        icub_options.resolution > options.resolution,
+        "{icub_options:?}"
+    );
     assert!(icub_options.range < options.range, "{icub_options:?}");
 
     // the description's own settings win, each on its own
