@@ -128,6 +128,50 @@ fn a_point_goal_is_reached_collision_free_around_a_new_box() {
     assert_eq!(again.trajectory, plan.trajectory);
 }
 
+/// A world changed by adding or removing objects keeps what the checks found where the change
+/// cannot alter it: the plans are those of a planner that checks everything again, with fewer
+/// edges checked.
+#[test]
+fn world_updates_keep_the_checks_they_cannot_change() {
+    let p = problem();
+    let map = map();
+    let options = PlanOptions::default();
+    let goal = Goal::TaskPoint {
+        t: map.points[map.points.len() / 2].t.clone(),
+        tolerance: 0.03,
+    };
+    let mut kept = Planner::new(&p.objective, &[map]).unwrap();
+    let first = kept.plan(&p.start, &goal, &options).unwrap();
+    for (world, what) in [
+        (with_box(), "a box added"),
+        (p.objective.world().clone(), "the box removed"),
+        (with_box(), "the box added again"),
+    ] {
+        kept.set_world(world.clone());
+        let planned = kept.plan(&p.start, &goal, &options).unwrap();
+        let mut fresh = Planner::new(&p.objective, &[map]).unwrap();
+        fresh.set_world(p.objective.world().clone());
+        fresh.plan(&p.start, &goal, &options).unwrap();
+        // the fresh planner's states: everything checked again in this world
+        fresh.set_world(with_box());
+        fresh.set_world(World::new());
+        fresh.set_world(world);
+        let again = fresh.plan(&p.start, &goal, &options).unwrap();
+        assert_eq!(planned.trajectory, again.trajectory, "{what}");
+        assert!(
+            planned.stats.edges_checked <= again.stats.edges_checked,
+            "{what}: {} edges checked, {} from scratch",
+            planned.stats.edges_checked,
+            again.stats.edges_checked
+        );
+        if what == "the box removed" {
+            // back in the map's world: the first query's path is as free as it was
+            assert_eq!(planned.trajectory, first.trajectory);
+            assert!(planned.stats.edges_checked < again.stats.edges_checked);
+        }
+    }
+}
+
 #[test]
 fn a_configuration_goal_ends_exactly_there() {
     let p = problem();

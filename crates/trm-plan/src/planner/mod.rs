@@ -148,11 +148,32 @@ impl Planner {
         self.checker.world()
     }
 
-    /// Replaces the world: every node and edge will be checked again when a search wants it.
+    /// Replaces the world. What the nodes' and edges' checks found so far is kept where the
+    /// change cannot alter it: when objects were only removed, what was found free stays free
+    /// (what was blocked will be checked again when a search wants it); when objects were only
+    /// added, what was found blocked stays blocked; otherwise (an object moved or changed)
+    /// everything will be checked again. Objects are compared by name, shape and pose.
     pub fn set_world(&mut self, world: World) {
+        let (old, new) = (self.checker.world(), &world);
+        let within = |a: &World, b: &World| {
+            a.objects().iter().all(|o| {
+                b.object(o.name())
+                    .is_ok_and(|p| p.shape() == o.shape() && p.pose() == o.pose())
+            })
+        };
+        // the states a check could now answer differently
+        let stale: &[State] = match (within(new, old), within(old, new)) {
+            (true, true) => &[],
+            (true, false) => &[State::Invalid],
+            (false, true) => &[State::Valid],
+            (false, false) => &[State::Valid, State::Invalid],
+        };
+        for state in self.node_state.iter_mut().chain(&mut self.edge_state) {
+            if stale.contains(state) {
+                *state = State::Unknown;
+            }
+        }
         self.checker.set_world(world);
-        self.node_state.fill(State::Unknown);
-        self.edge_state.fill(State::Unknown);
     }
 
     /// Replaces the allowed-collision matrix (a planning scene's, applied over the robot's own:
