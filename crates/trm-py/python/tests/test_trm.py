@@ -312,7 +312,8 @@ def test_a_robot_planner_keeps_experience_across_worlds(robot):
     again = planner.plan(goal, start=start, seed=4)
     if first["source"] == "sampled":
         assert planner.num_nodes > 0 and again["source"] == "retrieved"
-    # a new world: the kept path is checked again, never trusted
+    # the pole removed: what was found free stays free (a world that adds or moves objects
+    # has the kept path checked again)
     planner.world = trm.World()
     assert planner.plan(goal, start=start)["source"] in ("straight", "retrieved", "graph")
     with pytest.raises(trm.TrmError, match="start: give"):
