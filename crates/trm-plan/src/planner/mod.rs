@@ -81,6 +81,9 @@ pub struct Planner {
     checker: WorldChecker,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
+    /// [`Planner::rrt_options`], worked out on first use (the robot's bodies and active motors
+    /// do not change; an allowed-collision matrix does not move a body).
+    rrt: std::sync::OnceLock<RrtOptions>,
 }
 
 impl Planner {
@@ -140,6 +143,7 @@ impl Planner {
             edge_state,
             scratch: objective.scratch(),
             kept: Vec::new(),
+            rrt: std::sync::OnceLock::new(),
         })
     }
 
@@ -214,7 +218,11 @@ impl Planner {
     /// ([`RrtOptions::for_robot`]: the model description's, else sized by the bodies' lever
     /// arms). Callers override what their user set.
     pub fn rrt_options(&self) -> Result<RrtOptions, PlanError> {
-        RrtOptions::for_robot(self.objective.collision(), &self.active)
+        if let Some(options) = self.rrt.get() {
+            return Ok(options.clone());
+        }
+        let options = RrtOptions::for_robot(self.objective.collision(), &self.active)?;
+        Ok(self.rrt.get_or_init(|| options).clone())
     }
 
     /// The active motors the planner moves (its configurations' coordinates).
