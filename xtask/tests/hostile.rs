@@ -993,6 +993,28 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             names: names.into(),
         });
     }
+    // maps attached: missing, not a map, a map of other motors (the iCub's)
+    let bench_args = bench(&mbm);
+    let bench_refs: Vec<&str> = bench_args.iter().map(String::as_str).collect();
+    cases.extend(file_flag_cases(
+        &bench_refs,
+        "--map",
+        &["no_such.json", "posture.json", "map.json"],
+    ));
+    let request = at("crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml")
+        .to_string_lossy()
+        .to_string();
+    cases.extend(file_flag_cases(
+        &[
+            "plan",
+            "--model",
+            panda.as_str(),
+            "--request",
+            request.as_str(),
+        ],
+        "--with-map",
+        &["no_such.json", "posture.json", "map.json"],
+    ));
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);
     cases.push(Case {

@@ -29,4 +29,5 @@ pub use report::{Summary, markdown_table, quantile, runs_csv, side_by_side};
 pub use run::{Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set};
 pub use solve::{
     GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, path_is_free, path_is_free_loaded, solve, solve_loaded,
+    solve_with_maps,
 };

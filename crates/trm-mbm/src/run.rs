@@ -6,13 +6,14 @@ use std::fmt::Write as _;
 use trm_collision::CollisionModel;
 use trm_kinematics::RobotModel;
 use trm_plan::rrt::RrtOptions;
+use trm_roadmap::Roadmap;
 
 use crate::error::MbmError;
 use crate::experience::solve_with_experience;
 use crate::loaded::LoadedProblem;
 use crate::problems::Problem;
-use crate::report::markdown_table;
-use crate::solve::{Outcome, path_is_free_loaded, solve_loaded};
+use crate::report::{markdown_table, side_by_side};
+use crate::solve::{Outcome, path_is_free_loaded, solve_with_maps};
 
 /// One problem of a benchmark run and how it went.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -53,6 +54,9 @@ pub struct BenchmarkOptions {
     /// Runs of the set with experience kept after the plain one
     /// ([`solve_with_experience`]; 0: none).
     pub experience_passes: usize,
+    /// Maps for a second run of the set beside the plain one, attached to each problem's
+    /// planner ([`crate::solve_with_maps`]; none: no such run).
+    pub maps: Vec<Roadmap>,
 }
 
 /// What a set run came to: the plain run, and each pass with experience kept.
@@ -65,6 +69,8 @@ pub struct Benchmark {
     pub runs: Vec<Run>,
     /// Each pass with experience, one run per problem.
     pub experience: Vec<Vec<Run>>,
+    /// The run with [`BenchmarkOptions::maps`] attached, one per problem (empty without maps).
+    pub with_maps: Vec<Run>,
     /// Whether solved paths were re-checked ([`BenchmarkOptions::verify`]).
     pub verified: bool,
 }
@@ -80,14 +86,9 @@ pub fn benchmark(
     mut progress: impl FnMut(&str, usize, usize, &Problem),
 ) -> Result<Benchmark, MbmError> {
     let loaded = LoadedProblem::load_all(collision, problems)?;
-    let runs = run_set(
-        robot,
-        &loaded,
-        &options.rrt,
-        options.verify,
-        options.task_space.as_ref(),
-        |k, p| progress("problems", k, problems.len(), p),
-    )?;
+    let (runs, with_maps) = run_set(robot, &loaded, options, |k, p| {
+        progress("problems", k, problems.len(), p)
+    })?;
     let mut experience = Vec::new();
     if options.experience_passes > 0 {
         let total = options.experience_passes * problems.len();
@@ -123,47 +124,50 @@ pub fn benchmark(
         problems: loaded,
         runs,
         experience,
+        with_maps,
         verified: options.verify,
     })
 }
 
-/// Solves each problem by RRT-Connect + shortcutting ([`crate::solve`]), re-checking solved
-/// paths when `verify`; with `task_space`, each joint goal is first turned into the task-space
-/// goal it implies. `progress(done, problem)` after each.
+/// Solves each problem by RRT-Connect + shortcutting ([`crate::solve_loaded`]), re-checking
+/// solved paths when `options.verify`; with `options.task_space`, each joint goal is first
+/// turned into the task-space goal it implies. With `options.maps`, each problem is solved
+/// again right after with the maps attached ([`crate::solve_with_maps`]), so that a machine's
+/// changing load weighs on both runs alike. Returns the plain runs and those with the maps
+/// (empty without maps); `progress(done, problem)` after each problem.
 pub fn run_set(
     robot: &RobotModel,
     problems: &[LoadedProblem],
-    options: &RrtOptions,
-    verify: bool,
-    task_space: Option<&TaskSpaceGoals>,
+    options: &BenchmarkOptions,
     mut progress: impl FnMut(usize, &Problem),
-) -> Result<Vec<Run>, MbmError> {
-    let checks = BenchmarkOptions {
-        rrt: options.clone(),
-        verify,
-        ..Default::default()
-    };
+) -> Result<(Vec<Run>, Vec<Run>), MbmError> {
     let mut runs = Vec::with_capacity(problems.len());
+    let mut with_maps = Vec::new();
     for (k, p) in problems.iter().enumerate() {
         let posed;
-        let p = match task_space {
+        let p = match &options.task_space {
             Some(t) => {
                 posed = p.with_task_space(robot, t)?;
                 &posed
             }
             None => p,
         };
-        let outcome = solve_loaded(robot, p, options)?;
-        let verified = verify_outcome(robot, p, &outcome, &checks)?;
-        runs.push(Run {
-            family: p.problem.family.clone(),
-            index: p.problem.index,
-            outcome,
-            verified,
-        });
+        let run = |maps: &[Roadmap]| -> Result<Run, MbmError> {
+            let outcome = solve_with_maps(robot, p, &options.rrt, maps)?;
+            Ok(Run {
+                family: p.problem.family.clone(),
+                index: p.problem.index,
+                verified: verify_outcome(robot, p, &outcome, options)?,
+                outcome,
+            })
+        };
+        runs.push(run(&[])?);
+        if !options.maps.is_empty() {
+            with_maps.push(run(&options.maps)?);
+        }
         progress(k + 1, &p.problem);
     }
-    Ok(runs)
+    Ok((runs, with_maps))
 }
 
 /// With `options.verify`, whether a solved problem's path is free at half the resolution.
@@ -211,8 +215,34 @@ impl Benchmark {
                 md.push_str(&verified_line(runs, "Every path"));
             }
         }
+        if !self.with_maps.is_empty() {
+            let by_graph = self
+                .with_maps
+                .iter()
+                .filter(|r| r.outcome.solved && r.outcome.note.ends_with("graph"))
+                .count();
+            let solved = self.with_maps.iter().filter(|r| r.outcome.solved).count();
+            let _ = write!(
+                md,
+                "\nWith the maps attached ({by_graph} of {solved} solved problems answered through them), beside the plain run (ratio = with maps / without):\n\n{}",
+                side_by_side(
+                    (&family_outcomes(&self.with_maps), "with maps"),
+                    (&family_outcomes(&self.runs), "without")
+                )
+            );
+            if self.verified {
+                md.push_str(&verified_line(&self.with_maps, "Every path with maps"));
+            }
+        }
         md
     }
+}
+
+/// Each run's family and outcome.
+fn family_outcomes(runs: &[Run]) -> Vec<(&str, &Outcome)> {
+    runs.iter()
+        .map(|r| (r.family.as_str(), &r.outcome))
+        .collect()
 }
 
 /// "`what` re-checked …: F of N collide." of verified runs.

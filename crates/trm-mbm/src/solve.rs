@@ -6,6 +6,7 @@ use trm_kinematics::RobotModel;
 use trm_moveit::{MotionPlanRequest, PlanningScene, motors_from_state};
 use trm_plan::Planner;
 use trm_plan::rrt::{RrtOptions, path_length};
+use trm_roadmap::Roadmap;
 use trm_tasks::Objective;
 
 use crate::error::MbmError;
@@ -56,6 +57,18 @@ pub fn solve_loaded(
     problem: &LoadedProblem,
     options: &RrtOptions,
 ) -> Result<Outcome, MbmError> {
+    solve_with_maps(robot, problem, options, &[])
+}
+
+/// [`solve_loaded`] with `maps` (built for the request's group) attached to the planner
+/// ([`Planner::add_map`]: their nodes and edges checked in the problem's scene when the search
+/// first wants them).
+pub fn solve_with_maps(
+    robot: &RobotModel,
+    problem: &LoadedProblem,
+    options: &RrtOptions,
+    maps: &[Roadmap],
+) -> Result<Outcome, MbmError> {
     options.check()?;
     let (request, world) = (&problem.request, &problem.world);
     let (objective, active, mut start) = problem_objective(robot, &problem.own, world, request)?;
@@ -64,6 +77,9 @@ pub fn solve_loaded(
     // validity checks and the search
     let mut planner = Planner::new(&objective, &[])?;
     planner.set_collision(&problem.collision)?;
+    for map in maps {
+        planner.add_map(map)?;
+    }
     let mut outcome = Outcome {
         note: problem.notes.join("; "),
         ..Default::default()
@@ -117,6 +133,14 @@ pub fn solve_loaded(
             outcome.waypoints = found.path.len();
             outcome.checks = found.checks;
             outcome.path = found.path;
+            if !maps.is_empty() {
+                // how the maps served, after the problem's own notes
+                let source = found.source.name();
+                outcome.note = match outcome.note.is_empty() {
+                    true => source.into(),
+                    false => format!("{}; {source}", outcome.note),
+                };
+            }
         }
         Err(e) => outcome.note = e.to_string(),
     }

@@ -22,7 +22,10 @@ pub mod scenario;
 mod trajectory;
 
 pub use error::PlanError;
-pub use planner::{Connection, Planner, RETRIEVE_STEPS, Source};
+pub use planner::{
+    Connection, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS,
+    Source,
+};
 pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{
     Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,

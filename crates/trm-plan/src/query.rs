@@ -109,6 +109,10 @@ pub struct PlanOptions {
     /// RRT-Connect with these settings finishes the query ([`PlanStats::sampled`] says so);
     /// `None`: the maps alone answer.
     pub sampling: Option<crate::rrt::RrtOptions>,
+    /// A* searches the lazy search through the graph may run (each followed by the checks of
+    /// the path it found; `None`: no bound). When they are spent the query is
+    /// [`PlanError::Unreachable`] or, with [`PlanOptions::sampling`], finished by RRT-Connect.
+    pub max_searches: Option<usize>,
 }
 
 /// Weight of the task error in the exact finish of a task-point goal: large enough to dominate
@@ -156,6 +160,7 @@ impl Default for PlanOptions {
                 max_iterations: 20_000,
                 ..Default::default()
             }),
+            max_searches: None,
         }
     }
 }

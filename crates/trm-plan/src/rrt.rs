@@ -508,163 +508,244 @@ pub fn rrt_connect_in(
 ) -> Result<RrtPath, PlanError> {
     options.check()?;
     let began = Instant::now();
-    let before = checker.checks;
-    let mut iterations = 0;
-    for refinement in 0..3 {
-        let resolution = options.resolution / f64::from(1u32 << refinement);
-        let attempt = RrtOptions {
-            resolution,
-            ..options.clone()
-        };
-        let (mut found, edges) = search(checker, bounds, start, goal, &attempt, began)?;
-        // the edges checked at `resolution` (by the search: the edges it kept, or by the
-        // shortcut) need only their midpoints to be checked at half that; a piece of an edge
-        // a random shortcut cut needs its own points too
-        let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
-            (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
-                && checker.edge_midpoints_free(&w[0], &w[1], resolution)
-                // a refined search's points are not those of the asked resolution: those too,
-                // so that the path is free at every point a check at `options.resolution / 2`
-                // visits
-                && (refinement == 0
-                    || checker.edge_free(&w[0], &w[1], options.resolution)
-                        && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
-        });
-        iterations += found.iterations;
-        if free {
-            found.checks = checker.checks - before;
-            found.iterations = iterations;
-            found.refinements = refinement;
-            found.seconds = began.elapsed().as_secs_f64();
-            return Ok(found);
-        }
-    }
-    Err(PlanError::Unreachable {
-        reason: format!(
-            "every path RRT-Connect found grazed an obstacle between its checked points, down to a resolution of {} rad",
-            options.resolution / 4.0
-        ),
-        closest_node: None,
-        closest_distance: f64::INFINITY,
-    })
+    let growth = Growth::new(checker, start, goal, options)?;
+    growth.finish(checker, bounds, options, began)
 }
 
-/// One RRT-Connect search at `options.resolution`, its time counted from `began`.
-fn search(
-    checker: &mut WorldChecker,
-    (lower, upper): &(Vec<f64>, Vec<f64>),
-    start: &[f64],
-    goal: &[f64],
-    options: &RrtOptions,
-    began: Instant,
-) -> Result<(RrtPath, Vec<EdgeCheck>), PlanError> {
-    let dim = checker.dim();
-    for (what, q) in [("start", start), ("goal", goal)] {
-        if q.len() != dim || q.iter().any(|v| !v.is_finite()) {
-            return Err(PlanError::InvalidGoal {
-                problem: format!(
-                    "the {what} has {} values (or a non-finite one) for {dim} active motors",
-                    q.len()
-                ),
-                fix: format!("give {dim} finite values"),
+/// An RRT-Connect query under way: its two trees grow in as many rounds as its caller wants
+/// ([`Growth::grow`]), and [`Growth::finish`] ends it as [`rrt_connect_in`] would have (a
+/// planner tries its graph between a first round and the rest).
+pub(crate) struct Growth {
+    start: Vec<f64>,
+    goal: Vec<f64>,
+    /// The tree the next sample extends, and the other.
+    a: Tree,
+    b: Tree,
+    a_is_start: bool,
+    rng: ChaCha8Rng,
+    samples: Samples,
+    sample: Vec<f64>,
+    draws: usize,
+    result: RrtPath,
+    /// The path the trees made, once they met (or the straight segment).
+    raw: Option<Vec<Vec<f64>>>,
+    /// The checker's count when the query began.
+    before: u64,
+}
+
+impl Growth {
+    /// A query from `start` to `goal` at `options.resolution`: both checked, then the straight
+    /// segment (many queries need nothing else).
+    pub(crate) fn new(
+        checker: &mut WorldChecker,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+    ) -> Result<Self, PlanError> {
+        let dim = checker.dim();
+        for (what, q) in [("start", start), ("goal", goal)] {
+            if q.len() != dim || q.iter().any(|v| !v.is_finite()) {
+                return Err(PlanError::InvalidGoal {
+                    problem: format!(
+                        "the {what} has {} values (or a non-finite one) for {dim} active motors",
+                        q.len()
+                    ),
+                    fix: format!("give {dim} finite values"),
+                });
+            }
+        }
+        let before = checker.checks;
+        if !checker.free(start) {
+            return Err(PlanError::InvalidStart("it collides in the world".into()));
+        }
+        if !checker.free(goal) {
+            return Err(PlanError::Unreachable {
+                reason: format!("{GOAL_COLLIDES} in the world"),
+                closest_node: None,
+                closest_distance: f64::INFINITY,
             });
         }
+        let raw = checker
+            .edge_free(start, goal, options.resolution)
+            .then(|| vec![start.to_vec(), goal.to_vec()]);
+        Ok(Growth {
+            start: start.to_vec(),
+            goal: goal.to_vec(),
+            a: Tree::new(start),
+            b: Tree::new(goal),
+            a_is_start: true,
+            rng: ChaCha8Rng::seed_from_u64(options.seed),
+            samples: Samples::new(options.sampler, options.seed, dim),
+            sample: vec![0.0; dim],
+            draws: 0,
+            result: RrtPath::default(),
+            raw,
+            before,
+        })
     }
-    let before = checker.checks;
-    if !checker.free(start) {
-        return Err(PlanError::InvalidStart("it collides in the world".into()));
+
+    /// Samples drawn so far.
+    pub(crate) fn iterations(&self) -> usize {
+        self.result.iterations
     }
-    if !checker.free(goal) {
-        return Err(PlanError::Unreachable {
-            reason: "the goal configuration collides in the world".into(),
-            closest_node: None,
-            closest_distance: f64::INFINITY,
-        });
-    }
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut samples = Samples::new(options.sampler, options.seed, dim);
-    let mut result = RrtPath::default();
-    // the straight line first: many queries need nothing else
-    let mut raw = if checker.edge_free(start, goal, options.resolution) {
-        Some(vec![start.to_vec(), goal.to_vec()])
-    } else {
-        None
-    };
-    let (mut a, mut b) = (Tree::new(start), Tree::new(goal));
-    let mut a_is_start = true;
-    let mut sample = vec![0.0; dim];
-    let mut draws = 0usize;
-    while raw.is_none() && result.iterations < options.max_iterations {
-        // the clock read once per [`CLOCK_EVERY`] draws: most draws of a grown tree cost less
-        if draws.is_multiple_of(CLOCK_EVERY)
-            && options
-                .max_seconds
-                .is_some_and(|s| began.elapsed().as_secs_f64() > s)
-        {
-            break;
-        }
-        draws += 1;
-        if draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
-            break;
-        }
-        samples.next(lower, upper, &mut sample);
-        let new = match extend(&mut a, &sample, options, checker, options.dynamic_domain) {
-            // outside the dynamic domain: drawn again, not counted as a sample
-            Extend::Outside => continue,
-            Extend::Trapped => None,
-            Extend::Reached(i) | Extend::Advanced(i) => Some(i),
-        };
-        result.iterations += 1;
-        if let Some(i) = new {
-            let target = a.node(i).to_vec();
-            loop {
-                match extend(&mut b, &target, options, checker, false) {
-                    Extend::Advanced(_) => continue,
-                    Extend::Trapped | Extend::Outside => break,
-                    Extend::Reached(j) => {
-                        let (from_a, from_b) = (a.path_to(i), b.path_to(j));
-                        let (mut first, second) = if a_is_start {
-                            (from_a, from_b)
-                        } else {
-                            (from_b, from_a)
-                        };
-                        // the meeting point is in both halves
-                        first.pop();
-                        first.extend(second.into_iter().rev());
-                        raw = Some(first);
-                        break;
+
+    /// Grows the trees until they meet, `max_iterations` samples in all are drawn, or
+    /// `options.max_seconds` from `began` have passed; whether they met.
+    pub(crate) fn grow(
+        &mut self,
+        checker: &mut WorldChecker,
+        (lower, upper): &(Vec<f64>, Vec<f64>),
+        options: &RrtOptions,
+        max_iterations: usize,
+        began: Instant,
+    ) -> bool {
+        let Growth {
+            a, b, a_is_start, ..
+        } = self;
+        while self.raw.is_none() && self.result.iterations < max_iterations {
+            // the clock read once per [`CLOCK_EVERY`] draws: most draws of a grown tree cost
+            // less
+            if self.draws.is_multiple_of(CLOCK_EVERY)
+                && options
+                    .max_seconds
+                    .is_some_and(|s| began.elapsed().as_secs_f64() > s)
+            {
+                break;
+            }
+            self.draws += 1;
+            if self.draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
+                break;
+            }
+            self.samples.next(lower, upper, &mut self.sample);
+            let new = match extend(a, &self.sample, options, checker, options.dynamic_domain) {
+                // outside the dynamic domain: drawn again, not counted as a sample
+                Extend::Outside => continue,
+                Extend::Trapped => None,
+                Extend::Reached(i) | Extend::Advanced(i) => Some(i),
+            };
+            self.result.iterations += 1;
+            if let Some(i) = new {
+                let target = a.node(i).to_vec();
+                loop {
+                    match extend(b, &target, options, checker, false) {
+                        Extend::Advanced(_) => continue,
+                        Extend::Trapped | Extend::Outside => break,
+                        Extend::Reached(j) => {
+                            let (from_a, from_b) = (a.path_to(i), b.path_to(j));
+                            let (mut first, second) = if *a_is_start {
+                                (from_a, from_b)
+                            } else {
+                                (from_b, from_a)
+                            };
+                            // the meeting point is in both halves
+                            first.pop();
+                            first.extend(second.into_iter().rev());
+                            self.raw = Some(first);
+                            break;
+                        }
                     }
                 }
             }
+            // balanced: the next sample grows the smaller tree
+            let (na, nb) = (a.len() as f64, b.len() as f64);
+            if !options.balance || (na - nb).abs() / na < 1.0 {
+                std::mem::swap(a, b);
+                *a_is_start = !*a_is_start;
+            }
         }
-        // balanced: the next sample grows the smaller tree
-        let (na, nb) = (a.len() as f64, b.len() as f64);
-        if !options.balance || (na - nb).abs() / na < 1.0 {
-            std::mem::swap(&mut a, &mut b);
-            a_is_start = !a_is_start;
-        }
+        self.raw.is_some()
     }
-    result.nodes = a.len() + b.len();
-    let Some(mut path) = raw else {
-        result.checks = checker.checks - before;
-        return Err(PlanError::Unreachable {
+
+    /// Grows the trees within `options`' budget and ends the query as [`rrt_connect_in`]
+    /// does: the path shortcut and checked again at half the resolution, the search run again
+    /// at a finer resolution where the path grazes an obstacle (at most twice).
+    pub(crate) fn finish(
+        self,
+        checker: &mut WorldChecker,
+        bounds: &(Vec<f64>, Vec<f64>),
+        options: &RrtOptions,
+        began: Instant,
+    ) -> Result<RrtPath, PlanError> {
+        let before = self.before;
+        let (start, goal) = (self.start.clone(), self.goal.clone());
+        let mut iterations = 0;
+        let mut growth = Some(self);
+        for refinement in 0..3 {
+            let resolution = options.resolution / f64::from(1u32 << refinement);
+            let attempt = RrtOptions {
+                resolution,
+                ..options.clone()
+            };
+            let mut g = match growth.take() {
+                Some(g) => g,
+                None => Growth::new(checker, &start, &goal, &attempt)?,
+            };
+            g.grow(checker, bounds, &attempt, attempt.max_iterations, began);
+            let (mut found, edges) = g.shortcut(checker, &attempt, began)?;
+            // the edges checked at `resolution` (by the search: the edges it kept, or by the
+            // shortcut) need only their midpoints to be checked at half that; a piece of an
+            // edge a random shortcut cut needs its own points too
+            let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
+                (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
+                    && checker.edge_midpoints_free(&w[0], &w[1], resolution)
+                    // a refined search's points are not those of the asked resolution: those
+                    // too, so that the path is free at every point a check at
+                    // `options.resolution / 2` visits
+                    && (refinement == 0
+                        || checker.edge_free(&w[0], &w[1], options.resolution)
+                            && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
+            });
+            iterations += found.iterations;
+            if free {
+                found.checks = checker.checks - before;
+                found.iterations = iterations;
+                found.refinements = refinement;
+                found.seconds = began.elapsed().as_secs_f64();
+                return Ok(found);
+            }
+        }
+        Err(PlanError::Unreachable {
             reason: format!(
-                "RRT-Connect found no path in {} samples ({} nodes, {:.3} s)",
-                result.iterations,
-                result.nodes,
-                began.elapsed().as_secs_f64()
+                "every path RRT-Connect found grazed an obstacle between its checked points, down to a resolution of {} rad",
+                options.resolution / 4.0
             ),
             closest_node: None,
             closest_distance: f64::INFINITY,
-        });
-    };
-    result.raw_waypoints = path.len();
-    let edges = shortcut(&mut path, options, checker, &mut rng);
-    result.path = path;
-    result.checks = checker.checks - before;
-    result.seconds = began.elapsed().as_secs_f64();
-    Ok((result, edges))
+        })
+    }
+
+    /// The trees' path shortcut ([`shortcut`]), with how each edge was checked; an error when
+    /// the trees have not met.
+    fn shortcut(
+        mut self,
+        checker: &mut WorldChecker,
+        options: &RrtOptions,
+        began: Instant,
+    ) -> Result<(RrtPath, Vec<EdgeCheck>), PlanError> {
+        self.result.nodes = self.a.len() + self.b.len();
+        let Some(mut path) = self.raw.take() else {
+            return Err(PlanError::Unreachable {
+                reason: format!(
+                    "RRT-Connect found no path in {} samples ({} nodes, {:.3} s)",
+                    self.result.iterations,
+                    self.result.nodes,
+                    began.elapsed().as_secs_f64()
+                ),
+                closest_node: None,
+                closest_distance: f64::INFINITY,
+            });
+        };
+        self.result.raw_waypoints = path.len();
+        let edges = shortcut(&mut path, options, checker, &mut self.rng);
+        self.result.path = path;
+        self.result.checks = checker.checks - self.before;
+        self.result.seconds = began.elapsed().as_secs_f64();
+        Ok((self.result, edges))
+    }
 }
+
+/// How the reason of the error of a query whose goal collides begins.
+pub(crate) const GOAL_COLLIDES: &str = "the goal configuration collides";
 
 /// How [`shortcut`] left an edge of the path it returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

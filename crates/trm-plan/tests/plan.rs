@@ -7,7 +7,8 @@ use std::sync::OnceLock;
 
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
-use trm_plan::{ExactGoal, Goal, PlanError, PlanOptions, Planner};
+use trm_plan::rrt::RrtOptions;
+use trm_plan::{ExactGoal, Goal, HEAD_START_SAMPLES, PlanError, PlanOptions, Planner, Source};
 use trm_roadmap::{BuildOptions, Builder, Roadmap, connect};
 use trm_tasks::Problem;
 
@@ -306,6 +307,115 @@ fn goals_that_do_not_fit_the_spaces_are_named_not_searched_for() {
             "{goal:?}: {text}"
         );
     }
+}
+
+#[test]
+fn an_attached_map_is_checked_in_the_planners_world_not_trusted() {
+    let p = problem();
+    let map = map();
+    let mut objective = p.objective.clone();
+    objective.set_world(with_box());
+    let mut planner = Planner::new(&objective, &[]).unwrap();
+    assert_eq!(planner.add_map(map).unwrap(), map.points.len());
+    assert_eq!(planner.num_edges(), map.edges.len());
+    let goal = Goal::TaskPoint {
+        t: map.points[map.points.len() / 2].t.clone(),
+        tolerance: 0.03,
+    };
+    let options = PlanOptions::default();
+    let planned = planner.plan(&p.start, &goal, &options).unwrap();
+    check(&mut planner, &p.start, &planned, &options);
+    assert!(planned.stats.edges_checked > 0);
+    // the same as the map's own planner moved into that world (nothing trusted there either)
+    let mut moved = Planner::new(&p.objective, &[map]).unwrap();
+    moved.set_world(with_box());
+    let again = moved.plan(&p.start, &goal, &options).unwrap();
+    assert_eq!(planned.trajectory, again.trajectory);
+    assert_eq!(planned.stats.edges_checked, again.stats.edges_checked);
+    // a second map joins the first through its nearest nodes
+    planner.add_map(map).unwrap();
+    assert_eq!(
+        planner.num_edges(),
+        2 * map.edges.len() + 3 * map.points.len()
+    );
+    // a map of other motors is refused, naming them
+    let mut other = map.clone();
+    other.active[0] = "l_elbow".into();
+    let e = planner.add_map(&other).unwrap_err().to_string();
+    assert!(e.contains("l_elbow") && e.contains("map 2"), "{e}");
+}
+
+#[test]
+fn a_graph_attached_to_connect_can_only_help() {
+    let robot = trm_models::icub_upper_body();
+    let home = robot.posture("home").unwrap().to_vec();
+    let arm = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"];
+    let active = robot.active_set(&arm, &home).unwrap();
+    let mut world = World::new();
+    let pole = Shape::Box {
+        size: [0.04, 0.04, 2.0],
+    };
+    world
+        .add("pole", pole, Isometry3::translation(-0.25, 0.3, 0.0))
+        .unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let objective = trm_tasks::Objective::new(active, collision, world);
+    let start = objective.active().from_motors(&home);
+    let goal = vec![start[0] - 1.2, start[1] + 0.6, start[2] + 0.5];
+    // short steps: RRT-Connect needs more samples than its head start
+    let short = RrtOptions {
+        range: 0.1,
+        resolution: 0.05,
+        ..Default::default()
+    };
+    let mut plain = Planner::new(&objective, &[]).unwrap();
+    let mut kept = Planner::new(&objective, &[]).unwrap();
+    let first = kept.connect(&start, &goal, &short).unwrap();
+    assert_eq!(first.source, Source::Sampled);
+    kept.add_path(&first.path).unwrap();
+    let (mut sampled, mut through_graph) = (0, 0);
+    // queries near the kept one (farther than a retrieval's reach), with and without it, with
+    // short steps and with the default ones (RRT-Connect answers most in its head start)
+    let default = RrtOptions::default();
+    for k in 0..24 {
+        let options = if k < 12 { &short } else { &default };
+        let angle = k as f64 * 0.5;
+        let (c, s) = (0.15 * angle.cos(), 0.15 * angle.sin());
+        let a = vec![start[0] + c, start[1] + s, start[2] - c];
+        let b = vec![goal[0] - s, goal[1] + c, goal[2] + s];
+        if !plain.is_free(&a) || !plain.is_free(&b) {
+            continue;
+        }
+        let without = plain.connect(&a, &b, options).unwrap();
+        let with = kept.connect(&a, &b, options).unwrap();
+        match with.source {
+            // RRT-Connect drew the same samples, with or without the graph
+            Source::Sampled | Source::Straight => {
+                sampled += 1;
+                assert_eq!(with.path, without.path, "query {k}");
+                assert_eq!(with.iterations, without.iterations, "query {k}");
+            }
+            Source::Graph | Source::Retrieved => {
+                through_graph += 1;
+                // only after RRT-Connect's head start: not a query it answers that fast
+                assert!(
+                    without.iterations > HEAD_START_SAMPLES,
+                    "query {k}: {} samples",
+                    without.iterations
+                );
+                assert_eq!(with.iterations, HEAD_START_SAMPLES, "query {k}");
+                assert_eq!(with.path.first(), Some(&a));
+                assert_eq!(with.path.last(), Some(&b));
+                for w in with.path.windows(2) {
+                    assert!(plain.segment_free(&w[0], &w[1], options.resolution / 4.0));
+                }
+            }
+        }
+    }
+    assert!(
+        sampled > 0 && through_graph > 0,
+        "{sampled} answered by RRT-Connect, {through_graph} through the graph"
+    );
 }
 
 #[test]

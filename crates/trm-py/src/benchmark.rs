@@ -51,12 +51,13 @@ pub(crate) fn compare_optimisers<'py>(
 /// problems, `verify` re-checks each path one configuration at a time, `task_space` (a link)
 /// poses each joint goal as the task-space goal it implies for that link (a cube of side
 /// `position_tolerance`, `orientation_tolerance` about each axis), `sampler` is `uniform` or
-/// `halton` (RRT-Connect's samples). Returns a dict: `runs`
-/// (per problem: family, index, outcome {valid, solved, seconds, length, waypoints, checks,
-/// note, path}, verified), `table` (markdown: solved %, median and p95 time per family) and
-/// `csv`.
+/// `halton` (RRT-Connect's samples); with `maps` (`trm.Roadmap`s of the requests' group), each
+/// problem is solved again with them attached. Returns a dict: `runs` (per problem: family,
+/// index, outcome {valid, solved, seconds, length, waypoints, checks, note, path}, verified),
+/// `with_maps` (the same, with the maps; empty without), `table` (markdown: solved %, median and
+/// p95 time per family), `report` (`trm benchmark-mbm`'s tables) and `csv`.
 #[pyfunction]
-#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05, sampler = "uniform"))]
+#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05, sampler = "uniform", maps = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn benchmark_mbm<'py>(
     py: Python<'py>,
@@ -72,6 +73,7 @@ pub(crate) fn benchmark_mbm<'py>(
     position_tolerance: f64,
     orientation_tolerance: f64,
     sampler: &str,
+    maps: Vec<PyRef<'py, Roadmap>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sampler: trm_plan::rrt::Sampler = sampler.parse().map_err(err)?;
     let task_space = task_space.map(|link| trm_mbm::TaskSpaceGoals {
@@ -98,6 +100,7 @@ pub(crate) fn benchmark_mbm<'py>(
         verify,
         task_space,
         experience_passes: 0,
+        maps: maps.iter().map(|m| m.map.clone()).collect(),
     };
     let bench = py
         .detach(|| trm_mbm::benchmark(&robot, &collision, &set.problems, &options, |_, _, _, _| {}))
@@ -109,5 +112,7 @@ pub(crate) fn benchmark_mbm<'py>(
     )?;
     d.set_item("csv", trm_mbm::runs_csv(&bench.runs))?;
     d.set_item("runs", to_python(py, &bench.runs)?)?;
+    d.set_item("with_maps", to_python(py, &bench.with_maps)?)?;
+    d.set_item("report", bench.markdown())?;
     Ok(d)
 }

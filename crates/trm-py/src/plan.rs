@@ -186,6 +186,15 @@ impl Planner {
         self.planner.set_world(world.world.clone());
     }
 
+    /// Attaches a map built for the same moving motors, in any world: its nodes and edges are
+    /// checked in the current world when a search first wants them. A query between two
+    /// configurations is answered by RRT-Connect when it needs no more than its first samples
+    /// (as without the map), else through the map when it joins them, else by RRT-Connect
+    /// going on. Returns the number of nodes added.
+    fn add_map(&mut self, map: &Roadmap) -> PyResult<usize> {
+        self.planner.add_map(&map.map).map_err(err)
+    }
+
     /// Sets a world file as the current world: RON, or a MoveIt planning scene (`.yaml`), whose
     /// allowed-collision matrix then applies over the planner's own (the collision checks are
     /// made again only when the matrix changes). Returns notes on the matrix's entries that are

@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use trm_mbm::{Outcome, ProblemSet, path_is_free_loaded};
 use trm_plan::rrt::RrtOptions;
+use trm_roadmap::Roadmap;
 
 /// Arguments of `benchmark-mbm`.
 #[derive(clap::Args)]
@@ -83,6 +84,11 @@ pub struct Args {
     /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5).
     #[arg(long, conflicts_with = "families")]
     vamp: Option<PathBuf>,
+    /// Also solve the set with this map attached to each problem's planner (repeatable; built
+    /// for the requests' group, in any world: its nodes and edges are checked in each scene when
+    /// the search first wants them) and print that run beside the plain one.
+    #[arg(long = "map", value_name = "FILE", conflicts_with = "task_space")]
+    maps: Vec<PathBuf>,
     /// Where results.csv, results.md and times.svg go.
     #[arg(long, default_value = "target/benchmark-mbm")]
     pub out_dir: PathBuf,
@@ -150,6 +156,12 @@ pub fn run(args: &Args) -> Result<()> {
         ("results.csv", trm_mbm::runs_csv(&bench.runs).into_bytes()),
         ("times.svg", times_plot(&bench.runs)?.into_bytes()),
     ];
+    if !bench.with_maps.is_empty() {
+        files.push((
+            "results-maps.csv",
+            trm_mbm::runs_csv(&bench.with_maps).into_bytes(),
+        ));
+    }
     let outcomes: Vec<(&str, &Outcome)> = bench
         .runs
         .iter()
@@ -253,9 +265,14 @@ fn run_benchmark(
                 orientation_tolerance: args.orientation_tolerance,
             }),
         experience_passes: if args.experience { 2 } else { 0 },
+        maps: args
+            .maps
+            .iter()
+            .map(|p| Roadmap::load(p).with_context(|| format!("--map {}", p.display())))
+            .collect::<Result<_>>()?,
     };
     let mut bar: Option<(String, crate::progress::Progress)> = None;
-    let bench = trm_mbm::benchmark(
+    let bench = match trm_mbm::benchmark(
         robot,
         collision,
         problems,
@@ -274,7 +291,18 @@ fn run_benchmark(
                 b.set(done as u64, total as u64, &p.family);
             }
         },
-    )?;
+    ) {
+        Ok(bench) => bench,
+        Err(e) => {
+            // a map the requests' motors do not fit: named by its file
+            if let trm_mbm::MbmError::Plan(p) = &e
+                && let trm_plan::PlanError::IncompatibleMap { map, .. } = **p
+            {
+                anyhow::bail!("--map {}: {p}", args.maps[map].display());
+            }
+            return Err(e.into());
+        }
+    };
     if let Some((_, b)) = bar {
         b.finish();
     }

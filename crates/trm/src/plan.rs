@@ -32,6 +32,12 @@ pub struct Args {
     /// allowed_planning_time as the budget (instead of --from and --to).
     #[arg(long, conflicts_with = "to")]
     request: Option<PathBuf>,
+    /// Without maps' own spec: a map attached to the robot's planner (repeatable; built for
+    /// the same moving motors, in any world, its nodes and edges checked in --world when the
+    /// search wants them). RRT-Connect still answers what it answers in its first samples; the
+    /// map is searched only after that (`trm_plan::Planner::connect`).
+    #[arg(long = "with-map", value_name = "FILE", conflicts_with = "maps")]
+    with_maps: Vec<PathBuf>,
     /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps
     /// were built in. Without maps, a scene's allowed-collision matrix applies over the
     /// model's own.
@@ -368,6 +374,12 @@ fn run_without_maps(args: &Args) -> Result<()> {
         }
         planner.set_world(scene.world);
         planner.set_acm(scene.acm)?;
+    }
+    for path in &args.with_maps {
+        let map = Roadmap::load(path).with_context(|| format!("--with-map {}", path.display()))?;
+        planner
+            .add_map(&map)
+            .with_context(|| format!("--with-map {}", path.display()))?;
     }
     let configuration = |text: &str, what: &str| -> Result<Vec<f64>> {
         if text == "home" {

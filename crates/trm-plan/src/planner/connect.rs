@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::Planner;
 use crate::PlanError;
 use crate::query::{Goal, PlanOptions};
-use crate::rrt::{EdgeCheck, RrtOptions, rrt_connect_in, shortcut};
+use crate::rrt::{EdgeCheck, GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
 
 /// Where the path of a [`Planner::connect`] query came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -43,10 +43,9 @@ pub struct Connection {
     pub path: Vec<Vec<f64>>,
     /// Where the path came from.
     pub source: Source,
-    /// Configurations checked for collision by this query (the graph's lazy checks excluded
-    /// when RRT-Connect answered).
+    /// Configurations checked for collision by this query (RRT-Connect's and the graph's).
     pub checks: u64,
-    /// RRT-Connect's samples (0 when the graph answered).
+    /// RRT-Connect's samples.
     pub iterations: usize,
     /// Wall time, s.
     pub seconds: f64,
@@ -57,10 +56,14 @@ impl Planner {
     /// resolution, seed and budget:
     /// - without maps or kept paths, by RRT-Connect ([`crate::rrt::rrt_connect`]: the straight
     ///   segment first, the path shortcut and checked again at half the resolution);
-    /// - with them, through the graph first ([`Planner::plan`] to a configuration goal: a kept
-    ///   path repeating the query is retrieved, else A* with lazy checks), the path shortcut
-    ///   greedily and checked at half the resolution as RRT-Connect's paths are; where the
-    ///   graph does not join the two or its path grazes an obstacle, by RRT-Connect.
+    /// - with them, so that they can only help: a kept path repeating the query is retrieved
+    ///   (when it is still free); else RRT-Connect first, for [`HEAD_START_SAMPLES`] samples
+    ///   (the queries it answers that fast get the path and checks they get without a graph);
+    ///   then the graph ([`Planner::plan`] to a configuration goal: lazy A* for as many
+    ///   searches as [`Planner::graph_searches`] allows), its path shortcut greedily and
+    ///   checked at half the resolution as RRT-Connect's paths are; where the graph does not
+    ///   join the two in that effort, RRT-Connect goes on with the same trees within the rest
+    ///   of the budget.
     ///
     /// Nothing is kept: a caller keeping experience adds the path ([`Planner::add_path`]) when
     /// [`Connection::source`] is [`Source::Sampled`].
@@ -72,31 +75,67 @@ impl Planner {
     ) -> Result<Connection, PlanError> {
         options.check()?;
         let began = Instant::now();
+        let before = self.checker.checks;
         if self.nodes.is_empty() {
-            return self.sample(start, goal, options, began, 0);
+            return self.sample(start, goal, options, began, before);
         }
+        // a query repeating a kept path: that path, when it is still free
+        if !self.kept.is_empty()
+            && let Some(found) = self.through_graph(start, goal, options, 0)?
+        {
+            return Ok(Connection {
+                checks: self.checker.checks - before,
+                seconds: began.elapsed().as_secs_f64(),
+                ..found
+            });
+        }
+        let mut growth = match Growth::new(&mut self.checker, start, goal, options) {
+            Ok(growth) => growth,
+            Err(e) => return Err(self.name_collisions(e, start, goal)),
+        };
+        let head = options.max_iterations.min(HEAD_START_SAMPLES);
+        if !growth.grow(&mut self.checker, &self.bounds, options, head, began)
+            && let Some(found) = self.through_graph(start, goal, options, self.graph_searches())?
+        {
+            return Ok(Connection {
+                checks: self.checker.checks - before,
+                iterations: growth.iterations(),
+                seconds: began.elapsed().as_secs_f64(),
+                ..found
+            });
+        }
+        // the trees met within the head start, or the graph did not answer: RRT-Connect goes on
+        match growth.finish(&mut self.checker, &self.bounds, options, began) {
+            Ok(found) => Ok(self.sampled(found, began, before)),
+            Err(e) => Err(self.name_collisions(e, start, goal)),
+        }
+    }
+
+    /// The graph's path from `start` to `goal` ([`Planner::connect`]'s second try), shortcut and
+    /// checked at half the resolution; `None` where the graph does not join them within
+    /// `searches` A* searches (0: only a kept path repeating the query) or its path grazes an
+    /// obstacle.
+    fn through_graph(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+        searches: usize,
+    ) -> Result<Option<Connection>, PlanError> {
         let plan_options = PlanOptions {
             resolution: options.resolution,
             shortcuts: 0,
             seed: options.seed,
             exact_goal: false,
-            sampling: Some(options.clone()),
+            sampling: None,
+            max_searches: Some(searches),
             ..Default::default()
         };
         let planned = match self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options) {
             Ok(planned) => planned,
+            Err(PlanError::Unreachable { .. }) => return Ok(None),
             Err(e) => return Err(self.name_collisions(e, start, goal)),
         };
-        if let Some((iterations, checks)) = planned.stats.sampled {
-            return Ok(Connection {
-                path: planned.waypoints,
-                source: Source::Sampled,
-                checks,
-                iterations,
-                seconds: began.elapsed().as_secs_f64(),
-            });
-        }
-        let before = self.checker.checks;
         let mut path = planned.waypoints;
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
         let greedy = RrtOptions {
@@ -119,43 +158,67 @@ impl Planner {
             (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
                 && checker.edge_midpoints_free(&w[0], &w[1], r)
         });
-        let checks = self.checker.checks - before;
-        if free {
-            return Ok(Connection {
-                path,
-                source,
-                checks,
-                iterations: 0,
-                seconds: began.elapsed().as_secs_f64(),
-            });
-        }
-        self.sample(start, goal, options, began, checks)
+        Ok(free.then_some(Connection {
+            path,
+            source,
+            checks: 0,
+            iterations: 0,
+            seconds: 0.0,
+        }))
     }
 
-    /// RRT-Connect from `start` to `goal` with the planner's checker; `checks` already spent.
+    /// RRT-Connect from `start` to `goal` with the planner's checker, the query's checks
+    /// counted from `before`.
     fn sample(
         &mut self,
         start: &[f64],
         goal: &[f64],
         options: &RrtOptions,
         began: Instant,
-        checks: u64,
+        before: u64,
     ) -> Result<Connection, PlanError> {
-        let found = match rrt_connect_in(&mut self.checker, &self.bounds, start, goal, options) {
-            Ok(found) => found,
-            Err(e) => return Err(self.name_collisions(e, start, goal)),
-        };
-        Ok(Connection {
+        match rrt_connect_in(&mut self.checker, &self.bounds, start, goal, options) {
+            Ok(found) => Ok(self.sampled(found, began, before)),
+            Err(e) => Err(self.name_collisions(e, start, goal)),
+        }
+    }
+
+    /// The connection RRT-Connect's `found` makes.
+    fn sampled(&self, found: RrtPath, began: Instant, before: u64) -> Connection {
+        Connection {
             source: if found.iterations == 0 {
                 Source::Straight
             } else {
                 Source::Sampled
             },
             path: found.path,
-            checks: checks + found.checks,
+            checks: self.checker.checks - before,
             iterations: found.iterations,
             seconds: began.elapsed().as_secs_f64(),
-        })
+        }
+    }
+}
+
+/// RRT-Connect's samples before [`Planner::connect`] tries the graph: queries RRT-Connect
+/// answers within them are answered as without a graph.
+pub const HEAD_START_SAMPLES: usize = 64;
+
+/// Nodes and edges [`Planner::connect`]'s lazy searches through the graph may visit in all
+/// (each search visits the whole graph at worst): on a map of 300 nodes and 1 400 edges, 4
+/// searches; on a few kept paths, [`MAX_GRAPH_SEARCHES`].
+pub const GRAPH_SEARCH_WORK: usize = 8192;
+
+/// The most searches [`Planner::connect`] gives the graph, however small.
+pub const MAX_GRAPH_SEARCHES: usize = 32;
+
+impl Planner {
+    /// The A* searches [`Planner::connect`] gives the lazy search through the graph (each
+    /// followed by the checks of the path it found) before it returns to RRT-Connect:
+    /// [`GRAPH_SEARCH_WORK`] over the graph's nodes and edges, at least 2 and at most
+    /// [`MAX_GRAPH_SEARCHES`].
+    pub fn graph_searches(&self) -> usize {
+        (GRAPH_SEARCH_WORK / (self.nodes.len() + self.edges.len()).max(1))
+            .clamp(2, MAX_GRAPH_SEARCHES)
     }
 }
 
@@ -241,7 +304,7 @@ impl Planner {
                 reason,
                 closest_node,
                 closest_distance,
-            } if reason.starts_with("the goal configuration collides") => PlanError::Unreachable {
+            } if reason.starts_with(GOAL_COLLIDES) => PlanError::Unreachable {
                 reason: format!("{reason}{}", named(self.collisions(goal))),
                 closest_node,
                 closest_distance,

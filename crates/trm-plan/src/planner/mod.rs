@@ -2,7 +2,8 @@
 
 use std::time::Instant;
 
-use petgraph::graph::{NodeIndex, UnGraph};
+use petgraph::graph::{EdgeReference, NodeIndex, UnGraph};
+use petgraph::visit::{EdgeFiltered, EdgeRef, IntoEdges};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use trm_collision::edge::distance;
@@ -13,11 +14,11 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
-use crate::rrt::RrtOptions;
+use crate::rrt::{GOAL_COLLIDES, RrtOptions};
 use crate::trajectory::{Trajectory, time_parametrise};
 
 mod connect;
-pub use connect::{Connection, Source};
+pub use connect::{Connection, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Source};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum State {
@@ -84,6 +85,8 @@ pub struct Planner {
     /// [`Planner::rrt_options`], worked out on first use (the robot's bodies and active motors
     /// do not change; an allowed-collision matrix does not move a body).
     rrt: std::sync::OnceLock<RrtOptions>,
+    /// Maps attached so far.
+    maps: usize,
 }
 
 impl Planner {
@@ -92,59 +95,90 @@ impl Planner {
     /// are joined by edges from each node to its nearest nodes of every other map (checked when
     /// A* first wants them).
     pub fn new(objective: &Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
-        let names: Vec<&str> = objective.active().names().collect();
-        let mut nodes = Vec::new();
-        let mut edges = Vec::new();
-        let mut edge_state = Vec::new();
-        let mut starts = Vec::new();
-        for (k, map) in maps.iter().enumerate() {
-            if map
-                .active
-                .iter()
-                .map(String::as_str)
-                .ne(names.iter().copied())
-            {
-                return Err(PlanError::IncompatibleMap {
-                    map: k,
-                    problem: format!(
-                        "its active motors ({}) differ from the spec's ({})",
-                        map.active.len(),
-                        names.len()
-                    ),
-                });
-            }
-            let base = nodes.len();
-            starts.push(base);
-            nodes.extend(map.points.iter().map(|p| (p.q.clone(), p.t.clone())));
-            for &(a, b, l) in &map.edges {
-                edges.push((base + a, base + b, l));
-                edge_state.push(State::Valid);
-            }
-        }
-        starts.push(nodes.len());
-        // inter-map edges: each node to its 3 nearest nodes of every other map
-        for (ma, mb) in (0..maps.len()).flat_map(|a| (a + 1..maps.len()).map(move |b| (a, b))) {
-            for i in starts[ma]..starts[ma + 1] {
-                for (l, j) in k_nearest(&nodes[i].0, &nodes, starts[mb]..starts[mb + 1], 3) {
-                    edges.push((i, j, l));
-                    edge_state.push(State::Unknown);
-                }
-            }
-        }
-        Ok(Planner {
+        let mut planner = Planner {
             checker: objective.world_checker(objective.world())?,
             objective: objective.clone(),
             active: objective.active().clone(),
             bounds: objective.active().bounds(),
             own_acm: objective.collision().acm().clone(),
-            node_state: vec![State::Valid; nodes.len()],
-            nodes,
-            edges,
-            edge_state,
+            node_state: Vec::new(),
+            nodes: Vec::new(),
+            edges: Vec::new(),
+            edge_state: Vec::new(),
             scratch: objective.scratch(),
             kept: Vec::new(),
             rrt: std::sync::OnceLock::new(),
-        })
+            maps: 0,
+        };
+        let mut starts = Vec::with_capacity(maps.len() + 1);
+        for map in maps {
+            starts.push(planner.nodes.len());
+            planner.push_map(map, State::Valid)?;
+        }
+        starts.push(planner.nodes.len());
+        // between maps: each node to its 3 nearest nodes of every later map
+        for (ma, mb) in (0..maps.len()).flat_map(|a| (a + 1..maps.len()).map(move |b| (a, b))) {
+            for i in starts[ma]..starts[ma + 1] {
+                let near = k_nearest(
+                    &planner.nodes[i].0,
+                    &planner.nodes,
+                    starts[mb]..starts[mb + 1],
+                    3,
+                );
+                for (l, j) in near {
+                    planner.edges.push((i, j, l));
+                    planner.edge_state.push(State::Unknown);
+                }
+            }
+        }
+        Ok(planner)
+    }
+
+    /// Attaches `map` (built for the same active motors, in any world and with any model of the
+    /// robot) to the planner's graph: its nodes and edges are checked in the current world when a
+    /// search first wants them, and each node is joined to its 3 nearest nodes of the graph
+    /// already there (maps and kept paths). Returns the number of nodes added.
+    pub fn add_map(&mut self, map: &Roadmap) -> Result<usize, PlanError> {
+        let base = self.nodes.len();
+        self.push_map(map, State::Unknown)?;
+        for i in base..self.nodes.len() {
+            for (l, j) in k_nearest(&self.nodes[i].0, &self.nodes, 0..base, 3) {
+                self.edges.push((i, j, l));
+                self.edge_state.push(State::Unknown);
+            }
+        }
+        Ok(self.nodes.len() - base)
+    }
+
+    /// Adds the next map's nodes and own edges in `state` (an error when its active motors are
+    /// not the planner's).
+    fn push_map(&mut self, map: &Roadmap, state: State) -> Result<(), PlanError> {
+        if map
+            .active
+            .iter()
+            .map(String::as_str)
+            .ne(self.active.names())
+        {
+            let ours: Vec<&str> = self.active.names().collect();
+            return Err(PlanError::IncompatibleMap {
+                map: self.maps,
+                problem: format!(
+                    "its active motors ({}) differ from the planner's ({})",
+                    map.active.join(", "),
+                    ours.join(", ")
+                ),
+            });
+        }
+        let base = self.nodes.len();
+        self.nodes
+            .extend(map.points.iter().map(|p| (p.q.clone(), p.t.clone())));
+        self.node_state.resize(self.nodes.len(), state);
+        for &(a, b, l) in &map.edges {
+            self.edges.push((base + a, base + b, l));
+            self.edge_state.push(state);
+        }
+        self.maps += 1;
+        Ok(())
     }
 
     /// The current world.
@@ -407,9 +441,29 @@ impl Planner {
         }
         let mut stats = PlanStats::default();
         let mut extra_state = vec![State::Unknown; extra.len()];
+        // built for the first search: the graph and A*'s heuristic (a map node's distance to a
+        // configuration goal)
+        let mut graph = None;
         loop {
+            if options.max_searches.is_some_and(|m| stats.searches >= m) {
+                return Err(PlanError::Unreachable {
+                    reason: format!(
+                        "the search through the maps found no free path in {} searches",
+                        stats.searches
+                    ),
+                    closest_node: None,
+                    closest_distance: f64::INFINITY,
+                });
+            }
             stats.searches += 1;
-            let path = match self.search(&extra, &extra_state, &target, goal_q.as_deref()) {
+            let (graph, estimate) = graph.get_or_insert_with(|| {
+                let estimate: Vec<f64> = match &goal_q {
+                    Some(q) => self.nodes.iter().map(|(p, _)| distance(p, q)).collect(),
+                    None => Vec::new(),
+                };
+                (self.query_graph(&extra), estimate)
+            });
+            let path = match self.search(graph, &extra, &extra_state, &target, estimate) {
                 Ok(path) => path,
                 Err(reachable) => {
                     let closest = self.closest_to(reachable.into_iter(), &goal_t);
@@ -493,7 +547,7 @@ impl Planner {
         extra.push((n, n + 1, distance(start, q)));
         if !self.is_free(q) {
             return Err(PlanError::Unreachable {
-                reason: "the goal configuration collides in the current world".into(),
+                reason: format!("{GOAL_COLLIDES} in the current world"),
                 closest_node: None,
                 closest_distance: f64::INFINITY,
             });
@@ -522,29 +576,46 @@ impl Planner {
         }
     }
 
-    /// A* from the start (node n) to a goal node over the nodes and edges not known invalid:
-    /// the path's nodes, each with the edge that reaches it (`usize::MAX` for the first; edges
-    /// past the map's are `extra`'s). Without a path, the map nodes reachable from the start.
-    fn search(
-        &self,
-        extra: &[(usize, usize, f64)],
-        extra_state: &[State],
-        target: &Target,
-        goal_q: Option<&[f64]>,
-    ) -> Result<Vec<(usize, usize)>, Vec<usize>> {
-        let n = target.n;
-        let total = n + 2;
+    /// The graph a query searches: the map and kept nodes, the start (node n) and goal
+    /// (node n + 1), and every edge (the graph's, then `extra`), weighted by its index.
+    fn query_graph(&self, extra: &[Edge]) -> UnGraph<(), usize> {
+        let total = self.nodes.len() + 2;
         let mut graph = UnGraph::<(), usize>::with_capacity(total, self.edges.len() + extra.len());
         for _ in 0..total {
             graph.add_node(());
         }
-        let node_ok = |i: usize| i >= n || self.node_state[i] != State::Invalid;
-        let states = self.edge_state.iter().chain(extra_state);
-        for (k, (&(a, b, _), state)) in self.edges.iter().chain(extra).zip(states).enumerate() {
-            if *state != State::Invalid && node_ok(a) && node_ok(b) {
-                graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
-            }
+        for (k, &(a, b, _)) in self.edges.iter().chain(extra).enumerate() {
+            graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
         }
+        graph
+    }
+
+    /// A* on `graph` ([`Planner::query_graph`]) from the start (node n) to a goal node over the
+    /// nodes and edges not known invalid, `estimate[v]` the heuristic of map node v: the path's
+    /// nodes, each with the edge that reaches it (`usize::MAX` for the first; edges past the
+    /// map's are `extra`'s). Without a path, the map nodes reachable from the start.
+    fn search(
+        &self,
+        graph: &UnGraph<(), usize>,
+        extra: &[Edge],
+        extra_state: &[State],
+        target: &Target,
+        estimate: &[f64],
+    ) -> Result<Vec<(usize, usize)>, Vec<usize>> {
+        let n = target.n;
+        let node_ok = |i: usize| i >= n || self.node_state[i] != State::Invalid;
+        let state = |k: usize| {
+            if k < self.edges.len() {
+                self.edge_state[k]
+            } else {
+                extra_state[k - self.edges.len()]
+            }
+        };
+        let open = EdgeFiltered::from_fn(graph, |e: EdgeReference<'_, usize>| {
+            state(*e.weight()) != State::Invalid
+                && node_ok(e.source().index())
+                && node_ok(e.target().index())
+        });
         let length = |k: usize| {
             if k < self.edges.len() {
                 self.edges[k].2
@@ -553,18 +624,15 @@ impl Planner {
             }
         };
         let found = petgraph::algo::astar(
-            &graph,
+            &open,
             NodeIndex::new(n),
             |v| target.holds(v.index(), &self.nodes),
             |e| length(*e.weight()),
-            |v| match goal_q {
-                Some(q) if v.index() < n => distance(&self.nodes[v.index()].0, q),
-                _ => 0.0,
-            },
+            |v| estimate.get(v.index()).copied().unwrap_or(0.0),
         );
         let Some((_, path)) = found else {
             let reachable =
-                petgraph::algo::dijkstra(&graph, NodeIndex::new(n), None, |e| length(*e.weight()));
+                petgraph::algo::dijkstra(&open, NodeIndex::new(n), None, |e| length(*e.weight()));
             return Err(reachable
                 .keys()
                 .map(|v| v.index())
@@ -573,11 +641,10 @@ impl Planner {
         };
         let mut steps = vec![(path[0].index(), usize::MAX)];
         for w in path.windows(2) {
-            let k = *graph
-                .edges_connecting(w[0], w[1])
-                .next()
-                .map(|e| e.weight())
-                .unwrap_or(&usize::MAX);
+            let k = open
+                .edges(w[0])
+                .find(|e| e.target() == w[1])
+                .map_or(usize::MAX, |e| *e.weight());
             steps.push((w[1].index(), k));
         }
         Ok(steps)

@@ -330,6 +330,27 @@ def test_a_robot_planner_keeps_experience_across_worlds(robot):
         planner.plan_request(str(sorted(MBM.glob("*/request*.yaml"))[0]))
 
 
+def test_a_map_attached_to_a_robot_planner_is_checked_in_its_world(robot):
+    built = trm.Roadmap.build(SPEC, points=20, seed=0)
+    planner = trm.Planner(robot)
+    assert planner.add_map(built) == len(built) and planner.num_nodes == len(built)
+    a, b = built.postures[0], built.postures[len(built) // 2]
+    r = planner.plan(b, start=a)
+    assert np.allclose(r["waypoints"][0], a) and np.allclose(r["waypoints"][-1], b)
+    assert r["source"] in ("straight", "sampled", "graph")
+    arm = trm.Planner(robot, joints=["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"])
+    with pytest.raises(trm.TrmError, match="differ from the planner's"):
+        arm.add_map(built)
+
+
+def test_a_benchmark_with_a_map_runs_beside_the_plain_one():
+    panda_map = trm.Roadmap.build(str(ROOT / "specs" / "panda_reach.ron"), points=10, seed=0)
+    r = trm.benchmark_mbm(str(MBM), PANDA, families=["box_panda"], per_family=2, maps=[panda_map])
+    assert len(r["with_maps"]) == len(r["runs"]) == 2
+    assert all(w["outcome"]["solved"] for w in r["with_maps"])
+    assert "With the maps attached" in r["report"]
+
+
 def test_errors_are_located_trm_errors(robot, tmp_path):
     with pytest.raises(trm.TrmError, match="nope.urdf"):
         trm.Robot.load("nope.urdf")
