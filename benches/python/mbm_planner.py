@@ -1,9 +1,9 @@
 """MotionBenchMaker problems through Python's door: one `trm.Planner` for the robot, each
 problem's scene set on it (`load_scene`: world and allowed-collision matrix) and its request
-planned (`plan_request`), as a Python user plans MoveIt queries. Prints, per family: valid,
-solved, the planner's median and p95 time (what `trm benchmark-mbm` reports for the same
-problems and seed), and the median wall time of the Python call, without and with reading the
-scene. Compare with `trm benchmark-mbm SET --model MODEL` on the same set: the same planner
+planned (`plan_request`, the request read beforehand: `trm.MotionPlanRequest.load`), as a Python
+user plans MoveIt queries. Prints, per family: valid, solved, the planner's median and p95 time
+(what `trm benchmark-mbm` reports for the same problems and seed), and the median wall time of
+the Python call, without and with reading the scene. Compare with `trm benchmark-mbm SET --model MODEL` on the same set: the same planner
 object answers both, so solved counts and path lengths agree problem by problem.
 
 Run (the wheel installed: `python3 -m maturin build --release -m crates/trm-py/Cargo.toml`
@@ -80,12 +80,14 @@ def main():
         if args.per_family is not None and seen >= args.per_family:
             continue
         counts[family] = seen + 1
+        # the request read before the clock starts, as a user holding requests in memory does
+        read = trm.MotionPlanRequest.load(str(request))
         t0 = time.perf_counter()
         planner.load_scene(str(scene))
         t1 = time.perf_counter()
         row = {"family": family, "problem": number, "valid": True, "solved": False}
         try:
-            r = planner.plan_request(str(request), seed=args.seed, max_samples=args.max_samples)
+            r = planner.plan_request(read, seed=args.seed, max_samples=args.max_samples)
             row.update(solved=True, seconds=r["seconds"], length=r["length"],
                        waypoints=len(r["waypoints"]), checks=r["checks"], note=r["source"])
         except trm.TrmError as e:

@@ -1004,16 +1004,22 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
     let request = at("crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml")
         .to_string_lossy()
         .to_string();
+    let plan_request = [
+        "plan",
+        "--model",
+        panda.as_str(),
+        "--request",
+        request.as_str(),
+    ];
     cases.extend(file_flag_cases(
-        &[
-            "plan",
-            "--model",
-            panda.as_str(),
-            "--request",
-            request.as_str(),
-        ],
+        &plan_request,
         "--with-map",
         &["no_such.json", "posture.json", "map.json"],
+    ));
+    cases.extend(file_flag_cases(
+        &plan_request,
+        "--experience",
+        &["posture.json", "map.json"],
     ));
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);

@@ -78,6 +78,11 @@ fn ms(seconds: Option<f64>) -> String {
     seconds.map_or("—".to_string(), |s| format!("{:.2}", s * 1e3))
 }
 
+/// A path length, rad, or a dash.
+fn length(rad: Option<f64>) -> String {
+    rad.map_or("—".into(), |l| format!("{l:.2}"))
+}
+
 /// The field's per-family table in markdown: valid, solved, median and p95 time, median path
 /// length and collision checks, one row per family (in the order first met) and one for all.
 pub fn markdown_table<'a>(outcomes: impl IntoIterator<Item = (&'a str, &'a Outcome)>) -> String {
@@ -97,7 +102,7 @@ pub fn markdown_table<'a>(outcomes: impl IntoIterator<Item = (&'a str, &'a Outco
             100.0 * s.solved as f64 / s.valid.max(1) as f64,
             ms(s.time.map(|t| t.0)),
             ms(s.time.map(|t| t.1)),
-            s.length.map_or("—".into(), |l| format!("{l:.2}")),
+            length(s.length),
             s.checks
                 .filter(|&c| c > 0.0)
                 .map_or("—".into(), |c| format!("{c:.0}"))
@@ -125,14 +130,15 @@ fn families<'a>(outcomes: &[(&'a str, &Outcome)]) -> Vec<&'a str> {
 }
 
 /// Two planners side by side per family, in markdown: each one's solved share of the problems
-/// both call valid, its median and p95 time, and the ratios `ours / theirs`.
+/// both call valid, its median and p95 time and median path length, and the ratios
+/// `ours / theirs`.
 pub fn side_by_side<'a>(
     (ours, our_name): (&[(&'a str, &'a Outcome)], &str),
     (theirs, their_name): (&[(&'a str, &'a Outcome)], &str),
 ) -> String {
     use std::fmt::Write as _;
     let mut md = format!(
-        "| family | both valid | {our_name} solved | {their_name} solved | {our_name} median ms | {their_name} median ms | median ratio | {our_name} p95 ms | {their_name} p95 ms | p95 ratio |\n|---|---|---|---|---|---|---|---|---|---|\n"
+        "| family | both valid | {our_name} solved | {their_name} solved | {our_name} median ms | {their_name} median ms | median ratio | {our_name} p95 ms | {their_name} p95 ms | p95 ratio | {our_name} median length (rad) | {their_name} median length (rad) | length ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let mut row = |name: &str, pairs: Vec<(&Outcome, &Outcome)>| {
         let both: Vec<_> = pairs.iter().filter(|(a, b)| a.valid && b.valid).collect();
@@ -147,7 +153,7 @@ pub fn side_by_side<'a>(
         };
         let _ = writeln!(
             md,
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             both.len(),
             a.solved,
             b.solved,
@@ -157,6 +163,9 @@ pub fn side_by_side<'a>(
             ms(a.time.map(|t| t.1)),
             ms(b.time.map(|t| t.1)),
             ratio(a.time.map(|t| t.1), b.time.map(|t| t.1)),
+            length(a.length),
+            length(b.length),
+            ratio(a.length, b.length),
         );
     };
     let pair = |family: Option<&str>| -> Vec<(&Outcome, &Outcome)> {

@@ -13,6 +13,7 @@ use crate::error::MbmError;
 use crate::loaded::LoadedProblem;
 
 pub use trm_moveit::LIMIT_SLACK;
+pub use trm_plan::GOAL_ATTEMPTS;
 
 /// How one problem went.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
@@ -97,13 +98,7 @@ pub fn solve_with_maps(
             });
         }
         let started = std::time::Instant::now();
-        let found = request.pose_goal.solve(
-            objective.active(),
-            &start,
-            options.seed,
-            GOAL_ATTEMPTS,
-            |q| planner.is_free(q),
-        )?;
+        let found = planner.solve_pose(&start, &request.pose_goal, options.seed)?;
         goal_seconds = started.elapsed().as_secs_f64();
         match found {
             Some(q) => goal = q,
@@ -159,9 +154,6 @@ pub(crate) fn joint_goal_only(request: &MotionPlanRequest, what: &str) -> Result
         fix: "give joint constraints, or solve task-space goals with mbm::solve (benchmark-mbm without --experience/--vamp)".into(),
     })
 }
-
-/// IK starts tried for a task-space goal (the start, then seeded random configurations).
-pub const GOAL_ATTEMPTS: usize = 500;
 
 /// Why a problem is invalid (`None`: start and goal within the limits of the `active` motors
 /// and free for `planner`); a colliding start or goal names its pairs

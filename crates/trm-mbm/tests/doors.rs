@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use trm_collision::CollisionModel;
 use trm_kinematics::RobotModel;
 use trm_mbm::{LoadedProblem, find_problems, solve_loaded};
-use trm_moveit::{MotionPlanRequest, load_scene, motion_plan_response_yaml};
+use trm_moveit::{MotionPlanRequest, RequestGoal, load_scene, motion_plan_response_yaml};
 use trm_plan::rrt::RrtOptions;
 use trm_plan::{PlanOptions, Planner, Source};
 
@@ -83,6 +83,52 @@ fn one_planner_answers_every_problem_as_the_benchmark_does() {
     }
     // every sample scene carries a matrix, the model's own: nothing is compiled again
     assert_eq!(matrices_set, 0);
+}
+
+#[test]
+fn a_task_space_request_is_answered_as_the_benchmark_answers_it() {
+    let (robot, collision) = panda();
+    let problems = find_problems(&fixtures()).unwrap();
+    let goals = trm_mbm::TaskSpaceGoals {
+        link: "panda_hand".into(),
+        position_tolerance: 0.01,
+        orientation_tolerance: 0.05,
+    };
+    let options = RrtOptions::default();
+    for p in problems.iter().step_by(3) {
+        let (mut planner, _, _) = planner_in(&robot, &collision, p);
+        let posed = LoadedProblem::load(&collision, p)
+            .unwrap()
+            .with_task_space(&robot, &goals)
+            .unwrap();
+        let expected = solve_loaded(&robot, &posed, &options).unwrap();
+        let (start, goal) = posed.request.query(planner.active()).unwrap();
+        let RequestGoal::Pose(pose) = goal else {
+            panic!("{}: a joint goal", p.request.display())
+        };
+        let what = format!("{} {}", p.family, p.index);
+        let found = planner.connect_to_pose(&start, &pose, &options).unwrap();
+        assert!(expected.solved, "{what}: {}", expected.note);
+        assert_eq!(found.path, expected.path, "{what}");
+        // the path ends where the goal holds, collision-free
+        let end = found.path.last().unwrap();
+        let mut poses = robot.pose_buffer();
+        planner.active().forward(end, &mut poses).unwrap();
+        assert!(pose.met(&robot, &poses).unwrap(), "{what}");
+        assert!(planner.is_free(end), "{what}");
+    }
+    // a goal given in another frame is refused by name
+    let mut posed = LoadedProblem::load(&collision, &problems[0])
+        .unwrap()
+        .with_task_space(&robot, &goals)
+        .unwrap();
+    posed.request.pose_goal.positions[0].frame = "panda_link3".into();
+    let (mut planner, start, _) = planner_in(&robot, &collision, &problems[0]);
+    let e = planner
+        .connect_to_pose(&start, &posed.request.pose_goal, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("panda_link3") && e.contains("root frame"), "{e}");
 }
 
 #[test]

@@ -33,7 +33,9 @@ use std::path::Path;
 use trm_collision::{AllowedCollisionMatrix, CollisionModel, World};
 
 pub use error::{MoveItError, Result};
-pub use request::{JointGoal, JointState, LIMIT_SLACK, MotionPlanRequest, motors_from_state};
+pub use request::{
+    JointGoal, JointState, LIMIT_SLACK, MotionPlanRequest, RequestGoal, motors_from_state,
+};
 pub use response::motion_plan_response_yaml;
 pub use scene::{AllowedCollisions, CollisionObject, PlanningScene, Primitive};
 

@@ -67,6 +67,15 @@ pub struct MotionPlanRequest {
     pub planning_time: Option<f64>,
 }
 
+/// What a request asks a planner to reach ([`MotionPlanRequest::query`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum RequestGoal {
+    /// A configuration of the planner's motors.
+    Joints(Vec<f64>),
+    /// A task-space goal (position and orientation constraints on links).
+    Pose(trm_plan::pose_goal::PoseGoal),
+}
+
 impl Reader<'_> {
     pub(crate) fn joint_state(&self, node: &Node, what: &str) -> Result<JointState, MoveItError> {
         let names: Vec<String> = match node.get("name") {
@@ -578,6 +587,21 @@ impl MotionPlanRequest {
         )?)
     }
 
+    /// The request's start and goal in `active`'s coordinates (a planner's): its joint goal
+    /// ([`MotionPlanRequest::joint_query`]) or, when it constrains no joint, its task-space
+    /// goal, with the start checked as for a joint goal.
+    pub fn query(
+        &self,
+        active: &trm_kinematics::ActiveSet,
+    ) -> Result<(Vec<f64>, RequestGoal), MoveItError> {
+        if self.goal.names.is_empty() && !self.pose_goal.is_empty() {
+            let start = self.start_in(active)?;
+            return Ok((start, RequestGoal::Pose(self.pose_goal.clone())));
+        }
+        let (start, goal) = self.joint_query(active)?;
+        Ok((start, RequestGoal::Joints(goal)))
+    }
+
     /// The request's start and joint goal in `active`'s coordinates (a planner's): the start
     /// state's values of the active motors, the goal's by name. An error names what does not
     /// fit: a task-space goal, a goal that constrains a motor the set does not move or leaves
@@ -587,16 +611,10 @@ impl MotionPlanRequest {
         &self,
         active: &trm_kinematics::ActiveSet,
     ) -> Result<(Vec<f64>, Vec<f64>), MoveItError> {
-        let invalid = |problem: String, fix: &str| MoveItError::Invalid {
-            path: self.origin.clone(),
-            line: 0,
-            problem,
-            fix: fix.into(),
-        };
         let names: Vec<&str> = active.names().collect();
         let moved = names.join(", ");
         if self.goal.names.is_empty() {
-            return Err(invalid(
+            return Err(self.invalid(
                 "a task-space goal, where joint goals are taken".into(),
                 "give joint_constraints for the planner's motors",
             ));
@@ -604,7 +622,7 @@ impl MotionPlanRequest {
         let mut goal = vec![f64::NAN; names.len()];
         for (name, value) in self.goal.names.iter().zip(&self.goal.positions) {
             let k = names.iter().position(|n| n == name).ok_or_else(|| {
-                invalid(
+                self.invalid(
                     format!("the goal constrains `{name}`, which the planner does not move (it moves {moved})"),
                     "give a planner that moves the request's goal joints",
                 )
@@ -612,12 +630,21 @@ impl MotionPlanRequest {
             goal[k] = *value;
         }
         if let Some(k) = goal.iter().position(|v| v.is_nan()) {
-            return Err(invalid(
+            return Err(self.invalid(
                 format!("the goal leaves `{}` out", names[k]),
                 "constrain every motor the planner moves",
             ));
         }
-        let fixed = active.to_motors(&vec![0.0; names.len()]);
+        let start = self.start_in(active)?;
+        self.within_limits(active, "goal", &mut goal)?;
+        Ok((start, goal))
+    }
+
+    /// The start state's values of `active`'s motors, checked: every moving motor given, the
+    /// held ones where `active` holds them, within the limits (clamped within
+    /// [`LIMIT_SLACK`]).
+    fn start_in(&self, active: &trm_kinematics::ActiveSet) -> Result<Vec<f64>, MoveItError> {
+        let fixed = active.to_motors(&vec![0.0; active.len()]);
         let robot = active.model();
         let (motors, _) = motors_from_state(robot, &self.start, &fixed);
         let moving = active.motor_indices();
@@ -629,7 +656,7 @@ impl MotionPlanRequest {
         {
             if moving.contains(&i) {
                 if !self.start.names.contains(&m.name) {
-                    return Err(invalid(
+                    return Err(self.invalid(
                         format!(
                             "the start state does not give `{}`, which the planner moves",
                             m.name
@@ -638,7 +665,7 @@ impl MotionPlanRequest {
                     ));
                 }
             } else if (held - given).abs() > 1e-9 {
-                return Err(invalid(
+                return Err(self.invalid(
                     format!(
                         "the start state puts `{}` at {given}; the planner holds it at {held}",
                         m.name
@@ -648,22 +675,43 @@ impl MotionPlanRequest {
             }
         }
         let mut start = active.from_motors(&motors);
-        for (what, q) in [("start", &mut start), ("goal", &mut goal)] {
-            for (v, &i) in q.iter_mut().zip(moving) {
-                let (m, limits) = (&robot.motors()[i], &robot.motors()[i].limits);
-                if !(limits.lower - LIMIT_SLACK..=limits.upper + LIMIT_SLACK).contains(v) {
-                    return Err(invalid(
-                        format!(
-                            "the {what} puts `{}` at {v}, outside its limits [{}, {}]",
-                            m.name, limits.lower, limits.upper
-                        ),
-                        "give values within the joint limits",
-                    ));
-                }
-                *v = v.clamp(limits.lower, limits.upper);
+        self.within_limits(active, "start", &mut start)?;
+        Ok(start)
+    }
+
+    /// Checks that `q` (`what`: start or goal, in `active`'s coordinates) lies within the
+    /// joint limits (up to [`LIMIT_SLACK`]) and clamps it onto them.
+    fn within_limits(
+        &self,
+        active: &trm_kinematics::ActiveSet,
+        what: &str,
+        q: &mut [f64],
+    ) -> Result<(), MoveItError> {
+        let robot = active.model();
+        for (v, &i) in q.iter_mut().zip(active.motor_indices()) {
+            let (m, limits) = (&robot.motors()[i], &robot.motors()[i].limits);
+            if !(limits.lower - LIMIT_SLACK..=limits.upper + LIMIT_SLACK).contains(v) {
+                return Err(self.invalid(
+                    format!(
+                        "the {what} puts `{}` at {v}, outside its limits [{}, {}]",
+                        m.name, limits.lower, limits.upper
+                    ),
+                    "give values within the joint limits",
+                ));
             }
+            *v = v.clamp(limits.lower, limits.upper);
         }
-        Ok((start, goal))
+        Ok(())
+    }
+
+    /// An error about this request (no line: the request as a whole).
+    fn invalid(&self, problem: String, fix: &str) -> MoveItError {
+        MoveItError::Invalid {
+            path: self.origin.clone(),
+            line: 0,
+            problem,
+            fix: fix.into(),
+        }
     }
 
     /// Reads a request file (at most [`trm_io::MAX_INPUT_BYTES`]).

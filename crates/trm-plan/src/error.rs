@@ -23,6 +23,20 @@ pub enum PlanError {
         /// The operating-system error.
         source: std::io::Error,
     },
+    /// A versioned file (an experience file) could not be read or written.
+    #[error(transparent)]
+    File(#[from] trm_io::FileError),
+    /// An experience file that does not fit the planner (other motors, a path that is not a
+    /// path of its motors).
+    #[error("{}: {problem}\n  fix: {fix}", path.display())]
+    IncompatibleExperience {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What does not fit.
+        problem: String,
+        /// What to do about it.
+        fix: String,
+    },
     /// A trajectory file holds something invalid.
     #[error("{}{}: {problem}\n  fix: {fix}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
     InvalidTrajectory {

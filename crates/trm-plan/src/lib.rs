@@ -23,8 +23,8 @@ mod trajectory;
 
 pub use error::PlanError;
 pub use planner::{
-    Connection, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS,
-    Source,
+    Connection, EXPERIENCE_FORMAT, EXPERIENCE_VERSION, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK,
+    HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS, Source,
 };
 pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{

@@ -345,8 +345,8 @@ fn an_attached_map_is_checked_in_the_planners_world_not_trusted() {
     assert!(e.contains("l_elbow") && e.contains("map 2"), "{e}");
 }
 
-#[test]
-fn a_graph_attached_to_connect_can_only_help() {
+/// The iCub's right arm (3 motors) beside a pole, a start (home) and a goal behind the pole.
+fn arm_beside_a_pole() -> (trm_tasks::Objective, Vec<f64>, Vec<f64>) {
     let robot = trm_models::icub_upper_body();
     let home = robot.posture("home").unwrap().to_vec();
     let arm = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"];
@@ -362,6 +362,53 @@ fn a_graph_attached_to_connect_can_only_help() {
     let objective = trm_tasks::Objective::new(active, collision, world);
     let start = objective.active().from_motors(&home);
     let goal = vec![start[0] - 1.2, start[1] + 0.6, start[2] + 0.5];
+    (objective, start, goal)
+}
+
+#[test]
+fn experience_is_saved_and_loaded_whole_or_refused_whole() {
+    let (objective, start, goal) = arm_beside_a_pole();
+    let options = RrtOptions::default();
+    let mut kept = Planner::new(&objective, &[]).unwrap();
+    let first = kept.connect(&start, &goal, &options).unwrap();
+    kept.add_path(&first.path).unwrap();
+    let dir = std::env::temp_dir().join(format!("trm-experience-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("arm.experience.json");
+    kept.save_experience(&file).unwrap();
+    let mut fresh = Planner::new(&objective, &[]).unwrap();
+    assert_eq!(fresh.load_experience(&file).unwrap(), 1);
+    assert_eq!(fresh.kept_paths(), kept.kept_paths());
+    let again = fresh.connect(&start, &goal, &options).unwrap();
+    assert_eq!(again.source, Source::Retrieved);
+    assert_eq!(again.path, first.path);
+    // refused whole: other motors, a short waypoint, a cut file, another kind of file
+    let text = std::fs::read_to_string(&file).unwrap();
+    let bad = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let mut planner = Planner::new(&objective, &[]).unwrap();
+        let e = planner.load_experience(&path).unwrap_err().to_string();
+        assert_eq!(planner.num_nodes(), 0, "{name}: {e}");
+        assert!(e.contains(name), "{e}");
+        e
+    };
+    let e = bad("motors.json", &text.replace("r_elbow", "l_elbow"));
+    assert!(
+        e.contains("l_elbow") && e.contains("the planner moves"),
+        "{e}"
+    );
+    let short = text.replacen("[[[", "[[[1.0],[", 1);
+    assert!(bad("short.json", &short).contains("1 values, not 3"));
+    assert!(bad("cut.json", &text[..text.len() / 2]).contains("truncated"));
+    let other = text.replace("trm-experience", "trm-map");
+    assert!(bad("other.json", &other).contains("not a trm-experience file"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_graph_attached_to_connect_can_only_help() {
+    let (objective, start, goal) = arm_beside_a_pole();
     // short steps: RRT-Connect needs more samples than its head start
     let short = RrtOptions {
         range: 0.1,

@@ -19,7 +19,7 @@ mod wholebody;
 
 pub(crate) use collision::{Collision, PyWorld};
 pub(crate) use optim::{Optimizer, minimize_constrained};
-pub(crate) use plan::{Planner, run_scenario};
+pub(crate) use plan::{MotionPlanRequest, Planner, run_scenario};
 pub(crate) use problem::Problem;
 pub(crate) use roadmap::Roadmap;
 pub(crate) use robot::Robot;
@@ -183,6 +183,7 @@ fn _trm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Optimizer>()?;
     m.add_class::<Roadmap>()?;
     m.add_class::<Planner>()?;
+    m.add_class::<MotionPlanRequest>()?;
     m.add_function(wrap_pyfunction!(view, m)?)?;
     m.add_function(wrap_pyfunction!(minimize_constrained, m)?)?;
     m.add_class::<TaskMap>()?;

@@ -1,9 +1,92 @@
 //! `trm.Planner`: planning through maps in a world.
 
 use crate::*;
+use trm_moveit::RequestGoal;
 
 /// A planner for one robot, compiled once (`trm_plan::Planner`): worlds and planning scenes
 /// are set on it, maps and kept paths are optional, queries go without rebuilding anything.
+/// A MoveIt motion plan request (`.yaml`: start state, joint goal, group, planning time), read
+/// once: `Planner.plan_request` takes it as often as wanted without reading the file again.
+#[pyclass(module = "trm", frozen)]
+pub(crate) struct MotionPlanRequest {
+    request: trm_moveit::MotionPlanRequest,
+}
+
+#[pymethods]
+impl MotionPlanRequest {
+    /// Reads a request file; an error names the file, the line and the fix.
+    #[staticmethod]
+    fn load(path: &str) -> PyResult<Self> {
+        Ok(MotionPlanRequest {
+            request: trm_moveit::MotionPlanRequest::load(path).map_err(err)?,
+        })
+    }
+
+    /// The planning group it asks for.
+    #[getter]
+    fn group(&self) -> String {
+        self.request.group.clone()
+    }
+
+    /// Its `allowed_planning_time`, s (None when it gives none).
+    #[getter]
+    fn allowed_planning_time(&self) -> Option<f64> {
+        self.request.planning_time
+    }
+
+    /// The joints its goal constrains, in its order.
+    #[getter]
+    fn goal_joints(&self) -> Vec<String> {
+        self.request.goal.names.clone()
+    }
+
+    /// The goal's joint values, in the order of `goal_joints`.
+    #[getter]
+    fn goal<'py>(&self, py: Python<'py>) -> PyResult<Array<'py>> {
+        let goal = &self.request.goal.positions;
+        shaped(py, None, &[goal.len()], goal.clone())
+    }
+
+    /// This request with its joint goal replaced by the task-space goal it implies for `link`
+    /// of `robot` (its pose at the goal: a cube of side `position_tolerance` m around its
+    /// origin, `orientation_tolerance` rad about each axis, in the robot's root frame), as
+    /// `trm benchmark-mbm --task-space` poses its goals.
+    #[pyo3(signature = (robot, link, position_tolerance = 0.01, orientation_tolerance = 0.05))]
+    fn to_task_space(
+        &self,
+        robot: &Robot,
+        link: &str,
+        position_tolerance: f64,
+        orientation_tolerance: f64,
+    ) -> PyResult<Self> {
+        let request = self
+            .request
+            .to_task_space(
+                &robot.model,
+                link,
+                position_tolerance,
+                orientation_tolerance,
+            )
+            .map_err(err)?;
+        Ok(MotionPlanRequest { request })
+    }
+
+    /// Whether its goal is a task-space goal (position and orientation constraints).
+    #[getter]
+    fn is_task_space(&self) -> bool {
+        self.request.goal.names.is_empty() && !self.request.pose_goal.is_empty()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "MotionPlanRequest({}, group {}, {} goal joints)",
+            self.request.origin.display(),
+            self.request.group,
+            self.request.goal.names.len()
+        )
+    }
+}
+
 #[pyclass(module = "trm")]
 pub(crate) struct Planner {
     planner: trm_plan::Planner,
@@ -239,6 +322,29 @@ impl Planner {
         self.planner.add_path(&rows).map_err(err)
     }
 
+    /// The kept paths, in the order they were kept: one `(W, joints)` array each.
+    fn kept_paths<'py>(&self, py: Python<'py>) -> PyResult<Vec<Array<'py>>> {
+        let n = self.planner.active().len();
+        self.planner
+            .kept_paths()
+            .into_iter()
+            .map(|path| shaped(py, Some(path.len()), &[n], path.concat()))
+            .collect()
+    }
+
+    /// Writes the kept paths to `path` (a versioned JSON file: the moved motors' names and
+    /// every path's waypoints), atomically.
+    fn save_experience(&self, path: &str) -> PyResult<()> {
+        self.planner.save_experience(path).map_err(err)
+    }
+
+    /// Keeps the paths of a file `save_experience` wrote (checked in the current world when a
+    /// search wants them); a file of other motors is refused whole. Returns the number of
+    /// paths kept.
+    fn load_experience(&mut self, path: &str) -> PyResult<usize> {
+        self.planner.load_experience(path).map_err(err)
+    }
+
     /// Plans from `start` (the moved motors' values; a map planner's spec start when absent)
     /// to `to`: a posture (the moved motors' values; RRT-Connect through the kept paths, within
     /// `max_seconds` and `max_samples`, steps of at most `range` rad, edges checked every
@@ -281,11 +387,6 @@ impl Planner {
             ));
         }
         let d = PyDict::new(py);
-        let options = trm_plan::PlanOptions {
-            seed,
-            exact_goal: exact,
-            ..Default::default()
-        };
         let planned = if posture {
             if target.len() != dim {
                 return Err(err(format!(
@@ -294,35 +395,23 @@ impl Planner {
                     self.joint_names().join(", ")
                 )));
             }
-            let sized = self.planner.rrt_options().map_err(err)?;
-            let rrt = trm_plan::rrt::RrtOptions {
+            let budget = Budget {
                 seed,
                 max_seconds,
-                max_iterations: max_samples,
-                resolution: resolution.unwrap_or(sized.resolution),
-                range: range.unwrap_or(sized.range),
-                ..sized
+                max_samples,
+                resolution,
+                range,
             };
-            let (experience, planner) = (self.experience, &mut self.planner);
-            let (found, trajectory) = py
-                .detach(|| -> Result<_, trm_plan::PlanError> {
-                    let found = planner.connect(&from, &target, &rrt)?;
-                    if experience && found.source == trm_plan::Source::Sampled {
-                        planner.add_path(&found.path)?;
-                    }
-                    let trajectory = planner.trajectory(&found.path, &options);
-                    Ok((found, trajectory))
-                })
-                .map_err(err)?;
-            d.set_item("source", found.source.name())?;
-            d.set_item("checks", found.checks)?;
-            d.set_item("samples", found.iterations)?;
-            let length = trm_plan::rrt::path_length(&found.path);
-            (trajectory, found.path, length, found.seconds)
+            self.connect(py, &d, from, RequestGoal::Joints(target), &budget)?
         } else {
             let goal = trm_plan::Goal::TaskPoint {
                 t: target,
                 tolerance,
+            };
+            let options = trm_plan::PlanOptions {
+                seed,
+                exact_goal: exact,
+                ..Default::default()
             };
             let planner = &mut self.planner;
             let planned = py
@@ -335,6 +424,126 @@ impl Planner {
                 planned.stats.seconds,
             )
         };
+        self.fill(py, d, planned)
+    }
+
+    /// Plans a MoveIt motion plan request (a `MotionPlanRequest`, or a `.yaml` file read on
+    /// each call: its start state and its joint goal for the motors the planner moves, or its
+    /// task-space goal, met by IK for a collision-free configuration first; its
+    /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
+    /// its scene first (`load_scene`). Returns what `plan` returns.
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn plan_request<'py>(
+        &mut self,
+        py: Python<'py>,
+        request: &Bound<'py, PyAny>,
+        seed: u64,
+        max_seconds: Option<f64>,
+        max_samples: usize,
+        resolution: Option<f64>,
+        range: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let read;
+        let request = match request.cast::<MotionPlanRequest>() {
+            Ok(r) => &r.get().request,
+            Err(_) => {
+                let path: String = request
+                    .extract()
+                    .map_err(|_| err("request: give a MotionPlanRequest or a .yaml path"))?;
+                read = trm_moveit::MotionPlanRequest::load(&path).map_err(err)?;
+                &read
+            }
+        };
+        let (start, goal) = request.query(self.planner.active()).map_err(err)?;
+        let budget = Budget {
+            seed,
+            max_seconds: max_seconds.or(request.planning_time),
+            max_samples,
+            resolution,
+            range,
+        };
+        let d = PyDict::new(py);
+        let planned = self.connect(py, &d, start, goal, &budget)?;
+        self.fill(py, d, planned)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Planner(moves {} motors, {} graph nodes, {} world objects)",
+            self.planner.active().len(),
+            self.planner.num_nodes(),
+            self.planner.world().len()
+        )
+    }
+}
+
+/// A path, timed: the trajectory, the waypoints (moved motors), its length (rad) and the
+/// planning time (s).
+type Timed = (trm_plan::Trajectory, Vec<Vec<f64>>, f64, f64);
+
+/// A query's seed and budget as Python gives them (`None`: the planner's sized settings, the
+/// request's planning time).
+struct Budget {
+    seed: u64,
+    max_seconds: Option<f64>,
+    max_samples: usize,
+    resolution: Option<f64>,
+    range: Option<f64>,
+}
+
+impl Planner {
+    /// `from` joined to `goal` (a configuration or a task-space goal) by
+    /// `trm_plan::Planner::connect` / `connect_to_pose` within `budget`, the GIL released;
+    /// the path kept when the planner keeps experience. Sets `source`, `checks` and `samples`
+    /// in `d`.
+    fn connect(
+        &mut self,
+        py: Python<'_>,
+        d: &Bound<'_, PyDict>,
+        from: Vec<f64>,
+        goal: RequestGoal,
+        budget: &Budget,
+    ) -> PyResult<Timed> {
+        let sized = self.planner.rrt_options().map_err(err)?;
+        let rrt = trm_plan::rrt::RrtOptions {
+            seed: budget.seed,
+            max_seconds: budget.max_seconds,
+            max_iterations: budget.max_samples,
+            resolution: budget.resolution.unwrap_or(sized.resolution),
+            range: budget.range.unwrap_or(sized.range),
+            ..sized
+        };
+        let (experience, planner) = (self.experience, &mut self.planner);
+        let (found, trajectory) = py
+            .detach(|| -> Result<_, trm_plan::PlanError> {
+                let found = match &goal {
+                    RequestGoal::Joints(q) => planner.connect(&from, q, &rrt)?,
+                    RequestGoal::Pose(pose) => planner.connect_to_pose(&from, pose, &rrt)?,
+                };
+                if experience && found.source == trm_plan::Source::Sampled {
+                    planner.add_path(&found.path)?;
+                }
+                let trajectory = planner.trajectory(&found.path, &Default::default());
+                Ok((found, trajectory))
+            })
+            .map_err(err)?;
+        d.set_item("source", found.source.name())?;
+        d.set_item("checks", found.checks)?;
+        d.set_item("samples", found.iterations)?;
+        let length = trm_plan::rrt::path_length(&found.path);
+        Ok((trajectory, found.path, length, found.seconds))
+    }
+
+    /// `d` filled with a timed path: `times`, `positions`, `motor_names`, `waypoints`,
+    /// `task_path` (map planners), `length`, `seconds`.
+    fn fill<'py>(
+        &self,
+        py: Python<'py>,
+        d: Bound<'py, PyDict>,
+        planned: Timed,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let dim = self.planner.active().len();
         let (t, waypoints, length, seconds) = planned;
         d.set_item(
             "times",
@@ -362,49 +571,5 @@ impl Planner {
         d.set_item("length", length)?;
         d.set_item("seconds", seconds)?;
         Ok(d)
-    }
-
-    /// Plans a MoveIt motion plan request (`.yaml`: its start state and joint goal, for the
-    /// motors the planner moves; its `allowed_planning_time` as the budget unless
-    /// `max_seconds`), in the current world; load its scene first (`load_scene`). Returns what
-    /// `plan` returns.
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
-    #[allow(clippy::too_many_arguments)]
-    fn plan_request<'py>(
-        &mut self,
-        py: Python<'py>,
-        request: &str,
-        seed: u64,
-        max_seconds: Option<f64>,
-        max_samples: usize,
-        resolution: Option<f64>,
-        range: Option<f64>,
-    ) -> PyResult<Bound<'py, PyDict>> {
-        let request = trm_moveit::MotionPlanRequest::load(request).map_err(err)?;
-        let (start, goal) = request.joint_query(self.planner.active()).map_err(err)?;
-        let to = shaped(py, None, &[goal.len()], goal)?;
-        let from = shaped(py, None, &[start.len()], start)?;
-        self.plan(
-            py,
-            to.as_any(),
-            Some(from.as_any()),
-            0.0,
-            Some(true),
-            false,
-            seed,
-            max_seconds.or(request.planning_time),
-            max_samples,
-            resolution,
-            range,
-        )
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Planner(moves {} motors, {} graph nodes, {} world objects)",
-            self.planner.active().len(),
-            self.planner.num_nodes(),
-            self.planner.world().len()
-        )
     }
 }

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use trm_moveit::RequestGoal;
 use trm_plan::rrt::RrtOptions;
 use trm_plan::{ExactGoal, Goal, PlanOptions, Planner, Trajectory};
 use trm_roadmap::{RepairOptions, Roadmap};
@@ -38,6 +39,11 @@ pub struct Args {
     /// map is searched only after that (`trm_plan::Planner::connect`).
     #[arg(long = "with-map", value_name = "FILE", conflicts_with = "maps")]
     with_maps: Vec<PathBuf>,
+    /// Without maps' own spec: an experience file (`trm-experience`). The paths it holds are
+    /// tried first (checked in --world); a path RRT-Connect finds is kept in it (the file is
+    /// written again, atomically; created when absent).
+    #[arg(long, value_name = "FILE", conflicts_with = "maps")]
+    experience: Option<PathBuf>,
     /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps
     /// were built in. Without maps, a scene's allowed-collision matrix applies over the
     /// model's own.
@@ -375,6 +381,10 @@ fn run_without_maps(args: &Args) -> Result<()> {
         planner.set_world(scene.world);
         planner.set_acm(scene.acm)?;
     }
+    if let Some(file) = args.experience.as_ref().filter(|f| f.exists()) {
+        let paths = planner.load_experience(file)?;
+        println!("{}: {paths} kept paths", file.display());
+    }
     for path in &args.with_maps {
         let map = Roadmap::load(path).with_context(|| format!("--with-map {}", path.display()))?;
         planner
@@ -391,10 +401,13 @@ fn run_without_maps(args: &Args) -> Result<()> {
         Ok(active.from_motors(&motors))
     };
     let (start, goal) = match &request {
-        Some(r) => r.joint_query(&active)?,
+        Some(r) => r.query(&active)?,
         None => (
             configuration(&args.from, "--from")?,
-            configuration(args.to.as_deref().unwrap_or_default(), "--to")?,
+            RequestGoal::Joints(configuration(
+                args.to.as_deref().unwrap_or_default(),
+                "--to",
+            )?),
         ),
     };
     let sized = planner.rrt_options()?;
@@ -408,7 +421,13 @@ fn run_without_maps(args: &Args) -> Result<()> {
         range: args.range.unwrap_or(sized.range),
         ..sized
     };
-    for (what, q) in [("start", &start), ("goal", &goal)] {
+    let goal_configuration = match &goal {
+        RequestGoal::Joints(q) => Some(q),
+        RequestGoal::Pose(_) => None,
+    };
+    for (what, q) in
+        std::iter::once(("start", &start)).chain(goal_configuration.map(|q| ("goal", q)))
+    {
         if !planner.is_free(q) {
             anyhow::bail!(
                 "the {what} collides{}: {}\n  fix: give a collision-free {what}",
@@ -424,7 +443,11 @@ fn run_without_maps(args: &Args) -> Result<()> {
             );
         }
     }
-    let found = match planner.connect(&start, &goal, &options) {
+    let connected = match &goal {
+        RequestGoal::Joints(q) => planner.connect(&start, q, &options),
+        RequestGoal::Pose(pose) => planner.connect_to_pose(&start, pose, &options),
+    };
+    let found = match connected {
         Ok(found) => found,
         Err(e @ trm_plan::PlanError::Unreachable { .. }) => anyhow::bail!(
             "{e}\n  fix: a larger budget (--max-samples {}, --max-seconds), or a goal the robot can reach in this world",
@@ -472,6 +495,12 @@ fn run_without_maps(args: &Args) -> Result<()> {
             scene.add_frame(*t, q)?;
         }
         write_view(scene, planner.world(), args.out.as_deref())?;
+    }
+    // last: the experience file changes only once every output is written
+    if let (Some(file), trm_plan::Source::Sampled) = (&args.experience, found.source) {
+        planner.add_path(&found.path)?;
+        planner.save_experience(file)?;
+        println!("kept the path in {}", file.display());
     }
     Ok(())
 }

@@ -75,31 +75,41 @@ fn panda_problem() -> [std::path::PathBuf; 3] {
     ]
 }
 
-#[test]
-fn plan_without_maps_answers_a_moveit_request_and_writes_every_format() {
-    let dir = std::env::temp_dir().join(format!("trm-cli-plan-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let [model, scene, request] = panda_problem();
-    let out = trm(
-        &[
-            "plan",
-            "--model",
-            model.to_str().unwrap(),
-            "--world",
-            scene.to_str().unwrap(),
-            "--request",
-            request.to_str().unwrap(),
-            "--out",
-            "traj.csv",
-        ],
-        &dir,
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+/// `trm plan` for the Panda in `scene` asked `request` (paths as given, relative to `dir`), with
+/// `extra` arguments: its output, the command having succeeded.
+fn plan_panda(
+    dir: &std::path::Path,
+    scene: &std::path::Path,
+    request: &std::path::Path,
+    extra: &[&str],
+) -> String {
+    let [model, _, _] = panda_problem();
+    let mut args = vec![
+        "plan",
+        "--model",
+        model.to_str().unwrap(),
+        "--world",
+        scene.to_str().unwrap(),
+        "--request",
+        request.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let out = trm(&args, dir);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
     assert!(
         out.status.success(),
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    stdout
+}
+
+#[test]
+fn plan_without_maps_answers_a_moveit_request_and_writes_every_format() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let [_, scene, request] = panda_problem();
+    let stdout = plan_panda(&dir, &scene, &request, &["--out", "traj.csv"]);
     assert!(stdout.contains("7 of 7 motors move"), "{stdout}");
     for file in [
         "traj.csv",
@@ -195,5 +205,54 @@ fn plan_without_maps_refuses_what_does_not_fit_and_writes_nothing() {
         assert!(stderr.contains(expected), "{full:?}: {stderr}");
         assert!(!dir.join("traj.csv").exists(), "{full:?}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plan_keeps_experience_in_a_file_and_retrieves_it() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-experience-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let family = root.join("crates/trm-mbm/tests/fixtures/mbm/cage_panda");
+    let plan = |number: &str| {
+        let scene = family.join(format!("scene{number}.yaml"));
+        let request = family.join(format!("request{number}.yaml"));
+        plan_panda(
+            &dir,
+            &scene,
+            &request,
+            &["--experience", "cage.experience.json"],
+        )
+    };
+    // a cage needs RRT-Connect: its path is kept, and the same query again retrieves it
+    let first = plan("0001");
+    assert!(
+        first.contains("(sampled)") && first.contains("kept the path"),
+        "{first}"
+    );
+    let again = plan("0001");
+    assert!(
+        again.contains("1 kept paths") && again.contains("(retrieved)"),
+        "{again}"
+    );
+    let other = plan("0002");
+    assert!(other.contains("1 kept paths"), "{other}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plan_answers_a_task_space_request() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-pose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let [model, scene, request] = panda_problem();
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let posed = trm_moveit::MotionPlanRequest::load(&request)
+        .unwrap()
+        .to_task_space(&robot, "panda_hand", 0.01, 0.05)
+        .unwrap();
+    std::fs::write(dir.join("pose.yaml"), posed.to_yaml().unwrap()).unwrap();
+    let pose = std::path::Path::new("pose.yaml");
+    let stdout = plan_panda(&dir, &scene, pose, &["--out", "pose.csv"]);
+    assert!(stdout.contains("7 of 7 motors move") && dir.join("pose.csv").is_file());
     std::fs::remove_dir_all(&dir).unwrap();
 }

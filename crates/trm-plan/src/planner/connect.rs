@@ -8,6 +8,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::Planner;
 use crate::PlanError;
+use crate::pose_goal::PoseGoal;
 use crate::query::{Goal, PlanOptions};
 use crate::rrt::{EdgeCheck, GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
 
@@ -111,6 +112,69 @@ impl Planner {
         }
     }
 
+    /// A collision-free configuration (active values) that meets the task-space `goal`:
+    /// damped least-squares IK from `start`, then from configurations drawn from `seed`,
+    /// [`GOAL_ATTEMPTS`] starts in all ([`PoseGoal::solve`]); `None` when none is found. A
+    /// constraint given in a frame other than the robot's root is refused.
+    pub fn solve_pose(
+        &mut self,
+        start: &[f64],
+        goal: &PoseGoal,
+        seed: u64,
+    ) -> Result<Option<Vec<f64>>, PlanError> {
+        let robot = self.active.model();
+        let root = &robot.tree().links[0].name;
+        if let Some(frame) = goal.foreign_frame(root) {
+            return Err(PlanError::InvalidGoal {
+                problem: format!("a goal constraint is given in frame `{frame}`"),
+                fix: format!("give it in the robot's root frame `{root}`"),
+            });
+        }
+        if goal.is_empty() {
+            return Err(PlanError::InvalidGoal {
+                problem: "a task-space goal without a constraint".into(),
+                fix: "give position or orientation constraints".into(),
+            });
+        }
+        let active = self.active.clone();
+        Ok(goal.solve(&active, start, seed, GOAL_ATTEMPTS, |q| self.is_free(q))?)
+    }
+
+    /// A collision-free path from `start` to a configuration that meets the task-space `goal`
+    /// ([`Planner::solve_pose`] with `options.seed`, then [`Planner::connect`]); the time and
+    /// checks of the IK are counted in the connection's.
+    pub fn connect_to_pose(
+        &mut self,
+        start: &[f64],
+        goal: &PoseGoal,
+        options: &RrtOptions,
+    ) -> Result<Connection, PlanError> {
+        options.check()?;
+        let began = Instant::now();
+        let before = self.checker.checks;
+        let Some(q) = self.solve_pose(start, goal, options.seed)? else {
+            return Err(PlanError::Unreachable {
+                reason: format!(
+                    "no collision-free configuration meets the task-space goal ({GOAL_ATTEMPTS} IK starts)"
+                ),
+                closest_node: None,
+                closest_distance: f64::INFINITY,
+            });
+        };
+        let rest = RrtOptions {
+            max_seconds: options
+                .max_seconds
+                .map(|s| (s - began.elapsed().as_secs_f64()).max(f64::MIN_POSITIVE)),
+            ..options.clone()
+        };
+        let found = self.connect(start, &q, &rest)?;
+        Ok(Connection {
+            checks: self.checker.checks - before,
+            seconds: began.elapsed().as_secs_f64(),
+            ..found
+        })
+    }
+
     /// The graph's path from `start` to `goal` ([`Planner::connect`]'s second try), shortcut and
     /// checked at half the resolution; `None` where the graph does not join them within
     /// `searches` A* searches (0: only a kept path repeating the query) or its path grazes an
@@ -198,6 +262,10 @@ impl Planner {
         }
     }
 }
+
+/// IK starts [`Planner::solve_pose`] tries for a task-space goal (the start, then seeded random
+/// configurations).
+pub const GOAL_ATTEMPTS: usize = 500;
 
 /// RRT-Connect's samples before [`Planner::connect`] tries the graph: queries RRT-Connect
 /// answers within them are answered as without a graph.

@@ -18,7 +18,11 @@ use crate::rrt::{GOAL_COLLIDES, RrtOptions};
 use crate::trajectory::{Trajectory, time_parametrise};
 
 mod connect;
-pub use connect::{Connection, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Source};
+mod experience;
+pub use connect::{
+    Connection, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Source,
+};
+pub use experience::{EXPERIENCE_FORMAT, EXPERIENCE_VERSION};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum State {

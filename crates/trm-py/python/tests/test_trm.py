@@ -276,6 +276,16 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
         assert planner.load_scene(str(request.with_name(f"scene{number}.yaml"))) == []
         r = planner.plan_request(str(request))
         same = expected[(request.parent.name, int(number))]
+        # a request read once plans the same as its file
+        read = trm.MotionPlanRequest.load(str(request))
+        assert read.group == "panda_arm" and len(read.goal) == len(read.goal_joints) == 7
+        again = planner.plan_request(read)
+        np.testing.assert_array_equal(again["waypoints"], r["waypoints"])
+        # its goal posed as the hand's pose: IK, then the same planner
+        posed = read.to_task_space(robot, "panda_hand")
+        assert posed.is_task_space and not read.is_task_space
+        reached = planner.plan_request(posed)
+        assert planner.is_free(reached["waypoints"][-1]), request
         # the same planner object: the same path, found with the same checks
         assert same["solved"] and r["checks"] == same["checks"], request
         np.testing.assert_array_equal(r["waypoints"], np.array(same["path"]))
@@ -297,7 +307,7 @@ def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
     assert len(csv.read_text().splitlines()) == 15
 
 
-def test_a_robot_planner_keeps_experience_across_worlds(robot):
+def test_a_robot_planner_keeps_experience_across_worlds(robot, tmp_path):
     joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
     planner = trm.Planner(robot, joints=joints, experience=True)
     home = robot.posture("home")
@@ -312,6 +322,16 @@ def test_a_robot_planner_keeps_experience_across_worlds(robot):
     again = planner.plan(goal, start=start, seed=4)
     if first["source"] == "sampled":
         assert planner.num_nodes > 0 and again["source"] == "retrieved"
+    # saved, and loaded into another planner of the same motors
+    planner.save_experience(str(tmp_path / "arm.experience.json"))
+    other = trm.Planner(robot, world, joints=joints, experience=True)
+    assert other.load_experience(str(tmp_path / "arm.experience.json")) == len(planner.kept_paths())
+    for a, b in zip(other.kept_paths(), planner.kept_paths()):
+        np.testing.assert_array_equal(a, b)
+    if first["source"] == "sampled":
+        assert other.plan(goal, start=start, seed=4)["source"] == "retrieved"
+    with pytest.raises(trm.TrmError, match="the planner moves"):
+        trm.Planner(robot, joints=joints[:2]).load_experience(str(tmp_path / "arm.experience.json"))
     # the pole removed: what was found free stays free (a world that adds or moves objects
     # has the kept path checked again)
     planner.world = trm.World()
@@ -328,6 +348,10 @@ def test_a_robot_planner_keeps_experience_across_worlds(robot):
         trm.Planner(robot, joints=["nope"])
     with pytest.raises(trm.TrmError, match="the goal constrains `panda_joint1`"):
         planner.plan_request(str(sorted(MBM.glob("*/request*.yaml"))[0]))
+    with pytest.raises(trm.TrmError, match="give a MotionPlanRequest or a .yaml path"):
+        planner.plan_request(3)
+    with pytest.raises(trm.TrmError, match="nope.yaml"):
+        trm.MotionPlanRequest.load("nope.yaml")
 
 
 def test_a_map_attached_to_a_robot_planner_is_checked_in_its_world(robot):

@@ -20,7 +20,7 @@ from ._trm import TrmError, __version__
 from .collision import CollisionModel, World, fit_proxies
 from .kinematics import Robot
 from .optim import ALGORITHMS, Optimizer, compare_optimisers, minimize, minimize_constrained
-from .plan import Planner, benchmark_mbm, generate_mbm
+from .plan import MotionPlanRequest, Planner, benchmark_mbm, generate_mbm
 from .roadmap import Roadmap, run_scenario
 from .taskmap import TaskMap, reach_grasp
 from .tasks import Problem
