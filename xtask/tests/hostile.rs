@@ -972,6 +972,13 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
             names: "--vamp".into(),
         });
     }
+    let mut robot_alone = bench(&mbm);
+    robot_alone.extend(["--vamp-robot".into(), "ur5".into()]);
+    cases.push(Case {
+        what: "benchmark-mbm --vamp-robot without --vamp".into(),
+        args: robot_alone,
+        names: "--vamp".into(),
+    });
     // task-space goals: an unknown link, tolerances without --task-space, with experience
     for (extra, names) in [
         (vec!["--task-space", "panda_hnd"], "panda_hand"),

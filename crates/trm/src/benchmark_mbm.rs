@@ -81,9 +81,14 @@ pub struct Args {
     experience: bool,
     /// Also run VAMP's RRT-Connect + simplifier on the same problems and print its table and a
     /// side-by-side one after trm's: the program benches/peers/vamp/build.sh builds
-    /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5).
+    /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5),
+    /// or --vamp-robot's.
     #[arg(long, conflicts_with = "families")]
     vamp: Option<PathBuf>,
+    /// With --vamp: VAMP's robot to run (panda, fetch, ur5), where the URDF names it otherwise
+    /// (default: the URDF's robot name).
+    #[arg(long, value_name = "NAME", requires = "vamp")]
+    vamp_robot: Option<String>,
     /// Also solve the set with this map attached to each problem's planner (repeatable; built
     /// for the requests' group, in any world: its nodes and edges are checked in each scene when
     /// the search first wants them) and print that run beside the plain one.
@@ -174,7 +179,7 @@ pub fn run(args: &Args) -> Result<()> {
         let mut text = format!(
             "\nVAMP's RRT-Connect + simplifier on the same problems ({}, VAMP's sphere model of {}, Halton sampler, its range for the robot; time = planning + simplification as VAMP reports them):\n\n{}",
             binary.display(),
-            robot.name(),
+            args.vamp_robot.as_deref().unwrap_or(robot.name()),
             trm_mbm::markdown_table(theirs.iter().copied())
         );
         if args.verify {
@@ -378,7 +383,8 @@ fn run_vamp(
         bench.problems.iter().map(|p| p.problem.clone()).collect();
     let problems = &problems[..];
     use std::io::Write as _;
-    let input = trm_mbm::peer_problems(robot.name(), problems)?;
+    let vamp_robot = args.vamp_robot.as_deref().unwrap_or(robot.name());
+    let input = trm_mbm::peer_problems(vamp_robot, problems)?;
     let exported = input.clone();
     println!(
         "\nrunning VAMP on {} problems of {}",
