@@ -10,6 +10,14 @@
 //! * [`TimeLaw`]: a monotone map from time to phase, s(0) = 0, s(T) = 1, from an RBF network of
 //!   log-speeds, so that an optimiser can also shape how fast the motion runs.
 //!
+//! and the timing of paths a robot can execute:
+//!
+//! * [`BlendedPath`]: waypoints joined by straight lines whose corners are cut by circular
+//!   blends of bounded deviation;
+//! * [`time_optimal`]: its time-optimal timing under joint velocity and acceleration limits
+//!   ([`JointLimits`]) by reachability analysis (TOPP-RA), with constraints that hold over
+//!   whole grid intervals, so the [`TimedPath`] sampled at any rate keeps the limits.
+//!
 //! ```
 //! use trm_trajectory::RbfTrajectory;
 //! // 5 free RBFs over [0, 4.5] s, passing through 0.1 at t = 0 and 0.5 at t = 4.5
@@ -21,6 +29,12 @@
 
 use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
+
+mod path;
+mod timing;
+
+pub use path::BlendedPath;
+pub use timing::{JointLimits, Sample, TimedPath, TimingOptions, time_optimal};
 
 /// Bad settings or inputs.
 #[derive(Debug, Clone, PartialEq, Error)]
