@@ -111,6 +111,8 @@ fn reach(
             .iter()
             .map(|q| active.to_motors(q))
             .collect(),
+        velocities: Vec::new(),
+        accelerations: Vec::new(),
         task_path: Vec::new(),
     };
     trm::write_atomic(&csv, trajectory.to_csv(&csv)?.as_bytes())?;

@@ -55,6 +55,27 @@ pub struct ModelDescription {
     /// not suit it (e.g. `planning: (range: Some(0.5))`).
     #[serde(default, skip_serializing_if = "PlanningSpec::is_empty")]
     pub planning: PlanningSpec,
+    /// Motion limits of motors, by motor name (as MoveIt's `joint_limits.yaml`): a velocity
+    /// here replaces the URDF's; acceleration and jerk limits exist only here (e.g.
+    /// `motion_limits: {"panda_joint1": (acceleration: Some(3.75))}`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub motion_limits: BTreeMap<String, MotionLimitSpec>,
+}
+
+/// A motor's motion limits (rad/s, rad/s², rad/s³; m/… for prismatic motors); each one absent
+/// keeps what the URDF gives (velocity) or leaves the limit unknown.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionLimitSpec {
+    /// Largest speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<f64>,
+    /// Largest acceleration.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration: Option<f64>,
+    /// Largest jerk.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jerk: Option<f64>,
 }
 
 /// A robot's own settings for sampling planners; each one absent is sized by the robot's

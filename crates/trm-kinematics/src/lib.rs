@@ -53,7 +53,7 @@ pub use batch::{
 pub use derivatives::GRAVITY;
 pub use description::{
     CouplingSpec, DisableReason, DisabledCollisionSpec, FrameSpec, GroupSpec, ModelDescription,
-    MotorSpec, PlanningSpec, PostureSpec,
+    MotionLimitSpec, MotorSpec, PlanningSpec, PostureSpec,
 };
 pub use error::{KinematicsError, NameKind, Result};
 // The file plumbing lives in trm-io; re-exported here for the crates built on this one.

@@ -10,8 +10,8 @@ use crate::description::{DisableReason, FrameSpec, ModelDescription};
 use crate::error::{KinematicsError, NameKind, Result, unknown};
 use crate::fk::{AffineRow, FrameId, Plan, PoseBuffer, affine};
 use crate::resolve::{
-    DescCtx, resolve_collision_pairs, resolve_frames, resolve_groups, resolve_motors,
-    resolve_planning, resolve_postures,
+    DescCtx, resolve_collision_pairs, resolve_frames, resolve_groups, resolve_motion_limits,
+    resolve_motors, resolve_planning, resolve_postures,
 };
 use crate::tree::{Ctx, Limits, Tree};
 
@@ -248,7 +248,8 @@ impl RobotModel {
             origin: desc_text.map_or("<description>", |d| d.1),
             text: desc_text.map(|d| d.0),
         };
-        let (motors, couplings) = resolve_motors(&tree, desc, &dctx)?;
+        let (mut motors, couplings) = resolve_motors(&tree, desc, &dctx)?;
+        resolve_motion_limits(&mut motors, desc, &dctx)?;
         let frames = resolve_frames(&tree, Vec::new(), &desc.frames, &dctx)?;
         let groups = resolve_groups(&motors, desc, &dctx)?;
         let postures = resolve_postures(&motors, desc, &dctx)?;

@@ -241,6 +241,8 @@ fn assign_motors(
                             upper: spec.upper,
                             velocity: spec.velocity.unwrap_or(f64::INFINITY),
                             effort: f64::INFINITY,
+                            acceleration: f64::INFINITY,
+                            jerk: f64::INFINITY,
                         },
                     })
                 } else if let Some(other) = tree
@@ -533,6 +535,52 @@ pub(crate) fn resolve_planning(
         }
     }
     Ok(p)
+}
+
+/// `motors` with the description's `motion_limits` applied: each names a motor (with a
+/// suggestion when it does not) and gives finite positive limits.
+pub(crate) fn resolve_motion_limits(
+    motors: &mut [Motor],
+    desc: &ModelDescription,
+    ctx: &DescCtx,
+) -> Result<()> {
+    for (name, spec) in &desc.motion_limits {
+        let element = format!("motion_limits (\"{name}\")");
+        let Some(motor) = motors.iter_mut().find(|m| &m.name == name) else {
+            let names: Vec<String> = motors.iter().map(|m| m.name.clone()).collect();
+            return Err(ctx.invalid(
+                element,
+                name,
+                format!("limits `{name}`, which is no motor"),
+                suggestion_fix(
+                    name,
+                    names.iter().map(String::as_str),
+                    "use motor names (see `trm model-info`)",
+                ),
+            ));
+        };
+        for (what, value, slot) in [
+            ("velocity", spec.velocity, &mut motor.limits.velocity),
+            (
+                "acceleration",
+                spec.acceleration,
+                &mut motor.limits.acceleration,
+            ),
+            ("jerk", spec.jerk, &mut motor.limits.jerk),
+        ] {
+            let Some(v) = value else { continue };
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ctx.invalid(
+                    element,
+                    name,
+                    format!("gives `{name}` a {what} limit of {v}"),
+                    format!("give a finite positive {what} limit, or leave it out"),
+                ));
+            }
+            *slot = v;
+        }
+    }
+    Ok(())
 }
 
 pub(crate) fn resolve_postures(

@@ -7,7 +7,7 @@ use crate::error::{KinematicsError, Result};
 /// A ROS 2 `trajectory_msgs/msg/JointTrajectory` in YAML for a controller of `robot`, from motor
 /// positions (one full motor vector per waypoint, at `times` seconds from the start) and,
 /// optionally, motor velocities (zero at every waypoint without them: right for motions that
-/// stop at each waypoint). Joints: the URDF's movable joints without `<mimic>` (a controller
+/// stop at each waypoint) and accelerations (an empty list without them). Joints: the URDF's movable joints without `<mimic>` (a controller
 /// commands those), through the model's couplings; velocities through the same linear maps.
 /// Floats are written without exponents, so YAML 1.1 readers (PyYAML, which ROS's tools use)
 /// read them as floats, and exactly (shortest round-trip decimals).
@@ -16,6 +16,7 @@ pub fn joint_trajectory_yaml(
     times: &[f64],
     motors: &[Vec<f64>],
     velocities: Option<&[Vec<f64>]>,
+    accelerations: Option<&[Vec<f64>]>,
 ) -> Result<String> {
     let wrong = |what: &'static str, got: usize| KinematicsError::WrongLength {
         what,
@@ -28,6 +29,11 @@ pub fn joint_trajectory_yaml(
     if let Some(v) = velocities {
         if v.len() != times.len() {
             return Err(wrong("waypoints of motor velocities", v.len()));
+        }
+    }
+    if let Some(a) = accelerations {
+        if a.len() != times.len() {
+            return Err(wrong("waypoints of motor accelerations", a.len()));
         }
     }
     if let Some((k, t)) = times
@@ -56,6 +62,7 @@ pub fn joint_trajectory_yaml(
     ));
     let n = robot.num_joints();
     let (mut joints, mut rates, mut zero) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut accels = vec![0.0; n];
     robot.motors_to_joints(&vec![0.0; robot.motors().len()], &mut zero)?;
     for (k, (time, q)) in times.iter().zip(motors).enumerate() {
         robot.motors_to_joints(q, &mut joints)?;
@@ -66,24 +73,39 @@ pub fn joint_trajectory_yaml(
                 *r -= z;
             }
         }
-        if let Some(j) = (0..n).find(|&j| !(joints[j].is_finite() && rates[j].is_finite())) {
+        if let Some(a) = accelerations {
+            robot.motors_to_joints(&a[k], &mut accels)?;
+            for (r, z) in accels.iter_mut().zip(&zero) {
+                *r -= z;
+            }
+        }
+        if let Some(j) = (0..n)
+            .find(|&j| !(joints[j].is_finite() && rates[j].is_finite() && accels[j].is_finite()))
+        {
             return Err(KinematicsError::NonFinite {
                 what: "joint positions and velocities of a waypoint",
                 index: j,
                 name: format!("{} at waypoint {k}", robot.joint(j).name),
-                value: if joints[j].is_finite() {
+                value: if !joints[j].is_finite() {
+                    joints[j]
+                } else if !rates[j].is_finite() {
                     rates[j]
                 } else {
-                    joints[j]
+                    accels[j]
                 },
             });
         }
         // nanoseconds, rounded once, so that sec and nanosec never disagree
         let total = (time * 1e9).round() as u64;
         out.push_str(&format!(
-            "  - positions: {}\n    velocities: {}\n    accelerations: []\n    effort: []\n    time_from_start:\n      sec: {}\n      nanosec: {}\n",
+            "  - positions: {}\n    velocities: {}\n    accelerations: {}\n    effort: []\n    time_from_start:\n      sec: {}\n      nanosec: {}\n",
             list(&mut commanded.iter().map(|&j| yaml_float(joints[j]))),
             list(&mut commanded.iter().map(|&j| yaml_float(rates[j]))),
+            if accelerations.is_some() {
+                list(&mut commanded.iter().map(|&j| yaml_float(accels[j])))
+            } else {
+                "[]".to_string()
+            },
             total / 1_000_000_000,
             total % 1_000_000_000
         ));
@@ -125,7 +147,7 @@ pub fn named_postures_yaml(robot: &RobotModel, seconds: f64) -> Result<String> {
     for name in robot.posture_names() {
         let q = robot.posture(name)?.to_vec();
         text.push_str(&format!("---\n# posture `{name}` of `{}`\n", robot.name()));
-        text.push_str(&joint_trajectory_yaml(robot, &[seconds], &[q], None)?);
+        text.push_str(&joint_trajectory_yaml(robot, &[seconds], &[q], None, None)?);
     }
     Ok(text)
 }
@@ -167,6 +189,7 @@ mod tests {
                 &[2.5],
                 &[robot.posture(name).unwrap().to_vec()],
                 None,
+                None,
             )
             .unwrap();
             assert_eq!(list(&text, "positions", k), list(&single, "positions", 0));
@@ -190,6 +213,7 @@ mod tests {
             &[0.0, dt],
             &[q0.clone(), q1],
             Some(&[v.clone(), v.clone()]),
+            None,
         )
         .unwrap();
         let (p0, p1, rate) = (
@@ -211,7 +235,7 @@ mod tests {
         // without velocities: zeros; tiny values without exponents (YAML 1.1 floats)
         let mut tiny = q0.clone();
         tiny[0] = 1e-7;
-        let still = joint_trajectory_yaml(&robot, &[0.0], &[tiny], None).unwrap();
+        let still = joint_trajectory_yaml(&robot, &[0.0], &[tiny], None, None).unwrap();
         assert!(list(&still, "velocities", 0).iter().all(|r| *r == 0.0));
         for line in still
             .lines()
@@ -226,16 +250,17 @@ mod tests {
     fn bad_input_is_refused() {
         let robot = icub();
         let q = robot.neutral_motors();
-        let e =
-            joint_trajectory_yaml(&robot, &[0.0, 1.0], std::slice::from_ref(&q), None).unwrap_err();
+        let e = joint_trajectory_yaml(&robot, &[0.0, 1.0], std::slice::from_ref(&q), None, None)
+            .unwrap_err();
         assert!(e.to_string().contains("expected 2 values, got 1"), "{e}");
-        let e = joint_trajectory_yaml(&robot, &[-1.0], std::slice::from_ref(&q), None).unwrap_err();
+        let e = joint_trajectory_yaml(&robot, &[-1.0], std::slice::from_ref(&q), None, None)
+            .unwrap_err();
         assert!(e.to_string().contains("from 0 up"), "{e}");
         let mut nan = q.clone();
         nan[5] = f64::NAN;
-        let e = joint_trajectory_yaml(&robot, &[0.0], &[nan], None).unwrap_err();
+        let e = joint_trajectory_yaml(&robot, &[0.0], &[nan], None, None).unwrap_err();
         assert!(e.to_string().contains("finite"), "{e}");
-        let e = joint_trajectory_yaml(&robot, &[0.0], &[q[1..].to_vec()], None).unwrap_err();
+        let e = joint_trajectory_yaml(&robot, &[0.0], &[q[1..].to_vec()], None, None).unwrap_err();
         assert!(e.to_string().contains("motor values"), "{e}");
     }
 }

@@ -37,6 +37,11 @@ pub struct Limits {
     pub velocity: f64,
     /// Largest effort (N·m or N); infinite when the URDF gives none.
     pub effort: f64,
+    /// Largest acceleration (rad/s² or m/s²); infinite unless the model description's
+    /// `motion_limits` give one (a URDF has none).
+    pub acceleration: f64,
+    /// Largest jerk (rad/s³ or m/s³); infinite unless the model description gives one.
+    pub jerk: f64,
 }
 
 impl Limits {
@@ -578,6 +583,8 @@ fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) ->
             upper,
             velocity: positive_or_inf(l.velocity),
             effort: positive_or_inf(l.effort),
+            acceleration: f64::INFINITY,
+            jerk: f64::INFINITY,
         },
         mimic,
         coordinate: None,

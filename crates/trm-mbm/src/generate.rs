@@ -301,6 +301,8 @@ pub fn generate(
                     group: String::new(),
                     planning_time: Some(10.0),
                     pose_goal: Default::default(),
+                    velocity_scaling: None,
+                    acceleration_scaling: None,
                 },
                 target,
             });

@@ -10,7 +10,7 @@ use trm_kinematics::RobotModel;
 use trm_mbm::{LoadedProblem, find_problems, solve_loaded};
 use trm_moveit::{MotionPlanRequest, RequestGoal, load_scene, motion_plan_response_yaml};
 use trm_plan::rrt::RrtOptions;
-use trm_plan::{PlanOptions, Planner, Source};
+use trm_plan::{Planner, Source};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mbm")
@@ -153,10 +153,16 @@ fn experience_kept_on_the_planner_answers_a_repeated_query() {
         again.checks,
         first.checks
     );
-    // timed within the motors' limits, every waypoint reached
-    let trajectory = planner.trajectory(&again.path, &PlanOptions::default());
-    assert_eq!(trajectory.positions.len(), again.path.len());
+    // timed within the motors' limits, sampled, from the start to the goal
+    let timing = trm_plan::Timing::default();
+    let trajectory = planner.trajectory(&again.path, &timing).unwrap();
+    assert!(trajectory.positions.len() > again.path.len());
     assert!(trajectory.times.windows(2).all(|w| w[1] > w[0]));
+    let active = planner.active().clone();
+    let first = active.from_motors(&trajectory.positions[0]);
+    let last = active.from_motors(trajectory.positions.last().unwrap());
+    assert_eq!(&first, again.path.first().unwrap());
+    assert!(trm_collision::edge::distance(&last, again.path.last().unwrap()) < 1e-9);
 }
 
 /// An edit of a request's text.
@@ -282,7 +288,9 @@ fn a_plan_written_as_a_moveit_response_reads_back() {
     let found = planner
         .connect(&start, &goal, &RrtOptions::default())
         .unwrap();
-    let trajectory = planner.trajectory(&found.path, &PlanOptions::default());
+    let trajectory = planner
+        .trajectory(&found.path, &trm_plan::Timing::default())
+        .unwrap();
     let out = Path::new("plan.response.yaml");
     let text = motion_plan_response_yaml(&trajectory, &robot, "panda_arm", 0.25, out).unwrap();
     let doc = trm_moveit::yaml::parse(&text).unwrap();
@@ -296,7 +304,15 @@ fn a_plan_written_as_a_moveit_response_reads_back() {
         .and_then(|t| t.get("points"))
         .and_then(|p| p.items())
         .unwrap();
-    assert_eq!(points.len(), found.path.len());
+    assert_eq!(points.len(), trajectory.times.len());
+    // every point carries velocities and accelerations, the last at rest
+    for key in ["velocities", "accelerations"] {
+        let values = points[points.len() - 1]
+            .get(key)
+            .and_then(|p| p.items())
+            .unwrap();
+        assert!(!values.is_empty(), "{key}");
+    }
     let last: Vec<f64> = points[points.len() - 1]
         .get("positions")
         .and_then(|p| p.items())
@@ -306,7 +322,7 @@ fn a_plan_written_as_a_moveit_response_reads_back() {
         .collect();
     // the arm's 7 joints end at the goal (the fingers are not in the trajectory's motors)
     for (k, g) in goal.iter().enumerate() {
-        assert!((last[k] - g).abs() < 1e-12, "joint {k}: {} vs {g}", last[k]);
+        assert!((last[k] - g).abs() < 1e-9, "joint {k}: {} vs {g}", last[k]);
     }
     let start_state = doc
         .get("trajectory_start")

@@ -1,7 +1,8 @@
 //! MoveIt's planning inputs as YAML (the ROS message layout MotionBenchMaker and
 //! `moveit_msgs` tools write): a `PlanningScene` (world collision objects made of box, sphere
 //! and cylinder primitives, the allowed-collision matrix, the robot state) and a
-//! `MotionPlanRequest` (start state, joint-space goal, group, planning time).
+//! `MotionPlanRequest` (start state, joint-space or task-space goal, group, planning time,
+//! scaling factors), and a robot's `joint_limits.yaml` ([`JointLimitsFile`]).
 //!
 //! ```
 //! use trm_moveit::PlanningScene;
@@ -22,6 +23,7 @@
 //! the line.
 
 mod error;
+mod limits;
 mod reader;
 mod request;
 mod response;
@@ -33,6 +35,7 @@ use std::path::Path;
 use trm_collision::{AllowedCollisionMatrix, CollisionModel, World};
 
 pub use error::{MoveItError, Result};
+pub use limits::JointLimitsFile;
 pub use request::{
     JointGoal, JointState, LIMIT_SLACK, MotionPlanRequest, RequestGoal, motors_from_state,
 };

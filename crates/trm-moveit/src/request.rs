@@ -65,6 +65,10 @@ pub struct MotionPlanRequest {
     pub group: String,
     /// `allowed_planning_time`, s (`None` when absent or 0).
     pub planning_time: Option<f64>,
+    /// `max_velocity_scaling_factor`, in (0, 1] (`None` when absent or 0: full speed).
+    pub velocity_scaling: Option<f64>,
+    /// `max_acceleration_scaling_factor`, in (0, 1] (`None` when absent or 0).
+    pub acceleration_scaling: Option<f64>,
 }
 
 /// What a request asks a planner to reach ([`MotionPlanRequest::query`]).
@@ -401,6 +405,25 @@ impl MotionPlanRequest {
             }
             request.planning_time = (v > 0.0).then_some(v);
         }
+        for (key, slot) in [
+            ("max_velocity_scaling_factor", &mut request.velocity_scaling),
+            (
+                "max_acceleration_scaling_factor",
+                &mut request.acceleration_scaling,
+            ),
+        ] {
+            if let Some(f) = doc.get(key) {
+                let v = r.number(f, key)?;
+                if !(0.0..=1.0).contains(&v) {
+                    return Err(r.err(
+                        f.line,
+                        format!("{key} is {v}"),
+                        "give a factor in (0, 1] (0: the full limits)",
+                    ));
+                }
+                *slot = (v > 0.0).then_some(v);
+            }
+        }
         Ok(request)
     }
 
@@ -437,6 +460,12 @@ impl MotionPlanRequest {
         }
         if let Some(t) = self.planning_time {
             let _ = writeln!(out, "allowed_planning_time: {t:?}");
+        }
+        if let Some(f) = self.velocity_scaling {
+            let _ = writeln!(out, "max_velocity_scaling_factor: {f:?}");
+        }
+        if let Some(f) = self.acceleration_scaling {
+            let _ = writeln!(out, "max_acceleration_scaling_factor: {f:?}");
         }
         let names: Vec<String> = s.names.iter().map(|n| quote(n)).collect();
         let positions: Vec<String> = s.positions.iter().map(|v| format!("{v:?}")).collect();

@@ -1,7 +1,8 @@
 //! Planning through task-relevant roadmaps (Stollenga et al., IROS 2013, end of Section IV):
 //! A* over one or several maps joined through their common configuration space, with edges and
 //! nodes checked lazily against the *current* world (as OMPL's LazyPRM does), then shortcutting
-//! and time parametrisation within velocity (and acceleration) limits.
+//! and time-optimal timing within velocity and acceleration limits ([`timing`]: blends that
+//! stay collision-free, TOPP-RA).
 //!
 //! ```no_run
 //! use trm_plan::{Goal, Planner, PlanOptions};
@@ -19,6 +20,7 @@ pub mod pose_goal;
 mod query;
 pub mod rrt;
 pub mod scenario;
+pub mod timing;
 mod trajectory;
 
 pub use error::PlanError;
@@ -30,4 +32,5 @@ pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{
     Action, Scenario, ScenarioError, ScenarioOptions, ScenarioRun, StepReport, run_scenario,
 };
+pub use timing::Timing;
 pub use trajectory::{Trajectory, time_parametrise};

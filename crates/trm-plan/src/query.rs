@@ -92,10 +92,8 @@ pub struct PlanOptions {
     pub shortcuts: usize,
     /// Seed of the shortcut choices.
     pub seed: u64,
-    /// Joint velocity used where the model gives none (or a placeholder ≥ 1000), rad/s.
-    pub default_velocity: f64,
-    /// Optional joint acceleration limit, rad/s² (trapezoidal segments).
-    pub acceleration: Option<f64>,
+    /// How the path is timed: limits, blends, sampling ([`crate::Timing`]).
+    pub timing: crate::Timing,
     /// Finish a task-point goal at the point itself, not at the map node within the tolerance:
     /// NGIK from the last node (the map's costs plus [`EXACT_WEIGHT`] · the task error, in the
     /// current world) and a collision-checked straight final segment. When that fails, the
@@ -151,8 +149,7 @@ impl Default for PlanOptions {
             attach_neighbours: 10,
             shortcuts: 100,
             seed: 0,
-            default_velocity: 1.0,
-            acceleration: None,
+            timing: crate::Timing::default(),
             exact_goal: true,
             exact_tolerance: 1e-3,
             exact_evaluations: 30_000,
@@ -188,23 +185,7 @@ impl PlanOptions {
         if self.attach_neighbours == 0 {
             return bad("attach_neighbours", "0: give at least 1".into());
         }
-        if !(self.default_velocity.is_finite() && self.default_velocity > 0.0) {
-            return bad(
-                "default_velocity",
-                format!(
-                    "{} rad/s: give a finite positive speed",
-                    self.default_velocity
-                ),
-            );
-        }
-        if let Some(a) = self.acceleration {
-            if !(a.is_finite() && a > 0.0) {
-                return bad(
-                    "acceleration",
-                    format!("{a} rad/s²: give a finite positive limit"),
-                );
-            }
-        }
+        self.timing.check()?;
         if !(self.exact_tolerance.is_finite() && self.exact_tolerance > 0.0) {
             return bad(
                 "exact_tolerance",

@@ -602,6 +602,8 @@ pub fn run_scenario(
             .collect(),
         times,
         positions: postures,
+        velocities: Vec::new(),
+        accelerations: Vec::new(),
     };
     Ok(ScenarioRun {
         steps,

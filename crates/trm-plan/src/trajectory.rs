@@ -38,6 +38,12 @@ pub struct Trajectory {
     pub times: Vec<f64>,
     /// Motor values at each waypoint.
     pub positions: Vec<Vec<f64>>,
+    /// Motor velocities at each waypoint (empty: not given; a timed plan gives them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub velocities: Vec<Vec<f64>>,
+    /// Motor accelerations at each waypoint (empty: not given).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub accelerations: Vec<Vec<f64>>,
     /// Task vector at each waypoint.
     pub task_path: Vec<Vec<f64>>,
 }
@@ -120,26 +126,45 @@ impl Trajectory {
                 "give one time per waypoint",
             ));
         }
-        for (i, row) in self.positions.iter().enumerate() {
-            if row.len() != self.names.len() {
+        for (what, rows) in [
+            ("velocities", &self.velocities),
+            ("accelerations", &self.accelerations),
+        ] {
+            if !rows.is_empty() && rows.len() != self.times.len() {
                 return Err(invalid(
                     origin,
                     0,
-                    format!(
-                        "positions[{i}] has {} values for {} names",
-                        row.len(),
-                        self.names.len()
-                    ),
-                    "give one value per name",
+                    format!("{} {what} for {} times", rows.len(), self.times.len()),
+                    "give one row per waypoint, or none",
                 ));
             }
-            if let Some(k) = row.iter().position(|v| !v.is_finite()) {
-                return Err(invalid(
-                    origin,
-                    0,
-                    format!("positions[{i}][{k}] is {}", row[k]),
-                    "give finite values",
-                ));
+        }
+        for (what, rows) in [
+            ("positions", &self.positions),
+            ("velocities", &self.velocities),
+            ("accelerations", &self.accelerations),
+        ] {
+            for (i, row) in rows.iter().enumerate() {
+                if row.len() != self.names.len() {
+                    return Err(invalid(
+                        origin,
+                        0,
+                        format!(
+                            "{what}[{i}] has {} values for {} names",
+                            row.len(),
+                            self.names.len()
+                        ),
+                        "give one value per name",
+                    ));
+                }
+                if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+                    return Err(invalid(
+                        origin,
+                        0,
+                        format!("{what}[{i}][{k}] is {}", row[k]),
+                        "give finite values",
+                    ));
+                }
             }
         }
         if !self.task_path.is_empty() {
@@ -293,6 +318,8 @@ impl Trajectory {
             names: columns.iter().map(|(_, n)| n.to_string()).collect(),
             times: Vec::new(),
             positions: Vec::new(),
+            velocities: Vec::new(),
+            accelerations: Vec::new(),
             task_path: Vec::new(),
         };
         let mut line_of = Vec::new();
@@ -395,17 +422,38 @@ impl Trajectory {
 impl Trajectory {
     /// The trajectory as a ROS 2 `trajectory_msgs/msg/JointTrajectory` in YAML for a controller
     /// of `robot` ([`trm_kinematics::ros::joint_trajectory_yaml`]): the URDF joints a
-    /// controller commands, through the couplings, with zero velocity at every waypoint (the
-    /// motion stops at each one, so interpolating through them keeps to the straight, collision-
-    /// checked segments). Motors the trajectory does not name keep their neutral values.
+    /// controller commands, through the couplings, with the trajectory's velocities and
+    /// accelerations (zero velocity and no accelerations where it has none: a motion that stops
+    /// at each waypoint). Motors the trajectory does not name keep their neutral values.
     /// Refuses what the readers refuse; `path` names the file it is for.
     pub fn to_ros_yaml(&self, robot: &RobotModel, path: &Path) -> Result<String, PlanError> {
         self.check(path)?;
         self.check_robot(robot, path, |_| 0)?;
         let frames = self.motor_frames(robot, &robot.neutral_motors())?;
         let motors: Vec<Vec<f64>> = frames.into_iter().map(|(_, q)| q).collect();
-        trm_kinematics::ros::joint_trajectory_yaml(robot, &self.times, &motors, None)
-            .map_err(|e| invalid(path, 0, e.to_string(), "write a trajectory of this robot"))
+        let zero = vec![0.0; robot.motors().len()];
+        let full = |rows: &[Vec<f64>]| -> Result<Option<Vec<Vec<f64>>>, PlanError> {
+            if rows.is_empty() {
+                return Ok(None);
+            }
+            let as_positions = Trajectory {
+                positions: rows.to_vec(),
+                velocities: Vec::new(),
+                accelerations: Vec::new(),
+                ..self.clone()
+            };
+            let frames = as_positions.motor_frames(robot, &zero)?;
+            Ok(Some(frames.into_iter().map(|(_, q)| q).collect()))
+        };
+        let (velocities, accelerations) = (full(&self.velocities)?, full(&self.accelerations)?);
+        trm_kinematics::ros::joint_trajectory_yaml(
+            robot,
+            &self.times,
+            &motors,
+            velocities.as_deref(),
+            accelerations.as_deref(),
+        )
+        .map_err(|e| invalid(path, 0, e.to_string(), "write a trajectory of this robot"))
     }
 }
 

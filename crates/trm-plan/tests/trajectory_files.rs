@@ -26,6 +26,8 @@ fn what_is_written_reads_back() {
         names: vec!["joint1".into(), "joint2".into()],
         times: vec![0.0, 0.25, 0.5],
         positions: vec![vec![0.0, 0.1], vec![0.1, -0.2], vec![0.3, 1e-9]],
+        velocities: Vec::new(),
+        accelerations: Vec::new(),
         task_path: vec![vec![1.0, 2.0, 3.0]; 3],
     };
     let csv = Trajectory::from_csv(
@@ -167,6 +169,8 @@ fn writers_refuse_what_readers_refuse() {
         names: vec!["joint1".into()],
         times: vec![0.0, f64::INFINITY],
         positions: vec![vec![0.0], vec![0.1]],
+        velocities: Vec::new(),
+        accelerations: Vec::new(),
         task_path: vec![],
     };
     for e in [
@@ -211,6 +215,8 @@ proptest::proptest! {
             names: vec!["joint1".into(), "joint2".into()],
             times: rows.iter().map(|r| { time += r.0.abs(); if r.0.is_nan() { r.0 } else { time } }).collect(),
             positions: rows.iter().map(|r| vec![r.1, r.2]).collect(),
+            velocities: Vec::new(),
+            accelerations: Vec::new(),
             task_path: if task { rows.iter().map(|r| vec![r.1, 0.0, r.2]).collect() } else { vec![] },
         };
         let (csv_path, json_path) = (Path::new("t.csv"), Path::new("t.json"));

@@ -98,6 +98,8 @@ pub(crate) struct Planner {
     task_dim: usize,
     /// Keep every path RRT-Connect finds as experience.
     experience: bool,
+    /// How paths are timed (`set_timing`).
+    timing: trm_plan::Timing,
 }
 
 /// Runs a scenario (RON: objects that move, appear and vanish, goals that change; see
@@ -222,6 +224,7 @@ impl Planner {
                 start: None,
                 task_dim: 0,
                 experience,
+                timing: trm_plan::Timing::default(),
             });
         }
         if joints.is_some() || posture.is_some() || request.is_some() || collision.is_some() {
@@ -251,6 +254,7 @@ impl Planner {
             start: Some(problem.start.clone()),
             task_dim: problem.objective.task().map_or(0, |t| t.dim()),
             experience,
+            timing: trm_plan::Timing::default(),
         })
     }
 
@@ -345,6 +349,43 @@ impl Planner {
         self.planner.load_experience(path).map_err(err)
     }
 
+    /// How the next plans are timed: time-optimal within the joints' velocity and
+    /// acceleration limits (the robot's; `joint_limits`, a MoveIt `joint_limits.yaml`, replaces
+    /// them; `velocity` and `acceleration` where neither gives one), each scaled by its factor
+    /// in (0, 1] (a request's `max_*_scaling_factor` wins in `plan_request`), corners cut by
+    /// blends of at most `max_deviation` rad that are collision-checked (0: stop at every
+    /// waypoint), sampled every `sample_period` s.
+    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.1, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_timing(
+        &mut self,
+        velocity_scaling: f64,
+        acceleration_scaling: f64,
+        max_deviation: f64,
+        sample_period: f64,
+        velocity: f64,
+        acceleration: f64,
+        joint_limits: Option<&str>,
+    ) -> PyResult<()> {
+        let limits = match joint_limits {
+            Some(path) => trm_moveit::JointLimitsFile::load(path).map_err(err)?.limits,
+            None => Default::default(),
+        };
+        let timing = trm_plan::Timing {
+            default_velocity: velocity,
+            default_acceleration: acceleration,
+            limits,
+            velocity_scaling,
+            acceleration_scaling,
+            max_deviation,
+            sample_period,
+            resolution: None,
+        };
+        timing.joint_limits(self.planner.active()).map_err(err)?;
+        self.timing = timing;
+        Ok(())
+    }
+
     /// Plans from `start` (the moved motors' values; a map planner's spec start when absent)
     /// to `to`: a posture (the moved motors' values; RRT-Connect through the kept paths, within
     /// `max_seconds` and `max_samples`, steps of at most `range` rad, edges checked every
@@ -353,8 +394,8 @@ impl Planner {
     /// point itself). `posture` says which; by default a posture for a robot planner and a
     /// task point for a map planner. The GIL is released while planning.
     ///
-    /// Returns a dict: `times (T,)` and `positions (T, motors)` (every motor, stopping at each
-    /// waypoint), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
+    /// Returns a dict: `times (T,)`, `positions`, `velocities` and `accelerations` `(T, motors)`
+    /// (every motor, sampled as `set_timing` says), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
     /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
     /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
     #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
@@ -402,7 +443,8 @@ impl Planner {
                 resolution,
                 range,
             };
-            self.connect(py, &d, from, RequestGoal::Joints(target), &budget)?
+            let timing = self.timing.clone();
+            self.connect(py, &d, from, RequestGoal::Joints(target), &budget, &timing)?
         } else {
             let goal = trm_plan::Goal::TaskPoint {
                 t: target,
@@ -411,6 +453,7 @@ impl Planner {
             let options = trm_plan::PlanOptions {
                 seed,
                 exact_goal: exact,
+                timing: self.timing.clone(),
                 ..Default::default()
             };
             let planner = &mut self.planner;
@@ -464,7 +507,16 @@ impl Planner {
             range,
         };
         let d = PyDict::new(py);
-        let planned = self.connect(py, &d, start, goal, &budget)?;
+        let timing = trm_plan::Timing {
+            velocity_scaling: request
+                .velocity_scaling
+                .unwrap_or(self.timing.velocity_scaling),
+            acceleration_scaling: request
+                .acceleration_scaling
+                .unwrap_or(self.timing.acceleration_scaling),
+            ..self.timing.clone()
+        };
+        let planned = self.connect(py, &d, start, goal, &budget, &timing)?;
         self.fill(py, d, planned)
     }
 
@@ -504,6 +556,7 @@ impl Planner {
         from: Vec<f64>,
         goal: RequestGoal,
         budget: &Budget,
+        timing: &trm_plan::Timing,
     ) -> PyResult<Timed> {
         let sized = self.planner.rrt_options().map_err(err)?;
         let rrt = trm_plan::rrt::RrtOptions {
@@ -524,7 +577,7 @@ impl Planner {
                 if experience && found.source == trm_plan::Source::Sampled {
                     planner.add_path(&found.path)?;
                 }
-                let trajectory = planner.trajectory(&found.path, &Default::default());
+                let trajectory = planner.trajectory(&found.path, timing)?;
                 Ok((found, trajectory))
             })
             .map_err(err)?;
@@ -555,6 +608,15 @@ impl Planner {
             "positions",
             shaped(py, None, &[t.positions.len(), motors], flat)?,
         )?;
+        for (key, rows) in [
+            ("velocities", &t.velocities),
+            ("accelerations", &t.accelerations),
+        ] {
+            if rows.len() == t.times.len() {
+                let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+                d.set_item(key, shaped(py, None, &[rows.len(), motors], flat)?)?;
+            }
+        }
         d.set_item("motor_names", t.names.clone())?;
         let rows = waypoints.len();
         d.set_item(

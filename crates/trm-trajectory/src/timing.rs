@@ -197,7 +197,9 @@ impl TimedPath {
         }
         let d = self.duration();
         let count = (d / period).floor() as usize;
-        let mut out: Vec<Sample> = (0..=count).map(|k| self.sample(k as f64 * period)).collect();
+        let mut out: Vec<Sample> = (0..=count)
+            .map(|k| self.sample(k as f64 * period))
+            .collect();
         if out.last().is_none_or(|l| l.time < d - 1e-12) {
             out.push(self.sample(d));
         }
@@ -236,7 +238,11 @@ pub fn time_optimal(
     let s = grid(path, options);
     let n = s.len() - 1;
     let stops = path.stops();
-    let at_stop = |v: f64| stops.iter().any(|&p| (p - v).abs() <= 1e-12 * path.length().max(1.0));
+    let at_stop = |v: f64| {
+        stops
+            .iter()
+            .any(|&p| (p - v).abs() <= 1e-12 * path.length().max(1.0))
+    };
     // constraints of each interval, independent of the controllable sets
     let mut rows: Vec<Vec<Row>> = Vec::with_capacity(n);
     let mut bounds = Vec::new();
@@ -357,11 +363,7 @@ fn interval_rows(bounds: &[[f64; 4]], limits: &JointLimits, delta: f64) -> Vec<R
                     if pu == 0.0 && cx == 0.0 {
                         continue;
                     }
-                    rows.push(Row {
-                        a: pu,
-                        b: cx,
-                        c: a,
-                    });
+                    rows.push(Row { a: pu, b: cx, c: a });
                     rows.push(Row {
                         a: -pu,
                         b: -cx,
@@ -423,9 +425,5 @@ fn feasible_x(rows: &[Row]) -> (f64, f64) {
             bound(k, m);
         }
     }
-    if lo > hi {
-        (0.0, 0.0)
-    } else {
-        (lo, hi)
-    }
+    if lo > hi { (0.0, 0.0) } else { (lo, hi) }
 }

@@ -54,7 +54,11 @@ fn the_slowest_joint_sets_a_straight_segment_s_time() {
     let limits = JointLimits::new(vec![2.0, 1.0], vec![1.0, 4.0]).unwrap();
     let t = timed(&[vec![0.0, 0.0], vec![1.0, 2.0]], 0.1, &limits);
     let best = rest_to_rest(1.0, 0.5, 1.0);
-    assert!((t.duration() / best - 1.0).abs() < 0.005, "{}", t.duration());
+    assert!(
+        (t.duration() / best - 1.0).abs() < 0.005,
+        "{}",
+        t.duration()
+    );
 }
 
 #[test]
@@ -104,7 +108,11 @@ fn blending_beats_stopping_at_every_waypoint() {
 
 #[test]
 fn blends_stay_within_their_deviation_and_keep_the_tangent() {
-    let waypoints = vec![vec![0.0, 0.0, 0.0], vec![1.0, 0.0, 0.0], vec![1.0, 1.0, 0.5]];
+    let waypoints = vec![
+        vec![0.0, 0.0, 0.0],
+        vec![1.0, 0.0, 0.0],
+        vec![1.0, 1.0, 0.5],
+    ];
     for deviation in [0.01, 0.1, 10.0] {
         let path = BlendedPath::new(&waypoints, deviation).unwrap();
         let blends = path.blends();
@@ -140,7 +148,10 @@ fn bad_input_is_refused_with_the_place_named() {
     let nan = BlendedPath::new(&[vec![0.0, 0.0], vec![f64::NAN, 1.0]], 0.1).unwrap_err();
     assert!(nan.to_string().contains("waypoint 1, value 0"), "{nan}");
     let ragged = BlendedPath::new(&[vec![0.0, 0.0], vec![1.0]], 0.1).unwrap_err();
-    assert!(ragged.to_string().contains("waypoint 1 has 1 values"), "{ragged}");
+    assert!(
+        ragged.to_string().contains("waypoint 1 has 1 values"),
+        "{ragged}"
+    );
     let deviation = BlendedPath::new(&[vec![0.0], vec![1.0]], -1.0).unwrap_err();
     assert!(deviation.to_string().contains("deviation"), "{deviation}");
     assert!(BlendedPath::new(&[], 0.1).is_err());
@@ -162,7 +173,11 @@ fn a_single_point_is_a_motion_of_no_time() {
 }
 
 fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 proptest! {
@@ -201,7 +216,13 @@ fn segment_distance(p: &[f64], a: &[f64], b: &[f64]) -> f64 {
     let ab: Vec<f64> = b.iter().zip(a).map(|(x, y)| x - y).collect();
     let len2: f64 = ab.iter().map(|v| v * v).sum();
     let t = if len2 > 0.0 {
-        (p.iter().zip(a).zip(&ab).map(|((p, a), d)| (p - a) * d).sum::<f64>() / len2).clamp(0.0, 1.0)
+        (p.iter()
+            .zip(a)
+            .zip(&ab)
+            .map(|((p, a), d)| (p - a) * d)
+            .sum::<f64>()
+            / len2)
+            .clamp(0.0, 1.0)
     } else {
         0.0
     };

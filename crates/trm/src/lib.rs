@@ -417,6 +417,28 @@ pub mod parse {
         }
     }
 
+    /// A scaling factor: a number in (0, 1].
+    pub fn factor(text: &str) -> Result<f64, String> {
+        finite(text).and_then(|v| {
+            if v > 0.0 && v <= 1.0 {
+                Ok(v)
+            } else {
+                Err(format!("{v} is not in (0, 1]"))
+            }
+        })
+    }
+
+    /// A finite number, 0 or more.
+    pub fn non_negative(text: &str) -> Result<f64, String> {
+        finite(text).and_then(|v| {
+            if v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{v} is below 0"))
+            }
+        })
+    }
+
     /// A number in [0, 1].
     pub fn fraction(text: &str) -> Result<f64, String> {
         finite(text).and_then(|v| {

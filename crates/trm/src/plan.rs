@@ -98,9 +98,8 @@ pub struct Args {
     /// (`<stem>.scene.html`), or as target/plan.scene.html.
     #[arg(long)]
     view: bool,
-    /// Joint speed where the model has no limit, rad/s.
-    #[arg(long, default_value_t = 1.0)]
-    velocity: f64,
+    #[command(flatten)]
+    timing: crate::support::timing::TimingArgs,
 }
 
 fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
@@ -117,11 +116,6 @@ fn posture(path: &Path, problem: &Problem) -> Result<Vec<f64>> {
 /// Plans and reports.
 pub fn run(args: &Args) -> Result<()> {
     crate::check_csv_out(args.out.as_deref())?;
-    anyhow::ensure!(
-        args.velocity.is_finite() && args.velocity > 0.0,
-        "--velocity {}: give a finite positive joint speed (rad/s)",
-        args.velocity
-    );
     anyhow::ensure!(
         args.tolerance.is_finite() && args.tolerance > 0.0,
         "--tolerance {}: give a finite positive task-space distance",
@@ -194,7 +188,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let options = PlanOptions {
         seed: args.seed,
-        default_velocity: args.velocity,
+        timing: args.timing.timing((None, None))?,
         exact_goal: !args.no_exact,
         exact_tolerance: args.exact_tolerance,
         ..Default::default()
@@ -455,11 +449,12 @@ fn run_without_maps(args: &Args) -> Result<()> {
         ),
         Err(e) => return Err(e.into()),
     };
-    let timing = PlanOptions {
-        default_velocity: args.velocity,
-        ..Default::default()
-    };
-    let trajectory = planner.trajectory(&found.path, &timing);
+    let timing = args
+        .timing
+        .timing(request.as_ref().map_or((None, None), |r| {
+            (r.velocity_scaling, r.acceleration_scaling)
+        }))?;
+    let trajectory = planner.trajectory(&found.path, &timing)?;
     println!(
         "{}: {} of {} motors move; world: {} objects",
         robot.name(),

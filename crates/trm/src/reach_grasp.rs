@@ -87,6 +87,8 @@ pub fn run(args: &Args) -> Result<()> {
             names: e.model.motors().iter().map(|m| m.name.clone()).collect(),
             times,
             positions: m.trajectory.iter().map(|q| active.to_motors(q)).collect(),
+            velocities: Vec::new(),
+            accelerations: Vec::new(),
             task_path: Vec::new(),
         };
         crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;

@@ -13,7 +13,7 @@ use trm_tasks::Objective;
 use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 use crate::rrt::{GOAL_COLLIDES, RrtOptions};
-use crate::trajectory::{Trajectory, time_parametrise};
+use crate::trajectory::Trajectory;
 
 mod connect;
 mod experience;
@@ -373,7 +373,7 @@ impl Planner {
                 length: crate::rrt::path_length(&found.path),
                 ..Default::default()
             };
-            let trajectory = self.trajectory(&found.path, options);
+            let trajectory = self.trajectory(&found.path, &options.timing)?;
             stats.seconds = began.elapsed().as_secs_f64();
             return Ok(Planned {
                 trajectory,
@@ -492,7 +492,7 @@ impl Planner {
             let node_ids: Vec<usize> = path.iter().map(|&(v, _)| v).filter(|&i| i < n).collect();
             let waypoints: Vec<Vec<f64>> = path.iter().map(|&(v, _)| config(v, self)).collect();
             stats.path_nodes = node_ids.len();
-            return Ok(self.finish(waypoints, node_ids, goal, options, stats, began));
+            return self.finish(waypoints, node_ids, goal, options, stats, began);
         }
     }
 
@@ -638,7 +638,7 @@ impl Planner {
         options: &PlanOptions,
         mut stats: PlanStats,
         began: Instant,
-    ) -> Planned {
+    ) -> Result<Planned, PlanError> {
         self.shortcut(&mut waypoints, options);
         if let Goal::TaskPoint { t, .. } = goal {
             if options.exact_goal {
@@ -648,14 +648,14 @@ impl Planner {
             stats.goal_error = Some(distance(&self.task_of(&end), t));
         }
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.trajectory(&waypoints, options);
+        let trajectory = self.trajectory(&waypoints, &options.timing)?;
         stats.seconds = began.elapsed().as_secs_f64();
-        Planned {
+        Ok(Planned {
             trajectory,
             nodes,
             waypoints,
             stats,
-        }
+        })
     }
 
     /// The kept path whose ends lie nearest to `start` and `goal` (either way round), when both
@@ -734,7 +734,7 @@ impl Planner {
         stats.retrieved = true;
         self.shortcut(&mut waypoints, options);
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.trajectory(&waypoints, options);
+        let trajectory = self.trajectory(&waypoints, &options.timing)?;
         stats.seconds = began.elapsed().as_secs_f64();
         Ok(Some(Planned {
             trajectory,
@@ -850,34 +850,34 @@ impl Planner {
         }
     }
 
-    /// A path (active values) timed within the motors' velocity limits (and `options`'
-    /// acceleration): stopping at every waypoint, [`time_parametrise`]; with its task-space
-    /// path where the planner has a task.
-    pub fn trajectory(&mut self, waypoints: &[Vec<f64>], options: &PlanOptions) -> Trajectory {
-        let task_path = waypoints.iter().map(|q| self.task_of(q)).collect();
-        let model = self.active.model();
-        let velocity: Vec<f64> = self
-            .active
-            .motor_indices()
-            .iter()
-            .map(|&m| {
-                let v = model.motors()[m].limits.velocity;
-                if v.is_finite() && v > 0.0 && v < 1000.0 {
-                    v
-                } else {
-                    options.default_velocity
-                }
-            })
-            .collect();
-        let acceleration = options.acceleration.map(|a| vec![a; velocity.len()]);
-        let times = time_parametrise(waypoints, &velocity, acceleration.as_deref());
-        let positions: Vec<Vec<f64>> = waypoints.iter().map(|q| self.active.to_motors(q)).collect();
-        Trajectory {
-            names: model.motors().iter().map(|m| m.name.clone()).collect(),
-            times,
-            positions,
-            task_path,
+    /// A path (active values, collision-checked) as a trajectory the robot can execute:
+    /// corners blended where the blends are free in the current world, timed time-optimally
+    /// within the motors' limits, sampled with velocities and accelerations
+    /// ([`crate::timing::timed`]), with its task-space path where the planner has a task.
+    pub fn trajectory(
+        &mut self,
+        waypoints: &[Vec<f64>],
+        timing: &crate::Timing,
+    ) -> Result<Trajectory, PlanError> {
+        let resolution = match timing.resolution {
+            Some(r) => r,
+            None => self.rrt_options()?.resolution,
+        };
+        let active = self.active.clone();
+        let checker = &mut self.checker;
+        let mut trajectory =
+            crate::timing::timed(&active, waypoints, timing, resolution, |a, b| {
+                checker.segment_free(a, b, resolution)
+            })?;
+        if self.objective.task().is_some() {
+            let samples: Vec<Vec<f64>> = trajectory
+                .positions
+                .iter()
+                .map(|m| active.from_motors(m))
+                .collect();
+            trajectory.task_path = samples.iter().map(|q| self.task_of(q)).collect();
         }
+        Ok(trajectory)
     }
 }
 

@@ -62,11 +62,17 @@ impl Rollout {
     /// ([`trm_kinematics::ros::joint_trajectory_yaml`]): every control step with its joint
     /// positions and velocities. Refuses a rollout holding a non-finite value.
     pub fn to_ros_yaml(&self, model: &RobotModel) -> Result<String, crate::WholeBodyError> {
-        trm_kinematics::ros::joint_trajectory_yaml(model, &self.times, &self.q, Some(&self.qdot))
-            .map_err(|e| crate::WholeBodyError::Invalid {
-                what: "the rollout".into(),
-                problem: format!("{e}; not written as ROS YAML"),
-            })
+        trm_kinematics::ros::joint_trajectory_yaml(
+            model,
+            &self.times,
+            &self.q,
+            Some(&self.qdot),
+            None,
+        )
+        .map_err(|e| crate::WholeBodyError::Invalid {
+            what: "the rollout".into(),
+            problem: format!("{e}; not written as ROS YAML"),
+        })
     }
 
     /// The motion as CSV: a header `t,phase,<motor names of model>,com_x,com_z,com_desired_x,

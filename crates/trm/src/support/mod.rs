@@ -4,3 +4,4 @@ pub mod configs;
 pub mod description;
 pub mod scene;
 pub mod taskmap;
+pub mod timing;

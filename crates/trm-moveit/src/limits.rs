@@ -1,0 +1,115 @@
+//! MoveIt's `joint_limits.yaml` (the file MoveIt's setup assistant writes in a robot's
+//! `config/`): per-joint velocity, acceleration and jerk limits, each used when its
+//! `has_*_limits` flag is true, and the default scaling factors.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use trm_kinematics::MotionLimitSpec;
+
+use crate::error::MoveItError;
+use crate::reader::Reader;
+use crate::yaml::Node;
+
+/// What a `joint_limits.yaml` holds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JointLimitsFile {
+    /// Limits by joint name (only those whose `has_*_limits` flag is true).
+    pub limits: BTreeMap<String, MotionLimitSpec>,
+    /// `default_velocity_scaling_factor`.
+    pub velocity_scaling: Option<f64>,
+    /// `default_acceleration_scaling_factor`.
+    pub acceleration_scaling: Option<f64>,
+}
+
+impl JointLimitsFile {
+    /// Reads the file at `path`.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, MoveItError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| MoveItError::Invalid {
+            path: path.to_path_buf(),
+            line: 0,
+            problem: format!("cannot read it: {e}"),
+            fix: "give the path of a joint_limits.yaml".into(),
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses a `joint_limits.yaml`; `origin` names it in errors. Every limit given with its
+    /// flag true must be a finite positive number; a flag must be `true` or `false`.
+    pub fn parse(text: &str, origin: &Path) -> Result<Self, MoveItError> {
+        let r = Reader { origin };
+        let doc = r.parse(text)?;
+        let mut out = JointLimitsFile::default();
+        for (key, slot) in [
+            ("default_velocity_scaling_factor", &mut out.velocity_scaling),
+            (
+                "default_acceleration_scaling_factor",
+                &mut out.acceleration_scaling,
+            ),
+        ] {
+            if let Some(f) = doc.get(key) {
+                let v = r.number(f, key)?;
+                if !(v > 0.0 && v <= 1.0) {
+                    return Err(r.err(f.line, format!("{key} is {v}"), "give a factor in (0, 1]"));
+                }
+                *slot = Some(v);
+            }
+        }
+        let joints = r.field(&doc, "joint_limits", "the file")?;
+        let crate::yaml::Value::Map(entries) = &joints.value else {
+            return Err(r.err(
+                joints.line,
+                format!("joint_limits is {}", joints.kind()),
+                "give joint_limits as a mapping from joint names to their limits",
+            ));
+        };
+        for (name, node) in entries {
+            let mut spec = MotionLimitSpec::default();
+            for (what, slot) in [
+                ("velocity", &mut spec.velocity),
+                ("acceleration", &mut spec.acceleration),
+                ("jerk", &mut spec.jerk),
+            ] {
+                if !flag(&r, node, &format!("has_{what}_limits"), name)? {
+                    continue;
+                }
+                let key = format!("max_{what}");
+                let here = format!("joint_limits.{name}.{key}");
+                let value = r.field(node, &key, &format!("joint_limits.{name}"))?;
+                let v = r.number(value, &here)?;
+                if v <= 0.0 {
+                    return Err(r.err(
+                        value.line,
+                        format!("{here} is {v}"),
+                        format!("give a positive limit, or set has_{what}_limits: false"),
+                    ));
+                }
+                *slot = Some(v);
+            }
+            if spec != MotionLimitSpec::default() {
+                out.limits.insert(name.clone(), spec);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The boolean `key` of joint `joint`'s entry (false when absent).
+fn flag(r: &Reader, node: &Node, key: &str, joint: &str) -> Result<bool, MoveItError> {
+    match node.get(key) {
+        None => Ok(false),
+        Some(f) => match f.scalar().map(str::trim) {
+            Some("true" | "True" | "TRUE") => Ok(true),
+            Some("false" | "False" | "FALSE") => Ok(false),
+            _ => Err(r.err(
+                f.line,
+                format!(
+                    "joint_limits.{joint}.{key} is `{}`",
+                    f.scalar().unwrap_or(f.kind())
+                ),
+                "give true or false",
+            )),
+        },
+    }
+}

@@ -1,0 +1,70 @@
+//! The flags that say how a planned path is timed (limits, scaling, blends, sampling), shared
+//! by the commands that write trajectories.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use trm_plan::Timing;
+
+/// How the path becomes a trajectory: time-optimal within the joints' velocity and
+/// acceleration limits, corners blended where the blends are collision-free.
+#[derive(clap::Args, Debug, Clone)]
+pub struct TimingArgs {
+    /// Joint speed where the model has no limit, rad/s.
+    #[arg(long, default_value_t = 1.0, value_parser = crate::parse::positive)]
+    pub velocity: f64,
+    /// Joint acceleration where neither the model nor --joint-limits gives one, rad/s²
+    /// (MoveIt's default).
+    #[arg(long, default_value_t = 1.0, value_parser = crate::parse::positive)]
+    pub acceleration: f64,
+    /// MoveIt's joint_limits.yaml: its velocity and acceleration limits replace the model's.
+    #[arg(long, value_name = "FILE")]
+    pub joint_limits: Option<PathBuf>,
+    /// Factor on every velocity limit, (0, 1] [default: the request's
+    /// max_velocity_scaling_factor, else the --joint-limits file's default, else 1].
+    #[arg(long, value_parser = crate::parse::factor)]
+    pub velocity_scaling: Option<f64>,
+    /// Factor on every acceleration limit, (0, 1] [default: as --velocity-scaling's].
+    #[arg(long, value_parser = crate::parse::factor)]
+    pub acceleration_scaling: Option<f64>,
+    /// Largest joint-space distance a blend may cut from a corner of the path, rad (blends
+    /// that would collide are tightened); 0: stop at every waypoint.
+    #[arg(long, default_value_t = 0.1, value_parser = crate::parse::non_negative)]
+    pub max_deviation: f64,
+    /// Time between the trajectory's samples, s.
+    #[arg(long, default_value_t = 0.01, value_parser = crate::parse::positive)]
+    pub sample_period: f64,
+}
+
+impl TimingArgs {
+    /// The timing; `request` gives a MoveIt request's scaling factors (velocity, acceleration).
+    pub fn timing(&self, request: (Option<f64>, Option<f64>)) -> Result<Timing> {
+        let file = match &self.joint_limits {
+            Some(path) => Some(
+                trm_moveit::JointLimitsFile::load(path)
+                    .with_context(|| format!("--joint-limits {}", path.display()))?,
+            ),
+            None => None,
+        };
+        let from_file =
+            |f: fn(&trm_moveit::JointLimitsFile) -> Option<f64>| file.as_ref().and_then(f);
+        Ok(Timing {
+            default_velocity: self.velocity,
+            default_acceleration: self.acceleration,
+            velocity_scaling: self
+                .velocity_scaling
+                .or(request.0)
+                .or_else(|| from_file(|f| f.velocity_scaling))
+                .unwrap_or(1.0),
+            acceleration_scaling: self
+                .acceleration_scaling
+                .or(request.1)
+                .or_else(|| from_file(|f| f.acceleration_scaling))
+                .unwrap_or(1.0),
+            limits: file.map(|f| f.limits).unwrap_or_default(),
+            max_deviation: self.max_deviation,
+            sample_period: self.sample_period,
+            resolution: None,
+        })
+    }
+}
