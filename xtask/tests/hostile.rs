@@ -319,6 +319,12 @@ fn valid_files(dir: &Path) {
     ] {
         std::fs::copy(root.join(from), dir.join(to)).unwrap();
     }
+    // a joint_limits.yaml whose acceleration flag is on without a limit
+    std::fs::write(
+        dir.join("bad_limits.yaml"),
+        "joint_limits:\n  panda_joint1:\n    has_acceleration_limits: true\n",
+    )
+    .unwrap();
 }
 
 #[test]
@@ -1027,6 +1033,21 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         &plan_request,
         "--experience",
         &["posture.json", "map.json"],
+    ));
+    // timing: limits and factors out of range, joint-limit files that are none or wrong
+    for (flag, values) in [
+        ("--velocity-scaling", &["0", "1.5", "NaN"][..]),
+        ("--acceleration-scaling", &["-1", "2"][..]),
+        ("--max-deviation", &["-0.1", "inf"][..]),
+        ("--sample-period", &["0", "NaN"][..]),
+        ("--acceleration", &["0", "-2"][..]),
+    ] {
+        cases.extend(flag_cases(&plan_request, flag, values));
+    }
+    cases.extend(file_flag_cases(
+        &plan_request,
+        "--joint-limits",
+        &["no_such.yaml", "posture.json", "bad_limits.yaml"],
     ));
     let mut families = bench(&mbm);
     families.extend(["--families".into(), "box_pand".into()]);

@@ -257,6 +257,22 @@ fn other_description_mistakes_are_errors() {
             "planning.resolution",
         ),
         ("(urdf: \"x\", planning: (step: Some(1.0)))", "step"),
+        (
+            "(urdf: \"x\", motion_limits: {\"j3\": (acceleration: Some(1.0))})",
+            "which is no motor",
+        ),
+        (
+            "(urdf: \"x\", motion_limits: {\"j1\": (acceleration: Some(-1.0))})",
+            "acceleration limit of -1",
+        ),
+        (
+            "(urdf: \"x\", motion_limits: {\"j1\": (jerk: Some(inf))})",
+            "jerk limit",
+        ),
+        (
+            "(urdf: \"x\", motion_limits: {\"j1\": (accel: Some(1.0))})",
+            "accel",
+        ),
     ] {
         let message = description_error(ron);
         assert!(message.contains(needle), "{ron}: {message}");
@@ -320,4 +336,22 @@ fn a_namespace_the_xml_layer_chokes_on_is_an_error_not_a_panic() {
 fn a_bad_planning_setting_is_located() {
     let message = description_error("(urdf: \"x\",\n planning: (range: Some(-0.5)))");
     assert!(message.contains("model.ron:2"), "{message}");
+}
+
+#[test]
+fn motion_limits_replace_the_urdf_s_and_add_accelerations() {
+    let urdf = urdf(&format!(
+        "<link name=\"a\"/><link name=\"b\"/>\n{}",
+        revolute("j1", "a", "b", "")
+    ));
+    let ron = "(urdf: \"x\", motion_limits: {\"j1\": (velocity: Some(0.5), acceleration: Some(2.0), jerk: Some(40.0))})";
+    let d = ModelDescription::from_ron(ron, "model.ron").unwrap();
+    let robot = RobotModel::from_parts(&urdf, ORIGIN, &d, Some((ron, "model.ron"))).unwrap();
+    let limits = &robot.motors()[0].limits;
+    assert_eq!(
+        (limits.velocity, limits.acceleration, limits.jerk),
+        (0.5, 2.0, 40.0)
+    );
+    let plain = RobotModel::from_urdf_str(&urdf, ORIGIN).unwrap();
+    assert!(plain.motors()[0].limits.acceleration.is_infinite());
 }

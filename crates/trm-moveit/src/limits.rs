@@ -113,3 +113,69 @@ fn flag(r: &Reader, node: &Node, key: &str, joint: &str) -> Result<bool, MoveItE
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PANDA: &str = "default_velocity_scaling_factor: 0.5\njoint_limits:\n  panda_joint1:\n    has_velocity_limits: true\n    max_velocity: 2.175\n    has_acceleration_limits: true\n    max_acceleration: 3.75\n  panda_joint2:\n    has_velocity_limits: false\n    max_velocity: 9\n    has_acceleration_limits: true\n    max_acceleration: 1.875\n    has_jerk_limits: false\n  panda_finger_joint1:\n    has_velocity_limits: false\n    has_acceleration_limits: false\n    max_acceleration: 0\n";
+
+    #[test]
+    fn a_moveit_joint_limits_file_reads_its_flagged_limits() {
+        let f = JointLimitsFile::parse(PANDA, Path::new("joint_limits.yaml")).unwrap();
+        assert_eq!(f.velocity_scaling, Some(0.5));
+        assert_eq!(f.acceleration_scaling, None);
+        let j1 = f.limits["panda_joint1"];
+        assert_eq!((j1.velocity, j1.acceleration), (Some(2.175), Some(3.75)));
+        let j2 = f.limits["panda_joint2"];
+        assert_eq!((j2.velocity, j2.acceleration), (None, Some(1.875)));
+        assert!(!f.limits.contains_key("panda_finger_joint1"));
+    }
+
+    #[test]
+    fn bad_limits_are_located() {
+        for (text, needle) in [
+            (
+                "joint_limits:\n  j:\n    has_acceleration_limits: true\n",
+                "max_acceleration",
+            ),
+            (
+                "joint_limits:\n  j:\n    has_velocity_limits: yes please\n",
+                "true or false",
+            ),
+            (
+                "joint_limits:\n  j:\n    has_velocity_limits: true\n    max_velocity: -1\n",
+                "is -1",
+            ),
+            (
+                "default_acceleration_scaling_factor: 2\njoint_limits: {}\n",
+                "(0, 1]",
+            ),
+            ("joint_limits: [1, 2]\n", "mapping"),
+            ("limits: {}\n", "joint_limits"),
+        ] {
+            let e = JointLimitsFile::parse(text, Path::new("jl.yaml"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("jl.yaml") && e.contains(needle), "{text}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_request_s_scaling_factors_are_read_and_written() {
+        let text = "start_state:\n  joint_state:\n    name: [a]\n    position: [0]\ngoal_constraints:\n  - joint_constraints:\n      - joint_name: a\n        position: 1\nmax_velocity_scaling_factor: 0.25\nmax_acceleration_scaling_factor: 0\n";
+        let r = crate::MotionPlanRequest::parse(text, Path::new("r.yaml")).unwrap();
+        assert_eq!(
+            (r.velocity_scaling, r.acceleration_scaling),
+            (Some(0.25), None)
+        );
+        let again =
+            crate::MotionPlanRequest::parse(&r.to_yaml().unwrap(), Path::new("r.yaml")).unwrap();
+        assert_eq!(again.velocity_scaling, Some(0.25));
+        let bad = text.replace("0.25", "1.5");
+        let e = crate::MotionPlanRequest::parse(&bad, Path::new("r.yaml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("max_velocity_scaling_factor is 1.5"), "{e}");
+    }
+}

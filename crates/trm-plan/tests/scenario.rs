@@ -113,9 +113,13 @@ fn a_scenario_run_keeps_the_map_valid_reaches_goals_and_is_reproducible() {
     .unwrap();
     connect(&mut map, &problem.objective, 8, 0.05).unwrap();
     let scenario = Scenario::load(root().join("specs/scenarios/sliding_box.ron")).unwrap();
+    // the iCub's model gives no acceleration limits: an arm that reaches 1 rad/s in 0.25 s
+    let mut plan = ScenarioOptions::default().plan;
+    plan.timing.default_acceleration = 4.0;
     let options = ScenarioOptions {
         repair_seconds: None,
         repair_evaluations: Some(3_000),
+        plan,
         ..Default::default()
     };
     for bad in [

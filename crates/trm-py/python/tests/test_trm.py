@@ -289,10 +289,28 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
         # the same planner object: the same path, found with the same checks
         assert same["solved"] and r["checks"] == same["checks"], request
         np.testing.assert_array_equal(r["waypoints"], np.array(same["path"]))
-        assert r["positions"].shape == (len(r["waypoints"]), 7)
+        assert r["positions"].shape[1] == 7
+        assert r["positions"].shape == r["velocities"].shape == r["accelerations"].shape
+        assert r["positions"].shape[0] == r["times"].shape[0]
+        np.testing.assert_array_equal(r["positions"][0], r["waypoints"][0])
+        np.testing.assert_array_equal(r["positions"][-1], r["waypoints"][-1])
+        assert not r["velocities"][-1].any() and not r["velocities"][0].any()
         assert r["times"][0] == 0.0 and np.all(np.diff(r["times"]) > 0)
         assert r["source"] in ("straight", "sampled")
     assert "7 motors" in repr(planner)
+    # timing: MoveIt-like limits, scaled; stopping at every waypoint takes longer
+    limits = ROOT / "benches" / "timing" / "panda_joint_limits.yaml"
+    planner.set_timing(joint_limits=str(limits), sample_period=0.001)
+    blended = planner.plan_request(str(requests[0]))
+    acc = np.array([3.75, 1.875, 2.5, 3.125, 3.75, 5.0, 5.0])
+    assert np.all(np.abs(blended["accelerations"]) <= acc * (1 + 1e-6))
+    planner.set_timing(joint_limits=str(limits), max_deviation=0.0, velocity_scaling=0.5)
+    slow = planner.plan_request(str(requests[0]))
+    assert slow["times"][-1] > blended["times"][-1]
+    with pytest.raises(ValueError, match="velocity_scaling"):
+        planner.set_timing(velocity_scaling=1.5)
+    with pytest.raises(ValueError, match="no_such.yaml"):
+        planner.set_timing(joint_limits="no_such.yaml")
 
 
 def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
