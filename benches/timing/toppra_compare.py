@@ -64,6 +64,7 @@ def main():
     ap.add_argument("set", type=Path)
     ap.add_argument("--model", required=True)
     ap.add_argument("--paths", type=int, default=100)
+    ap.add_argument("--max-deviation", type=float, default=0.2)
     args = ap.parse_args()
     root = args.set
     if root.suffix == ".bz2":
@@ -87,7 +88,7 @@ def main():
     print("family,trm_s,toppra_s,ratio,stop_s,blend_over_stop,waypoints")
     for family, scene, request in chosen:
         planner.load_scene(str(scene))
-        planner.set_timing(joint_limits=str(LIMITS))
+        planner.set_timing(joint_limits=str(LIMITS), max_deviation=args.max_deviation)
         try:
             blended = planner.plan_request(str(request))
         except Exception as e:  # an invalid problem: skip, say so

@@ -50,7 +50,7 @@ impl Default for Timing {
             limits: BTreeMap::new(),
             velocity_scaling: 1.0,
             acceleration_scaling: 1.0,
-            max_deviation: 0.1,
+            max_deviation: 0.2,
             sample_period: 0.01,
             resolution: None,
         }

@@ -355,7 +355,7 @@ impl Planner {
     /// in (0, 1] (a request's `max_*_scaling_factor` wins in `plan_request`), corners cut by
     /// blends of at most `max_deviation` rad that are collision-checked (0: stop at every
     /// waypoint), sampled every `sample_period` s.
-    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.1, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None))]
+    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.2, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None))]
     #[allow(clippy::too_many_arguments)]
     fn set_timing(
         &mut self,

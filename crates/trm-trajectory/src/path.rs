@@ -144,7 +144,7 @@ impl BlendedPath {
             let (d2, l2) = &directions[k];
             let turn = dot(d1, d2).clamp(-1.0, 1.0).acos();
             let deviation = points[k].1;
-            if turn < STRAIGHT || turn > std::f64::consts::PI - REVERSAL || deviation == 0.0 {
+            if !(STRAIGHT..=std::f64::consts::PI - REVERSAL).contains(&turn) || deviation == 0.0 {
                 continue;
             }
             let half = turn / 2.0;
@@ -331,6 +331,14 @@ impl BlendedPath {
         }
     }
 
+    /// Angle (rad) the tangent turns through over `[s0, s1]` within one piece (0 on lines).
+    pub(crate) fn turn(&self, s0: f64, s1: f64) -> f64 {
+        match self.locate((s0 + s1) / 2.0) {
+            Some((Piece::Arc { radius, .. }, _)) => (s1 - s0) / radius,
+            _ => 0.0,
+        }
+    }
+
     /// Bounds of each joint's first and second derivative over `[s0, s1]` (within one piece):
     /// `(first_min, first_max, second_min, second_max)` per joint, into `out`.
     pub(crate) fn derivative_bounds(&self, s0: f64, s1: f64, out: &mut Vec<[f64; 4]>) {
@@ -345,12 +353,38 @@ impl BlendedPath {
                 out.extend(direction.iter().map(|&d| [d, d, 0.0, 0.0]));
             }
             Piece::Arc { x, y, radius, .. } => {
-                let (p0, p1) = ((a - half) / radius, (a + half) / radius);
+                // q' = −sin φ x + cos φ y and q'' = −(cos φ x + sin φ y) / r: each one's
+                // derivative in φ is the other's (times ∓r), so q' peaks (±A, A = |(x, y)|)
+                // inside the interval only where q'' changes sign, and q'' (±A/r) only where q'
+                // does
+                let (s0, c0) = ((a - half) / radius).sin_cos();
+                let (s1, c1) = ((a + half) / radius).sin_cos();
                 for j in 0..self.dim {
-                    // q' = −sin φ x + cos φ y,  q'' = −(cos φ x + sin φ y) / r
-                    let (lo1, hi1) = sinusoid_range(y[j], -x[j], p0, p1);
-                    let (lo2, hi2) = sinusoid_range(-x[j] / radius, -y[j] / radius, p0, p1);
-                    out.push([lo1, hi1, lo2, hi2]);
+                    let first = [-s0 * x[j] + c0 * y[j], -s1 * x[j] + c1 * y[j]];
+                    let second = [
+                        -(c0 * x[j] + s0 * y[j]) / radius,
+                        -(c1 * x[j] + s1 * y[j]) / radius,
+                    ];
+                    let amplitude = x[j].hypot(y[j]);
+                    let mut b = [
+                        first[0].min(first[1]),
+                        first[0].max(first[1]),
+                        second[0].min(second[1]),
+                        second[0].max(second[1]),
+                    ];
+                    // q' rises while q'' > 0 (dq'/dφ = r q''): a sign change + → − is a peak
+                    if second[0] > 0.0 && second[1] < 0.0 {
+                        b[1] = amplitude;
+                    } else if second[0] < 0.0 && second[1] > 0.0 {
+                        b[0] = -amplitude;
+                    }
+                    // dq''/dφ = −q'/r: q'' peaks where q' goes − → +
+                    if first[0] < 0.0 && first[1] > 0.0 {
+                        b[3] = amplitude / radius;
+                    } else if first[0] > 0.0 && first[1] < 0.0 {
+                        b[2] = -amplitude / radius;
+                    }
+                    out.push(b);
                 }
             }
         }
@@ -361,23 +395,6 @@ fn fill(buffer: &mut [f64], j: usize, value: f64) {
     if let Some(b) = buffer.get_mut(j) {
         *b = value;
     }
-}
-
-/// Range of `a cos φ + b sin φ` over `[p0, p1]`.
-fn sinusoid_range(a: f64, b: f64, p0: f64, p1: f64) -> (f64, f64) {
-    let f = |p: f64| a * p.cos() + b * p.sin();
-    let (mut lo, mut hi) = (f(p0).min(f(p1)), f(p0).max(f(p1)));
-    // extrema where the derivative −a sin φ + b cos φ vanishes: φ = atan2(b, a) + kπ
-    let base = b.atan2(a);
-    let pi = std::f64::consts::PI;
-    let mut k = ((p0 - base) / pi).ceil();
-    while base + k * pi <= p1 {
-        let v = f(base + k * pi);
-        lo = lo.min(v);
-        hi = hi.max(v);
-        k += 1.0;
-    }
-    (lo, hi)
 }
 
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -92,6 +92,10 @@ impl JointLimits {
     }
 }
 
+/// Largest turn of the path's tangent (rad) within one grid interval on an arc: the
+/// interval bounds of the derivatives, and so the timing's conservatism, shrink with it.
+const MAX_TURN: f64 = 0.03;
+
 /// Settings of [`time_optimal`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimingOptions {
@@ -105,7 +109,7 @@ pub struct TimingOptions {
 impl Default for TimingOptions {
     fn default() -> Self {
         TimingOptions {
-            intervals: 400,
+            intervals: 200,
             min_per_piece: 4,
         }
     }
@@ -178,10 +182,10 @@ impl TimedPath {
         let mut ddq = vec![0.0; n];
         self.path
             .evaluate(s, &mut out.position, &mut out.velocity, &mut ddq);
-        for j in 0..n {
-            let dq = out.velocity[j];
-            out.velocity[j] = dq * speed;
-            out.acceleration[j] = dq * u + ddq[j] * speed * speed;
+        for ((v, a), dd) in out.velocity.iter_mut().zip(&mut out.acceleration).zip(&ddq) {
+            let dq = *v;
+            *v = dq * speed;
+            *a = dq * u + dd * speed * speed;
         }
         out
     }
@@ -208,12 +212,28 @@ impl TimedPath {
 }
 
 /// One linear constraint `a·u + b·x ≤ c` on an interval's path acceleration `u` and start
-/// `x = ṡ²`.
+/// `x = ṡ²`, scaled so that `a` is -1, 0 or 1 (the bound on `u` is then `a (c − b x)`, no
+/// division in the passes).
 #[derive(Debug, Clone, Copy)]
 struct Row {
     a: f64,
     b: f64,
     c: f64,
+}
+
+impl Row {
+    fn new(a: f64, b: f64, c: f64) -> Row {
+        if a == 0.0 {
+            Row { a, b, c }
+        } else {
+            let scale = 1.0 / a.abs();
+            Row {
+                a: a.signum(),
+                b: b * scale,
+                c: c * scale,
+            }
+        }
+    }
 }
 
 /// The time-optimal timing of `path` under `limits`, starting and ending at rest and
@@ -243,36 +263,27 @@ pub fn time_optimal(
             .iter()
             .any(|&p| (p - v).abs() <= 1e-12 * path.length().max(1.0))
     };
-    // constraints of each interval, independent of the controllable sets
-    let mut rows: Vec<Vec<Row>> = Vec::with_capacity(n);
+    // constraints of each interval, independent of the controllable sets: interval i's rows
+    // are rows[starts[i]..starts[i + 1]]
+    let mut rows: Vec<Row> = Vec::new();
+    let mut starts = Vec::with_capacity(n + 1);
     let mut bounds = Vec::new();
     for i in 0..n {
+        starts.push(rows.len());
         path.derivative_bounds(s[i], s[i + 1], &mut bounds);
-        rows.push(interval_rows(&bounds, limits, s[i + 1] - s[i]));
+        interval_rows(&bounds, limits, s[i + 1] - s[i], &mut rows);
     }
-    // backward pass: controllable sets [lo, hi] of x at every grid point
+    starts.push(rows.len());
+    let rows_of = |i: usize| &rows[starts[i]..starts[i + 1]];
+    // backward pass: controllable sets [0, hi] of x at every grid point (rest is always
+    // controllable: x = 0, u = 0 meets every row and reaches rest at the next point)
     let mut sets = vec![(0.0, 0.0); n + 1];
-    let mut scratch = Vec::new();
     for i in (0..n).rev() {
-        let delta = s[i + 1] - s[i];
-        let (lo, hi) = sets[i + 1];
-        scratch.clear();
-        scratch.extend_from_slice(&rows[i]);
-        scratch.push(Row {
-            a: 2.0 * delta,
-            b: 1.0,
-            c: hi,
-        });
-        scratch.push(Row {
-            a: -2.0 * delta,
-            b: -1.0,
-            c: -lo,
-        });
-        let (xlo, xhi) = feasible_x(&scratch);
+        let reach = Row::new(2.0 * (s[i + 1] - s[i]), 1.0, sets[i + 1].1);
         sets[i] = if at_stop(s[i]) {
             (0.0, 0.0)
         } else {
-            (xlo.max(0.0), xhi.max(0.0))
+            (0.0, largest_x(rows_of(i), reach))
         };
     }
     // forward pass: greatest path acceleration that stays controllable
@@ -283,8 +294,8 @@ pub fn time_optimal(
         let (lo, hi) = sets[i + 1];
         let mut top = (hi - x[i]) / (2.0 * delta);
         let mut bottom = (lo - x[i]) / (2.0 * delta);
-        for r in &rows[i] {
-            let limit = (r.c - r.b * x[i]) / r.a;
+        for r in rows_of(i) {
+            let limit = r.a * (r.c - r.b * x[i]);
             if r.a > 0.0 {
                 top = top.min(limit);
             } else if r.a < 0.0 {
@@ -330,7 +341,11 @@ fn grid(path: &BlendedPath, options: &TimingOptions) -> Vec<f64> {
     let mut s = vec![0.0];
     for w in breaks.windows(2) {
         let len = w[1] - w[0];
-        let count = ((len / step).ceil() as usize).max(options.min_per_piece.max(1));
+        // arcs: at most MAX_TURN of tangent turn per interval (the bounds stay tight)
+        let by_turn = (path.turn(w[0], w[1]) / MAX_TURN).ceil() as usize;
+        let count = ((len / step).ceil() as usize)
+            .max(options.min_per_piece.max(1))
+            .max(by_turn);
         for k in 1..=count {
             s.push(if k == count {
                 w[1]
@@ -344,86 +359,154 @@ fn grid(path: &BlendedPath, options: &TimingOptions) -> Vec<f64> {
 }
 
 /// The constraints of one interval of length `delta`, with `bounds` of each joint's
-/// `(q'min, q'max, q''min, q''max)` over it: speed within limits at both ends
-/// (`x_end = x + 2 δ u`), and for every corner of the derivative bounds, acceleration
+/// `(q'min, q'max, q''min, q''max)` over it, appended to `rows`: speed within limits at both ends
+/// (`x_end = x + 2 δ u`), and for the worst corners of the derivative bounds, acceleration
 /// `q' u + q'' ṡ²` within limits at both ends.
-fn interval_rows(bounds: &[[f64; 4]], limits: &JointLimits, delta: f64) -> Vec<Row> {
-    let mut rows = Vec::with_capacity(4 + 16 * bounds.len());
+fn interval_rows(bounds: &[[f64; 4]], limits: &JointLimits, delta: f64, rows: &mut Vec<Row>) {
     let mut speed_cap = f64::INFINITY;
+    let mut line_cap = f64::INFINITY;
     for (j, b) in bounds.iter().enumerate() {
         let p = b[0].abs().max(b[1].abs());
         if p > 0.0 {
             speed_cap = speed_cap.min((limits.velocity[j] / p).powi(2));
         }
         let a = limits.acceleration[j];
+        if b[2] == 0.0 && b[3] == 0.0 {
+            // a straight piece: |q'| u ≤ a, one bound on u
+            if p > 0.0 {
+                line_cap = line_cap.min(a / p);
+            }
+            continue;
+        }
+        // p u + c x' ≤ a with x' = ṡ² ≥ 0 is worst at c = q''max, and −a ≤ p u + c x' at
+        // c = q''min; either sign of u makes either bound of p the worst: both kept
         for &p in &[b[0], b[1]] {
-            for &c in &[b[2], b[3]] {
-                // at the start: |p u + c x| ≤ a; at the end: |(p + 2δc) u + c x| ≤ a
-                for (pu, cx) in [(p, c), (p + 2.0 * delta * c, c)] {
-                    if pu == 0.0 && cx == 0.0 {
+            for (sign, c) in [(1.0, b[3]), (-1.0, b[2])] {
+                // at the start: p u + c x; at the end: (p + 2δc) u + c x
+                for pu in [p, p + 2.0 * delta * c] {
+                    if pu == 0.0 && c == 0.0 {
                         continue;
                     }
-                    rows.push(Row { a: pu, b: cx, c: a });
-                    rows.push(Row {
-                        a: -pu,
-                        b: -cx,
-                        c: a,
-                    });
+                    rows.push(Row::new(sign * pu, sign * c, a));
                 }
             }
         }
     }
-    if speed_cap.is_finite() {
-        rows.push(Row {
-            a: 0.0,
-            b: 1.0,
-            c: speed_cap,
-        });
-        rows.push(Row {
-            a: 2.0 * delta,
-            b: 1.0,
-            c: speed_cap,
-        });
+    if line_cap.is_finite() {
+        rows.push(Row::new(1.0, 0.0, line_cap));
+        rows.push(Row::new(-1.0, 0.0, line_cap));
     }
-    rows.push(Row {
-        a: 0.0,
-        b: -1.0,
-        c: 0.0,
-    });
-    rows.push(Row {
-        a: -2.0 * delta,
-        b: -1.0,
-        c: 0.0,
-    });
-    rows
+    if speed_cap.is_finite() {
+        rows.push(Row::new(0.0, 1.0, speed_cap));
+        rows.push(Row::new(2.0 * delta, 1.0, speed_cap));
+    }
+    rows.push(Row::new(0.0, -1.0, 0.0));
+    rows.push(Row::new(-2.0 * delta, -1.0, 0.0));
 }
 
-/// The interval of `x` for which some `u` meets every row (Fourier–Motzkin elimination of
-/// `u`); `(0, 0)` when only rest is feasible or nothing is (rest always is on a path
-/// that ends at rest).
-fn feasible_x(rows: &[Row]) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-    let mut bound = |k: f64, m: f64| {
-        // k x ≤ m
-        if k > 0.0 {
-            hi = hi.min(m / k);
-        } else if k < 0.0 {
-            lo = lo.max(m / k);
-        } else if m < 0.0 {
-            hi = f64::NEG_INFINITY;
-        }
-    };
-    for r in rows.iter().filter(|r| r.a == 0.0) {
-        bound(r.b, r.c);
-    }
-    for p in rows.iter().filter(|r| r.a > 0.0) {
-        for q in rows.iter().filter(|r| r.a < 0.0) {
-            // u ≤ (c_p − b_p x)/a_p and u ≥ (c_q − b_q x)/a_q
-            // ⇒ (c_q − b_q x)/a_q ≤ (c_p − b_p x)/a_p
-            let k = p.b / p.a - q.b / q.a;
-            let m = p.c / p.a - q.c / q.a;
-            bound(k, m);
+/// The largest `x ≥ 0` for which some `u` meets every row (0 when only rest does). The rows
+/// bounding `u` from above (`a > 0`) and below (`a < 0`) give a concave gap
+/// `g(x) = min upper(x) − max lower(x)`; from the largest `x` the `u`-free rows allow, each step
+/// moves to where the two active rows meet, which for a concave piecewise-linear `g` reaches
+/// its largest root from the right in finitely many steps.
+fn largest_x(rows: &[Row], extra: Row) -> f64 {
+    let all = || rows.iter().chain(std::iter::once(&extra));
+    let mut x = f64::INFINITY;
+    for r in all().filter(|r| r.a == 0.0) {
+        if r.b > 0.0 {
+            x = x.min(r.c / r.b);
+        } else if r.b == 0.0 && r.c < 0.0 {
+            return 0.0;
         }
     }
-    if lo > hi { (0.0, 0.0) } else { (lo, hi) }
+    if !x.is_finite() {
+        // no speed cap: the rows bounding u still bound x; start far out
+        x = 1e12;
+    }
+    for _ in 0..rows.len() + 2 {
+        if x <= 0.0 {
+            return 0.0;
+        }
+        let (mut upper, mut lower) = ((f64::INFINITY, None), (f64::NEG_INFINITY, None));
+        for r in all() {
+            let bound = r.a * (r.c - r.b * x);
+            if r.a > 0.0 && bound < upper.0 {
+                upper = (bound, Some(r));
+            } else if r.a < 0.0 && bound > lower.0 {
+                lower = (bound, Some(r));
+            }
+        }
+        let (Some(p), Some(q)) = (upper.1, lower.1) else {
+            return x;
+        };
+        if upper.0 >= lower.0 - 1e-12 * (1.0 + upper.0.abs()) {
+            return x;
+        }
+        // where the active pair meets: k x = m (the gap of this pair falls as x grows when k > 0)
+        let k = p.b * p.a - q.b * q.a;
+        let m = p.c * p.a - q.c * q.a;
+        if k <= 0.0 {
+            return 0.0;
+        }
+        let next = m / k;
+        if next >= x {
+            return x;
+        }
+        if x - next <= 1e-12 * x {
+            // converged to rounding: the pair's root
+            return next.max(0.0);
+        }
+        x = next;
+    }
+    x.max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `largest_x` against a bisection on the feasibility of `u` (an independent check).
+    #[test]
+    fn the_largest_feasible_speed_matches_a_bisection() {
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..200 {
+            let mut rows: Vec<Row> = (0..12)
+                .map(|_| Row::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 3.0 + 0.1))
+                .collect();
+            rows.push(Row::new(0.0, 1.0, 5.0));
+            rows.push(Row::new(0.0, -1.0, 0.0));
+            let extra = Row::new(0.3, 1.0, 2.0);
+            let feasible = |x: f64| {
+                let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+                for r in rows.iter().chain([&extra]) {
+                    let v = (r.c - r.b * x) / r.a;
+                    if r.a > 0.0 {
+                        hi = hi.min(v);
+                    } else if r.a < 0.0 {
+                        lo = lo.max(v);
+                    } else if r.b * x > r.c + 1e-12 {
+                        return false;
+                    }
+                }
+                lo <= hi + 1e-12
+            };
+            // feasible x form an interval holding 0 (every c > 0): bisect its top
+            let (mut a, mut b) = (0.0, 5.0);
+            if feasible(b) {
+                a = b;
+            }
+            for _ in 0..100 {
+                let m = 0.5 * (a + b);
+                if feasible(m) { a = m } else { b = m }
+            }
+            let got = largest_x(&rows, extra);
+            assert!((got - a).abs() < 1e-9, "{got} vs {a}");
+        }
+    }
 }

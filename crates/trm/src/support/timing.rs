@@ -29,7 +29,7 @@ pub struct TimingArgs {
     pub acceleration_scaling: Option<f64>,
     /// Largest joint-space distance a blend may cut from a corner of the path, rad (blends
     /// that would collide are tightened); 0: stop at every waypoint.
-    #[arg(long, default_value_t = 0.1, value_parser = crate::parse::non_negative)]
+    #[arg(long, default_value_t = 0.2, value_parser = crate::parse::non_negative)]
     pub max_deviation: f64,
     /// Time between the trajectory's samples, s.
     #[arg(long, default_value_t = 0.01, value_parser = crate::parse::positive)]
