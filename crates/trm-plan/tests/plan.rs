@@ -85,7 +85,9 @@ fn check(planner: &mut Planner, start: &[f64], plan: &trm_plan::Planned, options
             );
             assert!(
                 a[j].abs() <= limits.acceleration[j] * (1.0 + 1e-6),
-                "sample {k}"
+                "sample {k}: joint {j} at {} for {}",
+                a[j],
+                limits.acceleration[j]
             );
         }
     }

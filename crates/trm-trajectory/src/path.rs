@@ -408,3 +408,49 @@ pub(crate) fn distance(a: &[f64], b: &[f64]) -> f64 {
         .sum::<f64>()
         .sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The derivative bounds of every grid interval hold the derivatives sampled densely.
+    #[test]
+    fn derivative_bounds_hold_the_sampled_derivatives() {
+        let waypoints = vec![
+            vec![0.0, 0.0, 0.0],
+            vec![1.0, 0.3, -0.2],
+            vec![1.2, 1.0, 0.4],
+            vec![0.2, 1.1, 0.9],
+            vec![0.3, 0.0, 0.0],
+        ];
+        let path = BlendedPath::new(&waypoints, 0.3).unwrap();
+        let mut bounds = Vec::new();
+        let (mut q, mut dq, mut ddq) = (vec![0.0; 3], vec![0.0; 3], vec![0.0; 3]);
+        for (_, range) in path.blends() {
+            let n = 7;
+            for k in 0..n {
+                let s0 = range.start + (range.end - range.start) * k as f64 / n as f64;
+                let s1 = range.start + (range.end - range.start) * (k + 1) as f64 / n as f64;
+                path.derivative_bounds(s0, s1, &mut bounds);
+                for m in 0..=100 {
+                    // within the piece: its end point belongs to the next one
+                    let s = s0 + (s1 - s0) * (m as f64 / 100.0).min(1.0 - 1e-9);
+                    path.evaluate(s, &mut q, &mut dq, &mut ddq);
+                    for j in 0..3 {
+                        let b = bounds[j];
+                        assert!(
+                            dq[j] >= b[0] - 1e-9 && dq[j] <= b[1] + 1e-9,
+                            "q' {j}: {} not in {b:?}",
+                            dq[j]
+                        );
+                        assert!(
+                            ddq[j] >= b[2] - 1e-9 && ddq[j] <= b[3] + 1e-9,
+                            "q'' {j}: {} not in {b:?}",
+                            ddq[j]
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

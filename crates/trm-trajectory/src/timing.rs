@@ -408,8 +408,43 @@ fn interval_rows(bounds: &[[f64; 4]], limits: &JointLimits, delta: f64, rows: &m
 /// bounding `u` from above (`a > 0`) and below (`a < 0`) give a concave gap
 /// `g(x) = min upper(x) − max lower(x)`; from the largest `x` the `u`-free rows allow, each step
 /// moves to where the two active rows meet, which for a concave piecewise-linear `g` reaches
-/// its largest root from the right in finitely many steps.
+/// its largest root from the right in finitely many steps. Where rounding stalls the steps
+/// short of a feasible `x` (rows of very different scales), bisection finishes below it.
 fn largest_x(rows: &[Row], extra: Row) -> f64 {
+    let x = newton_x(rows, extra);
+    if x <= 0.0 || feasible(rows, extra, x) {
+        return x;
+    }
+    let (mut lo, mut hi) = (0.0, x);
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if feasible(rows, extra, mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Whether some `u` meets every row at `x` (to rounding).
+fn feasible(rows: &[Row], extra: Row, x: f64) -> bool {
+    let (mut lower, mut upper) = (f64::NEG_INFINITY, f64::INFINITY);
+    for r in rows.iter().chain(std::iter::once(&extra)) {
+        let bound = r.a * (r.c - r.b * x);
+        if r.a > 0.0 {
+            upper = upper.min(bound);
+        } else if r.a < 0.0 {
+            lower = lower.max(bound);
+        } else if r.b * x > r.c + 1e-12 * (1.0 + r.c.abs()) {
+            return false;
+        }
+    }
+    lower <= upper + 1e-12 * (1.0 + upper.abs() + lower.abs())
+}
+
+/// [`largest_x`]'s steps from the top.
+fn newton_x(rows: &[Row], extra: Row) -> f64 {
     let all = || rows.iter().chain(std::iter::once(&extra));
     let mut x = f64::INFINITY;
     for r in all().filter(|r| r.a == 0.0) {

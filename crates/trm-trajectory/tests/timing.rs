@@ -178,8 +178,48 @@ fn distance(a: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
+/// A path the iCub's planner found (41 motors, most of them still): rows whose path
+/// acceleration term is tiny beside their speed term once stalled the exact LP's steps; the
+/// limits must hold anyway.
+#[test]
+fn a_41_motor_path_with_still_motors_keeps_its_limits() {
+    let text = include_str!("fixtures/icub_arm_path.json");
+    let waypoints: Vec<Vec<f64>> = text
+        .trim()
+        .trim_start_matches('[')
+        .trim_end_matches(']')
+        .split("], [")
+        .map(|r| r.split(", ").map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!((waypoints.len(), waypoints[0].len()), (7, 41));
+    let limits = JointLimits::new(vec![1.0; 41], vec![1.0; 41]).unwrap();
+    for deviation in [0.05, 0.2] {
+        let t = timed(&waypoints, deviation, &limits);
+        assert!(worst_excess(&t, &limits) <= 1e-6, "deviation {deviation}");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Paths of 12 joints, some of them still and some barely moving, limits apart by orders
+    /// of magnitude: every limit holds at 1 kHz.
+    #[test]
+    fn paths_with_still_and_slow_joints_keep_their_limits(
+        points in prop::collection::vec(prop::collection::vec(-2.0..2.0f64, 12), 3..7),
+        scale in prop::collection::vec(prop_oneof![Just(0.0), Just(1e-7), Just(1e-3), Just(1.0)], 12),
+        velocity in prop::collection::vec(0.1..10.0f64, 12),
+        acceleration in prop::collection::vec(0.1..50.0f64, 12),
+    ) {
+        let points: Vec<Vec<f64>> = points
+            .iter()
+            .map(|p| p.iter().zip(&scale).map(|(v, s)| v * s).collect())
+            .collect();
+        prop_assume!(points.windows(2).any(|w| distance(&w[0], &w[1]) > 1e-3));
+        let limits = JointLimits::new(velocity, acceleration).unwrap();
+        let t = timed(&points, 0.2, &limits);
+        prop_assert!(worst_excess(&t, &limits) <= 1e-6);
+    }
 
     /// Random paths and limits: every limit holds at 1 kHz; the reported velocities and
     /// accelerations are the derivatives of the reported positions; the path never leaves the
