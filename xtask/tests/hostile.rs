@@ -1,7 +1,7 @@
 //! The hostile-input battery: several hundred malformed files, flag values and output paths
 //! across the commands, each run through the `xtask` binary. Every one must end in a clear
-//! error: exit code 1–100, no panic, within 30 s, naming the file (or flag) at fault, and
-//! writing nothing.
+//! error: exit code 1–100, no panic, no hang (240 s, far above any case's time on a loaded
+//! machine), naming the file (or flag) at fault, and writing nothing.
 //!
 //! Files are mutated mechanically from valid ones (specs/, models/, and a map, posture and
 //! trajectory this test makes): every number of a file (or an even sample of them) replaced by a
@@ -30,7 +30,11 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Runs the binary with `args` in `dir`: (exit code, stderr, seconds); killed after 30 s.
+/// A command still running after this is taken for hung: far above any case's time on a
+/// loaded 2-core machine, so that the verdict never depends on speed.
+const HANG: Duration = Duration::from_secs(240);
+
+/// Runs the binary with `args` in `dir`: (exit code, stderr, seconds); killed after [`HANG`].
 fn run(dir: &Path, args: &[String]) -> (Option<i32>, String, f64) {
     let start = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_xtask"))
@@ -47,7 +51,7 @@ fn run(dir: &Path, args: &[String]) -> (Option<i32>, String, f64) {
         if let Some(status) = child.try_wait().expect("wait") {
             break status.code();
         }
-        if start.elapsed() > Duration::from_secs(30) {
+        if start.elapsed() > HANG {
             let _ = child.kill();
             let _ = child.wait();
             break None;
@@ -1041,6 +1045,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
         ("--max-deviation", &["-0.1", "inf"][..]),
         ("--sample-period", &["0", "NaN"][..]),
         ("--acceleration", &["0", "-2"][..]),
+        ("--jerk", &["0", "NaN"][..]),
     ] {
         cases.extend(flag_cases(&plan_request, flag, values));
     }
@@ -1683,7 +1688,7 @@ fn hostile_inputs_get_clear_errors_and_write_nothing() {
                     }
                     drop(slow);
                     let problem = match code {
-                        None => Some("no exit within 30 s (or killed)".to_string()),
+                        None => Some(format!("no exit within {} s (or killed)", HANG.as_secs())),
                         Some(0) => Some("accepted".to_string()),
                         Some(c) if c > 100 => Some(format!("exit code {c}")),
                         _ if stderr.contains("panicked") => Some("panicked".into()),

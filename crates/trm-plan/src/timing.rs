@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use trm_kinematics::{ActiveSet, MotionLimitSpec};
-use trm_trajectory::{BlendedPath, JointLimits, TimingOptions, time_optimal};
+use trm_trajectory::{BlendedPath, JointLimits, Sample, TimingOptions, jerk_limited, time_optimal};
 
 use crate::{PlanError, Trajectory};
 
@@ -26,6 +26,11 @@ pub struct Timing {
     pub default_velocity: f64,
     /// Joint acceleration where the robot gives none, rad/s² (MoveIt's default: 1).
     pub default_acceleration: f64,
+    /// Joint jerk where the robot gives none, rad/s³ (used by [`Timing::jerk_limited`]).
+    pub default_jerk: f64,
+    /// Keep jerk limits too: the motion stops at every waypoint, each segment a double-S
+    /// profile (no blends); off: time-optimal within velocity and acceleration limits.
+    pub jerk_limited: bool,
     /// Limits by motor name replacing the robot's (e.g. MoveIt's `joint_limits.yaml`).
     pub limits: BTreeMap<String, MotionLimitSpec>,
     /// Factor on every velocity limit, (0, 1] (MoveIt's `max_velocity_scaling_factor`).
@@ -47,6 +52,8 @@ impl Default for Timing {
         Timing {
             default_velocity: 1.0,
             default_acceleration: 1.0,
+            default_jerk: 10.0,
+            jerk_limited: false,
             limits: BTreeMap::new(),
             velocity_scaling: 1.0,
             acceleration_scaling: 1.0,
@@ -70,6 +77,7 @@ impl Timing {
         for (what, v, unit) in [
             ("default_velocity", self.default_velocity, "rad/s"),
             ("default_acceleration", self.default_acceleration, "rad/s²"),
+            ("default_jerk", self.default_jerk, "rad/s³"),
             ("sample_period", self.sample_period, "s"),
             ("resolution", self.resolution.unwrap_or(1.0), "rad"),
         ] {
@@ -127,6 +135,28 @@ impl Timing {
                 problem: format!("{e}: give finite positive limits in the model or the timing"),
             })
     }
+
+    /// The jerk limit of each of `active`'s motors: [`Timing::limits`], else the model
+    /// description's, else [`Timing::default_jerk`] (not scaled: MoveIt's requests scale
+    /// velocity and acceleration only).
+    pub fn jerk_limits(&self, active: &ActiveSet) -> Vec<f64> {
+        let motors = active.model().motors();
+        active
+            .motor_indices()
+            .iter()
+            .map(|&m| {
+                let motor = &motors[m];
+                self.limits
+                    .get(&motor.name)
+                    .and_then(|l| l.jerk)
+                    .or_else(|| {
+                        let j = motor.limits.jerk;
+                        (j.is_finite() && j > 0.0).then_some(j)
+                    })
+                    .unwrap_or(self.default_jerk)
+            })
+            .collect()
+    }
 }
 
 /// `waypoints` (active values, a collision-checked path) as a timed trajectory of `active`'s
@@ -138,33 +168,20 @@ pub fn timed(
     waypoints: &[Vec<f64>],
     timing: &Timing,
     resolution: f64,
-    mut segment_free: impl FnMut(&[f64], &[f64]) -> bool,
+    segment_free: impl FnMut(&[f64], &[f64]) -> bool,
 ) -> Result<Trajectory, PlanError> {
     let limits = timing.joint_limits(active)?;
     let invalid = |e: trm_trajectory::TrajectoryError| PlanError::InvalidOptions {
         what: "path".into(),
         problem: e.to_string(),
     };
-    let mut path = BlendedPath::new(waypoints, timing.max_deviation).map_err(invalid)?;
-    let floor = BLEND_FLOOR * resolution;
-    'check: loop {
-        for (corner, range) in path.blends() {
-            let steps = ((range.end - range.start) / resolution).ceil().max(1.0) as usize;
-            let mut previous = path.position(range.start);
-            for k in 1..=steps {
-                let next = path
-                    .position(range.start + (range.end - range.start) * k as f64 / steps as f64);
-                if !segment_free(&previous, &next) {
-                    path = path.tightened(waypoints, corner, floor).map_err(invalid)?;
-                    continue 'check;
-                }
-                previous = next;
-            }
-        }
-        break;
-    }
-    let timed = time_optimal(&path, &limits, &TimingOptions::default()).map_err(invalid)?;
-    let mut samples = timed.sampled(timing.sample_period).map_err(invalid)?;
+    let mut samples = if timing.jerk_limited {
+        jerk_limited(waypoints, &limits, &timing.jerk_limits(active))
+            .and_then(|m| m.sampled(timing.sample_period))
+            .map_err(invalid)?
+    } else {
+        blended(waypoints, &limits, timing, resolution, segment_free)?
+    };
     // the last sample is the goal itself, not the path's end rounded
     if let (Some(last), Some(goal)) = (samples.last_mut(), waypoints.last()) {
         last.position.clone_from(goal);
@@ -189,4 +206,39 @@ pub fn timed(
         accelerations: samples.iter().map(|s| rates(&s.acceleration)).collect(),
         task_path: Vec::new(),
     })
+}
+
+/// The samples of the time-optimal motion along `waypoints` with its corners blended where
+/// `segment_free` says the blends are free.
+fn blended(
+    waypoints: &[Vec<f64>],
+    limits: &JointLimits,
+    timing: &Timing,
+    resolution: f64,
+    mut segment_free: impl FnMut(&[f64], &[f64]) -> bool,
+) -> Result<Vec<Sample>, PlanError> {
+    let invalid = |e: trm_trajectory::TrajectoryError| PlanError::InvalidOptions {
+        what: "path".into(),
+        problem: e.to_string(),
+    };
+    let mut path = BlendedPath::new(waypoints, timing.max_deviation).map_err(invalid)?;
+    let floor = BLEND_FLOOR * resolution;
+    'check: loop {
+        for (corner, range) in path.blends() {
+            let steps = ((range.end - range.start) / resolution).ceil().max(1.0) as usize;
+            let mut previous = path.position(range.start);
+            for k in 1..=steps {
+                let next = path
+                    .position(range.start + (range.end - range.start) * k as f64 / steps as f64);
+                if !segment_free(&previous, &next) {
+                    path = path.tightened(waypoints, corner, floor).map_err(invalid)?;
+                    continue 'check;
+                }
+                previous = next;
+            }
+        }
+        break;
+    }
+    let timed = time_optimal(&path, limits, &TimingOptions::default()).map_err(invalid)?;
+    timed.sampled(timing.sample_period).map_err(invalid)
 }

@@ -146,3 +146,51 @@ fn a_planned_panda_motion_keeps_its_limits_and_stays_free_at_1_khz() {
     }
     assert!(distance(samples.last().unwrap(), &goal) == 0.0);
 }
+
+#[test]
+fn a_jerk_limited_motion_keeps_the_jerk_limits_and_the_path() {
+    let (robot, _) = panda();
+    let active = robot
+        .active_set(&["panda_arm"], &robot.neutral_motors())
+        .unwrap();
+    let waypoints = vec![
+        vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+        vec![0.8, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+        vec![0.8, 0.3, 0.2, -1.8, 0.0, 1.5, 0.7],
+    ];
+    let timing = Timing {
+        jerk_limited: true,
+        default_jerk: 5.0,
+        sample_period: 1e-3,
+        ..Default::default()
+    };
+    let t = trm_plan::timing::timed(&active, &waypoints, &timing, 0.01, |_, _| true).unwrap();
+    let optimal = trm_plan::timing::timed(
+        &active,
+        &waypoints,
+        &Timing {
+            jerk_limited: false,
+            ..timing.clone()
+        },
+        0.01,
+        |_, _| true,
+    )
+    .unwrap();
+    assert!(t.times.last() > optimal.times.last());
+    // the mean jerk over each millisecond (the accelerations' differences) within the limit
+    let accelerations: Vec<Vec<f64>> = t
+        .accelerations
+        .iter()
+        .map(|a| active.from_motors(a))
+        .collect();
+    for (w, dt) in accelerations.windows(2).zip(t.times.windows(2)) {
+        for (a1, a0) in w[1].iter().zip(&w[0]) {
+            let jerk = (a1 - a0) / (dt[1] - dt[0]);
+            assert!(jerk.abs() <= 5.0 * (1.0 + 1e-6), "{jerk}");
+        }
+    }
+    // on the polyline, never off it
+    for m in &t.positions {
+        assert!(off_polyline(&active.from_motors(m), &waypoints) < 1e-9);
+    }
+}

@@ -354,8 +354,10 @@ impl Planner {
     /// them; `velocity` and `acceleration` where neither gives one), each scaled by its factor
     /// in (0, 1] (a request's `max_*_scaling_factor` wins in `plan_request`), corners cut by
     /// blends of at most `max_deviation` rad that are collision-checked (0: stop at every
-    /// waypoint), sampled every `sample_period` s.
-    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.2, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None))]
+    /// waypoint), sampled every `sample_period` s. With `jerk_limited=True` the jerk is limited
+    /// too (`joint_limits`' `max_jerk`, the model's, else `jerk` rad/s³) and the motion stops
+    /// at every waypoint (a double-S profile per segment, no blends).
+    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.2, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None, jerk_limited = false, jerk = 10.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_timing(
         &mut self,
@@ -366,6 +368,8 @@ impl Planner {
         velocity: f64,
         acceleration: f64,
         joint_limits: Option<&str>,
+        jerk_limited: bool,
+        jerk: f64,
     ) -> PyResult<()> {
         let limits = match joint_limits {
             Some(path) => trm_moveit::JointLimitsFile::load(path).map_err(err)?.limits,
@@ -374,6 +378,8 @@ impl Planner {
         let timing = trm_plan::Timing {
             default_velocity: velocity,
             default_acceleration: acceleration,
+            default_jerk: jerk,
+            jerk_limited,
             limits,
             velocity_scaling,
             acceleration_scaling,

@@ -16,7 +16,9 @@
 //!   blends of bounded deviation;
 //! * [`time_optimal`]: its time-optimal timing under joint velocity and acceleration limits
 //!   ([`JointLimits`]) by reachability analysis (TOPP-RA), with constraints that hold over
-//!   whole grid intervals, so the [`TimedPath`] sampled at any rate keeps the limits.
+//!   whole grid intervals, so the [`TimedPath`] sampled at any rate keeps the limits;
+//! * [`jerk_limited`]: a motion that also keeps jerk limits, stopping at every waypoint with a
+//!   double-S profile per segment ([`StopAndGo`]).
 //!
 //! ```
 //! use trm_trajectory::RbfTrajectory;
@@ -30,9 +32,11 @@
 use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
 
+mod jerk;
 mod path;
 mod timing;
 
+pub use jerk::{StopAndGo, jerk_limited};
 pub use path::BlendedPath;
 pub use timing::{JointLimits, Sample, TimedPath, TimingOptions, time_optimal};
 

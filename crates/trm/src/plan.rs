@@ -455,6 +455,23 @@ fn run_without_maps(args: &Args) -> Result<()> {
             (r.velocity_scaling, r.acceleration_scaling)
         }))?;
     let trajectory = planner.trajectory(&found.path, &timing)?;
+    let duration = |t: &trm_plan::Trajectory| t.times.last().copied().unwrap_or(0.0);
+    let timed = if timing.jerk_limited {
+        let optimal = trm_plan::Timing {
+            jerk_limited: false,
+            ..timing.clone()
+        };
+        format!(
+            "{:.2} s jerk-limited, stopping at each waypoint ({:.2} s time-optimal without a jerk limit)",
+            duration(&trajectory),
+            duration(&planner.trajectory(&found.path, &optimal)?)
+        )
+    } else {
+        format!(
+            "{:.2} s time-optimal within velocity and acceleration limits",
+            duration(&trajectory)
+        )
+    };
     println!(
         "{}: {} of {} motors move; world: {} objects",
         robot.name(),
@@ -463,11 +480,10 @@ fn run_without_maps(args: &Args) -> Result<()> {
         planner.world().len()
     );
     println!(
-        "path: {} waypoints ({}), joint-space length {:.3} rad, duration {:.2} s",
+        "path: {} waypoints ({}), joint-space length {:.3} rad; motion: {timed}",
         found.path.len(),
         found.source.name(),
         trm_plan::rrt::path_length(&found.path),
-        trajectory.times.last().copied().unwrap_or(0.0)
     );
     println!(
         "planning: {:.2} ms, {} samples, {} configurations checked",

@@ -307,6 +307,11 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
     planner.set_timing(joint_limits=str(limits), max_deviation=0.0, velocity_scaling=0.5)
     slow = planner.plan_request(str(requests[0]))
     assert slow["times"][-1] > blended["times"][-1]
+    planner.set_timing(joint_limits=str(limits), jerk_limited=True, jerk=20.0, sample_period=0.001)
+    smooth = planner.plan_request(str(requests[0]))
+    jerk = np.diff(smooth["accelerations"], axis=0) / np.diff(smooth["times"])[:, None]
+    assert np.all(np.abs(jerk) <= 20.0 * (1 + 1e-6))
+    assert smooth["times"][-1] > blended["times"][-1]
     with pytest.raises(ValueError, match="velocity_scaling"):
         planner.set_timing(velocity_scaling=1.5)
     with pytest.raises(ValueError, match="no_such.yaml"):

@@ -31,6 +31,13 @@ pub struct TimingArgs {
     /// that would collide are tightened); 0: stop at every waypoint.
     #[arg(long, default_value_t = 0.2, value_parser = crate::parse::non_negative)]
     pub max_deviation: f64,
+    /// Keep jerk limits too (--joint-limits' max_jerk, the model's, else --jerk): the motion
+    /// stops at every waypoint with a double-S profile per segment, no blends.
+    #[arg(long)]
+    pub jerk_limited: bool,
+    /// Joint jerk where neither the model nor --joint-limits gives one, rad/s³.
+    #[arg(long, default_value_t = 10.0, value_parser = crate::parse::positive)]
+    pub jerk: f64,
     /// Time between the trajectory's samples, s.
     #[arg(long, default_value_t = 0.01, value_parser = crate::parse::positive)]
     pub sample_period: f64,
@@ -51,6 +58,8 @@ impl TimingArgs {
         Ok(Timing {
             default_velocity: self.velocity,
             default_acceleration: self.acceleration,
+            default_jerk: self.jerk,
+            jerk_limited: self.jerk_limited,
             velocity_scaling: self
                 .velocity_scaling
                 .or(request.0)
