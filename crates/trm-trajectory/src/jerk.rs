@@ -17,7 +17,7 @@
 //! ```
 
 use crate::path::distance;
-use crate::timing::Sample;
+use crate::timing::{Sample, sample_every};
 use crate::{JointLimits, TrajectoryError, invalid};
 
 /// A rest-to-rest double-S profile over a distance: seven phases of constant jerk.
@@ -152,23 +152,9 @@ impl StopAndGo {
     /// Samples every `period` seconds from 0, and the end (exactly the last waypoint, at
     /// rest).
     pub fn sampled(&self, period: f64) -> Result<Vec<Sample>, TrajectoryError> {
-        if !(period.is_finite() && period > 0.0) {
-            return Err(invalid(
-                "sample period",
-                format!("{period} s: give a finite positive period"),
-            ));
-        }
-        let d = self.duration();
-        let count = (d / period).floor() as usize;
-        let mut out: Vec<Sample> = (0..=count)
-            .map(|k| self.sample(k as f64 * period))
-            .collect();
-        if out.last().is_none_or(|l| l.time < d - 1e-12) {
-            out.push(self.sample(d));
-        }
+        let mut out = sample_every(self.duration(), period, |t| self.sample(t))?;
         if let Some(last) = out.last_mut() {
             last.position.clone_from(&self.end);
-            last.velocity.iter_mut().for_each(|v| *v = 0.0);
             last.acceleration.iter_mut().for_each(|a| *a = 0.0);
         }
         Ok(out)

@@ -193,22 +193,32 @@ impl TimedPath {
     /// Samples every `period` seconds from 0, and the end (so the last sample is at rest at
     /// the goal). `period` must be finite and positive.
     pub fn sampled(&self, period: f64) -> Result<Vec<Sample>, TrajectoryError> {
-        if !(period.is_finite() && period > 0.0) {
-            return Err(invalid(
-                "sample period",
-                format!("{period} s: give a finite positive period"),
-            ));
-        }
-        let d = self.duration();
-        let count = (d / period).floor() as usize;
-        let mut out: Vec<Sample> = (0..=count)
-            .map(|k| self.sample(k as f64 * period))
-            .collect();
-        if out.last().is_none_or(|l| l.time < d - 1e-12) {
-            out.push(self.sample(d));
-        }
-        Ok(out)
+        sample_every(self.duration(), period, |t| self.sample(t))
     }
+}
+
+/// `sample` every `period` seconds from 0 over `duration`, and at the end, where the motion is
+/// at rest (velocity exactly 0: the last interval's speed rounds to a few 1e-17).
+pub(crate) fn sample_every(
+    duration: f64,
+    period: f64,
+    sample: impl Fn(f64) -> Sample,
+) -> Result<Vec<Sample>, TrajectoryError> {
+    if !(period.is_finite() && period > 0.0) {
+        return Err(invalid(
+            "sample period",
+            format!("{period} s: give a finite positive period"),
+        ));
+    }
+    let count = (duration / period).floor() as usize;
+    let mut out: Vec<Sample> = (0..=count).map(|k| sample(k as f64 * period)).collect();
+    if out.last().is_none_or(|l| l.time < duration - 1e-12) {
+        out.push(sample(duration));
+    }
+    if let Some(last) = out.last_mut() {
+        last.velocity.iter_mut().for_each(|v| *v = 0.0);
+    }
+    Ok(out)
 }
 
 /// One linear constraint `a·u + b·x ≤ c` on an interval's path acceleration `u` and start

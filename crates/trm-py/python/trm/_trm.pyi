@@ -161,6 +161,19 @@ class Planner:
     def kept_paths(self) -> list[Array]: ...
     def save_experience(self, path: str) -> None: ...
     def load_experience(self, path: str) -> int: ...
+    def set_timing(
+        self,
+        *,
+        velocity_scaling: float = 1.0,
+        acceleration_scaling: float = 1.0,
+        max_deviation: float = 0.2,
+        sample_period: float = 0.01,
+        velocity: float = 1.0,
+        acceleration: float = 1.0,
+        joint_limits: str | None = None,
+        jerk_limited: bool = False,
+        jerk: float = 10.0,
+    ) -> None: ...
     def plan(
         self,
         to: ArrayLike,
