@@ -16,12 +16,13 @@ where SET_DIR holds one folder per family (unpack benches/mbm/panda_problems.tar
 import argparse
 import math
 import sys
-import tarfile
-import tempfile
 import time
 from pathlib import Path
 
 import trm
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from mbm_set import problems, unpacked  # noqa: E402
 
 
 def quantile(values, q):
@@ -31,16 +32,6 @@ def quantile(values, q):
     s = sorted(values)
     k = min(max(math.ceil(q * len(s)), 1), len(s))
     return s[k - 1]
-
-
-def problems(root):
-    """(family, number, scene, request) of every problem, families and numbers in order."""
-    for family in sorted(p for p in root.iterdir() if p.is_dir()):
-        for request in sorted(family.glob("request*.yaml")):
-            number = request.stem[len("request"):]
-            scene = family / f"scene{number}.yaml"
-            if scene.is_file():
-                yield family.name, int(number), scene, request
 
 
 def main():
@@ -53,15 +44,7 @@ def main():
     ap.add_argument("--csv", type=Path)
     args = ap.parse_args()
 
-    root = args.set
-    if root.suffix == ".bz2":
-        tmp = tempfile.TemporaryDirectory()
-        with tarfile.open(root) as t:
-            t.extractall(tmp.name, filter="data")
-        root = Path(tmp.name)
-        inner = [p for p in root.iterdir() if p.is_dir()]
-        if len(inner) == 1 and not any(inner[0].glob("request*.yaml")):
-            root = inner[0]
+    root = unpacked(args.set)
 
     robot = trm.Robot.load(args.model)
     all_problems = list(problems(root))

@@ -15,8 +15,6 @@ import argparse
 import math
 import statistics
 import sys
-import tarfile
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -27,18 +25,11 @@ import toppra.constraint as constraint
 import trm
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "python"))
+from mbm_set import problems, unpacked  # noqa: E402
 LIMITS = HERE / "panda_joint_limits.yaml"
 VELOCITY = [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61]
 ACCELERATION = [3.75, 1.875, 2.5, 3.125, 3.75, 5.0, 5.0]
-
-
-def problems(root):
-    for family in sorted(p for p in root.iterdir() if p.is_dir()):
-        for request in sorted(family.glob("request*.yaml")):
-            number = request.stem[len("request"):]
-            scene = family / f"scene{number}.yaml"
-            if scene.is_file():
-                yield family.name, scene, request
 
 
 def toppra_duration(points):
@@ -66,27 +57,18 @@ def main():
     ap.add_argument("--paths", type=int, default=100)
     ap.add_argument("--max-deviation", type=float, default=0.2)
     args = ap.parse_args()
-    root = args.set
-    if root.suffix == ".bz2":
-        tmp = tempfile.TemporaryDirectory()
-        with tarfile.open(root) as t:
-            t.extractall(tmp.name, filter="data")
-        root = Path(tmp.name)
-        inner = [p for p in root.iterdir() if p.is_dir()]
-        if len(inner) == 1 and not any(inner[0].glob("request*.yaml")):
-            root = inner[0]
-    all_problems = list(problems(root))
+    all_problems = list(problems(unpacked(args.set)))
     if not all_problems:
         sys.exit(f"{args.set}: no MotionBenchMaker problems")
     # spread the paths over the families
     step = max(1, len(all_problems) // args.paths)
     chosen = all_problems[::step][: args.paths]
     robot = trm.Robot.load(args.model)
-    planner = trm.Planner(robot, request=str(chosen[0][2]))
+    planner = trm.Planner(robot, request=str(chosen[0][3]))
     arm = [robot.motor_names.index(n) for n in planner.joint_names]
     ratios, blend_vs_stop, waypoints = [], [], []
     print("family,trm_s,toppra_s,ratio,stop_s,blend_over_stop,waypoints")
-    for family, scene, request in chosen:
+    for family, _, scene, request in chosen:
         planner.load_scene(str(scene))
         planner.set_timing(joint_limits=str(LIMITS), max_deviation=args.max_deviation)
         try:

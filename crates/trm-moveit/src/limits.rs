@@ -16,7 +16,7 @@ use crate::yaml::Node;
 pub struct JointLimitsFile {
     /// Limits by joint name (only those whose `has_*_limits` flag is true).
     pub limits: BTreeMap<String, MotionLimitSpec>,
-    /// `default_velocity_scaling_factor`.
+    /// `default_velocity_scaling_factor` (absent or 0: none).
     pub velocity_scaling: Option<f64>,
     /// `default_acceleration_scaling_factor`.
     pub acceleration_scaling: Option<f64>,
@@ -41,21 +41,8 @@ impl JointLimitsFile {
         let r = Reader { origin };
         let doc = r.parse(text)?;
         let mut out = JointLimitsFile::default();
-        for (key, slot) in [
-            ("default_velocity_scaling_factor", &mut out.velocity_scaling),
-            (
-                "default_acceleration_scaling_factor",
-                &mut out.acceleration_scaling,
-            ),
-        ] {
-            if let Some(f) = doc.get(key) {
-                let v = r.number(f, key)?;
-                if !(v > 0.0 && v <= 1.0) {
-                    return Err(r.err(f.line, format!("{key} is {v}"), "give a factor in (0, 1]"));
-                }
-                *slot = Some(v);
-            }
-        }
+        out.velocity_scaling = r.factor(&doc, "default_velocity_scaling_factor")?;
+        out.acceleration_scaling = r.factor(&doc, "default_acceleration_scaling_factor")?;
         let joints = r.field(&doc, "joint_limits", "the file")?;
         let crate::yaml::Value::Map(entries) = &joints.value else {
             return Err(r.err(

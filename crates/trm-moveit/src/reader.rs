@@ -97,6 +97,23 @@ impl Reader<'_> {
             })
     }
 
+    /// The scaling factor `key` of `node`: absent or 0 is `None` (the full limits), else a
+    /// number in (0, 1].
+    pub(crate) fn factor(&self, node: &Node, key: &str) -> Result<Option<f64>, MoveItError> {
+        let Some(f) = node.get(key) else {
+            return Ok(None);
+        };
+        let v = self.number(f, key)?;
+        if !(0.0..=1.0).contains(&v) {
+            return Err(self.err(
+                f.line,
+                format!("{key} is {v}"),
+                "give a factor in (0, 1] (0: the full limits)",
+            ));
+        }
+        Ok((v > 0.0).then_some(v))
+    }
+
     pub(crate) fn numbers(&self, node: &Node, what: &str) -> Result<Vec<f64>, MoveItError> {
         self.seq(node, what)?
             .iter()

@@ -405,25 +405,8 @@ impl MotionPlanRequest {
             }
             request.planning_time = (v > 0.0).then_some(v);
         }
-        for (key, slot) in [
-            ("max_velocity_scaling_factor", &mut request.velocity_scaling),
-            (
-                "max_acceleration_scaling_factor",
-                &mut request.acceleration_scaling,
-            ),
-        ] {
-            if let Some(f) = doc.get(key) {
-                let v = r.number(f, key)?;
-                if !(0.0..=1.0).contains(&v) {
-                    return Err(r.err(
-                        f.line,
-                        format!("{key} is {v}"),
-                        "give a factor in (0, 1] (0: the full limits)",
-                    ));
-                }
-                *slot = (v > 0.0).then_some(v);
-            }
-        }
+        request.velocity_scaling = r.factor(&doc, "max_velocity_scaling_factor")?;
+        request.acceleration_scaling = r.factor(&doc, "max_acceleration_scaling_factor")?;
         Ok(request)
     }
 

@@ -451,6 +451,28 @@ pub fn run_scenario(
             "give the scenario's objects other names".into(),
         ));
     }
+    // an object present at the start must leave the robot's start posture free (one that
+    // swallows the robot later makes the steps report a failed plan and the robot stay)
+    let mut scratch = objective.scratch();
+    let start_free = objective.is_collision_free_in(&problem.start, &base, &mut scratch);
+    for (i, o) in scenario.objects.iter().enumerate() {
+        if !start_free || o.appear > 0.0 || o.vanish.is_some_and(|v| v <= 0.0) {
+            continue;
+        }
+        let mut alone = base.clone();
+        let placed = alone.add(&o.name, o.shape.clone(), pose_at(&o.path, 0.0));
+        if placed.is_ok() && !objective.is_collision_free_in(&problem.start, &alone, &mut scratch) {
+            return Err(scenario.error(
+                &format!("objects[{i}].path"),
+                format!(
+                    "`{}` collides with the robot's start posture at t = 0",
+                    o.name
+                ),
+                "place it clear of the robot at t = 0, let it appear later, or start elsewhere"
+                    .into(),
+            ));
+        }
+    }
     let mut live = LiveMap::new(map, problem)?;
     let dt = 1.0 / scenario.rate;
     let repair = RepairOptions {
@@ -459,7 +481,6 @@ pub fn run_scenario(
         refill: false,
     };
     let mut q = problem.start.clone();
-    let mut scratch = objective.scratch();
     let mut motion: Option<Motion> = None;
     // the goal of the last planning attempt, successful or not
     let mut tried: Option<Vec<f64>> = None;

@@ -138,6 +138,25 @@ fn a_scenario_run_keeps_the_map_valid_reaches_goals_and_is_reproducible() {
     ] {
         assert!(run_scenario(&map, &problem, &scenario, &bad).is_err());
     }
+    // an object that swallows the robot at its start is named, not stepped through
+    let text = std::fs::read_to_string(root().join("specs/scenarios/sliding_box.ron")).unwrap();
+    let swallowing = text.replace(
+        "(t: 0.0, xyz: (-0.24, 0.3, -0.06))],\n            appear: 2.0,",
+        "(t: 0.0, xyz: (0.0, 0.0, 0.0))],",
+    );
+    let swallowing = swallowing.replace(
+        "Cylinder(radius: 0.03, length: 0.12)",
+        "Sphere(radius: 0.5)",
+    );
+    assert_ne!(swallowing, text);
+    let scenario_in = Scenario::from_ron(&swallowing, "swallow.ron").unwrap();
+    let e = run_scenario(&map, &problem, &scenario_in, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("swallow.ron") && e.contains("objects[1].path") && e.contains("`can` collides"),
+        "{e}"
+    );
     let run = run_scenario(&map, &problem, &scenario, &options).unwrap();
     assert_eq!(run.steps.len(), scenario.steps());
     assert_eq!(run.motion.positions.len(), run.steps.len());

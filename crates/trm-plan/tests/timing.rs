@@ -18,6 +18,21 @@ fn panda() -> (RobotModel, CollisionModel) {
     (robot, collision)
 }
 
+/// The Panda's arm and a path of two segments turning a corner (the second also moving joint 3
+/// by `twist`).
+fn arm_corner(twist: f64) -> (trm_kinematics::ActiveSet, Vec<Vec<f64>>) {
+    let (robot, _) = panda();
+    let active = robot
+        .active_set(&["panda_arm"], &robot.neutral_motors())
+        .unwrap();
+    let waypoints = vec![
+        vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+        vec![0.8, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+        vec![0.8, 0.3, twist, -2.0 + twist, 0.0, 1.5, 0.7],
+    ];
+    (active, waypoints)
+}
+
 fn distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
@@ -49,15 +64,7 @@ fn off_polyline(p: &[f64], waypoints: &[Vec<f64>]) -> f64 {
 
 #[test]
 fn a_blend_that_is_not_free_is_tightened_until_it_is() {
-    let (robot, _) = panda();
-    let active = robot
-        .active_set(&["panda_arm"], &robot.neutral_motors())
-        .unwrap();
-    let waypoints = vec![
-        vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
-        vec![0.8, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
-        vec![0.8, 0.3, 0.0, -2.0, 0.0, 1.5, 0.7],
-    ];
+    let (active, waypoints) = arm_corner(0.0);
     let timing = Timing::default();
     let deviation = |t: &trm_plan::Trajectory| {
         t.positions
@@ -149,15 +156,7 @@ fn a_planned_panda_motion_keeps_its_limits_and_stays_free_at_1_khz() {
 
 #[test]
 fn a_jerk_limited_motion_keeps_the_jerk_limits_and_the_path() {
-    let (robot, _) = panda();
-    let active = robot
-        .active_set(&["panda_arm"], &robot.neutral_motors())
-        .unwrap();
-    let waypoints = vec![
-        vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
-        vec![0.8, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
-        vec![0.8, 0.3, 0.2, -1.8, 0.0, 1.5, 0.7],
-    ];
+    let (active, waypoints) = arm_corner(0.2);
     let timing = Timing {
         jerk_limited: true,
         default_jerk: 5.0,

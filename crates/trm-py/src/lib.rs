@@ -56,7 +56,8 @@ fn err(e: impl std::fmt::Display) -> PyErr {
     TrmError::new_err(e.to_string())
 }
 
-/// `obj` as a C-contiguous float64 array (lists and other sequences are converted).
+/// `obj` as a C-contiguous float64 array (lists and other sequences are converted; complex
+/// values are refused).
 fn float_array<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
     // the common case without a call into Python: already a contiguous float64 array
     if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>()
@@ -65,6 +66,12 @@ fn float_array<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArrayDyn<'py,
         return Ok(a);
     }
     let np = obj.py().import("numpy")?;
+    // numpy would drop an imaginary part with only a warning
+    if np.call_method1("iscomplexobj", (obj,))?.is_truthy()? {
+        return Err(err(
+            "complex values: give real numbers (take .real if the imaginary parts are 0)",
+        ));
+    }
     let a = np
         .call_method1("ascontiguousarray", (obj, "float64"))
         .map_err(|e| err(format!("expected numbers: {e}")))?;

@@ -56,10 +56,17 @@ impl Optimizer {
         shaped(py, None, &[rows, d], flat)
     }
 
-    /// The values of the last `ask`'s candidates, in order.
+    /// The values of the last `ask`'s candidates, in order: numbers, or `inf` for a candidate
+    /// that could not be evaluated (it ranks last); NaN and `-inf` are refused.
     fn tell(&self, values: &Bound<'_, PyAny>) -> PyResult<()> {
         let f = float_array(values)?;
         let f = f.as_slice().map_err(err)?;
+        if let Some(i) = f.iter().position(|v| v.is_nan() || *v == f64::NEG_INFINITY) {
+            return Err(err(format!(
+                "values[{i}] is {}: give every candidate a number (inf for one that cannot be evaluated)",
+                f[i]
+            )));
+        }
         self.with(|o, _| o.tell(f)).map_err(err)
     }
 

@@ -149,6 +149,11 @@ impl Problem {
     /// reports it (`Objective::clearance_in`); values above `cap` metres are given as `cap`.
     #[pyo3(signature = (q, world = None, cap = 0.5))]
     fn clearance(&self, q: &Bound<'_, PyAny>, world: Option<&PyWorld>, cap: f64) -> PyResult<f64> {
+        if cap.is_nan() || cap <= 0.0 {
+            return Err(err(format!(
+                "cap: {cap} m; give a positive distance (inf for no cap)"
+            )));
+        }
         let o = &self.problem.objective;
         let w = world.map_or(o.world(), |w| &w.world);
         let (values, batch) = configurations(q, o.dim(), "q")?;

@@ -42,9 +42,16 @@ pub struct Solution {
 }
 
 /// The optimiser's start for `objective` from the active values `start` with the solver
-/// settings: mean `start`, step `solver.sigma`, the motor limits as bounds, the spec's budgets.
+/// settings: mean `start`, step `solver.sigma`, the motor limits as bounds, the spec's budgets
+/// (an evaluation budget of 0 is an error).
 /// Build your own [`Optimizer`] from it and hand it to [`solve_with`].
 pub fn solver_start(objective: &Objective, start: &[f64], solver: &SolverSpec) -> Result<Start> {
+    if solver.max_evaluations == 0 {
+        return Err(crate::TaskError::Invalid {
+            what: "max_evaluations".into(),
+            problem: "0: give an evaluation budget of at least 1".into(),
+        });
+    }
     let (lower, upper) = objective.active().bounds();
     Ok(Start::new(start.to_vec(), solver.sigma)
         .with_bounds(Bounds::new(lower, upper)?)

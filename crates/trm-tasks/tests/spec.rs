@@ -122,6 +122,22 @@ fn bad_values_are_errors() {
             "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Position(part: \"tool\"))])",
             "missing field `target`",
         ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], start_values: {\"joint2\": 3.0})",
+            "start_values.joint2: 3 is outside `joint2`'s limits [-2.5, 2.5]",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], start_values: {\"joint1\": NaN})",
+            "NaN is outside",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], active: [\"joint1\", \"joint2\", \"joint1\"])",
+            "active[2]: `joint1` is given twice (also active[0])",
+        ),
+        (
+            "(model: \"planar_arm\", costs: [(weight: 1.0, cost: Displacement)], solver: (max_evaluations: 0))",
+            "max_evaluations",
+        ),
     ] {
         let e = error(text);
         assert!(e.contains(says), "{text}\n→ {e}");

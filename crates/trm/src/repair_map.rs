@@ -49,6 +49,13 @@ pub fn run(args: &Args) -> Result<()> {
         .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("{}: the spec stored in the map", args.map.display()))?;
     let world = trm_moveit::load_world(&args.world)?;
+    for name in covering_the_start(&problem, &world) {
+        println!(
+            "note: {}: `{name}` collides with the robot at the map's start posture (the spec's \
+             start): the map is repaired around it, but plans from that start will be refused",
+            args.world.display()
+        );
+    }
     let out = args.out_path();
     let pool = crate::thread_pool(args.threads)?;
     let started = Instant::now();
@@ -91,4 +98,20 @@ pub fn run(args: &Args) -> Result<()> {
     crate::write_atomic(&out, repaired.to_json(&out)?.as_bytes())?;
     println!("wrote {}", out.display());
     Ok(())
+}
+
+/// The objects of `world` that, each alone, collide with the robot at `problem`'s start.
+fn covering_the_start(problem: &trm_tasks::Problem, world: &trm_collision::World) -> Vec<String> {
+    let objective = &problem.objective;
+    let mut scratch = objective.scratch();
+    world
+        .objects()
+        .iter()
+        .filter(|o| {
+            let mut alone = trm_collision::World::new();
+            alone.add(o.name(), o.shape().clone(), *o.pose()).is_ok()
+                && !objective.is_collision_free_in(&problem.start, &alone, &mut scratch)
+        })
+        .map(|o| o.name().to_string())
+        .collect()
 }

@@ -256,3 +256,55 @@ fn plan_answers_a_task_space_request() {
     assert!(stdout.contains("7 of 7 motors move") && dir.join("pose.csv").is_file());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A world that swallows the robot at the map's start: the repair runs and says which object
+/// covers the start (issue 49's round 4: it used to pass without a word).
+#[test]
+fn a_repair_world_covering_the_start_is_named() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-repair-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron");
+    let built = trm(
+        &[
+            "build-map",
+            spec.to_str().unwrap(),
+            "--points",
+            "4",
+            "--out",
+            "map.json",
+        ],
+        &dir,
+    );
+    assert!(
+        built.status.success(),
+        "{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    std::fs::write(
+        dir.join("swallow.ron"),
+        "(objects: [(name: \"blob\", shape: Sphere(radius: 0.6), xyz: (0.0, 0.0, 0.0))])",
+    )
+    .unwrap();
+    let repaired = trm(
+        &[
+            "repair-map",
+            "map.json",
+            "--world",
+            "swallow.ron",
+            "--out",
+            "r.map.json",
+        ],
+        &dir,
+    );
+    let out = String::from_utf8_lossy(&repaired.stdout);
+    assert!(
+        repaired.status.success(),
+        "{}",
+        String::from_utf8_lossy(&repaired.stderr)
+    );
+    assert!(
+        out.contains("swallow.ron: `blob` collides with the robot"),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -450,6 +450,11 @@ def test_the_ompl_comparison_runs(capsys, monkeypatch):
         (lambda r, d: trm.World().add_box(" ", [1, 1, 1], [0, 0, 0]), "visible character"),
         (lambda r, d: trm.Roadmap.load(str(Path(d) / "missing.json")), "missing.json"),
         (lambda r, d: trm.Roadmap.build(SPEC, points=0), "0 points"),
+        # round 4 (issue 49): each once accepted without a word
+        (lambda r, d: r.fk(np.zeros(41) + 0.5j), "complex values"),
+        (lambda r, d: trm.minimize(lambda x: float("nan"), [0, 0], 1.0), r"fun returned nan at x = \["),
+        (lambda r, d: trm.Problem.load(SPEC).solve(max_evals=0), "max_evaluations: 0"),
+        (lambda r, d: trm.Problem.load(SPEC).clearance(trm.Problem.load(SPEC).start, cap=-0.1), "cap"),
     ],
 )
 def test_bad_input_is_a_located_error(robot, tmp_path, call, message):
@@ -459,9 +464,17 @@ def test_bad_input_is_a_located_error(robot, tmp_path, call, message):
 
 def test_an_optimiser_refuses_values_for_other_candidates():
     opt = trm.Optimizer("xnes", [0.0, 0.0], 1.0)
-    opt.ask()
+    xs = opt.ask()
     with pytest.raises(trm.TrmError, match="fitness values"):
         opt.tell([1.0])
+    values = np.ones(len(xs))
+    values[2] = np.nan
+    with pytest.raises(trm.TrmError, match=r"values\[2\] is NaN"):
+        opt.tell(values)
+    # inf is a candidate that could not be evaluated: it ranks last
+    values[2] = np.inf
+    opt.tell(values)
+    assert opt.evaluations == len(xs) and opt.best_f == 1.0
     world = trm.World()
     world.add_box("a", [1, 1, 1], [0, 0, 0])
     with pytest.raises(trm.TrmError, match="already exists"):

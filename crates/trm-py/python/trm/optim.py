@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Callable
 
-from ._trm import ALGORITHMS, Optimizer, compare_optimisers, minimize_constrained
+from ._trm import ALGORITHMS, Optimizer, TrmError, compare_optimisers, minimize_constrained
 
 __all__ = ["ALGORITHMS", "Optimizer", "compare_optimisers", "minimize", "minimize_constrained"]
 
@@ -28,8 +28,8 @@ def minimize(
     """Minimises ``fun`` from ``x0`` (step ``sigma``) with a trm-optim algorithm.
 
     ``fun`` takes one point ``(d,)`` and returns a float or, with ``batch=True``, takes the
-    whole population ``(λ, d)`` and returns ``(λ,)`` values. Returns ``(best_x, best_f,
-    evaluations)``.
+    whole population ``(λ, d)`` and returns ``(λ,)`` values (``inf`` for a point that cannot
+    be evaluated; NaN is an error naming the point). Returns ``(best_x, best_f, evaluations)``.
     """
     import numpy as np
 
@@ -40,5 +40,12 @@ def minimize(
             values = np.asarray(fun(xs), dtype=float)
         else:
             values = np.array([fun(x) for x in xs], dtype=float)
+        bad = np.flatnonzero(np.isnan(values) | (values == -np.inf))
+        if bad.size:
+            i = int(bad[0])
+            raise TrmError(
+                f"fun returned {values[i]} at x = {xs[i].tolist()} (evaluation {opt.evaluations + i + 1}): "
+                "return a number, or inf for a point that cannot be evaluated"
+            )
         opt.tell(values)
     return opt.best_x, opt.best_f, opt.evaluations

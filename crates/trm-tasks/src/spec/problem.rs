@@ -142,12 +142,30 @@ impl Problem {
                     ),
                 )
             })?;
+            let limits = &robot.motors()[i].limits;
+            if !(v.is_finite() && *v >= limits.lower && *v <= limits.upper) {
+                return Err(ctx.err(
+                    &format!("start_values.{name}"),
+                    format!(
+                        "{v} is outside `{name}`'s limits [{}, {}]",
+                        limits.lower, limits.upper
+                    ),
+                    "give a start value within the motor's limits",
+                ));
+            }
             motors[i] = *v;
         }
         let active = if spec.active.is_empty() {
             robot.all_active()
         } else {
             for (i, name) in spec.active.iter().enumerate() {
+                if let Some(first) = spec.active[..i].iter().position(|n| n == name) {
+                    return Err(ctx.err(
+                        &format!("active[{i}]"),
+                        format!("`{name}` is given twice (also active[{first}])"),
+                        "name each motor or group once (groups that share motors are joined)",
+                    ));
+                }
                 if robot.select_motors(&[name]).is_err() {
                     let candidates = robot
                         .motors()
