@@ -40,9 +40,11 @@ impl JointLimitsFile {
     pub fn parse(text: &str, origin: &Path) -> Result<Self, MoveItError> {
         let r = Reader { origin };
         let doc = r.parse(text)?;
-        let mut out = JointLimitsFile::default();
-        out.velocity_scaling = r.factor(&doc, "default_velocity_scaling_factor")?;
-        out.acceleration_scaling = r.factor(&doc, "default_acceleration_scaling_factor")?;
+        let mut out = JointLimitsFile {
+            limits: Default::default(),
+            velocity_scaling: r.factor(&doc, "default_velocity_scaling_factor")?,
+            acceleration_scaling: r.factor(&doc, "default_acceleration_scaling_factor")?,
+        };
         let joints = r.field(&doc, "joint_limits", "the file")?;
         let crate::yaml::Value::Map(entries) = &joints.value else {
             return Err(r.err(
