@@ -171,10 +171,12 @@ pub fn timed(
     segment_free: impl FnMut(&[f64], &[f64]) -> bool,
 ) -> Result<Trajectory, PlanError> {
     let limits = timing.joint_limits(active)?;
-    let invalid = |e: trm_trajectory::TrajectoryError| PlanError::InvalidOptions {
-        what: "path".into(),
-        problem: e.to_string(),
-    };
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(PlanError::InvalidOptions {
+            what: "resolution".into(),
+            problem: format!("{resolution} rad: give a finite positive gap between checks"),
+        });
+    }
     let mut samples = if timing.jerk_limited {
         jerk_limited(waypoints, &limits, &timing.jerk_limits(active))
             .and_then(|m| m.sampled(timing.sample_period))
@@ -208,6 +210,14 @@ pub fn timed(
     })
 }
 
+/// A path the timing refuses, as the planner's error.
+fn invalid(e: trm_trajectory::TrajectoryError) -> PlanError {
+    PlanError::InvalidOptions {
+        what: "path".into(),
+        problem: e.to_string(),
+    }
+}
+
 /// The samples of the time-optimal motion along `waypoints` with its corners blended where
 /// `segment_free` says the blends are free.
 fn blended(
@@ -217,10 +227,6 @@ fn blended(
     resolution: f64,
     mut segment_free: impl FnMut(&[f64], &[f64]) -> bool,
 ) -> Result<Vec<Sample>, PlanError> {
-    let invalid = |e: trm_trajectory::TrajectoryError| PlanError::InvalidOptions {
-        what: "path".into(),
-        problem: e.to_string(),
-    };
     let mut path = BlendedPath::new(waypoints, timing.max_deviation).map_err(invalid)?;
     let floor = BLEND_FLOOR * resolution;
     'check: loop {

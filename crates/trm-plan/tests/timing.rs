@@ -193,3 +193,19 @@ fn a_jerk_limited_motion_keeps_the_jerk_limits_and_the_path() {
         assert!(off_polyline(&active.from_motors(m), &waypoints) < 1e-9);
     }
 }
+
+#[test]
+fn a_bad_check_resolution_is_refused_not_looped_on() {
+    let (active, waypoints) = arm_corner(0.0);
+    for resolution in [0.0, -1.0, f64::NAN] {
+        let e = trm_plan::timing::timed(
+            &active,
+            &waypoints,
+            &Timing::default(),
+            resolution,
+            |_, _| true,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("resolution"), "{e}");
+    }
+}
