@@ -6,6 +6,7 @@ use std::sync::Arc;
 use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
 use crate::batch::PlacedBatch;
+use crate::certify::Certifier;
 use crate::edge::{edge_steps, rake, span_steps};
 use crate::error::Result;
 use crate::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
@@ -48,8 +49,12 @@ pub struct WorldChecker {
     engine: Engine,
     /// The points of the edge being checked.
     samples: Vec<f64>,
+    /// With it, an edge free at its points must also be proved free in continuous motion.
+    certifier: Option<Box<Certifier>>,
     /// Configurations checked so far (each point of an edge is one).
     pub checks: u64,
+    /// Edges proved free, or refused, by the certifier so far.
+    pub certified: u64,
 }
 
 /// How a [`WorldChecker`] checks.
@@ -100,7 +105,9 @@ impl WorldChecker {
             world,
             engine,
             samples: Vec::new(),
+            certifier: None,
             checks: 0,
+            certified: 0,
         })
     }
 
@@ -124,6 +131,20 @@ impl WorldChecker {
             *fast_world = checker.model().world(&world);
         }
         self.world = world;
+    }
+
+    /// Certified edges ([`Certifier`], made for the same robot and active set): with one, every
+    /// edge check but [`WorldChecker::edge_midpoints_free`] also proves the edge free in
+    /// continuous motion once its points are free, and refuses an edge it cannot prove; `None`
+    /// checks edges at their points only.
+    /// Returns the certifier it had.
+    pub fn set_certifier(&mut self, certifier: Option<Certifier>) -> Option<Certifier> {
+        std::mem::replace(&mut self.certifier, certifier.map(Box::new)).map(|c| *c)
+    }
+
+    /// The certifier edges are proved with, if any.
+    pub fn certifier(&self) -> Option<&Certifier> {
+        self.certifier.as_deref()
     }
 
     /// Whether the single-precision screen checks this robot.
@@ -184,7 +205,7 @@ impl WorldChecker {
     pub fn edge_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let steps = edge_steps(a, b, resolution);
         // interior points 1..steps (0 and steps are the checked ends)
-        self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64)
+        self.rake(a, b, steps - 1, |i| (i + 1) as f64 / steps as f64) && self.proved(a, b)
     }
 
     /// Whether the straight edge a → b is free at every `resolution` and at `b` (`a` is not
@@ -193,7 +214,7 @@ impl WorldChecker {
     pub fn edge_and_end_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let steps = edge_steps(a, b, resolution);
         // from b back towards a: b first, where an extension usually fails
-        self.rake(a, b, steps, |i| (steps - i) as f64 / steps as f64)
+        self.rake(a, b, steps, |i| (steps - i) as f64 / steps as f64) && self.proved(a, b)
     }
 
     /// Whether the points halfway between those [`WorldChecker::edge_free`] checks at
@@ -208,14 +229,25 @@ impl WorldChecker {
     /// `resolution` apart in Euclidean distance ([`edge_steps`]).
     pub fn segment_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let steps = edge_steps(a, b, resolution);
-        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64)
+        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64) && self.proved(a, b)
     }
 
     /// Whether the straight segment a → b is free, both ends included, at points along which no
     /// coordinate moves more than `resolution` ([`span_steps`]: a roadmap's edges).
     pub fn span_free(&mut self, a: &[f64], b: &[f64], resolution: f64) -> bool {
         let steps = span_steps(a, b, resolution);
-        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64)
+        self.rake(a, b, steps + 1, |s| s as f64 / steps as f64) && self.proved(a, b)
+    }
+
+    /// Whether the certifier, if there is one, proves the edge a → b free.
+    fn proved(&mut self, a: &[f64], b: &[f64]) -> bool {
+        match &mut self.certifier {
+            Some(certifier) => {
+                self.certified += 1;
+                certifier.segment_unchecked(&self.world, a, b).is_free()
+            }
+            None => true,
+        }
     }
 
     /// Whether the `n` points a + at(i)·(b − a), i < n, are free, visited raked.

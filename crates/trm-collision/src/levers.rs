@@ -17,6 +17,12 @@ use crate::{CollisionModel, Result};
 pub struct Levers {
     /// `(link index, λ per active coordinate)`, for the links that have bodies.
     links: Vec<(usize, Vec<f64>)>,
+    /// Per link with bodies (indexed by link): its chain to the root, each movable joint's tree
+    /// index and joint-value index with the displacement of the link's points per unit of that
+    /// joint's value.
+    chains: Vec<Vec<(usize, usize, f64)>>,
+    /// Per joint value: `|∂ joint value / ∂ active coordinate|` for each active coordinate.
+    slopes: Vec<Vec<f64>>,
     /// The number of active coordinates.
     coordinates: usize,
 }
@@ -50,6 +56,7 @@ impl Levers {
             }
         }
         let mut links = Vec::new();
+        let mut chains = vec![Vec::new(); tree.links.len()];
         for (link, e) in extent.iter().enumerate() {
             let Some(e) = *e else { continue };
             let mut lambda = vec![0.0; n];
@@ -66,10 +73,12 @@ impl Levers {
                     for (l, &slope) in lambda.iter_mut().zip(&slopes[c]) {
                         *l += slope * per_unit;
                     }
+                    chains[link].push((j, c, per_unit));
                 }
                 arm += joint.local_origin.translation.vector.norm();
                 if joint.kind == JointKind::Prismatic {
-                    arm += joint.limits.lower.abs().max(joint.limits.upper.abs());
+                    arm += joint.limits.lower.abs().max(joint.limits.upper.abs())
+                        + crate::certify::TRAVEL_SLACK;
                 }
                 child = joint.parent;
             }
@@ -77,6 +86,8 @@ impl Levers {
         }
         Ok(Levers {
             links,
+            chains,
+            slopes,
             coordinates: n,
         })
     }
@@ -89,6 +100,52 @@ impl Levers {
     /// `(link index, λ per active coordinate)` for every link with bodies.
     pub fn links(&self) -> &[(usize, Vec<f64>)] {
         &self.links
+    }
+
+    /// λ of link `a`'s points *relative to* link `b`'s, per active coordinate: the joints the
+    /// two links' chains share move both rigidly together and leave their distance unchanged,
+    /// so only the joints below their common ancestor count (a step `Δq` changes the distance
+    /// between a body of `a` and a body of `b` by at most `Σᵢ |Δqᵢ| λᵢ`). Written into `out`
+    /// (one value per active coordinate); a link without bodies counts as not moving.
+    ///
+    /// # Panics
+    /// If a link index is out of range or `out` does not hold one value per active coordinate.
+    pub fn relative_into(&self, a: usize, b: usize, out: &mut [f64]) {
+        assert_eq!(
+            out.len(),
+            self.coordinates,
+            "one value per active coordinate"
+        );
+        out.fill(0.0);
+        let (ca, cb) = (&self.chains[a], &self.chains[b]);
+        for (own, other) in [(ca, cb), (cb, ca)] {
+            for &(joint, c, per_unit) in own {
+                if other.iter().any(|&(j, _, _)| j == joint) {
+                    continue;
+                }
+                for (o, s) in out.iter_mut().zip(&self.slopes[c]) {
+                    *o += s * per_unit;
+                }
+            }
+        }
+    }
+
+    /// λ of link `link`'s points per active coordinate (zeros for a link without bodies).
+    ///
+    /// # Panics
+    /// If `link` is out of range or `out` does not hold one value per active coordinate.
+    pub fn link_into(&self, link: usize, out: &mut [f64]) {
+        assert_eq!(
+            out.len(),
+            self.coordinates,
+            "one value per active coordinate"
+        );
+        out.fill(0.0);
+        for &(_, c, per_unit) in &self.chains[link] {
+            for (o, s) in out.iter_mut().zip(&self.slopes[c]) {
+                *o += s * per_unit;
+            }
+        }
     }
 
     /// The largest displacement of any body point per unit Euclidean step in the active

@@ -40,10 +40,13 @@
 //!
 //! [`WorldChecker`] is what planners use: it checks configurations and straight edges
 //! ([`edge`]) of one robot in one world, on the screen where the model compiles to it and
-//! through the exact model otherwise, and counts what it checked.
+//! through the exact model otherwise, and counts what it checked. [`Certifier`] proves straight
+//! motions free in continuous motion (lever-arm bounds on exact distances, [`certify`]), for
+//! verifying paths independently of the planner that made them.
 
 mod acm;
 mod batch;
+pub mod certify;
 mod checker;
 mod cull;
 pub mod edge;
@@ -61,6 +64,7 @@ mod world;
 
 pub use acm::AllowedCollisionMatrix;
 pub use batch::PlacedBatch;
+pub use certify::{Certificate, Certifier, Contact, PathCertificate};
 pub use checker::WorldChecker;
 pub use error::{CollisionError, Result};
 pub use generate::{AcmOptions, AcmReport, generate_acm};

@@ -26,8 +26,10 @@ pub use loaded::LoadedProblem;
 pub use peers::{parse_peer_results, peer_problems};
 pub use problems::{Problem, ProblemSet, find_problems, rrt_options_for};
 pub use report::{Summary, markdown_table, quantile, runs_csv, side_by_side};
-pub use run::{Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set};
+pub use run::{
+    Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set, verdicts_line,
+};
 pub use solve::{
-    GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, path_is_free, path_is_free_loaded, solve, solve_loaded,
-    solve_with_maps,
+    GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, Verdict, certify_path, certify_path_loaded, solve,
+    solve_loaded, solve_with_maps,
 };

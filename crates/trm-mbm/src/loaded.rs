@@ -11,7 +11,7 @@ use crate::run::TaskSpaceGoals;
 /// A problem read and prepared once: its scene and request parsed, its world built and the
 /// scene's allowed-collision matrix applied to the robot's collision model. Solving it
 /// ([`crate::solve`]), solving it with experience and re-checking its paths
-/// ([`crate::path_is_free`]) read and compile nothing again.
+/// ([`crate::certify_path`]) read and compile nothing again.
 #[derive(Debug, Clone)]
 pub struct LoadedProblem {
     /// Its family, number and files (a problem made in memory: no family, its messages'

@@ -13,7 +13,7 @@ use crate::experience::solve_with_experience;
 use crate::loaded::LoadedProblem;
 use crate::problems::Problem;
 use crate::report::{markdown_table, side_by_side};
-use crate::solve::{Outcome, path_is_free_loaded, solve_with_maps};
+use crate::solve::{Outcome, Verdict, certify_path_loaded, solve_with_maps};
 
 /// One problem of a benchmark run and how it went.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -24,9 +24,8 @@ pub struct Run {
     pub index: u32,
     /// The planner's outcome.
     pub outcome: Outcome,
-    /// With verification: whether the path is free when re-checked one configuration at a time
-    /// at half the resolution ([`crate::path_is_free`]).
-    pub verified: Option<bool>,
+    /// With verification: what certification proved about the path ([`crate::certify_path`]).
+    pub verified: Option<Verdict>,
 }
 
 /// A set's joint goals posed as task-space goals
@@ -47,7 +46,7 @@ pub struct BenchmarkOptions {
     /// RRT-Connect's settings (a request's `allowed_planning_time` is its time limit unless
     /// `max_seconds` is given).
     pub rrt: RrtOptions,
-    /// Re-check every returned path one configuration at a time at half the resolution.
+    /// Prove every returned path free in continuous motion ([`crate::certify_path`]).
     pub verify: bool,
     /// Pose each joint goal as the task-space goal it implies (the plain run only).
     pub task_space: Option<TaskSpaceGoals>,
@@ -63,7 +62,7 @@ pub struct BenchmarkOptions {
 #[derive(Debug, Clone)]
 pub struct Benchmark {
     /// The problems as read and prepared (for checking other planners' paths in them:
-    /// [`crate::path_is_free_loaded`]).
+    /// [`crate::certify_path_loaded`]).
     pub problems: Vec<LoadedProblem>,
     /// The plain run, one per problem.
     pub runs: Vec<Run>,
@@ -170,15 +169,15 @@ pub fn run_set(
     Ok((runs, with_maps))
 }
 
-/// With `options.verify`, whether a solved problem's path is free at half the resolution.
+/// With `options.verify`, what certification proves about a solved problem's path.
 fn verify_outcome(
     robot: &RobotModel,
     problem: &LoadedProblem,
     outcome: &Outcome,
     options: &BenchmarkOptions,
-) -> Result<Option<bool>, MbmError> {
+) -> Result<Option<Verdict>, MbmError> {
     (options.verify && outcome.solved)
-        .then(|| path_is_free_loaded(robot, problem, &outcome.path, options.rrt.resolution / 2.0))
+        .then(|| certify_path_loaded(robot, problem, &outcome.path))
         .transpose()
 }
 
@@ -245,11 +244,21 @@ fn family_outcomes(runs: &[Run]) -> Vec<(&str, &Outcome)> {
         .collect()
 }
 
-/// "`what` re-checked …: F of N collide." of verified runs.
+/// "`what` certified …: P of N proved free, C collide, U …" of verified runs.
 fn verified_line(runs: &[Run], what: &str) -> String {
-    let checked = runs.iter().filter(|r| r.verified.is_some()).count();
-    let failed = runs.iter().filter(|r| r.verified == Some(false)).count();
+    verdicts_line(runs.iter().filter_map(|r| r.verified), what)
+}
+
+/// "`what` certified in continuous motion …: P of N proved free, C collide, U not proved."
+pub fn verdicts_line(verdicts: impl Iterator<Item = Verdict>, what: &str) -> String {
+    let mut counts = [0; 3];
+    for v in verdicts {
+        counts[v as usize] += 1;
+    }
+    let [proved, collides, unproved] = counts;
     format!(
-        "\n{what} re-checked one configuration at a time at half the resolution: {failed} of {checked} collide.\n"
+        "\n{what} certified in continuous motion (f64, exact distances, lever-arm bounds; its own code path): {proved} of {} proved free, {collides} collide, {unproved} come within {} µm of contact (not proved).\n",
+        proved + collides + unproved,
+        trm_collision::certify::DEFAULT_FLOOR * 1e6
     )
 }

@@ -1,5 +1,5 @@
-//! One problem solved by RRT-Connect on any robot model, and a path re-checked one
-//! configuration at a time.
+//! One problem solved by RRT-Connect on any robot model, and a path proved free in continuous
+//! motion.
 
 use trm_collision::CollisionModel;
 use trm_kinematics::RobotModel;
@@ -188,50 +188,68 @@ pub(crate) fn invalid(
     }
 }
 
-/// Whether every edge of `path` is free at `resolution` in the problem's world, checked one
-/// configuration at a time in `f64` from one end to the other (an independent check of a
-/// planner's raked, batched, single-precision edge checks): at the points a planner checking
-/// at `2 × resolution` and then at the midpoints visits
-/// ([`trm_collision::edge::edge_steps`]), no more than `resolution` apart.
-pub fn path_is_free(
+/// What certification proved about a path ([`certify_path`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Free in continuous motion.
+    Proved,
+    /// A configuration along it collides.
+    Collides,
+    /// Not proved: it comes within the certifier's floor of contact
+    /// ([`trm_collision::certify::DEFAULT_FLOOR`]).
+    Unproved,
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Verdict::Proved => "proved",
+            Verdict::Collides => "collides",
+            Verdict::Unproved => "unproved",
+        })
+    }
+}
+
+/// Whether `path` (the request's active motors, as a planner for it returns them) is free in
+/// continuous motion in the problem's world, proved by [`trm_collision::Certifier`]: `f64`,
+/// exact distances and lever-arm bounds, independent of the points and the precision of the
+/// planner that made the path (and so usable on any planner's paths).
+pub fn certify_path(
     robot: &RobotModel,
     collision: &CollisionModel,
     scene: &PlanningScene,
     request: &MotionPlanRequest,
     path: &[Vec<f64>],
-    resolution: f64,
-) -> Result<bool, MbmError> {
+) -> Result<Verdict, MbmError> {
     let problem = LoadedProblem::new(collision, scene.clone(), request.clone())?;
-    path_is_free_loaded(robot, &problem, path, resolution)
+    certify_path_loaded(robot, &problem, path)
 }
 
-/// [`path_is_free`] in a prepared problem.
-pub fn path_is_free_loaded(
+/// [`certify_path`] in a prepared problem.
+pub fn certify_path_loaded(
     robot: &RobotModel,
     problem: &LoadedProblem,
     path: &[Vec<f64>],
-    resolution: f64,
-) -> Result<bool, MbmError> {
-    let world = &problem.world;
-    let (objective, _, _) = problem_objective(robot, &problem.collision, world, &problem.request)?;
-    let mut scratch = objective.scratch();
-    for w in path.windows(2) {
-        // the points the planner's half-resolution check visits (`resolution` is that half):
-        // those at the full resolution and the midpoints between them
-        let steps = 2 * trm_collision::edge::edge_steps(&w[0], &w[1], 2.0 * resolution);
-        for s in 0..=steps {
-            let t = s as f64 / steps as f64;
-            let q: Vec<f64> = w[0]
-                .iter()
-                .zip(&w[1])
-                .map(|(a, b)| a + t * (b - a))
-                .collect();
-            if !objective.is_collision_free_in(&q, world, &mut scratch) {
-                return Ok(false);
-            }
-        }
-    }
-    Ok(true)
+) -> Result<Verdict, MbmError> {
+    let active = problem.request.active_set(robot, &neutral(robot))?;
+    let mut certifier = trm_collision::Certifier::new(&problem.collision, &active)?;
+    let certificate = certifier.path(&problem.world, path)?;
+
+    Ok(match certificate.failure {
+        None => Verdict::Proved,
+        Some((_, trm_collision::Certificate::Collides { .. })) => Verdict::Collides,
+        Some(_) => Verdict::Unproved,
+    })
+}
+
+/// Every motor at 0 clamped into its limits: where a request's start state is silent.
+fn neutral(robot: &RobotModel) -> Vec<f64> {
+    robot
+        .motors()
+        .iter()
+        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
+        .collect()
 }
 
 /// The objective of a request in `world`: the goal's joints active, every other motor where
@@ -243,11 +261,7 @@ pub(crate) fn problem_objective(
     world: &trm_collision::World,
     request: &MotionPlanRequest,
 ) -> Result<(Objective, Vec<usize>, Vec<f64>), MbmError> {
-    let base: Vec<f64> = robot
-        .motors()
-        .iter()
-        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
-        .collect();
+    let base = neutral(robot);
     let active_set = request.active_set(robot, &base)?;
     let active = active_set.motor_indices().to_vec();
     let (start_motors, _) = motors_from_state(robot, &request.start, &base);

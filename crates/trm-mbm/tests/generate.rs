@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use trm_mbm::generate::{SetOptions, generate, write_set};
-use trm_mbm::{ProblemSet, path_is_free, solve};
+use trm_mbm::{ProblemSet, Verdict, certify_path, solve};
 use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
 
@@ -41,7 +41,10 @@ fn generated_icub_problems_are_valid_and_solved() {
             &collision,
             &scene,
             &request,
-            &RrtOptions::default(),
+            &RrtOptions {
+                certified: true,
+                ..Default::default()
+            },
         )
         .unwrap();
         assert!(
@@ -52,15 +55,8 @@ fn generated_icub_problems_are_valid_and_solved() {
             outcome.note
         );
         assert!(
-            path_is_free(
-                &spec.robot,
-                &collision,
-                &scene,
-                &request,
-                &outcome.path,
-                1.0 / 64.0
-            )
-            .unwrap()
+            certify_path(&spec.robot, &collision, &scene, &request, &outcome.path).unwrap()
+                == Verdict::Proved
         );
         // the straight motion is not the answer everywhere: the path bends or is long
         assert!(

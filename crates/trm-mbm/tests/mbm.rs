@@ -1,11 +1,11 @@
 //! MoveIt scenes and requests (MotionBenchMaker's Panda sample in tests/fixtures/mbm): every
 //! file reads, scenes round-trip through the writer, malformed files are located errors, and
 //! RRT-Connect solves every sample problem on MotionBenchMaker's own Panda with paths that an
-//! independent check at half the resolution finds collision-free.
+//! independent certification proves free in continuous motion.
 
 use std::path::{Path, PathBuf};
 
-use trm_mbm::{LoadedProblem, find_problems, path_is_free, solve};
+use trm_mbm::{LoadedProblem, Verdict, certify_path, find_problems, solve};
 use trm_moveit::MoveItError;
 use trm_moveit::{MotionPlanRequest, PlanningScene};
 use trm_plan::rrt::RrtOptions;
@@ -14,8 +14,8 @@ fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/mbm")
 }
 
-/// Solves problem `p` for `robot`, asserts it is valid, solved and its path free at half the
-/// resolution (checked one configuration at a time); its request and outcome.
+/// Solves problem `p` for `robot` with certified paths, asserts it is valid, solved and its
+/// path proved free in continuous motion by the independent check; its request and outcome.
 fn solved_and_free(
     robot: &trm_kinematics::RobotModel,
     collision: &trm_collision::CollisionModel,
@@ -24,7 +24,11 @@ fn solved_and_free(
 ) -> (MotionPlanRequest, trm_mbm::Outcome) {
     let scene = PlanningScene::load(&p.scene).unwrap();
     let request = MotionPlanRequest::load(&p.request).unwrap();
-    let outcome = solve(robot, collision, &scene, &request, options).unwrap();
+    let certified = RrtOptions {
+        certified: true,
+        ..options.clone()
+    };
+    let outcome = solve(robot, collision, &scene, &request, &certified).unwrap();
     assert!(
         outcome.valid && outcome.solved,
         "{} {}: {}",
@@ -32,9 +36,8 @@ fn solved_and_free(
         p.index,
         outcome.note
     );
-    let half = options.resolution / 2.0;
     assert!(
-        path_is_free(robot, collision, &scene, &request, &outcome.path, half).unwrap(),
+        certify_path(robot, collision, &scene, &request, &outcome.path).unwrap() == Verdict::Proved,
         "{} {}",
         p.family,
         p.index
@@ -262,7 +265,7 @@ fn problem_sets_open_from_folders_and_archives_and_summarise() {
 
 /// The second MotionBenchMaker robot, from its files only (URDF, SRDF naming links the URDF
 /// lacks, STL meshes): its sample problems read, their ±π states are taken within
-/// `LIMIT_SLACK`, and RRT-Connect solves them with paths free at half the resolution.
+/// `LIMIT_SLACK`, and RRT-Connect solves them with paths proved free.
 #[test]
 fn the_fetch_runs_from_its_files_only() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -383,7 +386,7 @@ fn worlds_load_from_moveit_scenes_and_ron() {
 }
 
 /// Experience: one planner per family keeps what RRT-Connect finds; the second pass over the
-/// sample answers from it, every path free at half the resolution, and the whole run repeats
+/// sample answers from it, every path proved free, and the whole run repeats
 /// exactly for its seed.
 #[test]
 fn experience_answers_the_second_pass() {
@@ -409,15 +412,8 @@ fn experience_answers_the_second_pass() {
             let scene = PlanningScene::load(&p.scene).unwrap();
             let request = MotionPlanRequest::load(&p.request).unwrap();
             assert!(
-                path_is_free(
-                    &robot,
-                    &collision,
-                    &scene,
-                    &request,
-                    &o.path,
-                    options.resolution / 2.0
-                )
-                .unwrap()
+                certify_path(&robot, &collision, &scene, &request, &o.path).unwrap()
+                    == Verdict::Proved
             );
             assert_eq!(o.path.first().unwrap(), &request.start.positions[..7]);
             assert_eq!(o.path.last().unwrap(), &request.goal.positions);
@@ -479,12 +475,11 @@ fn plain_and_dynamic_domain_rrt_connect_both_solve() {
     );
 }
 
-/// Random shortcuts cut edges into pieces, which the half-resolution re-check must take at
-/// points of their own: every path they return is free at half the resolution (when the
-/// re-check took only the pieces' midpoints, 12 of MotionBenchMaker's 699 Panda paths with 50
-/// shortcuts collided at `--verify`).
+/// Random shortcuts cut corners close to obstacles: with certified paths, every path they
+/// return is proved free in continuous motion (checked only at points, 12 of MotionBenchMaker's
+/// 699 Panda paths with 50 shortcuts once collided between them).
 #[test]
-fn randomly_shortcut_paths_are_free_at_half_the_resolution() {
+fn randomly_shortcut_certified_paths_are_proved_free() {
     let model =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda_spherized.ron");
     let robot = trm_kinematics::RobotModel::load(&model).unwrap();
@@ -497,15 +492,15 @@ fn randomly_shortcut_paths_are_free_at_half_the_resolution() {
             let options = RrtOptions {
                 shortcuts: 50,
                 seed,
+                certified: true,
                 ..Default::default()
             };
             let outcome = solve(&robot, &collision, &scene, &request, &options).unwrap();
             if outcome.solved {
                 solved += 1;
-                let half = options.resolution / 2.0;
                 assert!(
-                    path_is_free(&robot, &collision, &scene, &request, &outcome.path, half)
-                        .unwrap(),
+                    certify_path(&robot, &collision, &scene, &request, &outcome.path).unwrap()
+                        == Verdict::Proved,
                     "{} {} seed {seed}",
                     p.family,
                     p.index
@@ -516,7 +511,7 @@ fn randomly_shortcut_paths_are_free_at_half_the_resolution() {
     assert!(solved >= 70, "{solved} of 84 solved");
 }
 
-/// The Halton sampler solves every sample problem too (paths free at half the resolution), the
+/// The Halton sampler solves every sample problem too (paths proved free), the
 /// same path for the same seed twice and another path for another seed (its shift).
 #[test]
 fn halton_samples_solve_reproducibly_and_seeds_shift_them() {
@@ -530,7 +525,7 @@ fn halton_samples_solve_reproducibly_and_seeds_shift_them() {
     };
     let mut differ = 0;
     for p in find_problems(&fixtures()).unwrap() {
-        // each run solved and its path free at half the resolution
+        // each run solved and its path proved free
         let run = |seed| solved_and_free(&robot, &collision, &p, &halton(seed)).1;
         let (first, again, other) = (run(0), run(0), run(1));
         assert_eq!(first.path, again.path, "{} {}", p.family, p.index);
@@ -620,9 +615,13 @@ fn task_space_goals_are_read_written_and_solved() {
     let (a, b) = (&back.pose_goal.orientations[0], &goal.orientations[0]);
     assert!(a.orientation.angle_to(&b.orientation) < 1e-12 && a.tolerance == b.tolerance);
     assert!(back.goal.names.is_empty() && back.group == "panda_arm");
-    let outcome = solve(&robot, &collision, &scene, &back, &RrtOptions::default()).unwrap();
+    let certified = RrtOptions {
+        certified: true,
+        ..Default::default()
+    };
+    let outcome = solve(&robot, &collision, &scene, &back, &certified).unwrap();
     assert!(outcome.valid && outcome.solved, "{}", outcome.note);
-    // the path ends where the goal holds, and is free
+    // the path ends where the goal holds, and is proved free
     let active = robot.group("panda_arm").unwrap();
     let mut end = start.clone();
     for (&i, v) in active.iter().zip(outcome.path.last().unwrap()) {
@@ -630,7 +629,9 @@ fn task_space_goals_are_read_written_and_solved() {
     }
     robot.forward_motors(&end, &mut poses).unwrap();
     assert!(goal.met(&robot, &poses).unwrap());
-    assert!(path_is_free(&robot, &collision, &scene, &back, &outcome.path, 0.01).unwrap());
+    assert!(
+        certify_path(&robot, &collision, &scene, &back, &outcome.path).unwrap() == Verdict::Proved
+    );
 
     // bad task-space goals: another frame, no group, joints and a pose at once
     let mut foreign = back.clone();

@@ -44,6 +44,12 @@ pub struct RrtOptions {
     pub balance: bool,
     /// Where samples come from.
     pub sampler: Sampler,
+    /// Certified paths: the returned path is proved free in continuous motion
+    /// ([`trm_collision::Certifier`]: `f64`, exact distances, lever-arm bounds), not only free
+    /// at its checked points. [`crate::Planner::connect`] proves each segment of the path it
+    /// found, and replaces a segment it cannot prove by a search between its ends whose every
+    /// accepted edge is proved.
+    pub certified: bool,
 }
 
 /// The sequence of samples an RRT-Connect search draws, in the box of the joint limits.
@@ -186,6 +192,7 @@ impl Default for RrtOptions {
             dynamic_domain: true,
             balance: true,
             sampler: Sampler::default(),
+            certified: false,
         }
     }
 }

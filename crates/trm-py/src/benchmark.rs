@@ -48,7 +48,8 @@ pub(crate) fn compare_optimisers<'py>(
 /// A MotionBenchMaker set (a folder or `.tar.bz2` of MoveIt scenes and joint-goal requests)
 /// solved by RRT-Connect + shortcutting with `model` (a `.urdf`, a `.ron` description or an
 /// embedded model's name), as `trm benchmark-mbm`: `families` and `per_family` select
-/// problems, `verify` re-checks each path one configuration at a time, `task_space` (a link)
+/// problems, `verify` proves each path free in continuous motion (its `verified`: `proved`,
+/// `collides` or `unproved`), `certified` plans certified paths, `task_space` (a link)
 /// poses each joint goal as the task-space goal it implies for that link (a cube of side
 /// `position_tolerance`, `orientation_tolerance` about each axis), `sampler` is `uniform` or
 /// `halton` (RRT-Connect's samples); with `maps` (`trm.Roadmap`s of the requests' group), each
@@ -57,7 +58,7 @@ pub(crate) fn compare_optimisers<'py>(
 /// `with_maps` (the same, with the maps; empty without), `table` (markdown: solved %, median and
 /// p95 time per family), `report` (`trm benchmark-mbm`'s tables) and `csv`.
 #[pyfunction]
-#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05, sampler = "uniform", maps = Vec::new()))]
+#[pyo3(signature = (path, model, families = Vec::new(), per_family = None, seed = 0, max_iterations = 1_000_000, verify = false, package_paths = Vec::new(), task_space = None, position_tolerance = 0.01, orientation_tolerance = 0.05, sampler = "uniform", maps = Vec::new(), certified = false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn benchmark_mbm<'py>(
     py: Python<'py>,
@@ -74,6 +75,7 @@ pub(crate) fn benchmark_mbm<'py>(
     orientation_tolerance: f64,
     sampler: &str,
     maps: Vec<PyRef<'py, Roadmap>>,
+    certified: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sampler: trm_plan::rrt::Sampler = sampler.parse().map_err(err)?;
     let task_space = task_space.map(|link| trm_mbm::TaskSpaceGoals {
@@ -93,6 +95,7 @@ pub(crate) fn benchmark_mbm<'py>(
         seed,
         max_iterations,
         sampler,
+        certified,
         ..sized
     };
     let options = trm_mbm::BenchmarkOptions {

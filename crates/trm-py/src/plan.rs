@@ -398,13 +398,15 @@ impl Planner {
     /// `resolution` rad; both sized by the robot's lever arms unless given) or, for a map
     /// planner, a task point (a map node within `tolerance`, then with `exact` NGIK to the
     /// point itself). `posture` says which; by default a posture for a robot planner and a
-    /// task point for a map planner. The GIL is released while planning.
+    /// task point for a map planner. With `certified`, a posture goal's path is proved free in
+    /// continuous motion (segments that cannot be proved planned again with proved edges). The
+    /// GIL is released while planning.
     ///
     /// Returns a dict: `times (T,)`, `positions`, `velocities` and `accelerations` `(T, motors)`
     /// (every motor, sampled as `set_timing` says), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
     /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
     /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
-    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &mut self,
@@ -419,6 +421,7 @@ impl Planner {
         max_samples: usize,
         resolution: Option<f64>,
         range: Option<f64>,
+        certified: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let dim = self.planner.active().len();
         let from = match (start, &self.start) {
@@ -448,6 +451,7 @@ impl Planner {
                 max_samples,
                 resolution,
                 range,
+                certified,
             };
             let timing = self.timing.clone();
             self.connect(py, &d, from, RequestGoal::Joints(target), &budget, &timing)?
@@ -481,7 +485,7 @@ impl Planner {
     /// task-space goal, met by IK for a collision-free configuration first; its
     /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
     /// its scene first (`load_scene`). Returns what `plan` returns.
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None))]
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false))]
     #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
         &mut self,
@@ -492,6 +496,7 @@ impl Planner {
         max_samples: usize,
         resolution: Option<f64>,
         range: Option<f64>,
+        certified: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let read;
         let request = match request.cast::<MotionPlanRequest>() {
@@ -511,6 +516,7 @@ impl Planner {
             max_samples,
             resolution,
             range,
+            certified,
         };
         let d = PyDict::new(py);
         let timing = trm_plan::Timing {
@@ -548,6 +554,8 @@ struct Budget {
     max_samples: usize,
     resolution: Option<f64>,
     range: Option<f64>,
+    /// Certified paths ([`trm_plan::rrt::RrtOptions::certified`]).
+    certified: bool,
 }
 
 impl Planner {
@@ -571,6 +579,7 @@ impl Planner {
             max_iterations: budget.max_samples,
             resolution: budget.resolution.unwrap_or(sized.resolution),
             range: budget.range.unwrap_or(sized.range),
+            certified: budget.certified,
             ..sized
         };
         let (experience, planner) = (self.experience, &mut self.planner);

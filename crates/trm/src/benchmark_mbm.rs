@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use trm_mbm::{Outcome, ProblemSet, path_is_free_loaded};
+use trm_mbm::{Outcome, ProblemSet, Verdict, certify_path_loaded};
 use trm_plan::rrt::RrtOptions;
 use trm_roadmap::Roadmap;
 
@@ -53,10 +53,14 @@ pub struct Args {
     /// Random shortcut attempts per path (after the greedy pass).
     #[arg(long, default_value_t = 0, value_parser = crate::parse::count(0, 1_000_000))]
     shortcuts: usize,
-    /// Re-check every returned path one configuration at a time at half the planner's
-    /// resolution (an independent check of the raked edge checks).
+    /// Prove every returned path (trm's and, with --vamp, VAMP's) free in continuous motion:
+    /// f64, exact distances and lever-arm bounds, independent of the planner's own checks.
     #[arg(long)]
     verify: bool,
+    /// Plan with certified edges: every edge the planner accepts is also proved free in
+    /// continuous motion, so every returned path is (see --verify).
+    #[arg(long)]
+    certified: bool,
     /// Pose every joint goal as the task-space goal it implies for this link (its pose at the
     /// goal: a cube of side --position-tolerance, --orientation-tolerance about each axis) and
     /// solve that: IK for a collision-free goal of the request's group, then RRT-Connect.
@@ -131,6 +135,7 @@ pub fn run(args: &Args) -> Result<()> {
         resolution: args.resolution.unwrap_or(sized.resolution),
         range: args.range.unwrap_or(sized.range),
         shortcuts: args.shortcuts,
+        certified: args.certified,
         sampler: match args.sampler {
             SamplerArg::Halton => trm_plan::rrt::Sampler::Halton,
             SamplerArg::Uniform => trm_plan::rrt::Sampler::Uniform,
@@ -173,7 +178,7 @@ pub fn run(args: &Args) -> Result<()> {
         .map(|r| (r.family.as_str(), &r.outcome))
         .collect();
     if let Some(binary) = &args.vamp {
-        let (peer, exported) = run_vamp(args, binary, &robot, &set, &bench, options.resolution)?;
+        let (peer, verdicts, exported) = run_vamp(args, binary, &robot, &set, &bench)?;
         files.push(("peer-problems.txt", exported.into_bytes()));
         let theirs: Vec<(&str, &Outcome)> = peer.iter().map(|(f, o)| (f.as_str(), o)).collect();
         let mut text = format!(
@@ -183,15 +188,10 @@ pub fn run(args: &Args) -> Result<()> {
             trm_mbm::markdown_table(theirs.iter().copied())
         );
         if args.verify {
-            let failed = peer
-                .iter()
-                .filter(|(_, o)| o.note == VAMP_PATH_COLLIDES)
-                .count();
-            let checked = peer.iter().filter(|(_, o)| o.solved).count();
-            let _ = writeln!(
-                text,
-                "\nVAMP's paths re-checked against trm's model at half trm's resolution: {failed} of {checked} collide there."
-            );
+            text.push_str(&trm_mbm::verdicts_line(
+                verdicts.into_iter(),
+                "VAMP's paths, in trm's model,",
+            ));
         }
         let _ = write!(
             text,
@@ -365,20 +365,20 @@ fn ompl_script() -> std::path::PathBuf {
 /// How to get VAMP's program.
 const VAMP_FIX: &str = "fix: build it with benches/peers/vamp/build.sh VAMP_DIR PDQSORT_DIR (benches/peers/vamp/README.md)";
 
-/// The note of a VAMP path that collides in trm's model (`--verify`).
-const VAMP_PATH_COLLIDES: &str = "VAMP's path collides in trm's model";
+/// A peer's outcomes (family, outcome) in the set's order, the verdicts on its solved paths
+/// (with `--verify`) and the problems as given to it.
+type PeerRun = (Vec<(String, Outcome)>, Vec<Verdict>, String);
 
 /// Runs VAMP's program on `problems` (exported with `trm_mbm::peer_problems`); its
-/// outcomes in the order of `problems`, with `--verify` its paths re-checked in trm's model,
-/// and the problems as given to it.
+/// outcomes in the order of `problems`, with `--verify` what certification proves about its
+/// paths in trm's model, and the problems as given to it.
 fn run_vamp(
     args: &Args,
     binary: &std::path::Path,
     robot: &trm_kinematics::RobotModel,
     set: &ProblemSet,
     bench: &trm_mbm::Benchmark,
-    resolution: f64,
-) -> Result<(Vec<(String, Outcome)>, String)> {
+) -> Result<PeerRun> {
     let problems: Vec<trm_mbm::Problem> =
         bench.problems.iter().map(|p| p.problem.clone()).collect();
     let problems = &problems[..];
@@ -410,22 +410,19 @@ fn run_vamp(
     );
     let results = trm_mbm::parse_peer_results(&String::from_utf8_lossy(&output.stdout))
         .map_err(|e| anyhow::anyhow!("--vamp: {}'s output, {e}", binary.display()))?;
-    let mut ordered = Vec::new();
+    let (mut ordered, mut verdicts) = (Vec::new(), Vec::new());
     for (p, loaded) in problems.iter().zip(&bench.problems) {
         let found = results
             .iter()
             .find(|(f, i, _)| *f == p.family && *i == p.index)
             .ok_or_else(|| anyhow::anyhow!("--vamp: no result for {} {}", p.family, p.index))?;
-        let mut outcome = found.2.clone();
-        if args.verify
-            && outcome.solved
-            && !path_is_free_loaded(robot, loaded, &outcome.path, resolution / 2.0)?
-        {
-            outcome.note = VAMP_PATH_COLLIDES.into();
+        let outcome = found.2.clone();
+        if args.verify && outcome.solved {
+            verdicts.push(certify_path_loaded(robot, loaded, &outcome.path)?);
         }
         ordered.push((p.family.clone(), outcome));
     }
-    Ok((ordered, exported))
+    Ok((ordered, verdicts, exported))
 }
 
 #[cfg(test)]

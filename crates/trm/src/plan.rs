@@ -86,6 +86,10 @@ pub struct Args {
     /// arms; 1 rad on the Panda).
     #[arg(long, value_parser = crate::parse::positive)]
     range: Option<f64>,
+    /// Without maps: prove the path free in continuous motion (f64, exact distances, lever-arm
+    /// bounds), planning again with proved edges any segment that cannot be proved.
+    #[arg(long)]
+    certified: bool,
     /// Trajectory output (CSV; beside it a .json, a .ros.yaml ROS 2 JointTrajectory, a
     /// .response.yaml MoveIt MotionPlanResponse and, with maps, an .svg of the path over the
     /// first map).
@@ -413,6 +417,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         max_iterations: args.max_samples,
         resolution: args.resolution.unwrap_or(sized.resolution),
         range: args.range.unwrap_or(sized.range),
+        certified: args.certified,
         ..sized
     };
     let goal_configuration = match &goal {

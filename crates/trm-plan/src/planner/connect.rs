@@ -7,6 +7,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::Planner;
+use trm_collision::Certifier;
+
 use crate::PlanError;
 use crate::pose_goal::PoseGoal;
 use crate::query::{Goal, PlanOptions};
@@ -77,6 +79,24 @@ impl Planner {
         options.check()?;
         let began = Instant::now();
         let before = self.checker.checks;
+        let mut found = self.find(start, goal, options, began, before)?;
+        if options.certified {
+            self.prove(&mut found.path, options)?;
+            found.checks = self.checker.checks - before;
+            found.seconds = began.elapsed().as_secs_f64();
+        }
+        Ok(found)
+    }
+
+    /// [`Planner::connect`]'s path, before any proof.
+    fn find(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+        began: Instant,
+        before: u64,
+    ) -> Result<Connection, PlanError> {
         if self.nodes.is_empty() {
             return self.sample(start, goal, options, began, before);
         }
@@ -260,6 +280,64 @@ impl Planner {
             iterations: found.iterations,
             seconds: began.elapsed().as_secs_f64(),
         }
+    }
+}
+
+impl Planner {
+    /// Proves every segment of `path` free in continuous motion ([`RrtOptions::certified`]);
+    /// a segment that cannot be proved is replaced by RRT-Connect between its ends with every
+    /// accepted edge proved (its checker given the certifier). An error when no proved path
+    /// joins them within `options`' budget.
+    fn prove(&mut self, path: &mut Vec<Vec<f64>>, options: &RrtOptions) -> Result<(), PlanError> {
+        let mut certifier = match self.certifier.take() {
+            Some(c) => c,
+            None => Certifier::new(self.objective.collision(), &self.active)?,
+        };
+        let mut i = 0;
+        let result = loop {
+            if i + 1 >= path.len() {
+                break Ok(());
+            }
+            let world = self.checker.world();
+            if certifier
+                .segment_unchecked(world, &path[i], &path[i + 1])
+                .is_free()
+            {
+                i += 1;
+                continue;
+            }
+            // the segment grazes or crosses an obstacle between its checked points
+            self.checker.set_certifier(Some(certifier));
+            let repaired = rrt_connect_in(
+                &mut self.checker,
+                &self.bounds,
+                &path[i],
+                &path[i + 1],
+                options,
+            );
+            certifier = self
+                .checker
+                .set_certifier(None)
+                .expect("the certifier was given to the checker");
+            match repaired {
+                Ok(found) => {
+                    let n = found.path.len();
+                    path.splice(i..i + 2, found.path);
+                    i += n - 1;
+                }
+                Err(e) => {
+                    break Err(PlanError::Unreachable {
+                        reason: format!(
+                            "segment {i} of the path found cannot be proved free in continuous motion, and no proved path replaces it: {e}"
+                        ),
+                        closest_node: None,
+                        closest_distance: f64::INFINITY,
+                    });
+                }
+            }
+        };
+        self.certifier = Some(certifier);
+        result
     }
 }
 

@@ -83,6 +83,9 @@ pub struct Planner {
     scratch: trm_tasks::Scratch,
     /// Checks in the current world.
     checker: WorldChecker,
+    /// Proves paths free in continuous motion ([`RrtOptions::certified`]); made on first use
+    /// for the current collision model.
+    certifier: Option<trm_collision::Certifier>,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
     /// [`Planner::rrt_options`], worked out on first use (the robot's bodies and active motors
@@ -100,6 +103,7 @@ impl Planner {
     pub fn new(objective: &Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
         let mut planner = Planner {
             checker: objective.world_checker(objective.world())?,
+            certifier: None,
             objective: objective.clone(),
             active: objective.active().clone(),
             bounds: objective.active().bounds(),
@@ -246,6 +250,7 @@ impl Planner {
         let checks = self.checker.checks;
         self.checker = self.objective.world_checker(&world)?;
         self.checker.checks = checks;
+        self.certifier = None;
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
         Ok(true)

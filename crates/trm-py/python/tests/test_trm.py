@@ -281,6 +281,9 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
         assert read.group == "panda_arm" and len(read.goal) == len(read.goal_joints) == 7
         again = planner.plan_request(read)
         np.testing.assert_array_equal(again["waypoints"], r["waypoints"])
+        # a certified path (proved free in continuous motion) joins the same ends
+        proved = planner.plan_request(read, certified=True)
+        np.testing.assert_array_equal(proved["waypoints"][[0, -1]], r["waypoints"][[0, -1]])
         # its goal posed as the hand's pose: IK, then the same planner
         posed = read.to_task_space(robot, "panda_hand")
         assert posed.is_task_space and not read.is_task_space
@@ -508,19 +511,19 @@ def test_table_iii_from_python_is_seeded_and_complete():
 def test_motionbenchmaker_from_python_solves_and_verifies():
     fixtures = ROOT / "crates" / "trm-mbm" / "tests" / "fixtures" / "mbm"
     model = str(ROOT / "models" / "panda-mbm" / "panda.ron")
-    r = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True)
+    r = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True, certified=True)
     assert len(r["runs"]) == 2 and all(run["family"] == "box_panda" for run in r["runs"])
     for run in r["runs"]:
-        assert run["outcome"]["valid"] and run["outcome"]["solved"] and run["verified"]
+        assert run["outcome"]["valid"] and run["outcome"]["solved"] and run["verified"] == "proved"
         assert len(run["outcome"]["path"]) >= 2
     assert "box_panda" in r["table"] and r["csv"].startswith("family,problem")
     # the same goals as the hand's pose: IK, then RRT-Connect
-    t = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True, task_space="panda_hand")
-    assert all(run["outcome"]["solved"] and run["verified"] for run in t["runs"])
+    t = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=2, verify=True, task_space="panda_hand", certified=True)
+    assert all(run["outcome"]["solved"] and run["verified"] == "proved" for run in t["runs"])
     with pytest.raises(trm.TrmError, match="box_panda"):
         trm.benchmark_mbm(str(fixtures), model, families=["box_pand"])
-    h = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=1, verify=True, sampler="halton")
-    assert h["runs"][0]["outcome"]["solved"] and h["runs"][0]["verified"]
+    h = trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], per_family=1, verify=True, sampler="halton", certified=True)
+    assert h["runs"][0]["outcome"]["solved"] and h["runs"][0]["verified"] == "proved"
     with pytest.raises(trm.TrmError, match="did you mean `halton`"):
         trm.benchmark_mbm(str(fixtures), model, families=["box_panda"], sampler="halton2")
 
