@@ -16,6 +16,7 @@
 //! ([`Certificate::Unproved`]). The check is `f64`, exact distances (the collision model's own
 //! bodies) and its own code path: it shares no sampling with the planners it verifies.
 
+use nalgebra::{Point3, Vector3};
 use trm_kinematics::{ActiveSet, PoseBuffer};
 
 use crate::error::{CollisionError, Result};
@@ -91,20 +92,58 @@ impl PathCertificate {
     }
 }
 
-/// A pair still open over a piece of the motion: its distances at the piece's two ends.
+/// A pair, or a group of pairs, still open over a piece of the motion: lower bounds on its
+/// distance at the piece's two ends (exact distances for a pair of bodies).
 #[derive(Debug, Clone, Copy)]
 struct Open {
+    /// The group: a pair of links, or a link and a world object.
+    group: u32,
+    /// One pair of the group (a body pair's index for a pair of links, a body for a link and
+    /// an object), or [`GROUP`] for the whole group bounded by its enclosing spheres.
     unit: u32,
     d0: f64,
     d1: f64,
 }
 
-/// A piece of the motion and the pairs its ends leave open.
+/// [`Open::unit`] of a whole group.
+const GROUP: u32 = u32::MAX;
+
+/// A piece of the motion: its ends (fractions, and the configurations placed there) and what
+/// its ends leave open.
 #[derive(Debug, Clone)]
 struct Piece {
     u0: f64,
     u1: f64,
+    s0: usize,
+    s1: usize,
     open: Vec<Open>,
+}
+
+/// A configuration placed: the bodies, and the centre of each link's enclosing sphere.
+#[derive(Debug, Clone)]
+struct Snapshot {
+    placed: PlacedBodies,
+    centers: Vec<Point3<f64>>,
+}
+
+/// A link with bodies: a sphere in its frame that encloses them all.
+#[derive(Debug, Clone)]
+struct Ball {
+    link: usize,
+    center: Point3<f64>,
+    radius: f64,
+    /// Its bodies.
+    bodies: Vec<u32>,
+}
+
+/// Checked body pairs of one pair of links.
+#[derive(Debug, Clone)]
+struct LinkPair {
+    balls: [usize; 2],
+    /// Indices into the model's checked body pairs.
+    pairs: Vec<u32>,
+    /// Relative lever arms of the two links, per active coordinate.
+    levers: Vec<f64>,
 }
 
 /// Proves straight motions of one robot free in one world (see the [module](self)).
@@ -130,22 +169,23 @@ pub struct Certifier {
     collision: CollisionModel,
     active: ActiveSet,
     floor: f64,
-    /// Per checked body pair: the relative lever arms of its two links, per active coordinate.
-    pair_levers: Vec<Vec<f64>>,
-    /// Per body: its link's lever arms, per active coordinate.
-    body_levers: Vec<Vec<f64>>,
-    /// Per unit of the current motion (checked body pairs, then body × object): its bound `r`
-    /// over the whole motion.
+    balls: Vec<Ball>,
+    /// Per link pair with checked body pairs.
+    link_pairs: Vec<LinkPair>,
+    /// Per ball: its link's lever arms, per active coordinate (for world objects).
+    ball_levers: Vec<Vec<f64>>,
+    /// Per group of the current motion (link pairs, then ball × object): its bound over the
+    /// whole motion.
     rates: Vec<f64>,
-    /// Per unit: the bounding-sphere lower bounds at the motion's two ends.
-    ends: [Vec<f64>; 2],
+    /// The current motion's configurations placed so far (reused).
+    snapshots: Vec<Snapshot>,
+    placed_count: usize,
     poses: PoseBuffer,
-    placed: PlacedBodies,
     q: Vec<f64>,
     /// Pieces to prove, and spare lists of open pairs.
     stack: Vec<Piece>,
     spare: Vec<Vec<Open>>,
-    /// Configurations placed and exact distances computed so far.
+    /// Configurations placed so far.
     pub configurations: u64,
     /// Exact distances computed so far.
     pub distances: u64,
@@ -157,34 +197,74 @@ impl Certifier {
     pub fn new(collision: &CollisionModel, active: &ActiveSet) -> Result<Self> {
         let levers = Levers::new(collision, active)?;
         let n = active.len();
-        let link = |b: usize| collision.bodies()[b].link;
-        let pair_levers = collision
-            .pairs()
-            .iter()
-            .map(|p| {
+        let robot = collision.robot();
+        // one enclosing sphere per link with bodies, around its bodies' enclosing spheres
+        let mut ball_of_link = vec![None; robot.tree().links.len()];
+        let mut balls: Vec<Ball> = Vec::new();
+        for (b, body) in collision.bodies().iter().enumerate() {
+            let k = *ball_of_link[body.link].get_or_insert_with(|| {
+                balls.push(Ball {
+                    link: body.link,
+                    center: Point3::origin(),
+                    radius: 0.0,
+                    bodies: Vec::new(),
+                });
+                balls.len() - 1
+            });
+            balls[k].bodies.push(b as u32);
+        }
+        for ball in &mut balls {
+            let spheres: Vec<_> = ball
+                .bodies
+                .iter()
+                .flat_map(|&b| collision.enclosing_spheres(b as usize))
+                .collect();
+            let center = spheres
+                .iter()
+                .fold(Vector3::zeros(), |sum, s| sum + s.center.coords)
+                / spheres.len().max(1) as f64;
+            ball.center = Point3::from(center);
+            ball.radius = spheres
+                .iter()
+                .map(|s| (s.center.coords - center).norm() + s.radius)
+                .fold(0.0, f64::max);
+        }
+        let ball = |body: u32| ball_of_link[collision.bodies()[body as usize].link].unwrap();
+        let mut link_pairs: Vec<LinkPair> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        for (k, pair) in collision.pairs().iter().enumerate() {
+            let balls_of = [ball(pair.a), ball(pair.b)];
+            let at = *index.entry(balls_of).or_insert_with(|| {
                 let mut out = vec![0.0; n];
-                levers.relative_into(link(p.a as usize), link(p.b as usize), &mut out);
-                out
-            })
-            .collect();
-        let body_levers = (0..collision.bodies().len())
+                levers.relative_into(balls[balls_of[0]].link, balls[balls_of[1]].link, &mut out);
+                link_pairs.push(LinkPair {
+                    balls: balls_of,
+                    pairs: Vec::new(),
+                    levers: out,
+                });
+                link_pairs.len() - 1
+            });
+            link_pairs[at].pairs.push(k as u32);
+        }
+        let ball_levers = balls
+            .iter()
             .map(|b| {
                 let mut out = vec![0.0; n];
-                levers.link_into(link(b), &mut out);
+                levers.link_into(b.link, &mut out);
                 out
             })
             .collect();
-        let robot = collision.robot();
         Ok(Certifier {
             collision: collision.clone(),
             active: active.clone(),
             floor: DEFAULT_FLOOR,
-            pair_levers,
-            body_levers,
+            balls,
+            link_pairs,
+            ball_levers,
             rates: Vec::new(),
-            ends: [Vec::new(), Vec::new()],
+            snapshots: Vec::new(),
+            placed_count: 0,
             poses: robot.pose_buffer(),
-            placed: collision.placed_bodies(),
             q: vec![0.0; n],
             stack: Vec::new(),
             spare: Vec::new(),
@@ -284,12 +364,7 @@ impl Certifier {
 
     /// [`Certifier::segment`] without checking the configurations.
     pub fn segment_unchecked(&mut self, world: &World, a: &[f64], b: &[f64]) -> Certificate {
-        let pairs = self.collision.pairs().len();
-        let bodies = self.collision.bodies().len();
         let objects = world.objects().len();
-        let units = pairs + bodies * objects;
-        // each unit's bound over the whole motion
-        self.rates.clear();
         let step = |lever: &[f64]| -> f64 {
             lever
                 .iter()
@@ -297,201 +372,269 @@ impl Certifier {
                 .map(|(l, (x, y))| l * (y - x).abs())
                 .sum()
         };
-        self.rates.extend(self.pair_levers.iter().map(|l| step(l)));
-        for lever in &self.body_levers {
+        // each group's bound over the whole motion: link pairs, then ball-major ball × object
+        self.rates.clear();
+        self.rates
+            .extend(self.link_pairs.iter().map(|p| step(&p.levers)));
+        for lever in &self.ball_levers {
             let r = step(lever);
             self.rates.extend(std::iter::repeat_n(r, objects));
         }
-        // world units are laid out body-major: unit = pairs + body * objects + object
-        let mut ends = std::mem::take(&mut self.ends);
-        for (end, q) in [a, b].into_iter().enumerate() {
-            self.place(q);
-            ends[end].clear();
-            ends[end].extend((0..units).map(|unit| self.lower_bound(world, unit)));
-        }
+        self.placed_count = 0;
+        let s0 = self.place(a);
+        let s1 = self.place(b);
         let mut open = self.spare.pop().unwrap_or_default();
         open.clear();
-        for (unit, ((&l0, &l1), &rate)) in ends[0].iter().zip(&ends[1]).zip(&self.rates).enumerate()
-        {
-            if l0 + l1 > rate + SLACK && l0 > 0.0 && l1 > 0.0 {
-                continue;
-            }
+        for group in 0..self.rates.len() {
             open.push(Open {
-                unit: unit as u32,
-                d0: f64::NAN,
-                d1: f64::NAN,
+                group: group as u32,
+                unit: GROUP,
+                d0: self.group_bound(world, s0, group),
+                d1: self.group_bound(world, s1, group),
             });
-        }
-        self.ends = ends;
-        // exact distances of the open units at both ends
-        for (end, q) in [a, b].into_iter().enumerate() {
-            if open.is_empty() {
-                break;
-            }
-            self.place(q);
-            for o in open.iter_mut() {
-                let d = self.distance(world, o.unit as usize);
-                if d <= 0.0 {
-                    let certificate = Certificate::Collides {
-                        at: end as f64,
-                        pair: self.contact(o.unit as usize, objects),
-                    };
-                    self.spare.push(open);
-                    return certificate;
-                }
-                if end == 0 {
-                    o.d0 = d;
-                } else {
-                    o.d1 = d;
-                }
-            }
         }
         self.stack.clear();
         self.stack.push(Piece {
             u0: 0.0,
             u1: 1.0,
+            s0,
+            s1,
             open,
         });
-        let verdict = self.prove(world, a, b, objects);
+        let verdict = self.prove(world, a, b);
         while let Some(piece) = self.stack.pop() {
             self.spare.push(piece.open);
         }
         verdict
     }
 
-    /// Bisects the pieces on the stack until every open pair is cleared.
-    fn prove(&mut self, world: &World, a: &[f64], b: &[f64], objects: usize) -> Certificate {
+    /// Bisects the pieces on the stack until every open group and pair is cleared.
+    fn prove(&mut self, world: &World, a: &[f64], b: &[f64]) -> Certificate {
         while let Some(mut piece) = self.stack.pop() {
-            let length = piece.u1 - piece.u0;
-            piece
-                .open
-                .retain(|o| o.d0 + o.d1 <= self.rates[o.unit as usize] * length + SLACK);
+            if let Err(certificate) = self.settle(world, &mut piece) {
+                self.spare.push(piece.open);
+                return certificate;
+            }
             if piece.open.is_empty() {
                 self.spare.push(piece.open);
                 continue;
-            }
-            if let Some(o) = piece
-                .open
-                .iter()
-                .find(|o| self.rates[o.unit as usize] * length < self.floor)
-            {
-                let (at, clearance) = if o.d0 <= o.d1 {
-                    (piece.u0, o.d0)
-                } else {
-                    (piece.u1, o.d1)
-                };
-                let pair = self.contact(o.unit as usize, objects);
-                self.spare.push(piece.open);
-                return Certificate::Unproved {
-                    at,
-                    pair,
-                    clearance,
-                };
             }
             let mid = 0.5 * (piece.u0 + piece.u1);
             for ((q, x), y) in self.q.iter_mut().zip(a).zip(b) {
                 *q = x + mid * (y - x);
             }
             let q = std::mem::take(&mut self.q);
-            self.place(&q);
+            let sm = self.place(&q);
             self.q = q;
-            let half = 0.5 * length;
+            let half = 0.5 * (piece.u1 - piece.u0);
             let mut left = self.spare.pop().unwrap_or_default();
             left.clear();
             let mut right = self.spare.pop().unwrap_or_default();
             right.clear();
             for o in &piece.open {
-                let unit = o.unit as usize;
-                let need = self.rates[unit] * half + SLACK;
-                // the bounding spheres first: exact only where they cannot clear both halves
-                let mut d = self.lower_bound(world, unit);
-                if !(d > 0.0 && o.d0 + d > need && d + o.d1 > need) {
-                    d = self.distance(world, unit);
-                }
-                if d <= 0.0 {
-                    self.spare.extend([piece.open, left, right]);
-                    return Certificate::Collides {
-                        at: mid,
-                        pair: self.contact(unit, objects),
-                    };
-                }
-                left.push(Open {
-                    unit: o.unit,
-                    d0: o.d0,
-                    d1: d,
-                });
-                right.push(Open {
-                    unit: o.unit,
-                    d0: d,
-                    d1: o.d1,
-                });
+                let d = if o.unit == GROUP {
+                    self.group_bound(world, sm, o.group as usize)
+                } else {
+                    // the bounding spheres first: exact only where they cannot clear both halves
+                    let need = self.rates[o.group as usize] * half + SLACK;
+                    let lower = self.unit_bound(world, sm, o.group, o.unit);
+                    if lower > 0.0 && o.d0 + lower > need && lower + o.d1 > need {
+                        lower
+                    } else {
+                        let d = self.unit_distance(world, sm, o.group, o.unit);
+                        if d <= 0.0 {
+                            let pair = self.contact(world, o.group, o.unit);
+                            self.spare.extend([piece.open, left, right]);
+                            return Certificate::Collides { at: mid, pair };
+                        }
+                        d
+                    }
+                };
+                left.push(Open { d1: d, ..*o });
+                right.push(Open { d0: d, ..*o });
             }
             self.spare.push(piece.open);
             self.stack.push(Piece {
                 u0: mid,
                 u1: piece.u1,
+                s0: sm,
+                s1: piece.s1,
                 open: right,
             });
             self.stack.push(Piece {
                 u0: piece.u0,
                 u1: mid,
+                s0: piece.s0,
+                s1: sm,
                 open: left,
             });
         }
         Certificate::Free
     }
 
-    /// Places the bodies at active configuration `q`.
-    fn place(&mut self, q: &[f64]) {
+    /// Drops what `piece`'s ends clear; opens into its pairs a group whose enclosing spheres
+    /// cannot clear it (touching at an end, or down to the floor), with their exact distances
+    /// at both ends. An error for a pair that collides at an end or cannot be cleared above the
+    /// floor.
+    fn settle(&mut self, world: &World, piece: &mut Piece) -> std::result::Result<(), Certificate> {
+        let length = piece.u1 - piece.u0;
+        let mut k = 0;
+        while k < piece.open.len() {
+            let o = piece.open[k];
+            let bound = self.rates[o.group as usize] * length;
+            if o.d0 + o.d1 > bound + SLACK {
+                piece.open.swap_remove(k);
+                continue;
+            }
+            if o.unit != GROUP {
+                if bound < self.floor {
+                    let (at, clearance) = if o.d0 <= o.d1 {
+                        (piece.u0, o.d0)
+                    } else {
+                        (piece.u1, o.d1)
+                    };
+                    return Err(Certificate::Unproved {
+                        at,
+                        pair: self.contact(world, o.group, o.unit),
+                        clearance,
+                    });
+                }
+                k += 1;
+                continue;
+            }
+            if o.d0 > 0.0 && o.d1 > 0.0 && bound >= self.floor {
+                k += 1;
+                continue;
+            }
+            // the group's spheres touch at an end: its pairs, each on its own
+            piece.open.swap_remove(k);
+            for unit in self.units(world, o.group) {
+                let lower = [piece.s0, piece.s1].map(|s| self.unit_bound(world, s, o.group, unit));
+                if lower[0] + lower[1] > bound + SLACK {
+                    continue;
+                }
+                let mut exact = [0.0; 2];
+                for (end, s) in [piece.s0, piece.s1].into_iter().enumerate() {
+                    exact[end] = self.unit_distance(world, s, o.group, unit);
+                    if exact[end] <= 0.0 {
+                        return Err(Certificate::Collides {
+                            at: [piece.u0, piece.u1][end],
+                            pair: self.contact(world, o.group, unit),
+                        });
+                    }
+                }
+                piece.open.push(Open {
+                    group: o.group,
+                    unit,
+                    d0: exact[0],
+                    d1: exact[1],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The pairs of group `group`: body pair indices of a link pair, bodies of a ball.
+    fn units(&self, world: &World, group: u32) -> std::ops::Range<u32> {
+        // ranges into `link_pairs[g].pairs` / `balls[b].bodies`, by position
+        let g = group as usize;
+        let len = if g < self.link_pairs.len() {
+            self.link_pairs[g].pairs.len()
+        } else {
+            let (ball, _) = self.ball_object(world, g);
+            self.balls[ball].bodies.len()
+        };
+        0..len as u32
+    }
+
+    /// Places the bodies at active configuration `q`: the index of its snapshot.
+    fn place(&mut self, q: &[f64]) -> usize {
         self.active.forward_unchecked(q, &mut self.poses);
-        self.collision.place(&self.poses, &mut self.placed);
+        if self.placed_count == self.snapshots.len() {
+            self.snapshots.push(Snapshot {
+                placed: self.collision.placed_bodies(),
+                centers: vec![Point3::origin(); self.balls.len()],
+            });
+        }
+        let snapshot = &mut self.snapshots[self.placed_count];
+        self.collision.place(&self.poses, &mut snapshot.placed);
+        let poses = self.poses.poses();
+        for (c, ball) in snapshot.centers.iter_mut().zip(&self.balls) {
+            *c = poses[ball.link] * ball.center;
+        }
         self.configurations += 1;
+        self.placed_count += 1;
+        self.placed_count - 1
     }
 
-    /// A lower bound on unit `unit`'s distance, from bounding spheres.
-    fn lower_bound(&self, world: &World, unit: usize) -> f64 {
-        let p = &self.placed.placed;
-        let pairs = self.collision.pairs();
-        if unit < pairs.len() {
-            let (a, b) = (&p[pairs[unit].a as usize], &p[pairs[unit].b as usize]);
-            (a.center - b.center).norm() - a.bound - b.bound
+    /// A lower bound on the distance of every pair of group `group` at snapshot `s`, from the
+    /// links' enclosing spheres (and the object's bounding sphere).
+    fn group_bound(&self, world: &World, s: usize, group: usize) -> f64 {
+        let snap = &self.snapshots[s];
+        if group < self.link_pairs.len() {
+            let [a, b] = self.link_pairs[group].balls;
+            (snap.centers[a] - snap.centers[b]).norm() - self.balls[a].radius - self.balls[b].radius
         } else {
-            let (body, object) = self.world_unit(world, unit);
-            let (a, o) = (&p[body], &world.objects()[object].placed);
-            (a.center - o.center).norm() - a.bound - o.bound
+            let (ball, object) = self.ball_object(world, group);
+            let o = &world.objects()[object].placed;
+            (snap.centers[ball] - o.center).norm() - self.balls[ball].radius - o.bound
         }
     }
 
-    /// Unit `unit`'s exact signed distance.
-    fn distance(&mut self, world: &World, unit: usize) -> f64 {
+    /// The two things pair `unit` of group `group` is about: (body, Ok(body)) or
+    /// (body, Err(object)).
+    fn unit_of(
+        &self,
+        world: &World,
+        group: u32,
+        unit: u32,
+    ) -> (usize, std::result::Result<usize, usize>) {
+        let g = group as usize;
+        if g < self.link_pairs.len() {
+            let pair = &self.collision.pairs()[self.link_pairs[g].pairs[unit as usize] as usize];
+            (pair.a as usize, Ok(pair.b as usize))
+        } else {
+            let (ball, object) = self.ball_object(world, g);
+            (self.balls[ball].bodies[unit as usize] as usize, Err(object))
+        }
+    }
+
+    /// A lower bound on pair `unit`'s distance at snapshot `s`, from bounding spheres.
+    fn unit_bound(&self, world: &World, s: usize, group: u32, unit: u32) -> f64 {
+        let p = &self.snapshots[s].placed.placed;
+        let (a, other) = self.unit_of(world, group, unit);
+        let o = match other {
+            Ok(b) => &p[b],
+            Err(object) => &world.objects()[object].placed,
+        };
+        (p[a].center - o.center).norm() - p[a].bound - o.bound
+    }
+
+    /// Pair `unit`'s exact signed distance at snapshot `s`.
+    fn unit_distance(&mut self, world: &World, s: usize, group: u32, unit: u32) -> f64 {
         self.distances += 1;
-        let (c, p) = (self.collision.compiled(), &self.placed.placed);
-        let pairs = self.collision.pairs();
-        if unit < pairs.len() {
-            let (a, b) = (pairs[unit].a as usize, pairs[unit].b as usize);
-            signed_distance(&c[a], &p[a], &c[b], &p[b])
-        } else {
-            let (body, object) = self.world_unit(world, unit);
-            let o = &world.objects()[object];
-            signed_distance(&c[body], &p[body], &o.compiled, &o.placed)
+        let (c, p) = (self.collision.compiled(), &self.snapshots[s].placed.placed);
+        match self.unit_of(world, group, unit) {
+            (a, Ok(b)) => signed_distance(&c[a], &p[a], &c[b], &p[b]),
+            (a, Err(object)) => {
+                let o = &world.objects()[object];
+                signed_distance(&c[a], &p[a], &o.compiled, &o.placed)
+            }
         }
     }
 
-    /// The (body, object) of a world unit.
-    fn world_unit(&self, world: &World, unit: usize) -> (usize, usize) {
-        let k = unit - self.collision.pairs().len();
+    /// The (ball, object) of a world group.
+    fn ball_object(&self, world: &World, group: usize) -> (usize, usize) {
+        let k = group - self.link_pairs.len();
         let objects = world.objects().len();
         (k / objects, k % objects)
     }
 
     /// The pair a unit is about.
-    fn contact(&self, unit: usize, objects: usize) -> Contact {
-        let pairs = self.collision.pairs();
-        if unit < pairs.len() {
-            Contact::Bodies(pairs[unit].a as usize, pairs[unit].b as usize)
-        } else {
-            let k = unit - pairs.len();
-            Contact::Object(k / objects, k % objects)
+    fn contact(&self, world: &World, group: u32, unit: u32) -> Contact {
+        match self.unit_of(world, group, unit) {
+            (a, Ok(b)) => Contact::Bodies(a, b),
+            (a, Err(object)) => Contact::Object(a, object),
         }
     }
 }

@@ -352,3 +352,78 @@ fn a_checker_moves_between_worlds_of_any_size() {
     }
     assert!(seen[0] > 10 && seen[1] > 10, "{seen:?}: both answers");
 }
+
+/// A link that is one box, screened against a link of convex hulls: the suspect-clearing step
+/// (the k-DOP screen) reads the box link's spheres, which nothing else placed for this block.
+/// A block that placed them far away (near a cylinder, which is screened through the link's
+/// spheres) and then a block in which the box grazes the hull by 10 µm — inside the margin,
+/// so the box test leaves it uncertain — must still find the collision.
+#[test]
+fn a_box_link_grazing_a_hull_link_is_not_cleared_by_stale_spheres() {
+    let urdf = r#"<robot name="slider">
+      <link name="base"/>
+      <link name="slider"/>
+      <link name="hull"/>
+      <joint name="x" type="prismatic"><parent link="base"/><child link="slider"/>
+        <axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="turn" type="revolute"><parent link="base"/><child link="hull"/>
+        <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+    </robot>"#;
+    let robot = RobotModel::from_urdf_str(urdf, "<slider>").unwrap();
+    let (slider, hull) = (
+        robot.tree().link_index("slider").unwrap(),
+        robot.tree().link_index("hull").unwrap(),
+    );
+    let cube: Vec<[f64; 3]> = (0..8)
+        .map(|k| {
+            let h = |bit: usize| if k >> bit & 1 == 1 { 0.05 } else { -0.05 };
+            [h(0), h(1), h(2)]
+        })
+        .collect();
+    let bodies = vec![
+        trm_collision::Body {
+            name: "slider".into(),
+            link: slider,
+            shape: Shape::Box {
+                size: [0.1, 0.1, 0.1],
+            },
+            local: Isometry3::identity(),
+        },
+        trm_collision::Body {
+            name: "hull".into(),
+            link: hull,
+            shape: Shape::Convex { points: cube },
+            local: Isometry3::translation(0.5, 0.0, 0.0),
+        },
+    ];
+    let geometry = [false, true, true];
+    let acm = trm_collision::AllowedCollisionMatrix::from_model(&robot, &geometry);
+    let collision = CollisionModel::from_bodies(&robot, bodies, acm).unwrap();
+    let mut world = World::new();
+    // beside the slider at x = -0.8, clear of it, near enough to place its spheres
+    world
+        .add(
+            "post",
+            Shape::Cylinder {
+                radius: 0.02,
+                length: 0.1,
+            },
+            Isometry3::translation(-0.8, 0.12, 0.0),
+        )
+        .unwrap();
+    let active = robot.all_active();
+    let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
+    let fast_world = checker.model().world(&world);
+    let (mut poses, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+    for q in [[-0.8, 0.0], [0.4 + 1e-5, 0.0]] {
+        active.forward(&q, &mut poses).unwrap();
+        collision.place(&poses, &mut placed);
+        let exact = !collision.is_colliding(&placed, &world);
+        let block: Vec<f64> = q.iter().copied().cycle().take(2 * FAST_LANES).collect();
+        assert_eq!(
+            checker.all_free(&block, &world, &fast_world).unwrap(),
+            exact,
+            "{q:?}"
+        );
+    }
+}
