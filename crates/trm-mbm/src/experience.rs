@@ -44,6 +44,72 @@ pub fn solve_with_experience(
     Ok(outcomes)
 }
 
+/// Which other problems' paths a problem plans through in [`solve_leave_one_out`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scope {
+    /// The other problems of its family.
+    Family,
+    /// Every other problem of the set that moves the same motors from the same other values.
+    Set,
+}
+
+/// Solves each of `problems` through the paths `paths[j]` found for the *other* problems
+/// (leave-one-out: a problem never sees its own path) of its family or of the whole set
+/// (`scope`), as a robot that has planned those before: a planner per problem holding those
+/// paths ([`Planner::add_path`], checked lazily in the problem's scene), RRT-Connect where they
+/// do not join start and goal; nothing is kept. `paths[k]` is empty for a problem without a
+/// path; `done(k)` after each problem. Notes as in [`solve_with_experience`].
+pub fn solve_leave_one_out(
+    robot: &RobotModel,
+    problems: &[LoadedProblem],
+    paths: &[Vec<Vec<f64>>],
+    scope: Scope,
+    options: &RrtOptions,
+    mut done: impl FnMut(usize),
+) -> Result<Vec<Outcome>, MbmError> {
+    options.check()?;
+    if paths.len() != problems.len() {
+        return Err(MbmError::Invalid {
+            path: Default::default(),
+            line: 0,
+            problem: format!("{} paths for {} problems", paths.len(), problems.len()),
+            fix: "give one path (empty where none was found) per problem".into(),
+        });
+    }
+    // the motors each problem moves and the values of the others: paths are shared only
+    // between problems that agree on both
+    let mut setups = Vec::with_capacity(problems.len());
+    for p in problems {
+        let (objective, active, start) = problem_objective(
+            robot,
+            &p.collision,
+            &trm_collision::World::new(),
+            &p.request,
+        )?;
+        setups.push((active, objective.active().to_motors(&start)));
+    }
+    let shares = |k: usize, j: usize| {
+        j != k
+            && !paths[j].is_empty()
+            && setups[j] == setups[k]
+            && (scope == Scope::Set || problems[j].problem.family == problems[k].problem.family)
+    };
+    let mut outcomes = Vec::with_capacity(problems.len());
+    for k in 0..problems.len() {
+        let mut run = FamilyRun::new(robot, problems, vec![k])?;
+        run.kept = (0..problems.len())
+            .filter(|&j| shares(k, j))
+            .map(|j| paths[j].clone())
+            .collect();
+        let mut results = vec![Outcome::default(); problems.len()];
+        run.keep = false;
+        run.pass(options, &mut results, |_| {})?;
+        outcomes.push(std::mem::take(&mut results[k]));
+        done(k);
+    }
+    Ok(outcomes)
+}
+
 /// One family's problems and the paths its planners keep, pass after pass.
 struct FamilyRun<'a> {
     robot: &'a RobotModel,
@@ -54,6 +120,8 @@ struct FamilyRun<'a> {
     active: Vec<usize>,
     /// Every path kept so far: each planner of the family starts from them.
     kept: Vec<Vec<Vec<f64>>>,
+    /// Whether paths RRT-Connect finds are kept.
+    keep: bool,
 }
 
 impl<'a> FamilyRun<'a> {
@@ -75,6 +143,7 @@ impl<'a> FamilyRun<'a> {
             members,
             active,
             kept: Vec::new(),
+            keep: true,
         })
     }
 
@@ -140,15 +209,17 @@ impl<'a> FamilyRun<'a> {
             Ok(found) => {
                 outcome.solved = true;
                 outcome.seconds = found.seconds;
+                outcome.simplify_seconds = found.simplify_seconds;
                 outcome.length = path_length(&found.path);
                 outcome.waypoints = found.path.len();
                 outcome.checks = found.checks;
                 outcome.note = match found.source {
-                    Source::Sampled => {
+                    Source::Sampled if self.keep => {
                         planner.add_path(&found.path)?;
                         self.kept.push(found.path.clone());
                         "RRT-Connect (path kept)".into()
                     }
+                    Source::Sampled => "RRT-Connect".into(),
                     Source::Graph => "experience".into(),
                     other => other.name().into(),
                 };

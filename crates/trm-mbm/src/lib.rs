@@ -21,7 +21,7 @@ mod run;
 mod solve;
 
 pub use error::{MbmError, Result};
-pub use experience::solve_with_experience;
+pub use experience::{Scope, solve_leave_one_out, solve_with_experience};
 pub use loaded::LoadedProblem;
 pub use peers::{parse_peer_results, peer_problems};
 pub use problems::{Problem, ProblemSet, find_problems, rrt_options_for};

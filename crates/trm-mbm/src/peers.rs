@@ -116,6 +116,7 @@ pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, Str
                     valid,
                     solved: valid && solved,
                     seconds: (number(4)? + number(5)?) * 1e-9,
+                    simplify_seconds: number(5)? * 1e-9,
                     length: number(7)?,
                     waypoints: number(9)? as usize,
                     note: match (valid, solved) {

@@ -15,6 +15,8 @@ pub struct Summary {
     pub solved: usize,
     /// Median and 95th percentile of the solved problems' times, s (`None` when none solved).
     pub time: Option<(f64, f64)>,
+    /// Median of the solved problems' planning times without simplification, s.
+    pub plan_time: Option<f64>,
     /// Median path length of the solved problems, rad.
     pub length: Option<f64>,
     /// Median collision checks of the solved problems.
@@ -41,28 +43,31 @@ impl Summary {
             valid: outcomes.iter().filter(|o| o.valid).count(),
             solved: solved.len(),
             time: quantile(&times, 0.5).zip(quantile(&times, 0.95)),
+            plan_time: quantile(&of(&|o| o.seconds - o.simplify_seconds), 0.5),
             length: quantile(&of(&|o| o.length), 0.5),
             checks: quantile(&of(&|o| o.checks as f64), 0.5),
         }
     }
 }
 
-/// The runs as CSV: family, problem, valid, solved, seconds, length, waypoints, checks,
-/// verified, note.
+/// The runs as CSV: family, problem, valid, solved, seconds, simplify_seconds (of seconds),
+/// length, waypoints, checks, verified, note.
 pub fn runs_csv(runs: &[Run]) -> String {
     use std::fmt::Write as _;
-    let mut csv =
-        String::from("family,problem,valid,solved,seconds,length,waypoints,checks,verified,note\n");
+    let mut csv = String::from(
+        "family,problem,valid,solved,seconds,simplify_seconds,length,waypoints,checks,verified,note\n",
+    );
     for r in runs {
         let o = &r.outcome;
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{},{},{},\"{}\"",
+            "{},{},{},{},{},{},{},{},{},{},\"{}\"",
             r.family,
             r.index,
             o.valid,
             o.solved,
             o.seconds,
+            o.simplify_seconds,
             o.length,
             o.waypoints,
             o.checks,
@@ -130,15 +135,15 @@ fn families<'a>(outcomes: &[(&'a str, &Outcome)]) -> Vec<&'a str> {
 }
 
 /// Two planners side by side per family, in markdown: each one's solved share of the problems
-/// both call valid, its median and p95 time and median path length, and the ratios
-/// `ours / theirs`.
+/// both call valid, its median planning time without simplification, its median and p95 time
+/// with it, its median path length, and the ratios `ours / theirs`.
 pub fn side_by_side<'a>(
     (ours, our_name): (&[(&'a str, &'a Outcome)], &str),
     (theirs, their_name): (&[(&'a str, &'a Outcome)], &str),
 ) -> String {
     use std::fmt::Write as _;
     let mut md = format!(
-        "| family | both valid | {our_name} solved | {their_name} solved | {our_name} median ms | {their_name} median ms | median ratio | {our_name} p95 ms | {their_name} p95 ms | p95 ratio | {our_name} median length (rad) | {their_name} median length (rad) | length ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+        "| family | both valid | {our_name} solved | {their_name} solved | {our_name} plan-only median ms | {their_name} plan-only median ms | {our_name} median ms | {their_name} median ms | median ratio | {our_name} p95 ms | {their_name} p95 ms | p95 ratio | {our_name} median length (rad) | {their_name} median length (rad) | length ratio |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     let mut row = |name: &str, pairs: Vec<(&Outcome, &Outcome)>| {
         let both: Vec<_> = pairs.iter().filter(|(a, b)| a.valid && b.valid).collect();
@@ -153,10 +158,12 @@ pub fn side_by_side<'a>(
         };
         let _ = writeln!(
             md,
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             both.len(),
             a.solved,
             b.solved,
+            ms(a.plan_time),
+            ms(b.plan_time),
             ms(a.time.map(|t| t.0)),
             ms(b.time.map(|t| t.0)),
             ratio(a.time.map(|t| t.0), b.time.map(|t| t.0)),

@@ -9,7 +9,7 @@ use trm_plan::rrt::RrtOptions;
 use trm_roadmap::Roadmap;
 
 use crate::error::MbmError;
-use crate::experience::solve_with_experience;
+use crate::experience::{Scope, solve_leave_one_out, solve_with_experience};
 use crate::loaded::LoadedProblem;
 use crate::problems::Problem;
 use crate::report::{markdown_table, side_by_side};
@@ -68,6 +68,9 @@ pub struct Benchmark {
     pub runs: Vec<Run>,
     /// Each pass with experience, one run per problem.
     pub experience: Vec<Vec<Run>>,
+    /// With experience: each problem planned through the plain run's paths of the other
+    /// problems of its family, then of the set ([`solve_leave_one_out`]), one run per problem.
+    pub leave_one_out: Vec<(Scope, Vec<Run>)>,
     /// The run with [`BenchmarkOptions::maps`] attached, one per problem (empty without maps).
     pub with_maps: Vec<Run>,
     /// Whether solved paths were re-checked ([`BenchmarkOptions::verify`]).
@@ -103,29 +106,58 @@ pub fn benchmark(
             },
         )?;
         for outcomes in passes {
-            let runs = outcomes
-                .into_iter()
-                .zip(&loaded)
-                .map(|(outcome, p)| {
-                    let verified = verify_outcome(robot, p, &outcome, options)?;
-                    Ok(Run {
-                        family: p.problem.family.clone(),
-                        index: p.problem.index,
-                        outcome,
-                        verified,
-                    })
-                })
-                .collect::<Result<_, MbmError>>()?;
-            experience.push(runs);
+            experience.push(runs_of(robot, &loaded, outcomes, options)?);
+        }
+    }
+    let mut leave_one_out = Vec::new();
+    if options.experience_passes > 0 {
+        // the plain run's paths, each problem planned through the others'
+        let paths: Vec<Vec<Vec<f64>>> = runs
+            .iter()
+            .map(|r| match r.outcome.solved {
+                true => r.outcome.path.clone(),
+                false => Vec::new(),
+            })
+            .collect();
+        for (scope, stage) in [
+            (Scope::Family, "leave-one-out, family"),
+            (Scope::Set, "leave-one-out, set"),
+        ] {
+            let outcomes = solve_leave_one_out(robot, &loaded, &paths, scope, &options.rrt, |k| {
+                progress(stage, k + 1, problems.len(), &problems[k])
+            })?;
+            leave_one_out.push((scope, runs_of(robot, &loaded, outcomes, options)?));
         }
     }
     Ok(Benchmark {
         problems: loaded,
         runs,
         experience,
+        leave_one_out,
         with_maps,
         verified: options.verify,
     })
+}
+
+/// Outcomes in the order of `problems` as runs, their paths verified when `options` say.
+fn runs_of(
+    robot: &RobotModel,
+    problems: &[LoadedProblem],
+    outcomes: Vec<Outcome>,
+    options: &BenchmarkOptions,
+) -> Result<Vec<Run>, MbmError> {
+    outcomes
+        .into_iter()
+        .zip(problems)
+        .map(|(outcome, p)| {
+            Ok(Run {
+                family: p.problem.family.clone(),
+                index: p.problem.index,
+                verified: verify_outcome(robot, p, &outcome, options)?,
+                outcome,
+            })
+        })
+        .collect()
 }
 
 /// Solves each problem by RRT-Connect + shortcutting ([`crate::solve_loaded`]), re-checking
@@ -204,7 +236,7 @@ impl Benchmark {
                 if pass == 0 {
                     "one planner per family: each problem planned through the paths of the family's earlier problems, checked lazily in its scene, RRT-Connect where they do not reach"
                 } else {
-                    "the set again, every path of pass 1 kept, the problem's own included"
+                    "the same queries again: the set once more with every path of pass 1 kept, the problem's own included — a replay, not experience of a new query"
                 },
                 solved(Some("experience")) + retrieved,
                 solved(None),
@@ -212,6 +244,31 @@ impl Benchmark {
             );
             if self.verified {
                 md.push_str(&verified_line(runs, "Every path"));
+            }
+        }
+        for (scope, runs) in &self.leave_one_out {
+            let through = runs
+                .iter()
+                .filter(|r| r.outcome.solved && r.outcome.note == "experience")
+                .count();
+            let _ = write!(
+                md,
+                "\nLeave-one-out experience, {}: each problem planned through the plain run's paths of every other problem of {} (never its own), RRT-Connect where they do not reach; {through} answered through them. Beside the plain run (ratio = leave-one-out / fresh):\n\n{}",
+                match scope {
+                    Scope::Family => "within the family",
+                    Scope::Set => "across the set",
+                },
+                match scope {
+                    Scope::Family => "its family",
+                    Scope::Set => "the set that moves the same motors",
+                },
+                side_by_side(
+                    (&family_outcomes(runs), "leave-one-out"),
+                    (&family_outcomes(&self.runs), "fresh")
+                )
+            );
+            if self.verified {
+                md.push_str(&verified_line(runs, "Every leave-one-out path"));
             }
         }
         if !self.with_maps.is_empty() {

@@ -25,6 +25,9 @@ pub struct Outcome {
     pub solved: bool,
     /// Planning time (checks, search, shortcutting; not reading the files), s.
     pub seconds: f64,
+    /// Of [`Outcome::seconds`], the time spent simplifying the path (shortcutting and checking
+    /// it again), s: the rest is planning alone.
+    pub simplify_seconds: f64,
     /// Path length, rad.
     pub length: f64,
     /// Waypoints of the path.
@@ -124,6 +127,7 @@ pub fn solve_with_maps(
         Ok(found) => {
             outcome.solved = true;
             outcome.seconds = goal_seconds + found.seconds;
+            outcome.simplify_seconds = found.simplify_seconds;
             outcome.length = path_length(&found.path);
             outcome.waypoints = found.path.len();
             outcome.checks = found.checks;

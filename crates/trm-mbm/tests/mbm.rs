@@ -791,3 +791,72 @@ fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Leave-one-out experience: each problem planned through the other problems' paths (of its
+/// family, or of the set) never retrieves its own, even when the paths given include it at its
+/// own index; a path given for itself alone is retrieved. Times split into planning and
+/// simplification.
+#[test]
+fn leave_one_out_experience_never_sees_the_problem_s_own_path() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let problems = find_problems(&fixtures()).unwrap();
+    let loaded = LoadedProblem::load_all(&collision, &problems).unwrap();
+    let options = RrtOptions::default();
+    let plain: Vec<trm_mbm::Outcome> = loaded
+        .iter()
+        .map(|p| trm_mbm::solve_loaded(&robot, p, &options).unwrap())
+        .collect();
+    for o in &plain {
+        assert!(o.solved && o.simplify_seconds >= 0.0 && o.simplify_seconds <= o.seconds);
+    }
+    let paths: Vec<Vec<Vec<f64>>> = plain.iter().map(|o| o.path.clone()).collect();
+    for scope in [trm_mbm::Scope::Family, trm_mbm::Scope::Set] {
+        let mut calls = 0;
+        let outcomes =
+            trm_mbm::solve_leave_one_out(&robot, &loaded, &paths, scope, &options, |_| calls += 1)
+                .unwrap();
+        assert_eq!(calls, problems.len());
+        for (p, o) in problems.iter().zip(&outcomes) {
+            assert!(o.solved, "{scope:?} {} {}: {}", p.family, p.index, o.note);
+            assert_ne!(o.note, "retrieved", "{scope:?} {} {}", p.family, p.index);
+        }
+    }
+    // the control: a problem's own path, given under another problem's index, is retrieved
+    let only_first: Vec<Vec<Vec<f64>>> = paths
+        .iter()
+        .enumerate()
+        .map(|(k, p)| if k == 0 { p.clone() } else { Vec::new() })
+        .collect();
+    let mut swapped = loaded.clone();
+    swapped.swap(0, 1);
+    let (a, b) = (&swapped[0].problem, &swapped[1].problem);
+    if a.family == b.family {
+        // the first problem's path, given at index 0, is left out of the planner of the problem
+        // now at index 0 (the second), and given to the problem now at index 1 (the first),
+        // which retrieves it: what leave-one-out would do with a problem's own path
+        let outcomes = trm_mbm::solve_leave_one_out(
+            &robot,
+            &swapped,
+            &only_first,
+            trm_mbm::Scope::Family,
+            &options,
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(outcomes[1].note, "retrieved", "{}", outcomes[1].note);
+        assert_ne!(outcomes[0].note, "retrieved");
+    }
+    let e = trm_mbm::solve_leave_one_out(
+        &robot,
+        &loaded,
+        &paths[1..],
+        trm_mbm::Scope::Family,
+        &options,
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("paths for"), "{e}");
+}

@@ -303,6 +303,9 @@ pub struct RrtPath {
     pub checks: u64,
     /// Wall time, s.
     pub seconds: f64,
+    /// Of [`RrtPath::seconds`], the time spent simplifying the path the trees made
+    /// (shortcutting and checking the result again), s: the rest is planning.
+    pub simplify_seconds: f64,
     /// Searches run again at a finer resolution because the path grazed an obstacle.
     pub refinements: u32,
 }
@@ -675,7 +678,7 @@ impl Growth {
     ) -> Result<RrtPath, PlanError> {
         let before = self.before;
         let (start, goal) = (self.start.clone(), self.goal.clone());
-        let mut iterations = 0;
+        let (mut iterations, mut simplify) = (0, 0.0);
         let mut growth = Some(self);
         for refinement in 0..3 {
             let resolution = options.resolution / f64::from(1u32 << refinement);
@@ -688,6 +691,7 @@ impl Growth {
                 None => Growth::new(checker, &start, &goal, &attempt)?,
             };
             g.grow(checker, bounds, &attempt, attempt.max_iterations, began);
+            let simplifying = Instant::now();
             let (mut found, edges) = g.shortcut(checker, &attempt, began)?;
             // the edges checked at `resolution` (by the search: the edges it kept, or by the
             // shortcut) need only their midpoints to be checked at half that; a piece of an
@@ -703,7 +707,9 @@ impl Growth {
                             && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
             });
             iterations += found.iterations;
+            simplify += simplifying.elapsed().as_secs_f64();
             if free {
+                found.simplify_seconds = simplify;
                 found.checks = checker.checks - before;
                 found.iterations = iterations;
                 found.refinements = refinement;

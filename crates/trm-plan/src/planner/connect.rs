@@ -52,6 +52,10 @@ pub struct Connection {
     pub iterations: usize,
     /// Wall time, s.
     pub seconds: f64,
+    /// Of [`Connection::seconds`], the time spent simplifying the path found (shortcutting it
+    /// and checking the result again; proving it, with certified paths), s: the rest is
+    /// planning.
+    pub simplify_seconds: f64,
 }
 
 impl Planner {
@@ -81,7 +85,9 @@ impl Planner {
         let before = self.checker.checks;
         let mut found = self.find(start, goal, options, began, before)?;
         if options.certified {
+            let proving = Instant::now();
             self.prove(&mut found.path, options)?;
+            found.simplify_seconds += proving.elapsed().as_secs_f64();
             found.checks = self.checker.checks - before;
             found.seconds = began.elapsed().as_secs_f64();
         }
@@ -215,12 +221,17 @@ impl Planner {
             max_searches: Some(searches),
             ..Default::default()
         };
-        let planned = match self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options) {
+        // the waypoints only: their trajectory would be thrown away
+        self.time_paths = false;
+        let planned = self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options);
+        self.time_paths = true;
+        let planned = match planned {
             Ok(planned) => planned,
             Err(PlanError::Unreachable { .. }) => return Ok(None),
             Err(e) => return Err(self.name_collisions(e, start, goal)),
         };
         let mut path = planned.waypoints;
+        let simplifying = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
         let greedy = RrtOptions {
             shortcuts: 0,
@@ -248,6 +259,7 @@ impl Planner {
             checks: 0,
             iterations: 0,
             seconds: 0.0,
+            simplify_seconds: simplifying.elapsed().as_secs_f64(),
         }))
     }
 
@@ -279,6 +291,7 @@ impl Planner {
             checks: self.checker.checks - before,
             iterations: found.iterations,
             seconds: began.elapsed().as_secs_f64(),
+            simplify_seconds: found.simplify_seconds,
         }
     }
 }

@@ -93,6 +93,9 @@ pub struct Planner {
     rrt: std::sync::OnceLock<RrtOptions>,
     /// Maps attached so far.
     maps: usize,
+    /// Whether [`Planner::plan`] times its path (a search that wants only the waypoints, as
+    /// [`Planner::connect`]'s through the graph, turns it off while it runs).
+    time_paths: bool,
 }
 
 impl Planner {
@@ -104,6 +107,7 @@ impl Planner {
         let mut planner = Planner {
             checker: objective.world_checker(objective.world())?,
             certifier: None,
+            time_paths: true,
             objective: objective.clone(),
             active: objective.active().clone(),
             bounds: objective.active().bounds(),
@@ -424,13 +428,22 @@ impl Planner {
         let began = Instant::now();
         self.check_query(start, goal, options)?;
         let n = self.nodes.len();
-        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
-        let (extra, goal_q) = self.query_edges(start, goal, options)?;
-        if let Some(q) = &goal_q {
+        // a kept path repeating the query first: before the start and goal are joined to the
+        // graph, which a query answered so (or allowed no search) does not need
+        if let Goal::Configuration(q) = goal {
             if let Some(planned) = self.retrieve(start, q, options, began)? {
                 return Ok(planned);
             }
+            if options.max_searches == Some(0) {
+                return Err(PlanError::Unreachable {
+                    reason: "no kept path repeats the query, and no search is allowed".into(),
+                    closest_node: None,
+                    closest_distance: f64::INFINITY,
+                });
+            }
         }
+        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
+        let (extra, goal_q) = self.query_edges(start, goal, options)?;
         let goal_t = match goal {
             Goal::Configuration(q) => self.task_of(q),
             Goal::TaskPoint { t, .. } => t.clone(),
@@ -653,7 +666,7 @@ impl Planner {
             stats.goal_error = Some(distance(&self.task_of(&end), t));
         }
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.trajectory(&waypoints, &options.timing)?;
+        let trajectory = self.timed_if_asked(&waypoints, &options.timing)?;
         stats.seconds = began.elapsed().as_secs_f64();
         Ok(Planned {
             trajectory,
@@ -739,7 +752,7 @@ impl Planner {
         stats.retrieved = true;
         self.shortcut(&mut waypoints, options);
         stats.length = waypoints.windows(2).map(|w| distance(&w[0], &w[1])).sum();
-        let trajectory = self.trajectory(&waypoints, &options.timing)?;
+        let trajectory = self.timed_if_asked(&waypoints, &options.timing)?;
         stats.seconds = began.elapsed().as_secs_f64();
         Ok(Some(Planned {
             trajectory,
@@ -853,6 +866,32 @@ impl Planner {
                 waypoints.drain(i + 1..j);
             }
         }
+    }
+
+    /// [`Planner::trajectory`] of `waypoints`, or (while [`Planner::time_paths`] is off) the
+    /// waypoints alone, untimed.
+    fn timed_if_asked(
+        &mut self,
+        waypoints: &[Vec<f64>],
+        timing: &crate::Timing,
+    ) -> Result<Trajectory, PlanError> {
+        if self.time_paths {
+            return self.trajectory(waypoints, timing);
+        }
+        Ok(Trajectory {
+            names: self
+                .active
+                .model()
+                .motors()
+                .iter()
+                .map(|m| m.name.clone())
+                .collect(),
+            times: Vec::new(),
+            positions: waypoints.iter().map(|q| self.active.to_motors(q)).collect(),
+            velocities: Vec::new(),
+            accelerations: Vec::new(),
+            task_path: Vec::new(),
+        })
     }
 
     /// A path (active values, collision-checked) as a trajectory the robot can execute:
