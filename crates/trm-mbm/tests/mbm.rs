@@ -183,7 +183,11 @@ fn rrt_connect_solves_every_sample_problem_with_paths_free_at_half_the_resolutio
             assert_eq!(path.last().unwrap(), &request.goal.positions);
             // the same seed finds the same path
             let scene = PlanningScene::load(&p.scene).unwrap();
-            let again = solve(&robot, &collision, &scene, &request, &options).unwrap();
+            let certified = RrtOptions {
+                certified: true,
+                ..options.clone()
+            };
+            let again = solve(&robot, &collision, &scene, &request, &certified).unwrap();
             assert_eq!(again.path, outcome.path);
         }
     }
@@ -386,7 +390,7 @@ fn worlds_load_from_moveit_scenes_and_ron() {
 }
 
 /// Experience: one planner per family keeps what RRT-Connect finds; the second pass over the
-/// sample answers from it, every path proved free, and the whole run repeats
+/// sample answers from it, every path proved free (certified planning), and the whole run repeats
 /// exactly for its seed.
 #[test]
 fn experience_answers_the_second_pass() {
@@ -394,7 +398,11 @@ fn experience_answers_the_second_pass() {
     let robot = trm_kinematics::RobotModel::load(&model).unwrap();
     let collision = trm_collision::CollisionModel::new(&robot).unwrap();
     let problems = find_problems(&fixtures()).unwrap();
-    let options = RrtOptions::default();
+    // certified: kept paths are proved, and so is what the second pass retrieves
+    let options = RrtOptions {
+        certified: true,
+        ..Default::default()
+    };
     let loaded = LoadedProblem::load_all(&collision, &problems).unwrap();
     let mut calls = 0;
     let passes =

@@ -33,6 +33,12 @@ pub struct RrtOptions {
     /// MotionBenchMaker's Panda set 100 attempts shortened paths by 7 % but tripled the median
     /// time, and their corner-cutting edges graze obstacles between checked points).
     pub shortcuts: usize,
+    /// Rounds of corner cutting after the shortcuts ([`shortcut`]): each interior waypoint
+    /// `v` between `a` and `b` moved to `(a + 2v + b) / 4` where the corner's two new edges
+    /// (from the midpoints of `a v` and `v b`) are free, then the greedy pass again, until a
+    /// round changes nothing — VAMP's B-spline step and shortcut, alternated as its simplifier
+    /// does ([`SMOOTHING_ROUNDS`] by default; 0: the greedy pass only).
+    pub smoothing: usize,
     /// Dynamic domain (Jaillet, Yershova, LaValle and Siméon, IROS 2005), as VAMP grows its
     /// trees: a node whose extension hit an obstacle takes samples only within a radius of it
     /// (first [`DOMAIN_RADIUS`], shrinking by [`DOMAIN_ALPHA`] at each failure down to
@@ -180,6 +186,13 @@ pub const DOMAIN_ALPHA: f64 = 1e-4;
 /// Smallest domain radius, rad.
 pub const DOMAIN_MIN_RADIUS: f64 = 1.0;
 
+/// [`RrtOptions::smoothing`]'s default: VAMP's simplifier's iterations.
+pub const SMOOTHING_ROUNDS: usize = 5;
+
+/// The least move of a waypoint corner cutting makes, rad (VAMP's B-spline `min_change`): a
+/// corner flatter than this is left as it is.
+pub const SMOOTHING_MIN_CHANGE: f64 = 0.1;
+
 impl Default for RrtOptions {
     fn default() -> Self {
         RrtOptions {
@@ -189,6 +202,7 @@ impl Default for RrtOptions {
             max_iterations: 100_000,
             max_seconds: None,
             shortcuts: 0,
+            smoothing: SMOOTHING_ROUNDS,
             dynamic_domain: true,
             balance: true,
             sampler: Sampler::default(),
@@ -781,25 +795,8 @@ pub fn shortcut(
     checker: &mut WorldChecker,
     rng: &mut impl RngExt,
 ) -> Vec<EdgeCheck> {
-    // greedy: from each kept point, the farthest later waypoint it sees
-    let mut kept = vec![path[0].clone()];
-    let mut edges = Vec::with_capacity(path.len());
-    let mut i = 0;
-    while i + 1 < path.len() {
-        let mut j = path.len() - 1;
-        while j > i + 1 && !checker.edge_free(&path[i], &path[j], options.resolution) {
-            j -= 1;
-        }
-        kept.push(path[j].clone());
-        // j > i + 1: that edge was just found free; else the given edge i → i + 1, unchecked
-        edges.push(if j > i + 1 {
-            EdgeCheck::Checked
-        } else {
-            EdgeCheck::Given
-        });
-        i = j;
-    }
-    *path = kept;
+    let mut edges = vec![EdgeCheck::Given; path.len().saturating_sub(1)];
+    greedy(path, &mut edges, options.resolution, checker);
     for _ in 0..options.shortcuts {
         if path.len() < 3 {
             break;
@@ -848,7 +845,92 @@ pub fn shortcut(
             edges = kept_edges;
         }
     }
+    for _ in 0..options.smoothing {
+        if !cut_corners(path, &mut edges, options.resolution, checker) {
+            break;
+        }
+        greedy(path, &mut edges, options.resolution, checker);
+    }
     edges
+}
+
+/// From each kept waypoint of `path`, the farthest later one it sees: the waypoints between
+/// are dropped, and `edges` (one per edge) says how each edge of the result was checked.
+fn greedy(
+    path: &mut Vec<Vec<f64>>,
+    edges: &mut Vec<EdgeCheck>,
+    resolution: f64,
+    checker: &mut WorldChecker,
+) {
+    let mut kept = vec![path[0].clone()];
+    let mut kept_edges = Vec::with_capacity(edges.len());
+    let mut i = 0;
+    while i + 1 < path.len() {
+        let mut j = path.len() - 1;
+        while j > i + 1 && !checker.edge_free(&path[i], &path[j], resolution) {
+            j -= 1;
+        }
+        kept.push(path[j].clone());
+        // j > i + 1: that edge was just found free; else the edge i → i + 1, as it was
+        kept_edges.push(if j > i + 1 {
+            EdgeCheck::Checked
+        } else {
+            edges[i]
+        });
+        i = j;
+    }
+    *path = kept;
+    *edges = kept_edges;
+}
+
+/// One round of corner cutting (see [`RrtOptions::smoothing`]): each interior waypoint `v`
+/// (between `a` and `b`) that would move by at least [`SMOOTHING_MIN_CHANGE`] is replaced by
+/// `m₁ → v' → m₂`, `m₁` and `m₂` the midpoints of `a v` and `v b` and `v'` the midpoint of
+/// `m₁ m₂`, where the three points and the two edges through `v'` are free. Whether any
+/// waypoint moved.
+fn cut_corners(
+    path: &mut Vec<Vec<f64>>,
+    edges: &mut Vec<EdgeCheck>,
+    resolution: f64,
+    checker: &mut WorldChecker,
+) -> bool {
+    let d = path[0].len();
+    let (mut changed, mut i) = (false, 1);
+    let mut points = vec![0.0; 3 * d];
+    while i + 1 < path.len() {
+        let (a, v, b) = (&path[i - 1], &path[i], &path[i + 1]);
+        let (m1, rest) = points.split_at_mut(d);
+        let (cut, m2) = rest.split_at_mut(d);
+        for k in 0..d {
+            m1[k] = 0.5 * (a[k] + v[k]);
+            m2[k] = 0.5 * (v[k] + b[k]);
+            cut[k] = 0.5 * (m1[k] + m2[k]);
+        }
+        if distance(cut, v) < SMOOTHING_MIN_CHANGE
+            || !checker.all_free(&points)
+            || !checker.edge_free(&points[..d], &points[d..2 * d], resolution)
+            || !checker.edge_free(&points[d..2 * d], &points[2 * d..], resolution)
+        {
+            i += 1;
+            continue;
+        }
+        // a → m₁ and m₂ → b are pieces of the edges they cut
+        let new = points.chunks(d).map(<[f64]>::to_vec);
+        path.splice(i..=i, new);
+        edges.splice(
+            i - 1..=i,
+            [
+                EdgeCheck::Piece,
+                EdgeCheck::Checked,
+                EdgeCheck::Checked,
+                EdgeCheck::Piece,
+            ],
+        );
+        changed = true;
+        // the next corner is the old b, now after m₂
+        i += 3;
+    }
+    changed
 }
 
 /// Length of a path, rad.

@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
-use trm_plan::rrt::RrtOptions;
+use trm_plan::rrt::{RrtOptions, path_length};
 use trm_plan::{ExactGoal, Goal, HEAD_START_SAMPLES, PlanError, PlanOptions, Planner, Source};
 use trm_roadmap::{BuildOptions, Builder, Roadmap, connect};
 use trm_tasks::Problem;
@@ -982,4 +982,36 @@ fn certified_paths_do_not_cross_what_points_miss() {
         ),
         (&start[..], &goal[..])
     );
+}
+
+/// Corner cutting (`RrtOptions::smoothing`) never lengthens a path, shortens the detours
+/// RRT-Connect takes round the pole, and keeps every path free at half the resolution.
+#[test]
+fn corner_cutting_shortens_paths_and_keeps_them_free() {
+    let (objective, start, goal) = arm_beside_a_pole();
+    let mut planner = Planner::new(&objective, &[]).unwrap();
+    let (mut shorter, mut total) = (0, 0);
+    for seed in 0..12 {
+        let plain = RrtOptions {
+            seed,
+            smoothing: 0,
+            ..Default::default()
+        };
+        let smoothed = RrtOptions {
+            smoothing: trm_plan::rrt::SMOOTHING_ROUNDS,
+            ..plain.clone()
+        };
+        let a = planner.connect(&start, &goal, &plain).unwrap();
+        let b = planner.connect(&start, &goal, &smoothed).unwrap();
+        let (la, lb) = (path_length(&a.path), path_length(&b.path));
+        assert!(lb <= la + 1e-9, "seed {seed}: {lb} > {la}");
+        shorter += usize::from(lb < la - 1e-6);
+        total += 1;
+        assert_eq!(b.path.first(), Some(&start));
+        assert_eq!(b.path.last(), Some(&goal));
+        for w in b.path.windows(2) {
+            assert!(planner.segment_free(&w[0], &w[1], smoothed.resolution / 2.0));
+        }
+    }
+    assert!(shorter * 2 >= total, "{shorter} of {total} paths shortened");
 }

@@ -53,6 +53,10 @@ pub struct Args {
     /// Random shortcut attempts per path (after the greedy pass).
     #[arg(long, default_value_t = 0, value_parser = crate::parse::count(0, 1_000_000))]
     shortcuts: usize,
+    /// Rounds of corner cutting after shortcutting, each followed by the greedy pass again
+    /// (VAMP's simplifier: B-spline step and shortcut; 0: the greedy pass only).
+    #[arg(long, default_value_t = trm_plan::rrt::SMOOTHING_ROUNDS, value_parser = crate::parse::count(0, 1_000))]
+    smoothing: usize,
     /// Prove every returned path (trm's and, with --vamp, VAMP's) free in continuous motion:
     /// f64, exact distances and lever-arm bounds, independent of the planner's own checks.
     #[arg(long)]
@@ -135,6 +139,7 @@ pub fn run(args: &Args) -> Result<()> {
         resolution: args.resolution.unwrap_or(sized.resolution),
         range: args.range.unwrap_or(sized.range),
         shortcuts: args.shortcuts,
+        smoothing: args.smoothing,
         certified: args.certified,
         sampler: match args.sampler {
             SamplerArg::Halton => trm_plan::rrt::Sampler::Halton,

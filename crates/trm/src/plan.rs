@@ -86,6 +86,10 @@ pub struct Args {
     /// arms; 1 rad on the Panda).
     #[arg(long, value_parser = crate::parse::positive)]
     range: Option<f64>,
+    /// Without maps: rounds of corner cutting after shortcutting (VAMP's B-spline step; 0:
+    /// the greedy shortcut only).
+    #[arg(long, default_value_t = trm_plan::rrt::SMOOTHING_ROUNDS, value_parser = crate::parse::count(0, 1_000))]
+    smoothing: usize,
     /// Without maps: prove the path free in continuous motion (f64, exact distances, lever-arm
     /// bounds), planning again with proved edges any segment that cannot be proved.
     #[arg(long)]
@@ -418,6 +422,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         resolution: args.resolution.unwrap_or(sized.resolution),
         range: args.range.unwrap_or(sized.range),
         certified: args.certified,
+        smoothing: args.smoothing,
         ..sized
     };
     let goal_configuration = match &goal {

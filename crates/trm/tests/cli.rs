@@ -194,6 +194,14 @@ fn plan_without_maps_refuses_what_does_not_fit_and_writes_nothing() {
             "--max-seconds",
         ),
         (vec!["--request", request, "--range", "0"], "--range"),
+        (
+            vec!["--request", request, "--smoothing", "-1"],
+            "--smoothing",
+        ),
+        (
+            vec!["--request", request, "--smoothing", "1001"],
+            "--smoothing",
+        ),
     ] {
         let mut full = vec!["plan", "--model", model, "--out", "traj.csv"];
         full.extend(args);
