@@ -16,7 +16,7 @@
 //! ([`Certificate::Unproved`]). The check is `f64`, exact distances (the collision model's own
 //! bodies) and its own code path: it shares no sampling with the planners it verifies.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use trm_kinematics::{ActiveSet, PoseBuffer};
 
 use crate::error::{CollisionError, Result};
@@ -119,11 +119,15 @@ struct Piece {
     open: Vec<Open>,
 }
 
-/// A configuration placed: the bodies, and the centre of each link's enclosing sphere.
+/// A configuration placed: its link poses, the centre of each link's enclosing sphere, and
+/// the bodies, each placed when a pair first needs it.
 #[derive(Debug, Clone)]
 struct Snapshot {
-    placed: PlacedBodies,
+    links: Vec<Isometry3<f64>>,
     centers: Vec<Point3<f64>>,
+    placed: PlacedBodies,
+    /// Per body: whether `placed` holds it at this configuration.
+    ready: Vec<bool>,
 }
 
 /// A link with bodies: a sphere in its frame that encloses them all.
@@ -552,13 +556,17 @@ impl Certifier {
         self.active.forward_unchecked(q, &mut self.poses);
         if self.placed_count == self.snapshots.len() {
             self.snapshots.push(Snapshot {
-                placed: self.collision.placed_bodies(),
+                links: Vec::new(),
                 centers: vec![Point3::origin(); self.balls.len()],
+                placed: self.collision.placed_bodies(),
+                ready: vec![false; self.collision.bodies().len()],
             });
         }
         let snapshot = &mut self.snapshots[self.placed_count];
-        self.collision.place(&self.poses, &mut snapshot.placed);
         let poses = self.poses.poses();
+        snapshot.links.clear();
+        snapshot.links.extend_from_slice(poses);
+        snapshot.ready.fill(false);
         for (c, ball) in snapshot.centers.iter_mut().zip(&self.balls) {
             *c = poses[ball.link] * ball.center;
         }
@@ -599,10 +607,36 @@ impl Certifier {
         }
     }
 
-    /// A lower bound on pair `unit`'s distance at snapshot `s`, from bounding spheres.
-    fn unit_bound(&self, world: &World, s: usize, group: u32, unit: u32) -> f64 {
-        let p = &self.snapshots[s].placed.placed;
+    /// Places body `body` at snapshot `s` unless it is there.
+    fn ready(&mut self, s: usize, body: usize) {
+        let snap = &mut self.snapshots[s];
+        if !snap.ready[body] {
+            let link = self.collision.bodies()[body].link;
+            self.collision.compiled()[body].place(&snap.links[link], &mut snap.placed.placed[body]);
+            snap.ready[body] = true;
+        }
+    }
+
+    /// Places pair `unit`'s bodies at snapshot `s`: the pair.
+    fn ready_unit(
+        &mut self,
+        world: &World,
+        s: usize,
+        group: u32,
+        unit: u32,
+    ) -> (usize, std::result::Result<usize, usize>) {
         let (a, other) = self.unit_of(world, group, unit);
+        self.ready(s, a);
+        if let Ok(b) = other {
+            self.ready(s, b);
+        }
+        (a, other)
+    }
+
+    /// A lower bound on pair `unit`'s distance at snapshot `s`, from bounding spheres.
+    fn unit_bound(&mut self, world: &World, s: usize, group: u32, unit: u32) -> f64 {
+        let (a, other) = self.ready_unit(world, s, group, unit);
+        let p = &self.snapshots[s].placed.placed;
         let o = match other {
             Ok(b) => &p[b],
             Err(object) => &world.objects()[object].placed,
@@ -613,8 +647,9 @@ impl Certifier {
     /// Pair `unit`'s exact signed distance at snapshot `s`.
     fn unit_distance(&mut self, world: &World, s: usize, group: u32, unit: u32) -> f64 {
         self.distances += 1;
+        let pair = self.ready_unit(world, s, group, unit);
         let (c, p) = (self.collision.compiled(), &self.snapshots[s].placed.placed);
-        match self.unit_of(world, group, unit) {
+        match pair {
             (a, Ok(b)) => signed_distance(&c[a], &p[a], &c[b], &p[b]),
             (a, Err(object)) => {
                 let o = &world.objects()[object];
