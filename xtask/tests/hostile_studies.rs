@@ -7,7 +7,7 @@ mod harness;
 
 use std::path::Path;
 
-use harness::{Case, file_flag_cases, flag_cases};
+use harness::{file_flag_cases, flag_cases};
 
 #[test]
 fn study_commands_refuse_bad_flags_and_outputs_in_the_way() {
@@ -42,19 +42,12 @@ fn study_commands_refuse_bad_flags_and_outputs_in_the_way() {
         "--iterations",
         &["0", "18446744073709551615"],
     ));
-    for command in [
-        vec!["task-map-studies", "--out-dir"],
-        vec!["speedup", spec, "--points", "2", "--out-dir"],
-    ] {
-        cases.push(Case {
-            what: format!("{} into a regular file", command[0]),
-            args: command
-                .iter()
-                .map(|s| s.to_string())
-                .chain(["posture.json".to_string()])
-                .collect(),
-            names: "posture.json".into(),
-        });
-    }
+    cases.extend(harness::into_file_cases(
+        &[
+            vec!["task-map-studies", "--out-dir"],
+            vec!["speedup", spec, "--points", "2", "--out-dir"],
+        ],
+        "posture.json",
+    ));
     harness::run_all(bin, &dir, &cases, 20);
 }

@@ -452,27 +452,20 @@ pub fn cases(dir: &Path) -> Vec<Case> {
             });
         }
     }
-    for command in [
-        vec![
-            "compare-optimisers",
-            "--spec",
-            spec,
-            "--runs",
-            "1",
-            "--out-dir",
+    cases.extend(into_file_cases(
+        &[
+            vec![
+                "compare-optimisers",
+                "--spec",
+                spec,
+                "--runs",
+                "1",
+                "--out-dir",
+            ],
+            vec!["stand-up", "--rollouts", "1", "--out"],
         ],
-        vec!["stand-up", "--rollouts", "1", "--out"],
-    ] {
-        cases.push(Case {
-            what: format!("{} into a regular file", command[0]),
-            args: command
-                .iter()
-                .map(|s| s.to_string())
-                .chain(["posture.json".to_string()])
-                .collect(),
-            names: "posture.json".into(),
-        });
-    }
+        "posture.json",
+    ));
 
     // files written beside --out (the ROS 2 trajectory) that are a directory or a symlink
     std::fs::create_dir_all(dir.join("beside.ros.yaml")).unwrap();

@@ -418,3 +418,20 @@ pub fn run_all(bin: &Path, dir: &Path, cases: &[Case], minimum: usize) {
     assert!(new.is_empty(), "failed runs left files behind: {new:?}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Each command given `file` (a regular file of the test folder) as its last argument, where
+/// it wants an output folder or path: the error must name the file.
+pub fn into_file_cases(commands: &[Vec<&str>], file: &str) -> Vec<Case> {
+    commands
+        .iter()
+        .map(|command| Case {
+            what: format!("{} into a regular file", command[0]),
+            args: command
+                .iter()
+                .map(|s| s.to_string())
+                .chain([file.to_string()])
+                .collect(),
+            names: file.into(),
+        })
+        .collect()
+}
