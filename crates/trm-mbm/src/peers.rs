@@ -1,5 +1,6 @@
 //! The problems in the plain form peer planners (VAMP, OMPL) read, and their answers read back.
 
+use trm_collision::{Shape, World};
 use trm_moveit::{MotionPlanRequest, PlanningScene};
 
 use crate::error::MbmError;
@@ -147,4 +148,82 @@ pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, Str
         }
     }
     Ok(results)
+}
+
+/// Which obstacles trm plans among in a benchmark.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Obstacles {
+    /// The scenes' own: cylinders as cylinders.
+    #[default]
+    AsGiven,
+    /// The obstacles VAMP plans among ([`vamp_world`]): its checks have no cylinder, so both
+    /// planners face the same, larger, obstacles.
+    AsVamp,
+}
+
+/// `world` as VAMP's MotionBenchMaker loader gives it to VAMP's checks (which never read
+/// cylinders): each cylinder a capsule of the same radius and axis length (its caps beyond the
+/// cylinder's ends), and in the `box` family (`box` or `box_…`, whose goals grasp a can from
+/// above) a box of the cylinder's diameter and length; every other object as it is.
+pub fn vamp_world(world: &World, family: &str) -> World {
+    let boxes = family == "box" || family.starts_with("box_");
+    let mut out = World::new();
+    for o in world.objects() {
+        let shape = match *o.shape() {
+            Shape::Cylinder { radius, length } if boxes => Shape::Box {
+                size: [2.0 * radius, 2.0 * radius, length],
+            },
+            Shape::Cylinder { radius, length } => Shape::Capsule { radius, length },
+            ref other => other.clone(),
+        };
+        out.add(o.name(), shape, *o.pose())
+            .expect("the names of a world are unique and its shapes valid");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trm_kinematics::nalgebra::Isometry3;
+
+    #[test]
+    fn vamp_sees_cylinders_as_capsules_and_in_the_box_family_as_boxes() {
+        let mut world = World::new();
+        let pose = Isometry3::translation(0.5, 0.0, 0.3);
+        let can = Shape::Cylinder {
+            radius: 0.04,
+            length: 0.12,
+        };
+        world.add("can", can.clone(), pose).unwrap();
+        world
+            .add("ball", Shape::Sphere { radius: 0.1 }, Isometry3::identity())
+            .unwrap();
+        let shapes =
+            |w: &World| -> Vec<Shape> { w.objects().iter().map(|o| o.shape().clone()).collect() };
+        let table = vamp_world(&world, "table_pick_panda");
+        assert_eq!(
+            shapes(&table),
+            [
+                Shape::Capsule {
+                    radius: 0.04,
+                    length: 0.12
+                },
+                Shape::Sphere { radius: 0.1 }
+            ]
+        );
+        assert_eq!(table.objects()[0].pose(), &pose);
+        let boxes = vamp_world(&world, "box_panda");
+        assert_eq!(
+            shapes(&boxes)[0],
+            Shape::Box {
+                size: [0.08, 0.08, 0.12]
+            }
+        );
+        // a family merely containing "box" is not the box family
+        assert!(matches!(
+            vamp_world(&world, "toolbox_panda").objects()[0].shape(),
+            Shape::Capsule { .. }
+        ));
+    }
 }

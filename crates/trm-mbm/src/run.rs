@@ -56,6 +56,8 @@ pub struct BenchmarkOptions {
     /// Maps for a second run of the set beside the plain one, attached to each problem's
     /// planner ([`crate::solve_with_maps`]; none: no such run).
     pub maps: Vec<Roadmap>,
+    /// The obstacles trm plans among, and its paths are verified in.
+    pub obstacles: crate::Obstacles,
 }
 
 /// What a set run came to: the plain run, and each pass with experience kept.
@@ -87,7 +89,12 @@ pub fn benchmark(
     options: &BenchmarkOptions,
     mut progress: impl FnMut(&str, usize, usize, &Problem),
 ) -> Result<Benchmark, MbmError> {
-    let loaded = LoadedProblem::load_all(collision, problems)?;
+    let mut loaded = LoadedProblem::load_all(collision, problems)?;
+    if options.obstacles == crate::Obstacles::AsVamp {
+        for p in &mut loaded {
+            p.world = crate::vamp_world(&p.world, &p.problem.family);
+        }
+    }
     let (runs, with_maps) = run_set(robot, &loaded, options, |k, p| {
         progress("problems", k, problems.len(), p)
     })?;

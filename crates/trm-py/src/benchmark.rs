@@ -104,6 +104,7 @@ pub(crate) fn benchmark_mbm<'py>(
         task_space,
         experience_passes: 0,
         maps: maps.iter().map(|m| m.map.clone()).collect(),
+        ..Default::default()
     };
     let bench = py
         .detach(|| trm_mbm::benchmark(&robot, &collision, &set.problems, &options, |_, _, _, _| {}))

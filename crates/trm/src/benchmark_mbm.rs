@@ -61,6 +61,11 @@ pub struct Args {
     /// f64, exact distances and lever-arm bounds, independent of the planner's own checks.
     #[arg(long)]
     verify: bool,
+    /// Plan and verify among the obstacles VAMP plans among (VAMP's checks have no cylinders):
+    /// each cylinder a capsule, in the box family a box, so that both planners face the same
+    /// obstacles (trm_mbm::vamp_world)
+    #[arg(long)]
+    vamp_obstacles: bool,
     /// Plan with certified edges: every edge the planner accepts is also proved free in
     /// continuous motion, so every returned path is (see --verify).
     #[arg(long)]
@@ -280,6 +285,11 @@ fn run_benchmark(
             .iter()
             .map(|p| Roadmap::load(p).with_context(|| format!("--map {}", p.display())))
             .collect::<Result<_>>()?,
+        obstacles: if args.vamp_obstacles {
+            trm_mbm::Obstacles::AsVamp
+        } else {
+            trm_mbm::Obstacles::AsGiven
+        },
     };
     let mut bar: Option<(String, crate::progress::Progress)> = None;
     let bench = match trm_mbm::benchmark(
