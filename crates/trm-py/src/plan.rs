@@ -399,14 +399,15 @@ impl Planner {
     /// planner, a task point (a map node within `tolerance`, then with `exact` NGIK to the
     /// point itself). `posture` says which; by default a posture for a robot planner and a
     /// task point for a map planner. With `certified`, a posture goal's path is proved free in
-    /// continuous motion (segments that cannot be proved planned again with proved edges). The
-    /// GIL is released while planning.
+    /// continuous motion (segments that cannot be proved planned again with proved edges).
+    /// `smoothing` rounds of corner cutting follow the shortcut (VAMP's simplifier; 0: the
+    /// greedy shortcut only). The GIL is released while planning.
     ///
     /// Returns a dict: `times (T,)`, `positions`, `velocities` and `accelerations` `(T, motors)`
     /// (every motor, sampled as `set_timing` says), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
     /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
     /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
-    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false))]
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &mut self,
@@ -422,6 +423,7 @@ impl Planner {
         resolution: Option<f64>,
         range: Option<f64>,
         certified: bool,
+        smoothing: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let dim = self.planner.active().len();
         let from = match (start, &self.start) {
@@ -452,6 +454,7 @@ impl Planner {
                 resolution,
                 range,
                 certified,
+                smoothing,
             };
             let timing = self.timing.clone();
             self.connect(py, &d, from, RequestGoal::Joints(target), &budget, &timing)?
@@ -485,7 +488,7 @@ impl Planner {
     /// task-space goal, met by IK for a collision-free configuration first; its
     /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
     /// its scene first (`load_scene`). Returns what `plan` returns.
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false))]
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS))]
     #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
         &mut self,
@@ -497,6 +500,7 @@ impl Planner {
         resolution: Option<f64>,
         range: Option<f64>,
         certified: bool,
+        smoothing: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
         let read;
         let request = match request.cast::<MotionPlanRequest>() {
@@ -517,6 +521,7 @@ impl Planner {
             resolution,
             range,
             certified,
+            smoothing,
         };
         let d = PyDict::new(py);
         let timing = trm_plan::Timing {
@@ -556,6 +561,8 @@ struct Budget {
     range: Option<f64>,
     /// Certified paths ([`trm_plan::rrt::RrtOptions::certified`]).
     certified: bool,
+    /// Corner-cutting rounds ([`trm_plan::rrt::RrtOptions::smoothing`]).
+    smoothing: usize,
 }
 
 impl Planner {
@@ -580,6 +587,7 @@ impl Planner {
             resolution: budget.resolution.unwrap_or(sized.resolution),
             range: budget.range.unwrap_or(sized.range),
             certified: budget.certified,
+            smoothing: budget.smoothing,
             ..sized
         };
         let (experience, planner) = (self.experience, &mut self.planner);

@@ -284,6 +284,11 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
         # a certified path (proved free in continuous motion) joins the same ends
         proved = planner.plan_request(read, certified=True)
         np.testing.assert_array_equal(proved["waypoints"][[0, -1]], r["waypoints"][[0, -1]])
+        # corner cutting (on by default) never lengthens the greedy shortcut's path
+        greedy = planner.plan_request(read, smoothing=0)
+        assert r["length"] <= greedy["length"] + 1e-9
+        with pytest.raises(OverflowError):
+            planner.plan_request(read, smoothing=-1)
         # its goal posed as the hand's pose: IK, then the same planner
         posed = read.to_task_space(robot, "panda_hand")
         assert posed.is_task_space and not read.is_task_space

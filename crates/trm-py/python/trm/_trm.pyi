@@ -188,6 +188,7 @@ class Planner:
         resolution: float | None = None,
         range: float | None = None,
         certified: bool = False,
+        smoothing: int = 5,
     ) -> dict: ...
     def plan_request(
         self,
@@ -199,6 +200,7 @@ class Planner:
         resolution: float | None = None,
         range: float | None = None,
         certified: bool = False,
+        smoothing: int = 5,
     ) -> dict: ...
 
 class TaskMap:
