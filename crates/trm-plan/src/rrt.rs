@@ -786,7 +786,9 @@ pub enum EdgeCheck {
 }
 
 /// Shortens `path`: first every waypoint skipped whose neighbours see each other (greedy, from
-/// the start), then random pairs of points on the path joined where the straight edge is free.
+/// the start), then `options.shortcuts` random pairs of points on the path joined where the
+/// straight edge is free, then `options.smoothing` rounds of corner cutting, each followed by
+/// the greedy pass (see [`RrtOptions::smoothing`]). Never longer than the path given.
 /// Returns how each edge of the result was checked (one per edge), so that a caller checking
 /// the path again can skip what is known.
 pub fn shortcut(

@@ -154,9 +154,10 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let bench = run_benchmark(args, &robot, &collision, &problems, &options)?;
     let mut md = format!(
-        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{})\n\n",
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{})\n\n",
         args.dir.display(),
         args.model.display(),
+        options.smoothing,
         args.seed,
         options.range,
         1.0 / options.resolution,
@@ -167,7 +168,12 @@ pub fn run(args: &Args) -> Result<()> {
         },
         args.max_iterations,
         args.max_seconds
-            .map_or(String::new(), |s| format!(", {s} s at most"))
+            .map_or(String::new(), |s| format!(", {s} s at most")),
+        if args.vamp_obstacles {
+            "; among VAMP's obstacles: cylinders as capsules, boxes in the box family"
+        } else {
+            ""
+        }
     );
     md.push_str(&bench.markdown());
     print!("{md}");
