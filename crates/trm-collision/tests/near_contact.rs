@@ -63,8 +63,9 @@ fn clutter(rng: &mut ChaCha8Rng, center: Point3<f64>, reach: f64) -> World {
 
 /// `target` near-contact configurations of `collision`'s robot checked by the screen against
 /// the exact model (see the module); returns how many of them collide. `None` when no
-/// configuration free of self-contact turns up in `attempts` draws, or no free and colliding
-/// pair of configurations in `attempts` more (a random robot may touch itself everywhere).
+/// configuration free of self-contact turns up in `attempts` draws, or `attempts` draws in a
+/// row give no free and colliding pair of configurations (a random robot may touch itself
+/// everywhere).
 fn near_contact(
     robot: &RobotModel,
     collision: &CollisionModel,
@@ -150,6 +151,7 @@ fn near_contact(
             }
             continue;
         }
+        misses = 0;
         let (mut lo, mut hi) = (0.0, 1.0);
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);

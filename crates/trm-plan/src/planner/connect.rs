@@ -223,7 +223,22 @@ impl Planner {
         };
         // the waypoints only: their trajectory would be thrown away
         self.time_paths = false;
-        let planned = self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options);
+        let d = self.active.len();
+        let well_formed = |q: &[f64]| q.len() == d && q.iter().all(|v| v.is_finite());
+        let planned = if searches == 0 && well_formed(start) && well_formed(goal) {
+            // only a kept path repeating the query: looked up without the query's own checks
+            // of its start (the kept path's joining edges check it; RRT-Connect does otherwise)
+            match self.retrieve(start, goal, &plan_options, Instant::now()) {
+                Ok(Some(planned)) => Ok(planned),
+                Ok(None) => {
+                    self.time_paths = true;
+                    return Ok(None);
+                }
+                Err(e) => Err(e),
+            }
+        } else {
+            self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options)
+        };
         self.time_paths = true;
         let planned = match planned {
             Ok(planned) => planned,

@@ -681,7 +681,7 @@ impl Planner {
     /// its two joining edges is free in the current world (its nodes and edges checked as a
     /// search checks them, states kept): experience retrieved as Lightning retrieves it
     /// (Berenson, Abbeel and Goldberg, ICRA 2012), for queries that repeat one planned before.
-    fn retrieve(
+    pub(crate) fn retrieve(
         &mut self,
         start: &[f64],
         goal: &[f64],
@@ -696,7 +696,23 @@ impl Planner {
             let backward = distance(start, last).max(distance(goal, first));
             (forward.min(backward), backward < forward)
         };
+        // a cheap test first: most kept paths end far away in their first coordinates (the
+        // bound is a hair wider than `near`, so that `ends` alone decides)
+        let wide = near * near * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+        let close = |a: &[f64], b: &[f64]| {
+            let mut sum = 0.0;
+            a.iter().zip(b).all(|(x, y)| {
+                sum += (x - y) * (x - y);
+                sum <= wide
+            })
+        };
+        let candidate = |k: usize, this: &Self| {
+            let (ids, _) = &this.kept[k];
+            let (first, last) = (&this.nodes[ids[0]].0, &this.nodes[ids[ids.len() - 1]].0);
+            close(start, first) && close(goal, last) || close(start, last) && close(goal, first)
+        };
         let Some((k, reversed)) = (0..self.kept.len())
+            .filter(|&k| candidate(k, self))
             .map(|k| (k, ends(k, self)))
             .filter(|(_, (d, _))| *d <= near)
             .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
