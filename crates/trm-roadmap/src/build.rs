@@ -472,13 +472,6 @@ pub(crate) fn run(
     team: &mut dyn Team,
     mut progress: impl FnMut(&Progress),
 ) -> Result<Roadmap> {
-    let problem = setup.problem;
-    let objective = setup.objective;
-    let settings = &setup.settings;
-    let (target, p_searches, seed, dim) = (setup.target, setup.searches, setup.seed, setup.dim);
-    let bounds = &setup.bounds;
-    let d = settings.spacing;
-    let m = dim; // the number of neighbours is tied to the task-space dimension
     if let Some(c) = checkpoint
         && c.every == 0
     {
@@ -492,11 +485,18 @@ pub(crate) fn run(
     let mut checkpointed = state.map.points.len();
     let (mut generations, mut parallel_seconds) = (0u64, 0.0f64);
     let mut near = Vec::new();
-    let stopped_because;
-
     let pool = ScratchPool::default();
-    let (rank, size) = (team.rank(), team.size());
-    loop {
+    let report = |state: &State, generations, parallel_seconds, seconds| Progress {
+        points: state.map.points.len(),
+        target: setup.target,
+        failures: state.failures,
+        total_failures: state.total_failures,
+        evaluations: state.evaluations,
+        generations,
+        parallel_seconds,
+        seconds,
+    };
+    let stopped_because = loop {
         if let Some(c) = checkpoint
             && state.map.points.len() >= checkpointed + c.every
         {
@@ -505,304 +505,339 @@ pub(crate) fn run(
             }
             checkpointed = state.map.points.len();
         }
-        let State {
-            master,
-            map,
-            searches,
-            started: started_count,
-            failures,
-            total_failures,
-            evaluations,
-            ..
-        } = &mut state;
-        if map.points.len() >= target {
-            stopped_because = format!("reached {target} points");
-            break;
+        if let Some(reason) = stop_reason(setup, &state, team)? {
+            break reason;
         }
-        let (counted, which) = match settings.failures {
-            FailureCount::Total => (*total_failures, "failed searches"),
-            FailureCount::Consecutive => (*failures as u64, "consecutive failed searches"),
-        };
-        if counted >= settings.failure_limit as u64 {
-            stopped_because = format!("{counted} {which} (k = {})", settings.failure_limit);
-            break;
-        }
-        if let Some(deadline) = setup.deadline {
-            // rank 0's clock decides for every process
-            let now = [f64::from(u8::from(Instant::now() >= deadline))];
-            let spent = if size > 1 {
-                all_gather_f64(team, &now)?[0]
-            } else {
-                now[0]
-            };
-            if spent != 0.0 {
-                stopped_because = "time budget spent".to_string();
-                break;
-            }
-        }
-        if setup.max_evaluations.is_some_and(|m| *evaluations >= m) {
-            stopped_because = format!("evaluation budget spent ({} evaluations)", *evaluations);
-            break;
-        }
-        // start searches: one from home while the map is empty, then up to P; each on the
-        // process that runs the fewest
-        let wanted = if map.points.is_empty() {
-            1
-        } else {
-            p_searches.min(map.points.len())
-        };
-        while searches.len() < wanted {
-            let from = map.select(master);
-            let (q0, (lambda, sigma)) = match from {
-                Some(i) => (map.points[i].q.clone(), settings.later_search),
-                None => (problem.start.clone(), settings.first_search),
-            };
-            let owner = least_loaded(searches, size);
-            let own = if owner == rank {
-                let start =
-                    Start::new(q0, sigma)
-                        .with_bounds(bounds.clone())
-                        .with_stop(StopOptions {
-                            center_stagnation: Some((20, 40)),
-                            max_generations: Some(setup.max_generations),
-                            tol_x: None,
-                            tol_fun: None,
-                            ..Default::default()
-                        });
-                let xnes = Xnes::new(
-                    &start,
-                    &XnesOptions {
-                        population: Some(lambda),
-                        ..Default::default()
-                    },
-                )?;
-                let mut rng = ChaCha8Rng::seed_from_u64(seed);
-                rng.set_stream(*started_count + 1);
-                Some(Owned {
-                    xnes,
-                    rng,
-                    candidates: Population::default(),
-                })
-            } else {
-                None
-            };
-            *started_count += 1;
-            searches.push(Search {
-                owner,
-                from,
-                population: lambda,
-                centre_t: vec![0.0; dim],
-                centre_f: f64::NAN,
-                stopped: None,
-                own,
-            });
-        }
-        // one generation of every search: each process asks its searches, evaluates their
-        // candidates in parallel and tells them
+        start_searches(setup, &mut state, team.rank(), team.size())?;
         let parallel_start = Instant::now();
-        let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
-        let have_centres = searches
-            .iter()
-            .map(|s| s.centre_f.is_finite())
-            .collect::<Vec<_>>();
-        // asks in parallel (each search draws from its own stream)
-        searches
-            .par_iter_mut()
-            .filter_map(|s| s.own.as_mut())
-            .for_each(|own| own.candidates.clone_from(own.xnes.ask(&mut own.rng)));
-        let jobs: Vec<(usize, &[f64])> = searches
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| s.own.as_ref().map(|own| (i, own)))
-            .flat_map(|(i, own)| own.candidates.iter().map(move |x| (i, x)))
-            .collect();
-        // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
-        let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {
-            // h_map: construction and smoothness over the m nearest map points
-            map.index.nearest(t, m, nn);
-            let mut h_map = 0.0;
-            for &(dt, j) in nn.iter() {
-                h_map += (d - dt).abs() + settings.smoothness * distance(q, &map.points[j].q);
-            }
-            let mut h = h + settings.construct_weight * h_map;
-            // h_repel: keep away from the other searches' centres
-            let mut h_rep = 0.0;
-            for (j, c) in centres.iter().enumerate() {
-                if j != i && have_centres[j] {
-                    h_rep += (d - distance(t, c)).max(0.0);
-                }
-            }
-            h += setup.repel_weight * h_rep;
-            h
-        };
-        // h* of (search, candidate) jobs: h and g on this process's threads, then h_map and
-        // h_repel in parallel batches: `fitness[k]`, and g in `tasks[k·dim..]`
-        let evaluate = |jobs: &[(usize, &[f64])], fitness: &mut [f64], tasks: &mut [f64]| {
-            let qs: Vec<&[f64]> = jobs.iter().map(|job| job.1).collect();
-            evaluate_on_threads(objective, &qs, fitness, tasks, &pool);
-            fitness
-                .par_chunks_mut(LANES)
-                .zip(tasks.par_chunks(LANES * dim))
-                .zip(jobs.par_chunks(LANES))
-                .for_each(|((fitness, tasks), jobs)| {
-                    NEAREST.with_borrow_mut(|nn| {
-                        for (k, &(i, q)) in jobs.iter().enumerate() {
-                            let t = &tasks[k * dim..(k + 1) * dim];
-                            fitness[k] = h_star(i, q, fitness[k], t, nn);
-                        }
-                    })
-                });
-        };
-        // every candidate of this process's searches
-        let mut fitness = vec![0.0; jobs.len()];
-        let mut tasks = vec![0.0; jobs.len() * dim];
-        evaluate(&jobs, &mut fitness, &mut tasks);
-        // tells in parallel, one task per search; then every search's centre
-        let mut offsets = Vec::with_capacity(searches.len());
-        let mut offset = 0;
-        for s in searches.iter() {
-            offsets.push(offset);
-            offset += s.own.as_ref().map_or(0, |_| s.population);
-        }
-        let told: Vec<trm_optim::Result<(usize, Vec<f64>)>> = searches
-            .par_iter_mut()
-            .enumerate()
-            .filter_map(|(i, s)| s.own.as_mut().map(|own| (i, s.population, own)))
-            .map(|(i, n, own)| {
-                own.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
-                let mut q = own.xnes.mean().to_vec();
-                bounds.clamp(&mut q);
-                Ok((i, q))
-            })
-            .collect();
-        let centre_qs = told.into_iter().collect::<trm_optim::Result<Vec<_>>>()?;
-        let centre_jobs: Vec<(usize, &[f64])> =
-            centre_qs.iter().map(|(i, q)| (*i, q.as_slice())).collect();
-        let mut centre_f = vec![0.0; centre_jobs.len()];
-        let mut centre_t = vec![0.0; centre_jobs.len() * dim];
-        evaluate(&centre_jobs, &mut centre_f, &mut centre_t);
-        // each search's outcome: [index, h* and g of its centre, whether it stopped, its mean]
-        let mut outcomes = Vec::new();
-        for (k, (i, q)) in centre_qs.iter().enumerate() {
-            let Some(own) = searches[*i].own.as_mut() else {
-                continue;
-            };
-            own.xnes.record_center_fitness(q, centre_f[k]);
-            let stopped = !own.xnes.stop().is_empty();
-            outcomes.push(*i as f64);
-            outcomes.push(centre_f[k]);
-            outcomes.extend_from_slice(&centre_t[k * dim..(k + 1) * dim]);
-            outcomes.push(f64::from(u8::from(stopped)));
-            outcomes.extend_from_slice(q);
-        }
-        let outcomes = if size > 1 {
-            all_gather_f64(team, &outcomes)?
-        } else {
-            outcomes
-        };
-        let record = 3 + dim + objective.dim();
-        if outcomes.len() != searches.len() * record {
-            return Err(RoadmapError::Unsuitable(format!(
-                "the processes of the build reported {} values for {} searches; start every process with the same spec and options",
-                outcomes.len(),
-                searches.len()
-            )));
-        }
-        let running = searches.len();
-        for outcome in outcomes.chunks_exact(record) {
-            let s = searches.get_mut(outcome[0] as usize).ok_or_else(|| {
-                RoadmapError::Unsuitable(format!(
-                    "a process of the build reported search {} of {running}",
-                    outcome[0]
-                ))
-            })?;
-            s.centre_f = outcome[1];
-            s.centre_t.copy_from_slice(&outcome[2..2 + dim]);
-            if outcome[2 + dim] != 0.0 {
-                s.stopped = Some(outcome[3 + dim..].to_vec());
-            }
-        }
-        *evaluations += searches
-            .iter()
-            .map(|s| s.population as u64 + 1)
-            .sum::<u64>();
+        state.evaluations += generation(setup, &mut state.searches, &state.map, team, &pool)?;
         parallel_seconds += parallel_start.elapsed().as_secs_f64();
         generations += 1;
-
-        // converged searches: CHECK their mean, add it or count a failure (in search order)
-        let mut changed = false;
-        let mut k = 0;
-        while k < searches.len() {
-            if searches[k].stopped.is_none() {
-                k += 1;
-                continue;
-            }
-            let s = searches.remove(k);
-            let q = s.stopped.unwrap_or_default();
-            let mut scratch = objective.scratch();
-            let mut t = vec![0.0; dim];
-            let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
-            let mut nn = Vec::new();
-            map.index.nearest(&t, 1, &mut nn);
-            let outside = nn.first().is_none_or(|(dt, _)| *dt >= d / 2.0);
-            let inside = setup
-                .region
-                .as_ref()
-                .is_none_or(|r| r.contains(&t, &mut nn));
-            let ok = cost.is_finite()
-                && outside
-                && inside
-                && objective.is_collision_free(&q, &mut scratch);
-            if ok {
-                map.add(MapPoint { q, t, cost }, 1.5 * d, &mut near, true);
-                *failures = 0;
-                changed = true;
-            } else {
-                *failures += 1;
-                *total_failures += 1;
-                if let Some(from) = s.from {
-                    map.set_fails(from, map.fails[from] + 1);
-                }
-            }
+        if check_converged(setup, &mut state, &mut near) {
+            progress(&report(&state, generations, parallel_seconds, seconds()));
         }
-        if changed {
-            progress(&Progress {
-                points: map.points.len(),
-                target,
-                failures: *failures,
-                total_failures: *total_failures,
-                evaluations: *evaluations,
-                generations,
-                parallel_seconds,
-                seconds: seconds(),
-            });
-        }
-    }
+    };
     if let Some(c) = checkpoint {
         if let Some(file) = state.checkpoint(setup, c.every, seconds(), team)? {
             file.save(&c.path)?;
         }
     }
     let build_seconds = seconds();
-    progress(&Progress {
-        points: state.map.points.len(),
-        target,
-        failures: state.failures,
-        total_failures: state.total_failures,
-        evaluations: state.evaluations,
+    progress(&report(
+        &state,
         generations,
         parallel_seconds,
-        seconds: build_seconds,
-    });
-    Ok(Roadmap {
+        build_seconds,
+    ));
+    Ok(finish(setup, state, stopped_because, build_seconds))
+}
+
+/// Why the build stops now, if it does: the target reached, too many failed searches, the time
+/// or evaluation budget spent (rank 0's clock decides for every process).
+fn stop_reason(setup: &Setup, state: &State, team: &mut dyn Team) -> Result<Option<String>> {
+    let (target, settings) = (setup.target, &setup.settings);
+    if state.map.points.len() >= target {
+        return Ok(Some(format!("reached {target} points")));
+    }
+    let (counted, which) = match settings.failures {
+        FailureCount::Total => (state.total_failures, "failed searches"),
+        FailureCount::Consecutive => (state.failures as u64, "consecutive failed searches"),
+    };
+    if counted >= settings.failure_limit as u64 {
+        return Ok(Some(format!(
+            "{counted} {which} (k = {})",
+            settings.failure_limit
+        )));
+    }
+    if let Some(deadline) = setup.deadline {
+        let now = [f64::from(u8::from(Instant::now() >= deadline))];
+        let spent = if team.size() > 1 {
+            all_gather_f64(team, &now)?[0]
+        } else {
+            now[0]
+        };
+        if spent != 0.0 {
+            return Ok(Some("time budget spent".to_string()));
+        }
+    }
+    if setup
+        .max_evaluations
+        .is_some_and(|m| state.evaluations >= m)
+    {
+        return Ok(Some(format!(
+            "evaluation budget spent ({} evaluations)",
+            state.evaluations
+        )));
+    }
+    Ok(None)
+}
+
+/// Starts searches: one from home while the map is empty, then up to P, each from a selected
+/// map point (or home) on the process that runs the fewest.
+fn start_searches(setup: &Setup, state: &mut State, rank: usize, size: usize) -> Result<()> {
+    let (problem, settings, bounds) = (setup.problem, &setup.settings, &setup.bounds);
+    let State {
+        master,
+        map,
+        searches,
+        started: started_count,
+        ..
+    } = state;
+    let wanted = if map.points.is_empty() {
+        1
+    } else {
+        setup.searches.min(map.points.len())
+    };
+    while searches.len() < wanted {
+        let from = map.select(master);
+        let (q0, (lambda, sigma)) = match from {
+            Some(i) => (map.points[i].q.clone(), settings.later_search),
+            None => (problem.start.clone(), settings.first_search),
+        };
+        let owner = least_loaded(searches, size);
+        let own = if owner == rank {
+            let start = Start::new(q0, sigma)
+                .with_bounds(bounds.clone())
+                .with_stop(StopOptions {
+                    center_stagnation: Some((20, 40)),
+                    max_generations: Some(setup.max_generations),
+                    tol_x: None,
+                    tol_fun: None,
+                    ..Default::default()
+                });
+            let xnes = Xnes::new(
+                &start,
+                &XnesOptions {
+                    population: Some(lambda),
+                    ..Default::default()
+                },
+            )?;
+            let mut rng = ChaCha8Rng::seed_from_u64(setup.seed);
+            rng.set_stream(*started_count + 1);
+            Some(Owned {
+                xnes,
+                rng,
+                candidates: Population::default(),
+            })
+        } else {
+            None
+        };
+        *started_count += 1;
+        searches.push(Search {
+            owner,
+            from,
+            population: lambda,
+            centre_t: vec![0.0; setup.dim],
+            centre_f: f64::NAN,
+            stopped: None,
+            own,
+        });
+    }
+    Ok(())
+}
+
+/// One generation of every search: each process asks its searches, evaluates their
+/// candidates and their new centres in parallel and tells them; every process then learns every
+/// search's centre and whether it stopped. The evaluations it took, over all processes.
+fn generation(
+    setup: &Setup,
+    searches: &mut [Search],
+    map: &Growing,
+    team: &mut dyn Team,
+    pool: &ScratchPool,
+) -> Result<u64> {
+    let (objective, settings, bounds, dim) =
+        (setup.objective, &setup.settings, &setup.bounds, setup.dim);
+    let d = settings.spacing;
+    let m = dim; // the number of neighbours is tied to the task-space dimension
+    let size = team.size();
+    let centres: Vec<Vec<f64>> = searches.iter().map(|s| s.centre_t.clone()).collect();
+    let have_centres = searches
+        .iter()
+        .map(|s| s.centre_f.is_finite())
+        .collect::<Vec<_>>();
+    // asks in parallel (each search draws from its own stream)
+    searches
+        .par_iter_mut()
+        .filter_map(|s| s.own.as_mut())
+        .for_each(|own| own.candidates.clone_from(own.xnes.ask(&mut own.rng)));
+    let jobs: Vec<(usize, &[f64])> = searches
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.own.as_ref().map(|own| (i, own)))
+        .flat_map(|(i, own)| own.candidates.iter().map(move |x| (i, x)))
+        .collect();
+    // h* = h + h_map + h_repel for candidate q of search i, given h(q) and g(q) = t
+    let h_star = |i: usize, q: &[f64], h: f64, t: &[f64], nn: &mut Vec<(f64, usize)>| {
+        // h_map: construction and smoothness over the m nearest map points
+        map.index.nearest(t, m, nn);
+        let mut h_map = 0.0;
+        for &(dt, j) in nn.iter() {
+            h_map += (d - dt).abs() + settings.smoothness * distance(q, &map.points[j].q);
+        }
+        let mut h = h + settings.construct_weight * h_map;
+        // h_repel: keep away from the other searches' centres
+        let mut h_rep = 0.0;
+        for (j, c) in centres.iter().enumerate() {
+            if j != i && have_centres[j] {
+                h_rep += (d - distance(t, c)).max(0.0);
+            }
+        }
+        h += setup.repel_weight * h_rep;
+        h
+    };
+    // h* of (search, candidate) jobs: h and g on this process's threads, then h_map and
+    // h_repel in parallel batches: `fitness[k]`, and g in `tasks[k·dim..]`
+    let evaluate = |jobs: &[(usize, &[f64])], fitness: &mut [f64], tasks: &mut [f64]| {
+        let qs: Vec<&[f64]> = jobs.iter().map(|job| job.1).collect();
+        evaluate_on_threads(objective, &qs, fitness, tasks, pool);
+        fitness
+            .par_chunks_mut(LANES)
+            .zip(tasks.par_chunks(LANES * dim))
+            .zip(jobs.par_chunks(LANES))
+            .for_each(|((fitness, tasks), jobs)| {
+                NEAREST.with_borrow_mut(|nn| {
+                    for (k, &(i, q)) in jobs.iter().enumerate() {
+                        let t = &tasks[k * dim..(k + 1) * dim];
+                        fitness[k] = h_star(i, q, fitness[k], t, nn);
+                    }
+                })
+            });
+    };
+    // every candidate of this process's searches
+    let mut fitness = vec![0.0; jobs.len()];
+    let mut tasks = vec![0.0; jobs.len() * dim];
+    evaluate(&jobs, &mut fitness, &mut tasks);
+    // tells in parallel, one task per search; then every search's centre
+    let mut offsets = Vec::with_capacity(searches.len());
+    let mut offset = 0;
+    for s in searches.iter() {
+        offsets.push(offset);
+        offset += s.own.as_ref().map_or(0, |_| s.population);
+    }
+    let told: Vec<trm_optim::Result<(usize, Vec<f64>)>> = searches
+        .par_iter_mut()
+        .enumerate()
+        .filter_map(|(i, s)| s.own.as_mut().map(|own| (i, s.population, own)))
+        .map(|(i, n, own)| {
+            own.xnes.tell(&fitness[offsets[i]..offsets[i] + n])?;
+            let mut q = own.xnes.mean().to_vec();
+            bounds.clamp(&mut q);
+            Ok((i, q))
+        })
+        .collect();
+    let centre_qs = told.into_iter().collect::<trm_optim::Result<Vec<_>>>()?;
+    let centre_jobs: Vec<(usize, &[f64])> =
+        centre_qs.iter().map(|(i, q)| (*i, q.as_slice())).collect();
+    let mut centre_f = vec![0.0; centre_jobs.len()];
+    let mut centre_t = vec![0.0; centre_jobs.len() * dim];
+    evaluate(&centre_jobs, &mut centre_f, &mut centre_t);
+    // each search's outcome: [index, h* and g of its centre, whether it stopped, its mean]
+    let mut outcomes = Vec::new();
+    for (k, (i, q)) in centre_qs.iter().enumerate() {
+        let Some(own) = searches[*i].own.as_mut() else {
+            continue;
+        };
+        own.xnes.record_center_fitness(q, centre_f[k]);
+        let stopped = !own.xnes.stop().is_empty();
+        outcomes.push(*i as f64);
+        outcomes.push(centre_f[k]);
+        outcomes.extend_from_slice(&centre_t[k * dim..(k + 1) * dim]);
+        outcomes.push(f64::from(u8::from(stopped)));
+        outcomes.extend_from_slice(q);
+    }
+    let outcomes = if size > 1 {
+        all_gather_f64(team, &outcomes)?
+    } else {
+        outcomes
+    };
+    let record = 3 + dim + objective.dim();
+    if outcomes.len() != searches.len() * record {
+        return Err(RoadmapError::Unsuitable(format!(
+            "the processes of the build reported {} values for {} searches; start every process with the same spec and options",
+            outcomes.len(),
+            searches.len()
+        )));
+    }
+    let running = searches.len();
+    for outcome in outcomes.chunks_exact(record) {
+        let s = searches.get_mut(outcome[0] as usize).ok_or_else(|| {
+            RoadmapError::Unsuitable(format!(
+                "a process of the build reported search {} of {running}",
+                outcome[0]
+            ))
+        })?;
+        s.centre_f = outcome[1];
+        s.centre_t.copy_from_slice(&outcome[2..2 + dim]);
+        if outcome[2 + dim] != 0.0 {
+            s.stopped = Some(outcome[3 + dim..].to_vec());
+        }
+    }
+    Ok(searches
+        .iter()
+        .map(|s| s.population as u64 + 1)
+        .sum::<u64>())
+}
+
+/// CHECK of the converged searches (in search order): each mean added to the map, or counted
+/// as a failure of the search and of the point it started from. Whether the map grew.
+fn check_converged(setup: &Setup, state: &mut State, near: &mut Vec<usize>) -> bool {
+    let (objective, dim, d) = (setup.objective, setup.dim, setup.settings.spacing);
+    let State {
+        map,
+        searches,
+        failures,
+        total_failures,
+        ..
+    } = state;
+    let mut changed = false;
+    let mut k = 0;
+    while k < searches.len() {
+        if searches[k].stopped.is_none() {
+            k += 1;
+            continue;
+        }
+        let s = searches.remove(k);
+        let q = s.stopped.unwrap_or_default();
+        let mut scratch = objective.scratch();
+        let mut t = vec![0.0; dim];
+        let cost = objective.eval_with_task(&q, &mut scratch, &mut t);
+        let mut nn = Vec::new();
+        map.index.nearest(&t, 1, &mut nn);
+        let outside = nn.first().is_none_or(|(dt, _)| *dt >= d / 2.0);
+        let inside = setup
+            .region
+            .as_ref()
+            .is_none_or(|r| r.contains(&t, &mut nn));
+        let ok =
+            cost.is_finite() && outside && inside && objective.is_collision_free(&q, &mut scratch);
+        if ok {
+            map.add(MapPoint { q, t, cost }, 1.5 * d, near, true);
+            *failures = 0;
+            changed = true;
+        } else {
+            *failures += 1;
+            *total_failures += 1;
+            if let Some(from) = s.from {
+                map.set_fails(from, map.fails[from] + 1);
+            }
+        }
+    }
+    changed
+}
+
+/// The map the build made, with its settings and statistics.
+fn finish(setup: &Setup, state: State, stopped_because: String, build_seconds: f64) -> Roadmap {
+    let (problem, objective) = (setup.problem, setup.objective);
+    Roadmap {
         format: FORMAT.into(),
         version: VERSION,
         software: software(),
         spec_path: problem.origin.clone(),
         spec: problem.text.clone(),
-        seed,
-        searches: p_searches,
-        settings: settings.clone(),
+        seed: setup.seed,
+        searches: setup.searches,
+        settings: setup.settings.clone(),
         active: active_names(problem),
         task: objective.task().map(|t| t.label()).unwrap_or_default(),
         points: state.map.points,
@@ -819,7 +854,7 @@ pub(crate) fn run(
             stopped_because,
             threads: rayon::current_num_threads(),
         },
-    })
+    }
 }
 
 #[cfg(test)]
