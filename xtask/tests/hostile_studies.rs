@@ -42,7 +42,7 @@ fn study_commands_refuse_bad_flags_and_outputs_in_the_way() {
         "--iterations",
         &["0", "18446744073709551615"],
     ));
-    cases.extend(harness::into_file_cases(
+    cases.extend(harness::output_cases(
         &[
             vec!["task-map-studies", "--out-dir"],
             vec!["speedup", spec, "--points", "2", "--out-dir"],

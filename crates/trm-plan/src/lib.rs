@@ -20,6 +20,7 @@ pub mod pose_goal;
 mod query;
 pub mod rrt;
 pub mod scenario;
+mod simplify;
 pub mod timing;
 mod trajectory;
 

@@ -420,7 +420,7 @@ pub fn cases(dir: &Path) -> Vec<Case> {
         "a_directory",
         "posture.json/x.json",
     ] {
-        for command in [
+        let commands = [
             vec!["solve", spec, "--out"],
             vec!["build-map", spec, "--points", "2", "--out"],
             vec![
@@ -440,19 +440,10 @@ pub fn cases(dir: &Path) -> Vec<Case> {
             vec!["explore-task-map", stick.as_str(), "--out"],
             vec!["model-info", "--ros-postures"],
             vec!["repair-map", "map.json", "--world", "world.ron", "--out"],
-        ] {
-            cases.push(Case {
-                what: format!("{} --out {out}", command[0]),
-                args: command
-                    .iter()
-                    .map(|s| s.to_string())
-                    .chain([out.to_string()])
-                    .collect(),
-                names: out.to_string(),
-            });
-        }
+        ];
+        cases.extend(output_cases(&commands, out));
     }
-    cases.extend(into_file_cases(
+    cases.extend(output_cases(
         &[
             vec![
                 "compare-optimisers",

@@ -419,19 +419,20 @@ pub fn run_all(bin: &Path, dir: &Path, cases: &[Case], minimum: usize) {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// Each command given `file` (a regular file of the test folder) as its last argument, where
-/// it wants an output folder or path: the error must name the file.
-pub fn into_file_cases(commands: &[Vec<&str>], file: &str) -> Vec<Case> {
+/// Each command given `path` as its last argument, where it wants an output (a file or a
+/// folder) and `path` cannot be one (a regular file for a folder, a symlink, a device, a
+/// directory, a path under a file): the error must name `path`.
+pub fn output_cases(commands: &[Vec<&str>], path: &str) -> Vec<Case> {
     commands
         .iter()
         .map(|command| Case {
-            what: format!("{} into a regular file", command[0]),
+            what: format!("{} with {path} as its output", command[0]),
             args: command
                 .iter()
                 .map(|s| s.to_string())
-                .chain([file.to_string()])
+                .chain([path.to_string()])
                 .collect(),
-            names: file.into(),
+            names: path.into(),
         })
         .collect()
 }
