@@ -345,6 +345,12 @@ pub fn cases(dir: &Path) -> Vec<Case> {
         "--map",
         &["no_such.json", "posture.json", "map.json"],
     ));
+    // corner-cutting rounds: negative, not a number, beyond the bound
+    cases.extend(flag_cases(
+        &bench_refs,
+        "--smoothing",
+        &["-1", "x", "NaN", "1001", "18446744073709551616"],
+    ));
     let request = at("crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml")
         .to_string_lossy()
         .to_string();
