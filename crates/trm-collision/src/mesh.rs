@@ -76,6 +76,38 @@ pub fn convex_hull_of_mesh_bytes(
     path: &Path,
     scale: [f64; 3],
 ) -> Result<Vec<[f64; 3]>, String> {
+    let (points, _) = triangles_of_mesh_bytes(bytes, path, scale)?;
+    let points: Vec<Point3<f64>> = points.into_iter().map(Point3::from).collect();
+    let flat = || "the mesh is flat: its convex hull has no volume".to_string();
+    if !crate::shape::spans_volume(&points) {
+        return Err(flat());
+    }
+    let hull = ConvexPolyhedron::from_convex_hull(&points).ok_or_else(flat)?;
+    let corners: Vec<Point3<f64>> = hull.points().to_vec();
+    if corners.len() < 4 || !crate::shape::spans_volume(&corners) {
+        return Err(flat());
+    }
+    Ok(corners.iter().map(|p| [p.x, p.y, p.z]).collect())
+}
+
+/// Loads a mesh file (STL, COLLADA or OBJ; at most [`trm_io::MAX_INPUT_BYTES`]) and scales
+/// it: its vertices and triangles (every mesh of the file in one), for a world object
+/// ([`crate::Shape::Mesh`]).
+pub fn triangles_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Triangles, String> {
+    let bytes = trm_io::read_input_bytes(path).map_err(|e| e.to_string())?;
+    triangles_of_mesh_bytes(&bytes, path, scale)
+}
+
+/// A mesh's vertices and its triangles as indices into them.
+pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// [`triangles_of_mesh`] of a file's bytes (see [`convex_hull_of_mesh_bytes`]); vertices must
+/// be finite and within [`MAX_VERTEX_DISTANCE`] of the mesh's origin.
+pub fn triangles_of_mesh_bytes(
+    bytes: &[u8],
+    path: &Path,
+    scale: [f64; 3],
+) -> Result<Triangles, String> {
     let collada = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("dae"))
@@ -97,46 +129,34 @@ pub fn convex_hull_of_mesh_bytes(
     })
     .map_err(|_| "the mesh reader failed on this file (malformed mesh)".to_string())?
     .map_err(|e| e.to_string())?;
-    let points: Vec<Point3<f64>> = scene
-        .meshes
-        .iter()
-        .flat_map(|m| m.vertices.iter())
-        .map(|v| {
-            Point3::new(
+    let (mut points, mut triangles) = (Vec::new(), Vec::new());
+    for mesh in &scene.meshes {
+        let base = points.len() as u32;
+        points.extend(mesh.vertices.iter().map(|v| {
+            [
                 f64::from(v[0]) * scale[0],
                 f64::from(v[1]) * scale[1],
                 f64::from(v[2]) * scale[2],
-            )
-        })
-        .collect();
+            ]
+        }));
+        triangles.extend(mesh.faces.iter().map(|f| f.map(|i| base + i)));
+    }
     if points.is_empty() {
         return Err("the file holds no vertices".to_string());
     }
-    if points
-        .iter()
-        .any(|p| !p.coords.iter().all(|c| c.is_finite()))
-    {
+    if points.iter().flatten().any(|c| !c.is_finite()) {
         return Err("the file holds non-finite vertices".to_string());
     }
     if let Some(far) = points
         .iter()
-        .find(|p| p.coords.amax() > MAX_VERTEX_DISTANCE)
+        .find(|p| p.iter().any(|c| c.abs() > MAX_VERTEX_DISTANCE))
     {
         return Err(format!(
             "a vertex lies at ({:e}, {:e}, {:e}), more than {MAX_VERTEX_DISTANCE} m from the mesh's origin: check the file's format and the scale",
-            far.x, far.y, far.z
+            far[0], far[1], far[2]
         ));
     }
-    let flat = || "the mesh is flat: its convex hull has no volume".to_string();
-    if !crate::shape::spans_volume(&points) {
-        return Err(flat());
-    }
-    let hull = ConvexPolyhedron::from_convex_hull(&points).ok_or_else(flat)?;
-    let corners: Vec<Point3<f64>> = hull.points().to_vec();
-    if corners.len() < 4 || !crate::shape::spans_volume(&corners) {
-        return Err(flat());
-    }
-    Ok(corners.iter().map(|p| [p.x, p.y, p.z]).collect())
+    Ok((points, triangles))
 }
 
 #[cfg(test)]

@@ -177,6 +177,17 @@ impl CollisionModel {
                 });
             }
             let element = format!("body `{}`", b.name);
+            if !b.shape.is_convex() {
+                return Err(CollisionError::InvalidShape {
+                    origin: robot.origin().to_string(),
+                    line: None,
+                    element,
+                    problem: format!("a link's body cannot be a {}", b.shape.kind()),
+                    fix: "give links convex bodies (a mesh's convex hull: Shape::Convex); point \
+                          clouds and triangle meshes are world objects"
+                        .into(),
+                });
+            }
             compiled.push(b.shape.compile(&b.local).ok_or_else(|| {
                 let p = b
                     .shape

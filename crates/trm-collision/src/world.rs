@@ -61,6 +61,54 @@ pub struct WorldSpec {
     /// The objects.
     #[serde(default)]
     pub objects: Vec<ObjectSpec>,
+    /// Point clouds read from PLY or PCD files.
+    #[serde(default)]
+    pub clouds: Vec<CloudFileSpec>,
+    /// Triangle meshes read from STL, OBJ or COLLADA files.
+    #[serde(default)]
+    pub meshes: Vec<MeshFileSpec>,
+}
+
+/// A point cloud of a [`WorldSpec`] read from a file: `(name: "scan", file: "scan.ply",
+/// radius: 0.005)`; non-finite points (a camera's invalid pixels) are dropped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudFileSpec {
+    /// Unique name.
+    pub name: String,
+    /// PLY or PCD file, relative to the world file.
+    pub file: String,
+    /// Radius of every point, m (> 0).
+    pub radius: f64,
+    /// Position of the cloud's frame (the camera's, say) in the world, metres.
+    #[serde(default)]
+    pub xyz: [f64; 3],
+    /// Orientation as URDF roll-pitch-yaw, radians.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+/// A triangle mesh of a [`WorldSpec`] read from a file: `(name: "bowl", file: "bowl.stl")`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshFileSpec {
+    /// Unique name.
+    pub name: String,
+    /// STL, OBJ or COLLADA file, relative to the world file.
+    pub file: String,
+    /// Scale along each axis.
+    #[serde(default = "unit_scale")]
+    pub scale: [f64; 3],
+    /// Position in the world, metres.
+    #[serde(default)]
+    pub xyz: [f64; 3],
+    /// Orientation as URDF roll-pitch-yaw, radians.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+fn unit_scale() -> [f64; 3] {
+    [1.0; 3]
 }
 
 /// One object of a [`WorldSpec`].
@@ -112,14 +160,59 @@ impl World {
 
     fn build(spec: &WorldSpec, origin: &str, located: Option<(&str, &str)>) -> Result<Self> {
         let mut world = World::new();
-        for (i, o) in spec.objects.iter().enumerate() {
-            let path = format!("{}[{i}]", located.map_or("objects", |(_, at)| at));
+        // files beside the world file (an origin that is not a path: the working directory)
+        let dir = Path::new(origin).parent().unwrap_or(Path::new(""));
+        let at = located.map_or("objects", |(_, at)| at);
+        let lists = at.strip_suffix("objects").unwrap_or("");
+        let from_files = (spec.clouds.iter().enumerate())
+            .map(|(i, c)| {
+                let shape = trm_io::read_points(&dir.join(&c.file)).map(|f| Shape::Points {
+                    points: f.points,
+                    radius: c.radius,
+                });
+                (
+                    format!("{lists}clouds[{i}]"),
+                    &c.name,
+                    &c.file,
+                    shape,
+                    c.xyz,
+                    c.rpy,
+                )
+            })
+            .chain(spec.meshes.iter().enumerate().map(|(i, m)| {
+                let shape = crate::mesh::triangles_of_mesh(&dir.join(&m.file), m.scale).map(
+                    |(vertices, triangles)| Shape::Mesh {
+                        vertices,
+                        triangles,
+                    },
+                );
+                (
+                    format!("{lists}meshes[{i}]"),
+                    &m.name,
+                    &m.file,
+                    shape,
+                    m.xyz,
+                    m.rpy,
+                )
+            }));
+        let objects = spec.objects.iter().enumerate().map(|(i, o)| {
+            let shape = Ok(o.shape.clone());
+            (format!("{at}[{i}]"), &o.name, &o.name, shape, o.xyz, o.rpy)
+        });
+        for (path, name, file, shape, xyz, rpy) in objects.chain(from_files) {
             let line = located
                 .and_then(|(text, _)| trm_io::locate_ron_path(text, &path))
                 .map(|(line, _)| line);
-            let element = format!("{path} (\"{}\")", o.name);
+            let element = format!("{path} (\"{name}\")");
+            let shape = shape.map_err(|problem| CollisionError::InvalidShape {
+                origin: origin.to_string(),
+                line,
+                element: element.clone(),
+                problem: format!("{}: {problem}", dir.join(file).display()),
+                fix: "give a readable file, relative to the world file".into(),
+            })?;
             world
-                .add(&o.name, o.shape.clone(), pose_from_xyz_rpy(o.xyz, o.rpy))
+                .add(name, shape, pose_from_xyz_rpy(xyz, rpy))
                 .map_err(|e| match e {
                     CollisionError::InvalidShape { problem, fix, .. } => {
                         CollisionError::InvalidShape {
@@ -175,9 +268,11 @@ impl World {
         Self::from_ron(&text, &path.display().to_string())
     }
 
-    /// The world as RON data.
+    /// The world as RON data (point clouds and meshes written out in full, as objects).
     pub fn to_spec(&self) -> WorldSpec {
         WorldSpec {
+            clouds: Vec::new(),
+            meshes: Vec::new(),
             objects: self
                 .objects
                 .iter()
@@ -340,5 +435,62 @@ mod tests {
         assert!(e.starts_with("w.ron:1:"), "{e}");
         world.remove("ball").unwrap();
         assert_eq!(world.len(), 1);
+    }
+
+    /// Point clouds and meshes come from files beside the world file; a cloud and a mesh round
+    /// trip through RON inline; a missing or malformed file names the entry, its line and the
+    /// file.
+    #[test]
+    fn clouds_and_meshes_load_from_files_beside_the_world() {
+        let dir = std::env::temp_dir().join(format!("trm-world-files-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n0.1 0 0\nnan 0 0\n";
+        std::fs::write(dir.join("scan.ply"), ply).unwrap();
+        let mut stl = String::from("solid t\n");
+        for f in [[0, 1, 2], [0, 2, 3]] {
+            let v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]];
+            stl.push_str("facet normal 0 0 0\n outer loop\n");
+            for i in f {
+                stl.push_str(&format!(" vertex {} {} {}\n", v[i][0], v[i][1], v[i][2]));
+            }
+            stl.push_str(" endloop\nendfacet\n");
+        }
+        stl.push_str("endsolid t\n");
+        std::fs::write(dir.join("fold.stl"), stl).unwrap();
+        let text = r#"(
+    clouds: [(name: "scan", file: "scan.ply", radius: 0.01, xyz: (0.5, 0.0, 0.2))],
+    meshes: [(name: "fold", file: "fold.stl", scale: (0.5, 0.5, 0.5))],
+)"#;
+        let path = dir.join("world.ron");
+        std::fs::write(&path, text).unwrap();
+        let world = World::load(&path).unwrap();
+        let Shape::Points { points, radius } = world.object("scan").unwrap().shape() else {
+            panic!("a cloud");
+        };
+        assert_eq!((points.len(), *radius), (2, 0.01));
+        let Shape::Mesh { triangles, .. } = world.object("fold").unwrap().shape() else {
+            panic!("a mesh");
+        };
+        assert_eq!(triangles.len(), 2);
+        let again = World::from_spec(&world.to_spec(), "again").unwrap();
+        assert_eq!(
+            again.object("scan").unwrap().shape(),
+            world.object("scan").unwrap().shape()
+        );
+        let missing = text.replace("fold.stl", "gone.stl");
+        std::fs::write(&path, missing).unwrap();
+        let e = World::load(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(":3: meshes[0] (\"fold\")") && e.contains("gone.stl"),
+            "{e}"
+        );
+        std::fs::write(dir.join("scan.ply"), "ply\nformat ascii 1.0\n").unwrap();
+        std::fs::write(&path, text).unwrap();
+        let e = World::load(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(":2: clouds[0] (\"scan\")") && e.contains("never ends"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

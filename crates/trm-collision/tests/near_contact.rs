@@ -3,7 +3,8 @@
 //! contact (self or world, whatever pair touches first), and eight configurations spread over
 //! ±50 µm of body motion around it are checked by the screen — as a block and one at a time,
 //! yes/no and counts — against the exact model, on every shipped model (spheres, capsules and
-//! boxes, mesh hulls, links of one box beside links of hulls) in worlds of every object shape.
+//! boxes, mesh hulls, links of one box beside links of hulls) in worlds of every object shape
+//! (point clouds and triangle meshes included).
 //! The default run checks 400 such configurations per model; `--ignored` checks 20 000 per
 //! model (CI runs both), `TRM_NEAR_CONTACT=100000` as many as asked. A proptest does the same on
 //! random tree-shaped robots whose links mix spheres, boxes, capsules, cylinders and convex
@@ -20,9 +21,9 @@ use trm_kinematics::RobotModel;
 /// Objects of every shape the screen takes, scattered within `reach` of `center`.
 fn clutter(rng: &mut ChaCha8Rng, center: Point3<f64>, reach: f64) -> World {
     let mut world = World::new();
-    for i in 0..10 {
+    for i in 0..14 {
         let mut size = || rng.random_range(0.03..0.2);
-        let shape = match i % 5 {
+        let shape = match i % 7 {
             0 => Shape::Box {
                 size: [size(), size(), size()],
             },
@@ -35,6 +36,35 @@ fn clutter(rng: &mut ChaCha8Rng, center: Point3<f64>, reach: f64) -> World {
                 radius: 0.3 * size(),
                 length: size(),
             },
+            // a camera's view of a box: points on three of its faces
+            5 => {
+                let side = [size(), size(), size()];
+                let radius = rng.random_range(0.002..0.02);
+                let points = (0..rng.random_range(1..400))
+                    .map(|k| {
+                        let mut p: [f64; 3] =
+                            std::array::from_fn(|a| rng.random_range(0.0..side[a]));
+                        p[k % 3] = 0.0;
+                        p
+                    })
+                    .collect();
+                Shape::Points { points, radius }
+            }
+            // an open, folded surface of triangles
+            6 => {
+                let (w, h) = (size(), size());
+                let fold = rng.random_range(-0.1..0.1);
+                Shape::Mesh {
+                    vertices: vec![
+                        [0.0, 0.0, 0.0],
+                        [w, 0.0, 0.0],
+                        [0.0, h, 0.0],
+                        [w, h, fold],
+                        [2.0 * w, 0.0, -fold],
+                    ],
+                    triangles: vec![[0, 1, 2], [1, 3, 2], [1, 4, 3]],
+                }
+            }
             _ => Shape::Convex {
                 points: vec![
                     [0.0, 0.0, 0.0],

@@ -10,6 +10,7 @@
 //!   [`save_json`]) and a checksummed binary twin ([`binary_bytes`],
 //!   [`parse_binary_versioned`]) carrying a format name and a version a reader checks;
 //!   duplicate keys refused ([`check_unique_keys`]).
+//! - **Point clouds**: [`read_points`] reads PLY and PCD files (ASCII and binary).
 //! - **Located errors**: [`SpecError`] and [`locate_ron_path`] turn a RON field path into
 //!   `file:line:column`, [`explain_ron_error`] says what a RON parse error means and how to fix
 //!   it, [`closest_names`] gives the "did you mean" candidates.
@@ -27,6 +28,7 @@
 
 mod files;
 mod names;
+mod points;
 mod ron_path;
 mod xml;
 
@@ -37,5 +39,6 @@ pub use files::{
     write_file_bytes,
 };
 pub use names::closest_names;
+pub use points::{PointFile, parse_points, read_points};
 pub use ron_path::{RonProblem, SpecError, explain_ron_error, locate_ron_field, locate_ron_path};
 pub use xml::{TooDeep, XML_NESTING_LIMIT, check_xml_nesting};

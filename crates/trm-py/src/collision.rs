@@ -2,7 +2,8 @@
 
 use crate::*;
 
-/// Obstacles: boxes, spheres, capsules, cylinders at poses (root frame).
+/// Obstacles: boxes, spheres, capsules, cylinders, point clouds and triangle meshes at poses
+/// (root frame).
 #[pyclass(name = "World", module = "trm")]
 #[derive(Clone, Default)]
 pub(crate) struct PyWorld {
@@ -68,6 +69,46 @@ impl PyWorld {
         self.add(name, Shape::Cylinder { radius, length }, xyz, rpy)
     }
 
+    /// Adds a point cloud: `points` an (N, 3) array in the cloud's frame (a camera's, placed at
+    /// `xyz`, `rpy`), each point a ball of `radius`. Rows with a NaN or infinite coordinate
+    /// (invalid pixels) are dropped; returns how many points were kept.
+    #[pyo3(signature = (name, points, radius, xyz = [0.0; 3], rpy = [0.0; 3]))]
+    fn add_points(
+        &mut self,
+        name: &str,
+        points: &Bound<'_, PyAny>,
+        radius: f64,
+        xyz: [f64; 3],
+        rpy: [f64; 3],
+    ) -> PyResult<usize> {
+        let points: Vec<[f64; 3]> = rows3(points, "points")?
+            .into_iter()
+            .filter(|p| p.iter().all(|v| v.is_finite()))
+            .collect();
+        let kept = points.len();
+        self.add(name, Shape::Points { points, radius }, xyz, rpy)?;
+        Ok(kept)
+    }
+
+    /// Adds a triangle mesh (its surface, concave parts included): `vertices` an (N, 3) array,
+    /// `triangles` an (M, 3) array of vertex indices.
+    #[pyo3(signature = (name, vertices, triangles, xyz = [0.0; 3], rpy = [0.0; 3]))]
+    fn add_mesh(
+        &mut self,
+        name: &str,
+        vertices: &Bound<'_, PyAny>,
+        triangles: Vec<[u32; 3]>,
+        xyz: [f64; 3],
+        rpy: [f64; 3],
+    ) -> PyResult<()> {
+        let vertices = rows3(vertices, "vertices")?;
+        let shape = Shape::Mesh {
+            vertices,
+            triangles,
+        };
+        self.add(name, shape, xyz, rpy)
+    }
+
     /// Moves an object.
     #[pyo3(signature = (name, xyz, rpy = [0.0; 3]))]
     fn set_pose(&mut self, name: &str, xyz: [f64; 3], rpy: [f64; 3]) -> PyResult<()> {
@@ -91,6 +132,20 @@ impl PyWorld {
 
     fn __len__(&self) -> usize {
         self.world.len()
+    }
+}
+
+/// The rows of an (N, 3) array.
+fn rows3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
+    let a = float_array(obj)?;
+    match a.shape() {
+        [_, 3] => Ok(a
+            .as_slice()
+            .map_err(err)?
+            .chunks_exact(3)
+            .map(|r| [r[0], r[1], r[2]])
+            .collect()),
+        shape => Err(err(format!("{what}: shape {shape:?}; expected (N, 3)"))),
     }
 }
 

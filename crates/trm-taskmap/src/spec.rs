@@ -293,6 +293,7 @@ impl LoadedTaskMapSpec {
         World::from_spec_in(
             &WorldSpec {
                 objects: self.spec.object.clone(),
+                ..WorldSpec::default()
             },
             &self.origin,
             &self.text,

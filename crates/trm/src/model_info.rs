@@ -245,6 +245,10 @@ fn shape_text(shape: &Shape) -> String {
         Shape::Cylinder { radius, length } => format!("cylinder r {radius:.4} l {length:.4}"),
         Shape::Capsule { radius, length } => format!("capsule r {radius:.4} l {length:.4}"),
         Shape::Convex { points } => format!("convex hull of {} points", points.len()),
+        Shape::Points { points, radius } => {
+            format!("{} points r {radius:.4}", points.len())
+        }
+        Shape::Mesh { triangles, .. } => format!("mesh of {} triangles", triangles.len()),
     }
 }
 

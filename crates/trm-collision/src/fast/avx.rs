@@ -136,6 +136,13 @@ pub(super) fn distance2(object: &Object, c: &[F; 3]) -> __m256 {
             let axial = beyond(abs(z), half);
             _mm256_fmadd_ps(axial, axial, _mm256_mul_ps(radial, radial))
         }
+        Object::Cloud { center, half, .. } => {
+            let out = |k: usize| {
+                let d = _mm256_sub_ps(load(&c[k]), _mm256_set1_ps(center[k]));
+                beyond(abs(d), half[k])
+            };
+            norm2([out(0), out(1), out(2)])
+        }
         Object::Bounded { center, .. } => norm2([
             _mm256_sub_ps(load(&c[0]), _mm256_set1_ps(center[0])),
             _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(center[1])),

@@ -45,6 +45,7 @@
 #[allow(unsafe_code)]
 mod avx;
 mod checker;
+mod cloud;
 mod kdop;
 mod lanes;
 mod model;

@@ -79,7 +79,10 @@ impl Solid {
                 b: to_f32(t),
                 radius: radius as f32,
             }),
-            Shape::Cylinder { .. } | Shape::Convex { .. } => None,
+            Shape::Cylinder { .. }
+            | Shape::Convex { .. }
+            | Shape::Points { .. }
+            | Shape::Mesh { .. } => None,
         }
     }
 

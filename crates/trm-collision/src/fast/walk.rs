@@ -1,6 +1,7 @@
 use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
+use super::cloud::solids_against_cloud;
 use super::kdop::kdop_clear;
 use super::lanes::{
     F, PORTABLE, compiled_per_isa, distance2, inverse_transform, link_frame, splat, transform,
@@ -256,10 +257,18 @@ pub(super) fn object_link<const AVX: bool>(
     if near == 0 {
         return false;
     }
-    let (hit, close) = if let Some(contacts) = object_solids::<AVX>(model, object, g, scratch, m) {
+    let cloud = match *object {
+        Object::Cloud { index, radius, .. } => Some((&world.clouds[index as usize], radius)),
+        _ => None,
+    };
+    let solids = match cloud {
+        Some((cloud, radius)) => solids_against_cloud(model, cloud, radius, g, near, scratch, m),
+        None => object_solids::<AVX>(model, object, g, scratch, m),
+    };
+    let (hit, close) = if let Some(contacts) = solids {
         contacts
     } else {
-        object_balls::<AVX>(model, object, g, near, scratch, m)
+        object_balls::<AVX>(model, world, object, g, near, scratch)
     };
     let suspect = Suspect::Object {
         object: o as u32,
@@ -315,7 +324,7 @@ fn object_solids_in<const AVX: bool>(
             ],
             (half[0] * half[0] + half[1] * half[1] + half[2] * half[2]).sqrt(),
         ),
-        Object::Cylinder { .. } | Object::Bounded { .. } => return None,
+        Object::Cylinder { .. } | Object::Bounded { .. } | Object::Cloud { .. } => return None,
     };
     place_solids(model, g, scratch);
     let mut contact = Contact::default();
@@ -354,17 +363,18 @@ fn object_solids_in<const AVX: bool>(
 #[inline(always)]
 fn object_balls<const AVX: bool>(
     model: &FastModel,
+    world: &FastWorld,
     object: &Object,
     g: usize,
     near: LaneMask,
     scratch: &mut FastScratch,
-    m: f32,
 ) -> (LaneMask, LaneMask) {
-    let group = &model.groups[g];
+    let (m, group) = (world.margin, &model.groups[g]);
     place_balls::<AVX>(model, g, scratch);
     let mut contact = Contact::default();
     for i in group.balls.clone() {
-        object.test::<AVX>(&mut contact, &scratch.balls[i], model.balls[i].radius, m);
+        let r = model.balls[i].radius;
+        world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, near);
     }
     let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
     if !model.exact {
@@ -373,7 +383,7 @@ fn object_balls<const AVX: bool>(
         if near & close != 0 {
             for i in group.inner.clone() {
                 let r = model.inner[i].radius;
-                object.test::<AVX>(&mut inside, &scratch.inner[i], r, m);
+                world.test::<AVX>(object, &mut inside, &scratch.inner[i], r, m, near);
             }
         }
         hit = inside.hit.mask::<AVX>();

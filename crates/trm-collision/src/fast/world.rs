@@ -1,6 +1,7 @@
 use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
+use super::cloud::CloudGrid;
 use super::lanes::{
     F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, norm,
     segment_distance2, splat, to_f32,
@@ -9,7 +10,10 @@ use super::model::FastModel;
 use super::outcome::Contact;
 use crate::shape::Shape;
 use crate::world::World;
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
+
+/// The world's axes, as rows of a rotation.
+const IDENTITY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Rounding budget of the margin, m per metre of the largest coordinate per joint of the
 /// deepest chain (see [`FastWorld::margin`]).
@@ -40,6 +44,15 @@ pub(super) enum Object {
     },
     /// Anything else, through its bounding sphere: near it is uncertain, never colliding.
     Bounded { center: [f32; 3], radius: f32 },
+    /// A point cloud, or a triangle mesh through samples on it: the points' box (centre and
+    /// half sizes) and their radius (0 for a mesh); the points are
+    /// [`FastWorld::clouds`]`[index]`.
+    Cloud {
+        index: u32,
+        center: [f32; 3],
+        half: [f32; 3],
+        radius: f32,
+    },
 }
 
 /// A world compiled for a [`FastModel`] (made by [`FastModel::world`]; compile it again when
@@ -55,6 +68,8 @@ pub struct FastWorld {
     pub(super) margin: f32,
     /// Per ball pair of the model ([`FastModel::pairs`]): its [`limits`] with this margin.
     pub(super) limits: Vec<[f32; 2]>,
+    /// The point clouds' grids ([`Object::Cloud`]).
+    pub(super) clouds: Vec<CloudGrid>,
 }
 
 impl FastWorld {
@@ -79,12 +94,61 @@ impl FastWorld {
     pub fn is_empty(&self) -> bool {
         self.objects.is_empty()
     }
+
+    /// Squared distances from the point in every lane of `lanes` to `object`'s geometry (as
+    /// [`Object::distance2`]), a point cloud's nearest point among those within `range` (or
+    /// one nearer than `√stop2`).
+    #[inline(always)]
+    fn distance2(&self, object: &Object, c: &[F; 3], range: f32, stop2: f32, lanes: LaneMask) -> F {
+        match *object {
+            Object::Cloud { index, .. } => {
+                self.clouds[index as usize].distance2(c, range, stop2, lanes)
+            }
+            _ => object.distance2(c),
+        }
+    }
+
+    /// [`Object::test`] for any object: a point cloud's nearest point, in the lanes of `lanes`
+    /// near its box, as a sphere of the points' radius.
+    #[inline(always)]
+    pub(super) fn test<const AVX: bool>(
+        &self,
+        object: &Object,
+        contact: &mut Contact,
+        c: &[F; 3],
+        r: f32,
+        m: f32,
+        lanes: LaneMask,
+    ) {
+        if let Object::Cloud { .. } = object {
+            let reach = object.reach(r);
+            let near = lanes & object.near::<AVX>(c, r + m);
+            if near != 0 {
+                let Object::Cloud { index, .. } = *object else {
+                    unreachable!()
+                };
+                let gap = self.clouds[index as usize].gap;
+                // a point certainly colliding settles the lane: the scan may stop there
+                let [inner2, _] = limits(reach, m);
+                let d2 = self.distance2(object, c, reach + gap + m, inner2, near);
+                let outer = reach + gap + m;
+                contact.add_within(d2, [inner2, outer * outer]);
+            }
+        } else {
+            object.test::<AVX>(contact, c, r, m);
+        }
+    }
 }
 
 impl FastModel {
     /// `world` compiled for [`FastModel::check`], with its margin (see [`FastWorld::margin`]).
     pub fn world(&self, world: &World) -> FastWorld {
         let mut farthest: f64 = 0.0;
+        // a point cloud's cells: as wide as the largest sphere's reach
+        let cloud_cell = (self.balls.iter().chain(&self.inner))
+            .map(|b| b.radius)
+            .fold(0.0, f32::max);
+        let mut clouds = Vec::new();
         let objects: Vec<Object> = world
             .objects()
             .iter()
@@ -119,7 +183,41 @@ impl FastModel {
                         radius: *radius as f32,
                         half: (0.5 * length) as f32,
                     },
-                    Shape::Convex { .. } => {
+                    Shape::Points { points, radius } => {
+                        let points: Vec<[f32; 3]> = points
+                            .iter()
+                            .map(|p| to_f32((pose * Point3::from(*p)).coords))
+                            .collect();
+                        let grid = CloudGrid::new(&points, 0.5 * (cloud_cell + *radius as f32));
+                        let object = Object::Cloud {
+                            index: clouds.len() as u32,
+                            center: grid.center,
+                            half: grid.half,
+                            radius: *radius as f32,
+                        };
+                        clouds.push(grid);
+                        object
+                    }
+                    Shape::Mesh {
+                        vertices,
+                        triangles,
+                    } if let Some(grid) = {
+                        let corners: Vec<[[f64; 3]; 3]> = (triangles.iter())
+                            .map(|t| t.map(|v| (pose * Point3::from(vertices[v as usize])).into()))
+                            .collect();
+                        CloudGrid::of_mesh(&corners, 0.5 * cloud_cell)
+                    } =>
+                    {
+                        let object = Object::Cloud {
+                            index: clouds.len() as u32,
+                            center: grid.center,
+                            half: grid.half,
+                            radius: 0.0,
+                        };
+                        clouds.push(grid);
+                        object
+                    }
+                    Shape::Convex { .. } | Shape::Mesh { .. } => {
                         let c = bounds.center();
                         Object::Bounded {
                             center: to_f32(c.coords),
@@ -154,6 +252,7 @@ impl FastModel {
             original: order,
             compiled_of,
             margin,
+            clouds,
             limits: self
                 .pairs
                 .iter()
@@ -180,6 +279,12 @@ impl Object {
                 ..
             } => (center, radius.hypot(half)),
             Object::Bounded { center, radius } => (center, radius),
+            Object::Cloud {
+                center,
+                half,
+                radius,
+                ..
+            } => (center, norm(half) as f32 + radius),
         }
     }
 
@@ -188,13 +293,15 @@ impl Object {
     #[inline(always)]
     pub(super) fn reach(&self, r: f32) -> f32 {
         match *self {
-            Object::Round { radius, .. } | Object::Bounded { radius, .. } => r + radius,
+            Object::Round { radius, .. }
+            | Object::Bounded { radius, .. }
+            | Object::Cloud { radius, .. } => r + radius,
             Object::Box { .. } | Object::Cylinder { .. } => r,
         }
     }
 
     /// Squared distance from the point in every lane to the object's geometry (the segment of
-    /// a round object, the centre of a bounded one; 0 inside).
+    /// a round object, the centre of a bounded one, a point cloud's box; 0 inside).
     #[inline(always)]
     pub(super) fn distance2(&self, c: &[F; 3]) -> F {
         match *self {
@@ -207,11 +314,12 @@ impl Object {
                 half,
             } => cylinder_distance2(c, center, &axes, radius, half),
             Object::Bounded { center, .. } => distance2(c, &splat(center)),
+            Object::Cloud { center, half, .. } => box_distance2(c, center, &IDENTITY, half),
         }
     }
 
     /// Lanes whose sphere at `c` of radius `r` may come within reach of the object (its
-    /// bounding sphere for [`Object::Bounded`]).
+    /// bounding sphere for [`Object::Bounded`], its points' box for [`Object::Cloud`]).
     #[inline(always)]
     pub(super) fn near<const AVX: bool>(&self, c: &[F; 3], r: f32) -> LaneMask {
         let reach = self.reach(r);
@@ -224,9 +332,11 @@ impl Object {
         self.distance2(c).within(reach * reach).mask::<PORTABLE>()
     }
 
-    /// Adds the sphere at `c` of radius `r` against the object.
+    /// Adds the sphere at `c` of radius `r` against the object (a point cloud through
+    /// [`FastWorld::test`]).
     #[inline(always)]
     pub(super) fn test<const AVX: bool>(&self, contact: &mut Contact, c: &[F; 3], r: f32, m: f32) {
+        debug_assert!(!matches!(self, Object::Cloud { .. }));
         let reach = self.reach(r);
         #[cfg(target_arch = "x86_64")]
         if AVX {

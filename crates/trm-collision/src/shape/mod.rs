@@ -14,6 +14,7 @@ use hull::HullWalk;
 mod compiled;
 mod hull;
 mod pair;
+mod sample;
 mod segment_box;
 mod segment_lanes;
 mod spheres;
@@ -25,8 +26,11 @@ pub(crate) use pair::{
 pub(crate) use segment_lanes::{PointLanes, segment_distance_squared_lanes};
 pub use spheres::{CONVEX_SPHERES, Sphere};
 
-/// A convex collision shape in its own frame, with URDF conventions: boxes, cylinders and
-/// capsules are centred on the origin, cylinders and capsules run along z. Lengths in metres.
+/// A collision shape in its own frame, with URDF conventions: boxes, cylinders and capsules
+/// are centred on the origin, cylinders and capsules run along z. Lengths in metres.
+///
+/// A robot's bodies are convex (the first five kinds); the world may also hold what cameras and
+/// CAD give: point clouds ([`Shape::Points`]) and triangle meshes ([`Shape::Mesh`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Shape {
@@ -59,6 +63,24 @@ pub enum Shape {
         /// The points, in the shape frame.
         points: Vec<[f64; 3]>,
     },
+    /// A point cloud (world objects only): a ball of `radius` about every point — a depth
+    /// camera's points with their uncertainty. The points are the truth: a body collides when
+    /// it comes within `radius` of one of them.
+    Points {
+        /// The points, in the shape frame (at least one).
+        points: Vec<[f64; 3]>,
+        /// Radius of every point (> 0).
+        radius: f64,
+    },
+    /// A triangle mesh taken as its surface, concave parts included (world objects only): a
+    /// body collides when it touches a triangle, as MoveIt's meshes (a body wholly inside a
+    /// closed mesh touches none).
+    Mesh {
+        /// The vertices, in the shape frame.
+        vertices: Vec<[f64; 3]>,
+        /// The triangles, as indices into `vertices` (at least one).
+        triangles: Vec<[u32; 3]>,
+    },
 }
 
 /// What is wrong with a shape, and how to fix it.
@@ -88,8 +110,14 @@ impl Shape {
             Shape::Capsule { radius, length } => {
                 Some(PI * radius * radius * (length + 4.0 * radius / 3.0))
             }
-            Shape::Convex { .. } => None,
+            Shape::Convex { .. } | Shape::Points { .. } | Shape::Mesh { .. } => None,
         }
+    }
+
+    /// Whether a robot's link may be made of it (every kind but [`Shape::Points`] and
+    /// [`Shape::Mesh`], which only the world holds).
+    pub fn is_convex(&self) -> bool {
+        !matches!(self, Shape::Points { .. } | Shape::Mesh { .. })
     }
 
     /// The shape's kind as written in files.
@@ -100,10 +128,13 @@ impl Shape {
             Shape::Cylinder { .. } => "cylinder",
             Shape::Capsule { .. } => "capsule",
             Shape::Convex { .. } => "convex",
+            Shape::Points { .. } => "points",
+            Shape::Mesh { .. } => "mesh",
         }
     }
 
-    /// Checks that every size is finite and the shape has a volume.
+    /// Checks that every size is finite and the shape has a volume (a point cloud: points and a
+    /// radius; a mesh: triangles of distinct vertices).
     pub fn check(&self) -> Result<(), ShapeProblem> {
         let positive = |what: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
@@ -152,6 +183,56 @@ impl Shape {
                 }
                 Ok(())
             }
+            Shape::Points { points, radius } => {
+                positive("radius", *radius)?;
+                if points.is_empty() {
+                    return Err(problem(
+                        "point cloud has no point",
+                        "give at least one point, or leave the object out",
+                    ));
+                }
+                match points.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
+                    Some(i) => Err(problem(
+                        format!("point {i} of the cloud is not finite: {:?}", points[i]),
+                        "drop the camera's invalid (NaN) points before handing the cloud over",
+                    )),
+                    None => Ok(()),
+                }
+            }
+            Shape::Mesh {
+                vertices,
+                triangles,
+            } => {
+                if triangles.is_empty() {
+                    return Err(problem(
+                        "mesh has no triangle",
+                        "give at least one triangle",
+                    ));
+                }
+                if let Some(i) = vertices
+                    .iter()
+                    .position(|p| p.iter().any(|v| !v.is_finite()))
+                {
+                    return Err(problem(
+                        format!("mesh vertex {i} is not finite: {:?}", vertices[i]),
+                        "remove NaN/inf vertices",
+                    ));
+                }
+                let n = vertices.len();
+                match triangles
+                    .iter()
+                    .position(|t| t.iter().any(|&v| v as usize >= n))
+                {
+                    Some(i) => Err(problem(
+                        format!(
+                            "mesh triangle {i} {:?} names a vertex beyond the {n} given",
+                            triangles[i]
+                        ),
+                        "index vertices from 0",
+                    )),
+                    None => Ok(()),
+                }
+            }
         }
     }
 
@@ -171,6 +252,22 @@ impl Shape {
             Shape::Convex { points } => {
                 let pts: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
                 SharedShape::convex_hull(&pts)?
+            }
+            Shape::Points { points, radius } => {
+                // one ball shared by every point; parry's compound keeps them in a BVH
+                let ball = SharedShape::ball(*radius);
+                let balls = points
+                    .iter()
+                    .map(|p| (Isometry3::translation(p[0], p[1], p[2]), ball.clone()))
+                    .collect();
+                SharedShape::compound(balls)
+            }
+            Shape::Mesh {
+                vertices,
+                triangles,
+            } => {
+                let vertices = vertices.iter().map(|p| Point3::from(*p)).collect();
+                SharedShape::trimesh(vertices, triangles.clone()).ok()?
             }
         };
         Some((Isometry3::identity(), shape))

@@ -29,8 +29,9 @@ impl Shape {
     /// 11.8 % wider than the capsule); a cylinder one per piece of its axis no longer than its diameter (both at
     /// most 64 pieces); a box is cut in two along every side at least half as long as the
     /// longest (up to 8 cells, one sphere around each); a convex hull is cut into
-    /// [`CONVEX_SPHERES`] cells, each enclosed exactly ([`crate::fit::fit_convex_spheres`]). An
-    /// empty vector for a shape that fails [`Shape::check`].
+    /// [`CONVEX_SPHERES`] cells, each enclosed exactly ([`crate::fit::fit_convex_spheres`]); a
+    /// point cloud is its points' balls, a mesh one sphere about each triangle. An empty vector
+    /// for a shape that fails [`Shape::check`].
     pub fn enclosing_spheres(&self) -> Vec<Sphere> {
         if self.check().is_err() {
             return Vec::new();
@@ -57,6 +58,26 @@ impl Shape {
                     .map(|(center, radius)| Sphere { center, radius })
                     .collect()
             }
+            Shape::Points { points, radius } => points
+                .iter()
+                .map(|p| sphere(Point3::from(*p), *radius))
+                .collect(),
+            Shape::Mesh {
+                vertices,
+                triangles,
+            } => triangles
+                .iter()
+                .map(|t| {
+                    let corners = t.map(|v| Point3::from(vertices[v as usize]));
+                    let center =
+                        Point3::from(corners.iter().map(|c| c.coords).sum::<Vector3<f64>>() / 3.0);
+                    let radius = corners
+                        .iter()
+                        .map(|c| (c - center).norm())
+                        .fold(0.0, f64::max);
+                    sphere(center, radius)
+                })
+                .collect(),
         }
     }
 }
@@ -67,10 +88,22 @@ impl Shape {
     /// of its [`Shape::enclosing_spheres`] (and, for a convex hull, one about the mean of its
     /// points), as large as the shape's surface allows, dropped where that is under two
     /// micrometres; none for a shape that fails [`Shape::check`]. A capsule's are spheres of its
-    /// radius along its segment, a sphere's is itself.
+    /// radius along its segment, a sphere's is itself, a point cloud's its points' balls; a mesh
+    /// (a surface) has none.
     pub fn inscribed_spheres(&self) -> Vec<Sphere> {
-        if self.check().is_err() {
-            return Vec::new();
+        match self {
+            _ if self.check().is_err() => return Vec::new(),
+            Shape::Points { points, radius } => {
+                return points
+                    .iter()
+                    .map(|p| Sphere {
+                        center: Point3::from(*p),
+                        radius: radius - MARGIN,
+                    })
+                    .collect();
+            }
+            Shape::Mesh { .. } => return Vec::new(),
+            _ => {}
         }
         let mut centres: Vec<Point3<f64>> = self
             .enclosing_spheres()
@@ -117,6 +150,7 @@ impl Shape {
                 .iter()
                 .map(|(n, offset)| offset - n.dot(&c.coords))
                 .fold(f64::INFINITY, f64::min),
+            Shape::Points { .. } | Shape::Mesh { .. } => f64::NEG_INFINITY,
         };
         centres
             .into_iter()

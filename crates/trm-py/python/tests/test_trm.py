@@ -94,6 +94,30 @@ def test_collision_counts_checks_and_pairs(robot):
     assert col.count(home, world) == 0
 
 
+def test_point_clouds_and_meshes_are_obstacles(robot):
+    col = trm.CollisionModel(robot)
+    home = robot.posture("home")
+    hand = robot.frame_pose(home, "r_hand")[:3, 3]
+    rng = np.random.default_rng(0)
+    cloud = hand + rng.uniform(-0.03, 0.03, size=(500, 3))
+    cloud[::50] = np.nan  # a camera's invalid pixels are dropped
+    world = trm.World()
+    assert world.add_points("scan", cloud, 0.005) == 490
+    assert col.is_colliding(home, world) is True
+    world.set_pose("scan", [2.0, 0.0, 0.0])
+    assert col.is_colliding(home, world) is False
+    far = hand + np.array([0.0, 0.0, 1.0])
+    fold = np.array([far, far + [0.3, 0, 0], far + [0, 0.3, 0], far + [0.3, 0.3, 0.1]])
+    world.add_mesh("fold", fold, [[0, 1, 2], [1, 3, 2]])
+    assert col.is_colliding(home, world) is False
+    world.set_pose("fold", [0.0, 0.0, -1.0])
+    assert col.is_colliding(home, world) is True
+    with pytest.raises(trm.TrmError, match=r"expected \(N, 3\)"):
+        world.add_points("flat", np.zeros((4, 2)), 0.01)
+    with pytest.raises(trm.TrmError, match="beyond the 4 given"):
+        world.add_mesh("bad", fold, [[0, 1, 9]])
+
+
 def test_ngik_solves_the_reach_spec_reproducibly():
     problem = trm.Problem.load(SPEC)
     start_cost = problem.cost(problem.start)
