@@ -45,6 +45,7 @@
 //! verifying paths independently of the planner that made them.
 
 mod acm;
+mod attached;
 mod batch;
 pub mod certify;
 mod checker;
@@ -63,6 +64,7 @@ mod shape;
 mod world;
 
 pub use acm::AllowedCollisionMatrix;
+pub use attached::AttachedObject;
 pub use batch::PlacedBatch;
 pub use certify::{Certificate, Certifier, Contact, PathCertificate};
 pub use checker::WorldChecker;
@@ -77,7 +79,7 @@ pub use placed::PlacedBodies;
 pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
 pub use shape::{CONVEX_SPHERES, Shape, ShapeProblem, Sphere};
 pub use trm_kinematics::DisableReason;
-pub use world::{ObjectSpec, World, WorldObject, WorldSpec};
+pub use world::{CloudFileSpec, MeshFileSpec, ObjectSpec, World, WorldObject, WorldSpec};
 
 /// The file formats this crate reads and writes.
 pub mod formats {

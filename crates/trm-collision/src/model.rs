@@ -62,6 +62,8 @@ struct Inner {
     pairs: Vec<BodyPair>,
     link_pairs: usize,
     culling: Culling,
+    /// Objects the robot holds, their bodies among `bodies`.
+    attached: Vec<crate::AttachedObject>,
     /// Every body's [`CollisionModel::enclosing_spheres`] and
     /// [`CollisionModel::inscribed_spheres`], fitted on first use and shared by the models
     /// [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
@@ -72,7 +74,7 @@ struct Inner {
 
 /// Per body, its spheres in its link's frame, each set fitted on first use.
 #[derive(Debug, Default)]
-struct SphereSets {
+pub(crate) struct SphereSets {
     enclosing: OnceLock<Vec<Vec<crate::Sphere>>>,
     inscribed: OnceLock<Vec<Vec<crate::Sphere>>>,
 }
@@ -141,14 +143,16 @@ impl CollisionModel {
         bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
     ) -> Result<Self> {
-        Self::build(robot, bodies, acm, Default::default())
+        Self::build(robot, bodies, acm, Vec::new(), Default::default())
     }
 
-    /// [`CollisionModel::from_bodies`] with the bodies' spheres, fitted or still to fit.
-    fn build(
+    /// [`CollisionModel::from_bodies`] holding `attached` objects (their bodies among
+    /// `bodies`), with the bodies' spheres, fitted or still to fit.
+    pub(crate) fn build(
         robot: &RobotModel,
         mut bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
+        attached: Vec<crate::AttachedObject>,
         spheres: Arc<SphereSets>,
     ) -> Result<Self> {
         if acm.num_links() != robot.num_links() {
@@ -206,7 +210,24 @@ impl CollisionModel {
                 }
             })?);
         }
-        let (pairs, link_pairs) = body_pairs(&bodies, &acm);
+        // a held object's bodies are checked against every other link but its touch links,
+        // whatever the matrix says of its holding link (as MoveIt checks attached objects)
+        let touching: Vec<Option<Vec<usize>>> = bodies
+            .iter()
+            .map(|b| {
+                let o = attached.iter().find(|o| o.holds(&b.name))?;
+                let mut links = o.touch_link_indices(robot.tree());
+                links.push(b.link);
+                Some(links)
+            })
+            .collect();
+        let checked = |i: usize, j: usize| match (&touching[i], &touching[j]) {
+            (Some(exempt), _) if !exempt.contains(&bodies[j].link) => true,
+            (_, Some(exempt)) if !exempt.contains(&bodies[i].link) => true,
+            (None, None) => acm.is_checked(bodies[i].link, bodies[j].link),
+            _ => false,
+        };
+        let (pairs, link_pairs) = body_pairs(&bodies, checked);
         let links: Vec<usize> = bodies.iter().map(|b| b.link).collect();
         let culling = Culling::new(robot.tree(), &links, &compiled, &pairs);
         Ok(CollisionModel {
@@ -218,6 +239,7 @@ impl CollisionModel {
                 pairs,
                 link_pairs,
                 culling,
+                attached,
                 spheres,
                 fast: OnceLock::new(),
             }),
@@ -230,6 +252,7 @@ impl CollisionModel {
             &self.inner.robot,
             self.inner.bodies.clone(),
             acm,
+            self.inner.attached.clone(),
             self.inner.spheres.clone(),
         )
     }
@@ -375,6 +398,54 @@ impl CollisionModel {
         Ok(())
     }
 
+    /// The objects the robot holds ([`CollisionModel::with_attached`]).
+    pub fn attached(&self) -> &[crate::AttachedObject] {
+        &self.inner.attached
+    }
+
+    /// Sphere sets for `bodies`: those already fitted for this model's bodies of the same
+    /// name kept, the others fitted on first use with the rest.
+    pub(crate) fn carried_spheres(&self, bodies: &[Body]) -> Arc<SphereSets> {
+        let carry = |old: &OnceLock<Vec<Vec<crate::Sphere>>>,
+                     fit: fn(&crate::Shape) -> Vec<crate::Sphere>| {
+            let cell = OnceLock::new();
+            if let Some(old) = old.get() {
+                let sets = bodies
+                    .iter()
+                    .map(|b| match self.body_index(&b.name) {
+                        Ok(i) if self.inner.bodies[i].shape == b.shape => old[i].clone(),
+                        _ => {
+                            let mut spheres = fit(&b.shape);
+                            for s in &mut spheres {
+                                s.center = b.local * s.center;
+                            }
+                            spheres
+                        }
+                    })
+                    .collect();
+                let _ = cell.set(sets);
+            }
+            cell
+        };
+        let spheres = &self.inner.spheres;
+        Arc::new(SphereSets {
+            enclosing: carry(&spheres.enclosing, crate::Shape::enclosing_spheres),
+            inscribed: carry(&spheres.inscribed, crate::Shape::inscribed_spheres),
+        })
+    }
+
+    /// The robot's own bodies' model with `attached` objects held (their bodies among
+    /// `bodies`).
+    pub(crate) fn holding(
+        &self,
+        bodies: Vec<Body>,
+        attached: Vec<crate::AttachedObject>,
+    ) -> Result<Self> {
+        let spheres = self.carried_spheres(&bodies);
+        let acm = self.inner.acm.clone();
+        Self::build(&self.inner.robot, bodies, acm, attached, spheres)
+    }
+
     /// Where [`crate::fast::FastModel::of`] keeps this model's compilation.
     pub(crate) fn fast_cell(&self) -> &OnceLock<Arc<crate::fast::FastModel>> {
         &self.inner.fast
@@ -402,12 +473,12 @@ fn has_geometry(links: usize, bodies: &[Body]) -> Vec<bool> {
 }
 
 /// Checked body pairs grouped by link pair, and the number of link pairs.
-fn body_pairs(bodies: &[Body], acm: &AllowedCollisionMatrix) -> (Vec<BodyPair>, usize) {
+fn body_pairs(bodies: &[Body], checked: impl Fn(usize, usize) -> bool) -> (Vec<BodyPair>, usize) {
     let mut groups: std::collections::BTreeMap<[usize; 2], Vec<(u32, u32)>> = Default::default();
     for i in 0..bodies.len() {
         for j in i + 1..bodies.len() {
             let (la, lb) = (bodies[i].link, bodies[j].link);
-            if !acm.is_checked(la, lb) {
+            if !checked(i, j) {
                 continue;
             }
             groups

@@ -293,6 +293,7 @@ pub fn generate(
                         names: motor_names.clone(),
                         positions: objective.active().to_motors(&from),
                     },
+                    attached: Vec::new(),
                     goal: JointGoal {
                         names: active_names.clone(),
                         tolerances: vec![(0.0, 0.0); goal.len()],

@@ -1,8 +1,9 @@
 //! MoveIt's planning inputs as YAML (the ROS message layout MotionBenchMaker and
 //! `moveit_msgs` tools write): a `PlanningScene` (world collision objects made of box, sphere
-//! and cylinder primitives, the allowed-collision matrix, the robot state) and a
-//! `MotionPlanRequest` (start state, joint-space or task-space goal, group, planning time,
-//! scaling factors), and a robot's `joint_limits.yaml` ([`JointLimitsFile`]).
+//! and cylinder primitives and triangle meshes, the allowed-collision matrix, the robot state
+//! with the objects it holds) and a `MotionPlanRequest` (start state with held objects,
+//! joint-space or task-space goal, group, planning time, scaling factors), and a robot's
+//! `joint_limits.yaml` ([`JointLimitsFile`]).
 //!
 //! ```
 //! use trm_moveit::PlanningScene;
@@ -18,9 +19,13 @@
 //! Each primitive becomes one world object, posed by the object's `pose` (identity when absent)
 //! times its `primitive_poses` entry; an object of several primitives names them `id/0`,
 //! `id/1`, …. Poses are read as `position: [x, y, z]` or `{x:, y:, z:}` and `orientation:
-//! [x, y, z, w]` or `{x:, y:, z:, w:}`. Meshes, planes, cones and attached objects are refused
-//! with the object named (trm's worlds hold convex primitives). Every error names the file and
-//! the line.
+//! [x, y, z, w]` or `{x:, y:, z:, w:}`. Meshes (`shape_msgs/Mesh`: `vertices` and
+//! `triangles`, with `mesh_poses`) become triangle meshes; a mesh may instead name a file,
+//! `resource: "package://pkg/meshes/x.stl"` or a path relative to the scene, with an optional
+//! `scale`. Attached collision objects (`robot_state.attached_collision_objects`, a request's
+//! `start_state`) are read as [`trm_collision::AttachedObject`]s, posed in their link's frame,
+//! with their touch links. Planes and cones are refused with the object named. Every error
+//! names the file and the line.
 
 mod error;
 mod limits;
@@ -63,6 +68,8 @@ pub struct Scene {
     pub acm: AllowedCollisionMatrix,
     /// The scene's matrix entries that are not links of the robot (skipped).
     pub notes: Vec<String>,
+    /// What the robot holds in the scene (`robot_state.attached_collision_objects`).
+    pub attached: Vec<trm_collision::AttachedObject>,
 }
 
 /// A world file (RON, or a MoveIt planning scene `.yaml`) read for `collision`'s robot: the
@@ -87,12 +94,14 @@ pub fn load_scene(
                 world: scene.to_world()?,
                 acm,
                 notes,
+                attached: scene.attached,
             })
         }
         _ => Ok(Scene {
             world: World::load(path)?,
             acm: own(),
             notes: Vec::new(),
+            attached: Vec::new(),
         }),
     }
 }

@@ -56,6 +56,9 @@ pub struct MotionPlanRequest {
     pub origin: PathBuf,
     /// `start_state.joint_state`.
     pub start: JointState,
+    /// `start_state.attached_collision_objects`: what the robot holds at the start (and
+    /// carries along the motion).
+    pub attached: Vec<trm_collision::AttachedObject>,
     /// `goal_constraints[0].joint_constraints` (may be empty when `pose_goal` is not).
     pub goal: JointGoal,
     /// `goal_constraints[0].position_constraints` and `orientation_constraints`: a task-space
@@ -312,6 +315,7 @@ impl MotionPlanRequest {
             if let Some(js) = start.get("joint_state") {
                 request.start = r.joint_state(js, "start_state.joint_state")?;
             }
+            request.attached = r.attached_objects(start, "start_state")?;
         }
         let goals = r.seq(
             r.field(&doc, "goal_constraints", "the request")?,
@@ -458,6 +462,7 @@ impl MotionPlanRequest {
             names.join(", "),
             positions.join(", ")
         );
+        crate::scene::write_attached(&mut out, &self.attached);
         if task_space {
             out.push_str("goal_constraints:\n");
             write_pose_goal(&mut out, &self.pose_goal).map_err(|p| refuse(&p))?;

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use trm_collision::{Shape, World};
+use trm_collision::{AttachedObject, Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
 
 use crate::error::MoveItError;
@@ -171,6 +171,9 @@ pub struct PlanningScene {
     pub allowed_collisions: Option<AllowedCollisions>,
     /// `robot_state.joint_state`, when given.
     pub robot_state: Option<JointState>,
+    /// `robot_state.attached_collision_objects`: what the robot holds (poses in the frames of
+    /// the links holding them).
+    pub attached: Vec<AttachedObject>,
 }
 
 impl Reader<'_> {
@@ -224,14 +227,7 @@ impl Reader<'_> {
 
     fn object(&self, node: &Node, k: usize) -> Result<CollisionObject, MoveItError> {
         let what = format!("world.collision_objects[{k}]");
-        let id = self.text(self.field(node, "id", &what)?, &format!("{what}.id"))?;
-        if id.trim().is_empty() {
-            return Err(self.err(
-                node.line,
-                format!("{what} has an empty id"),
-                "give every object an id",
-            ));
-        }
+        let id = self.object_id(node, &what)?;
         let what = format!("object `{id}`");
         if let Some(op) = node.get("operation").and_then(Node::scalar) {
             if !matches!(op, "0" | "ADD" | "add" | "\x00") {
@@ -242,7 +238,30 @@ impl Reader<'_> {
                 ));
             }
         }
-        for unsupported in ["meshes", "planes", "subframe_names"] {
+        Ok(CollisionObject {
+            primitives: self.shapes(node, &what)?,
+            id,
+            line: node.line,
+        })
+    }
+
+    /// A collision object's `id` (not empty).
+    fn object_id(&self, node: &Node, what: &str) -> Result<String, MoveItError> {
+        let id = self.text(self.field(node, "id", what)?, &format!("{what}.id"))?;
+        if id.trim().is_empty() {
+            return Err(self.err(
+                node.line,
+                format!("{what} has an empty id"),
+                "give every object an id",
+            ));
+        }
+        Ok(id)
+    }
+
+    /// A collision object's primitives and meshes, each posed by the object's `pose`
+    /// (identity when absent) times its own.
+    fn shapes(&self, node: &Node, what: &str) -> Result<Vec<Primitive>, MoveItError> {
+        for unsupported in ["planes", "subframe_names"] {
             if node
                 .get(unsupported)
                 .and_then(Node::items)
@@ -251,7 +270,7 @@ impl Reader<'_> {
                 return Err(self.err(
                     node.line,
                     format!("{what} has {unsupported}"),
-                    "trm's worlds hold boxes, spheres and cylinders: replace meshes and planes by primitives",
+                    "trm's worlds hold primitives, meshes and point clouds: replace planes by thin boxes",
                 ));
             }
         }
@@ -259,37 +278,198 @@ impl Reader<'_> {
             Some(p) => self.pose(p, &format!("{what}.pose"))?,
             None => Isometry3::identity(),
         };
-        let shapes = match node.get("primitives") {
-            Some(p) => self.seq(p, &format!("{what}.primitives"))?,
-            None => &[],
-        };
-        let poses = match node.get("primitive_poses") {
-            Some(p) => self.seq(p, &format!("{what}.primitive_poses"))?,
-            None => &[],
-        };
-        if shapes.is_empty() || shapes.len() != poses.len() {
+        let mut primitives = Vec::new();
+        for (list, poses, meshes) in [
+            ("primitives", "primitive_poses", false),
+            ("meshes", "mesh_poses", true),
+        ] {
+            let list_of = |key: &str| match node.get(key) {
+                Some(p) => self.seq(p, &format!("{what}.{key}")),
+                None => Ok(&[][..]),
+            };
+            let (shapes, poses_of) = (list_of(list)?, list_of(poses)?);
+            if shapes.len() != poses_of.len() {
+                return Err(self.err(
+                    node.line,
+                    format!(
+                        "{what} has {} {list} and {} {poses}",
+                        shapes.len(),
+                        poses_of.len()
+                    ),
+                    format!("give one pose per entry of {list}"),
+                ));
+            }
+            for (i, (s, p)) in shapes.iter().zip(poses_of).enumerate() {
+                let here = format!("{what}.{list}[{i}]");
+                let shape = if meshes {
+                    self.mesh(s, &here)?
+                } else {
+                    self.primitive(s, &here)?
+                };
+                let pose = object_pose * self.pose(p, &format!("{what}.{poses}[{i}]"))?;
+                primitives.push(Primitive { shape, pose });
+            }
+        }
+        if primitives.is_empty() {
             return Err(self.err(
                 node.line,
-                format!(
-                    "{what} has {} primitives and {} primitive poses",
-                    shapes.len(),
-                    poses.len()
-                ),
-                "give at least one primitive and one pose per primitive",
+                format!("{what} has no primitive and no mesh"),
+                "give at least one primitive (and its pose) or mesh (and its pose)",
             ));
         }
-        let mut primitives = Vec::new();
-        for (i, (s, p)) in shapes.iter().zip(poses).enumerate() {
-            let here = format!("{what}.primitives[{i}]");
-            let shape = self.primitive(s, &here)?;
-            let pose = object_pose * self.pose(p, &format!("{what}.primitive_poses[{i}]"))?;
-            primitives.push(Primitive { shape, pose });
+        Ok(primitives)
+    }
+
+    /// A `shape_msgs/Mesh` (`vertices` as points, `triangles` as `vertex_indices`), or — trm's
+    /// extension — a mesh file: `resource: "package://…/x.stl"` (or a path, relative to the
+    /// scene) with an optional `scale: [x, y, z]`.
+    fn mesh(&self, node: &Node, here: &str) -> Result<Shape, MoveItError> {
+        if let Some(resource) = node.get("resource") {
+            let uri = self.text(resource, &format!("{here}.resource"))?;
+            let scale = match node.get("scale") {
+                Some(s) => self.vector(s, &format!("{here}.scale"), &["x", "y", "z"])?,
+                None => vec![1.0; 3],
+            };
+            let dir = self.origin.parent();
+            let paths = trm_collision::CollisionOptions::with_ros_package_path(Vec::new());
+            let path = trm_collision::mesh::resolve_mesh(&uri, dir, &paths.package_paths).map_err(|tried| {
+                self.err(
+                    resource.line,
+                    format!("{here}: `{uri}` is not found (tried {tried:?})"),
+                    "give a path relative to the scene, or a package:// URI whose package is on ROS_PACKAGE_PATH",
+                )
+            })?;
+            let (vertices, triangles) =
+                trm_collision::mesh::triangles_of_mesh(&path, [scale[0], scale[1], scale[2]])
+                    .map_err(|e| {
+                        self.err(
+                            resource.line,
+                            format!("{here}: {}: {e}", path.display()),
+                            "give an STL, OBJ or COLLADA mesh",
+                        )
+                    })?;
+            return Ok(Shape::Mesh {
+                vertices,
+                triangles,
+            });
         }
-        Ok(CollisionObject {
-            id,
-            primitives,
-            line: node.line,
+        let vertices = self
+            .seq(
+                self.field(node, "vertices", here)?,
+                &format!("{here}.vertices"),
+            )?
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let p = self.vector(v, &format!("{here}.vertices[{i}]"), &["x", "y", "z"])?;
+                Ok([p[0], p[1], p[2]])
+            })
+            .collect::<Result<Vec<_>, MoveItError>>()?;
+        let triangles = self
+            .seq(
+                self.field(node, "triangles", here)?,
+                &format!("{here}.triangles"),
+            )?
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let at = format!("{here}.triangles[{i}]");
+                let indices = t.get("vertex_indices").unwrap_or(t);
+                let v = self.numbers(indices, &at)?;
+                let index = |x: f64| {
+                    (x >= 0.0 && x.fract() == 0.0 && (x as usize) < vertices.len())
+                        .then_some(x as u32)
+                };
+                match v.as_slice() {
+                    [a, b, c] => match (index(*a), index(*b), index(*c)) {
+                        (Some(a), Some(b), Some(c)) => Ok([a, b, c]),
+                        _ => Err(self.err(
+                            t.line,
+                            format!("{at} is {v:?}, beyond the {} vertices", vertices.len()),
+                            "index vertices from 0",
+                        )),
+                    },
+                    _ => Err(self.err(
+                        t.line,
+                        format!("{at} has {} indices", v.len()),
+                        "give three vertex indices per triangle",
+                    )),
+                }
+            })
+            .collect::<Result<Vec<_>, MoveItError>>()?;
+        let shape = Shape::Mesh {
+            vertices,
+            triangles,
+        };
+        shape
+            .check()
+            .map_err(|p| self.err(node.line, format!("{here}: {}", p.problem), p.fix))?;
+        Ok(shape)
+    }
+
+    /// A `moveit_msgs/AttachedCollisionObject`: the object's shapes in its link's frame.
+    fn attached(&self, node: &Node, k: usize) -> Result<AttachedObject, MoveItError> {
+        let what = format!("attached_collision_objects[{k}]");
+        let link = self.text(
+            self.field(node, "link_name", &what)?,
+            &format!("{what}.link_name"),
+        )?;
+        let object = self.field(node, "object", &what)?;
+        let name = self.object_id(object, &format!("{what}.object"))?;
+        let what = format!("held object `{name}`");
+        let frame = object
+            .get("header")
+            .and_then(|h| h.get("frame_id"))
+            .and_then(Node::scalar)
+            .unwrap_or("");
+        if !frame.is_empty() && frame.trim_start_matches('/') != link {
+            return Err(self.err(
+                object.line,
+                format!("{what} is posed in frame `{frame}`, not in its link `{link}`"),
+                "give the held object's poses in the frame of the link holding it",
+            ));
+        }
+        let touch_links = match node.get("touch_links") {
+            Some(t) => self
+                .seq(t, &format!("{what}.touch_links"))?
+                .iter()
+                .map(|l| self.text(l, "a touch link"))
+                .collect::<Result<_, _>>()?,
+            None => Vec::new(),
+        };
+        Ok(AttachedObject {
+            shapes: (self.shapes(object, &what)?.into_iter())
+                .map(|p| (p.shape, p.pose))
+                .collect(),
+            name,
+            link,
+            touch_links,
         })
+    }
+
+    /// The `attached_collision_objects` of a robot state (none when absent).
+    pub(crate) fn attached_objects(
+        &self,
+        state: &Node,
+        what: &str,
+    ) -> Result<Vec<AttachedObject>, MoveItError> {
+        let Some(list) = state.get("attached_collision_objects") else {
+            return Ok(Vec::new());
+        };
+        let list = self.seq(list, &format!("{what}.attached_collision_objects"))?;
+        let mut held: Vec<AttachedObject> = Vec::new();
+        for (k, node) in list.iter().enumerate() {
+            let object = self.attached(node, k)?;
+            if held.iter().any(|o| o.name == object.name) {
+                return Err(self.err(
+                    node.line,
+                    format!("held object `{}` is given twice", object.name),
+                    "give every held object its own id",
+                ));
+            }
+            held.push(object);
+        }
+        Ok(held)
     }
 
     fn allowed(&self, node: &Node) -> Result<AllowedCollisions, MoveItError> {
@@ -433,17 +613,7 @@ impl PlanningScene {
             if let Some(js) = state.get("joint_state") {
                 scene.robot_state = Some(r.joint_state(js, "robot_state.joint_state")?);
             }
-            if state
-                .get("attached_collision_objects")
-                .and_then(Node::items)
-                .is_some_and(|l| !l.is_empty())
-            {
-                return Err(r.err(
-                    state.line,
-                    "the robot state has attached collision objects",
-                    "detach them into the world (trm does not carry objects with the robot yet)",
-                ));
-            }
+            scene.attached = r.attached_objects(state, "robot_state")?;
         }
         Ok(scene)
     }
@@ -480,10 +650,10 @@ impl PlanningScene {
     }
 
     /// The scene as YAML in the layout [`PlanningScene::parse`] reads (a round trip keeps every
-    /// field it reads; numbers are written in their shortest exact form). Refuses what the
-    /// reader refuses: shapes other than boxes, spheres and cylinders, invalid dimensions or
-    /// poses, repeated ids, a robot state with non-finite values or one value short, a
-    /// non-square allowed-collision matrix.
+    /// field it reads; numbers are written in their shortest exact form; meshes inline).
+    /// Refuses what the reader refuses: shapes other than boxes, spheres, cylinders and meshes,
+    /// invalid dimensions or poses, repeated ids, a robot state with non-finite values or one
+    /// value short, a non-square allowed-collision matrix.
     pub fn to_yaml(&self) -> Result<String, MoveItError> {
         let refuse = |problem: String, fix: &str| MoveItError::Invalid {
             path: self.origin.clone(),
@@ -492,22 +662,31 @@ impl PlanningScene {
             fix: fix.into(),
         };
         self.to_world()?;
-        for o in &self.objects {
-            if o.primitives.is_empty() {
-                return Err(refuse(
-                    format!("object `{}` has no primitive", o.id),
-                    "give it one",
-                ));
+        let held = self.attached.iter().map(|o| {
+            let shapes: Vec<&Shape> = o.shapes.iter().map(|(s, _)| s).collect();
+            (&o.name, shapes)
+        });
+        let world =
+            (self.objects.iter()).map(|o| (&o.id, o.primitives.iter().map(|p| &p.shape).collect()));
+        for (id, shapes) in world.chain(held) {
+            if shapes.is_empty() {
+                return Err(refuse(format!("object `{id}` has no shape"), "give it one"));
             }
-            if let Some(p) = o.primitives.iter().find(|p| {
+            if let Some(shape) = shapes.iter().find(|s| {
                 !matches!(
-                    p.shape,
-                    Shape::Box { .. } | Shape::Sphere { .. } | Shape::Cylinder { .. }
-                )
+                    s,
+                    Shape::Box { .. }
+                        | Shape::Sphere { .. }
+                        | Shape::Cylinder { .. }
+                        | Shape::Mesh { .. }
+                ) || s.check().is_err()
             }) {
                 return Err(refuse(
-                    format!("object `{}` holds a {:?}", o.id, p.shape),
-                    "MoveIt scenes hold boxes, spheres and cylinders",
+                    format!(
+                        "object `{id}` holds a {} that MoveIt cannot carry or that is invalid",
+                        shape.kind()
+                    ),
+                    "MoveIt scenes hold boxes, spheres, cylinders and meshes",
                 ));
             }
         }
@@ -531,23 +710,21 @@ impl PlanningScene {
             }
         }
         let mut out = String::new();
-        let list = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{x:?}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
         let _ = writeln!(out, "name: {}", quote(&self.name));
         let _ = writeln!(out, "robot_model_name: {}", quote(&self.robot_model_name));
+        if self.robot_state.is_some() || !self.attached.is_empty() {
+            let _ = writeln!(out, "robot_state:");
+        }
         if let Some(state) = &self.robot_state {
             let names: Vec<String> = state.names.iter().map(|n| quote(n)).collect();
             let _ = writeln!(
                 out,
-                "robot_state:\n  joint_state:\n    name: [{}]\n    position: [{}]",
+                "  joint_state:\n    name: [{}]\n    position: [{}]",
                 names.join(", "),
                 list(&state.positions)
             );
         }
+        write_attached(&mut out, &self.attached);
         if let Some(acm) = &self.allowed_collisions {
             let names: Vec<String> = acm.names.iter().map(|n| quote(n)).collect();
             let _ = writeln!(
@@ -573,32 +750,104 @@ impl PlanningScene {
             if self.objects.is_empty() { " []" } else { "" }
         );
         for o in &self.objects {
-            let _ = writeln!(out, "    - id: {}\n      primitives:", quote(&o.id));
-            for p in &o.primitives {
-                let (kind, d) = match &p.shape {
-                    Shape::Box { size } => ("box", size.to_vec()),
-                    Shape::Sphere { radius } => ("sphere", vec![*radius]),
-                    Shape::Cylinder { radius, length } => ("cylinder", vec![*length, *radius]),
-                    _ => unreachable!("checked above"),
-                };
-                let _ = writeln!(
-                    out,
-                    "        - type: {kind}\n          dimensions: [{}]",
-                    list(&d)
-                );
-            }
-            let _ = writeln!(out, "      primitive_poses:");
-            for p in &o.primitives {
-                let t = p.pose.translation.vector;
-                let q = p.pose.rotation.coords; // x, y, z, w
-                let _ = writeln!(
-                    out,
-                    "        - position: [{}]\n          orientation: [{}]",
-                    list(&[t.x, t.y, t.z]),
-                    list(&[q.x, q.y, q.z, q.w])
-                );
-            }
+            let shapes: Vec<(&Shape, &Isometry3<f64>)> =
+                o.primitives.iter().map(|p| (&p.shape, &p.pose)).collect();
+            let _ = write!(out, "    - ");
+            write_object(&mut out, "      ", &o.id, &shapes);
         }
         Ok(out)
+    }
+}
+
+/// Numbers in their shortest exact form, comma-separated.
+fn list(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format!("{x:?}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// `attached_collision_objects:` under a robot state (nothing when there are none).
+pub(crate) fn write_attached(out: &mut String, attached: &[AttachedObject]) {
+    if attached.is_empty() {
+        return;
+    }
+    let _ = writeln!(out, "  attached_collision_objects:");
+    for o in attached {
+        let touch: Vec<String> = o.touch_links.iter().map(|l| quote(l)).collect();
+        let _ = write!(
+            out,
+            "    - link_name: {}\n      touch_links: [{}]\n      object:\n        ",
+            quote(&o.link),
+            touch.join(", ")
+        );
+        let shapes: Vec<(&Shape, &Isometry3<f64>)> = o.shapes.iter().map(|(s, p)| (s, p)).collect();
+        write_object(out, "        ", &o.name, &shapes);
+    }
+}
+
+/// A collision object's fields (`id`, primitives and meshes with their poses), each line
+/// indented by `indent` but the first (written where the caller stands).
+fn write_object(out: &mut String, indent: &str, id: &str, shapes: &[(&Shape, &Isometry3<f64>)]) {
+    let _ = writeln!(out, "id: {}", quote(id));
+    let pose = |out: &mut String, p: &Isometry3<f64>| {
+        let t = p.translation.vector;
+        let q = p.rotation.coords; // x, y, z, w
+        let _ = writeln!(
+            out,
+            "{indent}  - position: [{}]\n{indent}    orientation: [{}]",
+            list(&[t.x, t.y, t.z]),
+            list(&[q.x, q.y, q.z, q.w])
+        );
+    };
+    let (meshes, primitives): (Vec<_>, Vec<_>) = shapes
+        .iter()
+        .partition(|(s, _)| matches!(s, Shape::Mesh { .. }));
+    if !primitives.is_empty() {
+        let _ = writeln!(out, "{indent}primitives:");
+        for (shape, _) in &primitives {
+            let (kind, d) = match shape {
+                Shape::Box { size } => ("box", size.to_vec()),
+                Shape::Sphere { radius } => ("sphere", vec![*radius]),
+                Shape::Cylinder { radius, length } => ("cylinder", vec![*length, *radius]),
+                _ => unreachable!("checked by to_yaml"),
+            };
+            let _ = writeln!(
+                out,
+                "{indent}  - type: {kind}\n{indent}    dimensions: [{}]",
+                list(&d)
+            );
+        }
+        let _ = writeln!(out, "{indent}primitive_poses:");
+        for (_, p) in &primitives {
+            pose(out, p);
+        }
+    }
+    if !meshes.is_empty() {
+        let _ = writeln!(out, "{indent}meshes:");
+        for (shape, _) in &meshes {
+            let Shape::Mesh {
+                vertices,
+                triangles,
+            } = shape
+            else {
+                unreachable!("partitioned")
+            };
+            let vertices: Vec<String> = vertices.iter().map(|v| format!("[{}]", list(v))).collect();
+            let triangles: Vec<String> = triangles
+                .iter()
+                .map(|t| format!("[{}, {}, {}]", t[0], t[1], t[2]))
+                .collect();
+            let _ = writeln!(
+                out,
+                "{indent}  - vertices: [{}]\n{indent}    triangles: [{}]",
+                vertices.join(", "),
+                triangles.join(", ")
+            );
+        }
+        let _ = writeln!(out, "{indent}mesh_poses:");
+        for (_, p) in &meshes {
+            pose(out, p);
+        }
     }
 }

@@ -283,8 +283,9 @@ impl Planner {
     }
 
     /// Sets a world file as the current world: RON, or a MoveIt planning scene (`.yaml`), whose
-    /// allowed-collision matrix then applies over the planner's own (the collision checks are
-    /// made again only when the matrix changes). Returns notes on the matrix's entries that are
+    /// allowed-collision matrix then applies over the planner's own and whose attached
+    /// collision objects the robot then holds (the collision checks are made again only when
+    /// the matrix or the held objects change). Returns notes on the matrix's entries that are
     /// not links of the robot.
     fn load_scene(&mut self, py: Python<'_>, path: &str) -> PyResult<Vec<String>> {
         let scene = trm_moveit::load_scene(path, &self.own).map_err(err)?;
@@ -292,6 +293,7 @@ impl Planner {
         py.detach(|| -> Result<(), trm_plan::PlanError> {
             planner.set_world(scene.world);
             planner.set_acm(scene.acm)?;
+            planner.set_attached(scene.attached)?;
             Ok(())
         })
         .map_err(err)?;
@@ -487,7 +489,8 @@ impl Planner {
     /// each call: its start state and its joint goal for the motors the planner moves, or its
     /// task-space goal, met by IK for a collision-free configuration first; its
     /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
-    /// its scene first (`load_scene`). Returns what `plan` returns.
+    /// its scene first (`load_scene`). Objects its start state holds are held from then on
+    /// (beside the scene's). Returns what `plan` returns.
     #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS))]
     #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
@@ -513,6 +516,14 @@ impl Planner {
                 &read
             }
         };
+        if !request.attached.is_empty() {
+            let mut held = self.planner.attached().to_vec();
+            for object in &request.attached {
+                held.retain(|o| o.name != object.name);
+                held.push(object.clone());
+            }
+            self.planner.set_attached(held).map_err(err)?;
+        }
         let (start, goal) = request.query(self.planner.active()).map_err(err)?;
         let budget = Budget {
             seed,
@@ -535,6 +546,44 @@ impl Planner {
         };
         let planned = self.connect(py, &d, start, goal, &budget, &timing)?;
         self.fill(py, d, planned)
+    }
+
+    /// Holds an object: the objects of `shapes` (a World, its poses read in `link`'s frame)
+    /// move with `link` and are checked against the world and the robot's other links except
+    /// `touch_links` (the fingers holding it). Maps and kept paths are checked again for the
+    /// robot's new shape when a search wants them.
+    #[pyo3(signature = (name, link, shapes, touch_links = Vec::new()))]
+    fn attach(
+        &mut self,
+        name: &str,
+        link: &str,
+        shapes: &PyWorld,
+        touch_links: Vec<String>,
+    ) -> PyResult<()> {
+        let object = trm_collision::AttachedObject {
+            name: name.to_string(),
+            link: link.to_string(),
+            shapes: (shapes.world.objects().iter())
+                .map(|o| (o.shape().clone(), *o.pose()))
+                .collect(),
+            touch_links,
+        };
+        self.planner.attach(object).map_err(err)
+    }
+
+    /// Puts down the held object `name`.
+    fn detach(&mut self, name: &str) -> PyResult<()> {
+        self.planner.detach(name).map_err(err)
+    }
+
+    /// The names of the objects the robot holds.
+    #[getter]
+    fn attached(&self) -> Vec<String> {
+        self.planner
+            .attached()
+            .iter()
+            .map(|o| o.name.clone())
+            .collect()
     }
 
     fn __repr__(&self) -> String {

@@ -195,18 +195,23 @@ impl Objective {
     }
 
     /// Replaces the collision model by another of the same robot and bodies — the same model
-    /// with another allowed-collision matrix (a planning scene's, say) — keeping its compiled
-    /// screen when it has one. Scratches made before are made again when next used. An error
-    /// for a model of another robot or other bodies.
+    /// with another allowed-collision matrix (a planning scene's, say) or holding other objects
+    /// ([`CollisionModel::with_attached`]) — keeping its compiled screen when it has one.
+    /// Scratches made before are made again when next used. An error for a model of another
+    /// robot or other bodies of its own.
     pub fn set_collision(&mut self, collision: CollisionModel) -> Result<()> {
         collision.check_active(&self.active)?;
-        if collision.bodies().len() != self.collision.bodies().len() {
+        let own = |c: &CollisionModel| {
+            let held: usize = c.attached().iter().map(|o| o.shapes.len()).sum();
+            c.bodies().len() - held
+        };
+        if own(&collision) != own(&self.collision) {
             return Err(TaskError::Invalid {
                 what: "collision model".into(),
                 problem: format!(
-                    "{} bodies where the objective's model has {}",
-                    collision.bodies().len(),
-                    self.collision.bodies().len()
+                    "{} bodies of its own where the objective's model has {}",
+                    own(&collision),
+                    own(&self.collision)
                 ),
             });
         }

@@ -375,6 +375,8 @@ fn run_without_maps(args: &Args) -> Result<()> {
         &trm_tasks::Objective::new(active.clone(), collision.clone(), Default::default()),
         &[],
     )?;
+    // what the robot holds: the scene's, then the request's start state's (by name, over them)
+    let mut held = Vec::new();
     if let Some(world) = &args.world {
         let scene = trm_moveit::load_scene(world, &collision)?;
         for note in &scene.notes {
@@ -382,7 +384,15 @@ fn run_without_maps(args: &Args) -> Result<()> {
         }
         planner.set_world(scene.world);
         planner.set_acm(scene.acm)?;
+        held = scene.attached;
     }
+    for object in request.iter().flat_map(|r| r.attached.iter()) {
+        held.retain(|o: &trm_collision::AttachedObject| o.name != object.name);
+        held.push(object.clone());
+    }
+    planner
+        .set_attached(held)
+        .context("the objects the robot holds (attached_collision_objects)")?;
     if let Some(file) = args.experience.as_ref().filter(|f| f.exists()) {
         let paths = planner.load_experience(file)?;
         println!("{}: {paths} kept paths", file.display());

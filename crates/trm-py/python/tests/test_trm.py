@@ -362,6 +362,29 @@ def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
     assert len(csv.read_text().splitlines()) == 15
 
 
+def test_a_held_object_moves_with_the_hand_and_is_checked(robot):
+    joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
+    planner = trm.Planner(robot, joints=joints)
+    home = robot.posture("home")
+    start = np.array([home[robot.motor_names.index(j)] for j in joints])
+    goal = start + np.array([-0.6, 0.3, 0.3])
+    assert planner.plan(goal, start=start, seed=1)["waypoints"].shape[1] == 3
+    # a long bar in the right hand, reaching through the torso: every start collides
+    bar = trm.World()
+    bar.add_box("bar", [0.05, 0.05, 1.2], [0.0, 0.0, 0.0])
+    planner.attach("bar", "r_hand", bar)
+    assert planner.attached == ["bar"]
+    with pytest.raises(trm.TrmError, match="bar"):
+        planner.plan(goal, start=start, seed=1)
+    with pytest.raises(trm.TrmError, match="did you mean `bar`"):
+        planner.detach("bat")
+    planner.detach("bar")
+    assert planner.attached == []
+    assert planner.plan(goal, start=start, seed=1)["waypoints"].shape[1] == 3
+    with pytest.raises(trm.TrmError, match="r_hand"):
+        planner.attach("bar", "r_hnd", bar)
+
+
 def test_a_robot_planner_keeps_experience_across_worlds(robot, tmp_path):
     joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
     planner = trm.Planner(robot, joints=joints, experience=True)
