@@ -33,8 +33,8 @@ impl AttachedObject {
         }
     }
 
-    /// Whether `body` is one of its bodies.
-    pub(crate) fn holds(&self, body: &str) -> bool {
+    /// Whether the body named `body` is one of its bodies.
+    pub fn holds(&self, body: &str) -> bool {
         body == self.name
             || body
                 .strip_prefix(self.name.as_str())

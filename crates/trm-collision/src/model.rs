@@ -438,9 +438,12 @@ impl CollisionModel {
     /// `bodies`).
     pub(crate) fn holding(
         &self,
-        bodies: Vec<Body>,
+        mut bodies: Vec<Body>,
         attached: Vec<crate::AttachedObject>,
     ) -> Result<Self> {
+        // in the order the model keeps them (by link), so that the spheres carried over line
+        // up with the bodies
+        bodies.sort_by_key(|b| b.link);
         let spheres = self.carried_spheres(&bodies);
         let acm = self.inner.acm.clone();
         Self::build(&self.inner.robot, bodies, acm, attached, spheres)

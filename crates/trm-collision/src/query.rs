@@ -217,6 +217,35 @@ impl CollisionModel {
         self.any_world_collision(placed, world) || self.any_self_collision(placed)
     }
 
+    /// The points of a cloud that no body at `placed` comes within `radius` of: a depth
+    /// camera's cloud without the robot's own points (VAMP's `filter_self_from_pointcloud`),
+    /// in their order. Pad `radius` beyond the cloud's own for a camera that sees the robot
+    /// a little off where its model says.
+    pub fn points_off_robot(
+        &self,
+        placed: &PlacedBodies,
+        points: &[[f64; 3]],
+        radius: f64,
+    ) -> Vec<[f64; 3]> {
+        let Some(ball) = crate::Shape::Sphere {
+            radius: radius.max(f64::MIN_POSITIVE),
+        }
+        .compile(&nalgebra::Isometry3::identity()) else {
+            return points.to_vec();
+        };
+        let (compiled, bodies) = (self.compiled(), &placed.placed);
+        let mut at = crate::shape::Placed::default();
+        points
+            .iter()
+            .filter(|p| {
+                ball.place(&nalgebra::Isometry3::translation(p[0], p[1], p[2]), &mut at);
+                !(compiled.iter().zip(bodies))
+                    .any(|(c, b)| !bounds_apart(&at, b) && intersects(&ball, &at, c, b))
+            })
+            .copied()
+            .collect()
+    }
+
     /// Every colliding body pair (self pairs first, then world), with signed distances.
     pub fn colliding_pairs(&self, placed: &PlacedBodies, world: &World) -> Vec<CollidingPair> {
         let (bodies, compiled, p) = (self.bodies(), self.compiled(), &placed.placed);

@@ -38,6 +38,8 @@ fn rod(touch_links: &[&str]) -> AttachedObject {
 fn a_held_object_turns_a_free_motion_into_a_colliding_one() {
     let (robot, bare) = panda();
     let active = robot.all_active();
+    // spheres fitted before holding (as a planner's compiled screen has them): carried over
+    let _ = FastChecker::new(&bare, active.clone()).unwrap();
     let start = active.from_motors(robot.posture("default").unwrap());
     let mut goal = start.clone();
     goal[0] += 1.0; // the whole arm turns about the base
@@ -180,5 +182,45 @@ fn bad_attachments_say_what_is_wrong() {
             .unwrap_err()
             .to_string()
             .contains("no shape")
+    );
+}
+
+/// A camera's cloud of the robot and a table: filtering the robot's own points out keeps
+/// every table point and drops every point on the robot's bodies.
+#[test]
+fn the_robots_own_points_are_filtered_out_of_a_cloud() {
+    let (robot, collision) = panda();
+    let active = robot.all_active();
+    let q = active.from_motors(robot.posture("default").unwrap());
+    let (mut poses, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+    active.forward(&q, &mut poses).unwrap();
+    collision.place(&poses, &mut placed);
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let on_robot: Vec<[f64; 3]> = collision
+        .bodies()
+        .iter()
+        .flat_map(|b| {
+            let pose = poses.poses()[b.link] * b.local;
+            b.shape
+                .surface_samples(200, &mut rng)
+                .into_iter()
+                .map(move |p| (pose * Point3::from(p)).coords.into())
+        })
+        .collect();
+    let table = Shape::Box {
+        size: [0.6, 0.8, 0.04],
+    };
+    let on_table: Vec<[f64; 3]> = table
+        .surface_samples(2000, &mut rng)
+        .into_iter()
+        .map(|p| [p[0] + 0.9, p[1], p[2] + 0.3])
+        .collect();
+    let cloud: Vec<[f64; 3]> = on_robot.iter().chain(&on_table).copied().collect();
+    let kept = collision.points_off_robot(&placed, &cloud, 0.01);
+    assert_eq!(
+        kept,
+        on_table,
+        "{} robot points left",
+        kept.len() - on_table.len().min(kept.len())
     );
 }

@@ -398,7 +398,9 @@ impl Planner {
 
 impl Planner {
     /// What makes `q` (active values) collide in the current world, one line per colliding
-    /// pair of links (or link and object) at its deepest contact, deepest first: the robot's links and the world's objects by name, and for
+    /// pair of links (or link and object; a held object counts as a part of its own) at its
+    /// deepest contact, deepest first: the robot's links, held objects and the world's objects
+    /// by name, and for
     /// a pair of links which allowed-collision matrix has it checked — the model's own, or a
     /// matrix set since ([`Planner::set_acm`], a planning scene's) that checks a pair the
     /// model's own disables (and why the model disables it). Empty when `q` is free.
@@ -419,11 +421,27 @@ impl Planner {
         collision.place(&poses, &mut placed);
         let link = |body: usize| collision.bodies()[body].link;
         let name = |l: usize| robot.tree().links[l].name.as_str();
-        // one line per pair of links (or link and object), its deepest contact, deepest first
+        // a body is part of a link, or of an object the robot holds
+        let held = |body: usize| {
+            let body = &collision.bodies()[body].name;
+            collision.attached().iter().position(|o| o.holds(body))
+        };
+        let part = |body: usize| match held(body) {
+            Some(k) => robot.num_links() + k,
+            None => link(body),
+        };
+        let who = |body: usize| match held(body) {
+            Some(k) => {
+                let o = &collision.attached()[k];
+                format!("held object `{}` (on `{}`)", o.name, o.link)
+            }
+            None => format!("link `{}`", name(link(body))),
+        };
+        // one line per pair of parts (or part and object), its deepest contact, deepest first
         let mut pairs = collision.colliding_pairs(&placed, self.checker.world());
         let key = |p: &trm_collision::CollidingPair| match p.other {
-            trm_collision::Other::Body(_) => (link(p.body_index), link(p.other_index), false),
-            trm_collision::Other::Object(_) => (link(p.body_index), p.other_index, true),
+            trm_collision::Other::Body(_) => (part(p.body_index), part(p.other_index), false),
+            trm_collision::Other::Object(_) => (part(p.body_index), p.other_index, true),
         };
         pairs.sort_by(|a, b| key(a).cmp(&key(b)).then(a.distance.total_cmp(&b.distance)));
         pairs.dedup_by(|b, a| key(a) == key(b));
@@ -434,18 +452,28 @@ impl Planner {
                 let depth = format!("{:.1} mm deep", -1e3 * p.distance);
                 match &p.other {
                     trm_collision::Other::Object(object) => {
-                        format!("link `{}` and object `{object}`, {depth}", name(link(p.body_index)))
+                        format!("{} and object `{object}`, {depth}", who(p.body_index))
                     }
                     trm_collision::Other::Body(_) => {
                         let (a, b) = (link(p.body_index), link(p.other_index));
-                        let why = match self.own_acm.reason(a, b) {
-                            Some(reason) => format!(
-                                "checked by the matrix set on the planner (a scene's); the model's own disables it ({})",
-                                reason.as_str()
-                            ),
-                            None => "checked by the model's own matrix".into(),
+                        let why = if held(p.body_index).is_some() || held(p.other_index).is_some() {
+                            "a held object is checked against every link but its touch links"
+                                .to_string()
+                        } else {
+                            match self.own_acm.reason(a, b) {
+                                Some(reason) => format!(
+                                    "checked by the matrix set on the planner (a scene's); the model's own disables it ({})",
+                                    reason.as_str()
+                                ),
+                                None => "checked by the model's own matrix".into(),
+                            }
                         };
-                        format!("links `{}` and `{}`, {depth}: {why}", name(a), name(b))
+                        let (x, y) = (p.body_index, p.other_index);
+                        if held(x).is_none() && held(y).is_none() {
+                            format!("links `{}` and `{}`, {depth}: {why}", name(a), name(b))
+                        } else {
+                            format!("{} and {}, {depth}: {why}", who(x), who(y))
+                        }
                     }
                 }
             })
