@@ -100,7 +100,8 @@ fn malformed_scenes_and_requests_are_located_errors() {
         (object(&prim.replace("[0, 0, 0, 1]", "[0, 0, 0, 3]")), "orientation has norm 3.0000"),
         (object(&prim.replace("position: [0, 0, 0]", "position: [0, .nan, 0]")), "s.yaml:8: object `a`.primitive_poses[0].position[1] is `.nan`"),
         (object(&prim.replace("        - position: [0, 0, 0]\n          orientation: [0, 0, 0, 1]\n", "")), "s.yaml:8: object `a`.primitive_poses is a scalar, not a list"),
-        (object(&format!("{prim}      meshes: [{{}}]\n")), "s.yaml:3: object `a` has meshes"),
+        (object(&format!("{prim}      planes: [{{}}]\n")), "s.yaml:3: object `a` has planes"),
+        (object(&format!("{prim}      meshes: [{{}}]\n")), "s.yaml:3: object `a` has 1 meshes and 0 mesh_poses"),
         (format!("{}    - id: a\n{prim}", object(prim)), "s.yaml:10: object `a` is given twice (first at line 3)"),
         (object(prim).replace("id: a", "id: \"\""), "s.yaml:3: world.collision_objects[0] has an empty id"),
         ("allowed_collision_matrix:\n  entry_names: [a, b]\n  entry_values:\n    - [false, true]\n    - [false, false]\n".into(), "(b, a) is false one way and true the other"),
@@ -207,7 +208,7 @@ fn the_writer_refuses_what_the_reader_refuses() {
             length: 0.2,
         }
     });
-    assert!(e.contains("not written") && e.contains("Capsule"), "{e}");
+    assert!(e.contains("not written") && e.contains("capsule"), "{e}");
     let e = refused(&|s| s.objects[0].primitives[0].pose.translation.vector.x = f64::NAN);
     assert!(e.contains("not finite"), "{e}");
     let e = refused(&|s| s.robot_state.as_mut().unwrap().positions[0] = f64::INFINITY);
