@@ -3,7 +3,7 @@
 // table. Reads the problems on stdin (the format `trm_plan::mbm::peer_problems` writes), prints
 // one line per problem on stdout (after `robot NAME`, `configurations N` instead of `joints`
 // times FK + self-collision of N configurations instead: see `configurations` below):
-//   result FAMILY INDEX VALID SOLVED PLAN_NS SIMPLIFY_NS COST SIMPLIFIED_COST ITERATIONS WAYPOINTS
+//   result FAMILY INDEX VALID SOLVED PLAN_NS SIMPLIFY_NS COST SIMPLIFIED_COST ITERATIONS WAYPOINTS BUILD_NS
 //   path q1 … qd   (one line per waypoint of the simplified path)
 // Settings as VAMP's own evaluate_mbm.py: Halton sampler reset per problem, dynamic-domain
 // RRT-Connect with the robot's range, default simplification, rake = the CPU's float lanes.
@@ -69,7 +69,15 @@ namespace
     // Cylinders as VAMP's own MotionBenchMaker loader (vamp.problem_dict_to_vamp) gives them:
     // capsules (VAMP's checks never read Environment::cylinders), and in the `box` family,
     // whose goals grasp a can from above, boxes of half extents (r, r, length / 2).
-    auto read_environment(std::istream &in, bool cylinders_as_boxes) -> vamp::collision::Environment<float>
+    // A point cloud (`cloud N RADIUS` and N lines `x y z`) becomes VAMP's CAPT for the robot's
+    // sphere radii [r_min, r_max], as its evaluate_mbm.py --pointcloud builds it; `build_ns`
+    // adds the time building it took.
+    auto read_environment(
+        std::istream &in,
+        bool cylinders_as_boxes,
+        float r_min,
+        float r_max,
+        std::size_t &build_ns) -> vamp::collision::Environment<float>
     {
         vamp::collision::Environment<float> environment;
         expect(in, "objects");
@@ -77,6 +85,22 @@ namespace
         for (std::size_t i = 0; i < n; ++i)
         {
             const auto kind = read<std::string>(in, "an object kind");
+            if (kind == "cloud")
+            {
+                const auto count = read<std::size_t>(in, "the point count");
+                const auto radius = read<float>(in, "the point radius");
+                std::vector<vamp::collision::Point> points(count);
+                for (auto &q : points)
+                {
+                    const auto v = read_vector(in);
+                    q = {v[0], v[1], v[2]};
+                }
+                const auto began = std::chrono::steady_clock::now();
+                environment.pointclouds.emplace_back(points, r_min, r_max, radius);
+                build_ns += static_cast<std::size_t>(
+                    std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - began).count());
+                continue;
+            }
             const auto p = read_vector(in);
             if (kind == "sphere")
             {
@@ -171,33 +195,36 @@ namespace
             const auto start = configuration("start");
             const auto goal = configuration("goal");
             const bool box_family = family.rfind("box_", 0) == 0 or family == "box";
-            const Environment environment(read_environment(in, box_family));
+            std::size_t build_ns = 0;
+            const Environment environment(
+                read_environment(in, box_family, Robot::min_radius, Robot::max_radius, build_ns));
 
             const bool valid = vamp::planning::validate_motion<Robot, rake, 1>(start, start, environment) and
                                vamp::planning::validate_motion<Robot, rake, 1>(goal, goal, environment);
             std::printf("result %s %zu %d", family.c_str(), index, valid ? 1 : 0);
             if (not valid)
             {
-                std::printf(" 0 0 0 0 0 0 0\n");
+                std::printf(" 0 0 0 0 0 0 0 %zu\n", build_ns);
                 continue;
             }
             rng->reset();
             const auto result = RRTC::solve(start, goal, environment, settings, rng);
             if (result.path.empty())
             {
-                std::printf(" 0 %zu 0 0 0 %zu 0\n", result.nanoseconds, result.iterations);
+                std::printf(" 0 %zu 0 0 0 %zu 0 %zu\n", result.nanoseconds, result.iterations, build_ns);
                 continue;
             }
             const auto simple = vamp::planning::simplify<Robot, rake, Robot::resolution>(
                 result.path, environment, simplify_settings, rng);
             std::printf(
-                " 1 %zu %zu %.6f %.6f %zu %zu\n",
+                " 1 %zu %zu %.6f %.6f %zu %zu %zu\n",
                 result.nanoseconds,
                 simple.nanoseconds,
                 result.path.cost(),
                 simple.path.cost(),
                 result.iterations,
-                simple.path.size());
+                simple.path.size(),
+                build_ns);
             for (const auto &q : simple.path)
             {
                 const auto a = q.to_array();

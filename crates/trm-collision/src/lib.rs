@@ -59,6 +59,7 @@ mod levers;
 pub mod mesh;
 mod model;
 mod placed;
+mod points;
 mod query;
 mod shape;
 mod world;
@@ -76,6 +77,7 @@ pub use model::{Body, CollisionModel, CollisionOptions};
 /// [`WorldObject::bounding_box`] return them.
 pub use parry3d_f64::bounding_volume::Aabb;
 pub use placed::PlacedBodies;
+pub use points::thin_points;
 pub use query::{CollidingPair, CollisionCount, NearPair, Other, PairDistance};
 pub use shape::{CONVEX_SPHERES, Shape, ShapeProblem, Sphere};
 pub use trm_kinematics::DisableReason;

@@ -31,6 +31,9 @@ pub struct LoadedProblem {
     pub own: CollisionModel,
     /// The scene's matrix entries that are not links of the robot (skipped).
     pub notes: Vec<String>,
+    /// When `world` is the scene seen as a point cloud ([`crate::Obstacles::Cloud`]): how it
+    /// was made.
+    pub cloud: Option<crate::CloudBuild>,
 }
 
 impl LoadedProblem {
@@ -61,6 +64,7 @@ impl LoadedProblem {
             own: collision.clone(),
             collision: applied,
             notes,
+            cloud: None,
         })
     }
 

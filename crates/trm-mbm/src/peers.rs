@@ -11,12 +11,18 @@ use crate::solve::{Outcome, joint_goal_only};
 /// benchmark (`benches/peers/vamp/mbm.cc`): a header naming `robot` and the goal's joints,
 /// then per problem its family, number, start and goal (in that joint order) and its world's
 /// primitives (`box x y z qw qx qy qz hx hy hz`, `cylinder x y z qw qx qy qz radius length`,
-/// `sphere x y z radius`), every number in its shortest exact form.
-pub fn peer_problems(robot: &str, problems: &[Problem]) -> Result<String, MbmError> {
+/// `sphere x y z radius`), every number in its shortest exact form. With `clouds`, problem k's
+/// obstacles are instead the point cloud `clouds[k]` (a world of one [`Shape::Points`], as
+/// [`cloud_world`] makes), written as `cloud N RADIUS` and a line `x y z` per point.
+pub fn peer_problems(
+    robot: &str,
+    problems: &[Problem],
+    clouds: Option<&[World]>,
+) -> Result<String, MbmError> {
     use std::fmt::Write as _;
     let mut joints: Option<Vec<String>> = None;
     let mut body = String::new();
-    for p in problems {
+    for (k, p) in problems.iter().enumerate() {
         let scene = PlanningScene::load(&p.scene)?;
         let request = MotionPlanRequest::load(&p.request)?;
         joint_goal_only(&request, "peer planners")?;
@@ -48,6 +54,21 @@ pub fn peer_problems(robot: &str, problems: &[Problem]) -> Result<String, MbmErr
                 let _ = write!(body, " {}", values[i]);
             }
             body.push('\n');
+        }
+        if let Some(world) = clouds.and_then(|c| c.get(k)) {
+            let points = world.objects().iter().filter_map(|o| match o.shape() {
+                Shape::Points { points, radius } => Some((points, radius)),
+                _ => None,
+            });
+            let points: Vec<_> = points.collect();
+            let _ = writeln!(body, "objects {}", points.len());
+            for (points, radius) in points {
+                let _ = writeln!(body, "cloud {} {radius}", points.len());
+                for q in points {
+                    let _ = writeln!(body, "{} {} {}", q[0], q[1], q[2]);
+                }
+            }
+            continue;
         }
         let primitives: Vec<_> = scene.objects.iter().flat_map(|o| &o.primitives).collect();
         let _ = writeln!(body, "objects {}", primitives.len());
@@ -91,7 +112,8 @@ pub fn peer_problems(robot: &str, problems: &[Problem]) -> Result<String, MbmErr
 
 /// One problem as a peer planner reported it (`result` lines of `benches/peers/vamp/mbm.cc`):
 /// the family, the number and the outcome (time = planning + simplification; `checks` 0: the
-/// peer does not count them).
+/// peer does not count them; an 11th field, when given, the time to build the obstacles'
+/// structures).
 pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, String> {
     let mut results: Vec<(String, u32, Outcome)> = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -100,8 +122,9 @@ pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, Str
         match words.next() {
             Some("result") => {
                 let fields: Vec<&str> = words.collect();
-                if fields.len() != 10 {
-                    return Err(at("a result has 10 fields"));
+                // the 11th, when there is one: building the obstacles' structures (a cloud's), ns
+                if !(10..=11).contains(&fields.len()) {
+                    return Err(at("a result has 10 or 11 fields"));
                 }
                 let number = |k: usize| -> Result<f64, String> {
                     fields[k]
@@ -120,6 +143,11 @@ pub fn parse_peer_results(text: &str) -> Result<Vec<(String, u32, Outcome)>, Str
                     simplify_seconds: number(5)? * 1e-9,
                     length: number(7)?,
                     waypoints: number(9)? as usize,
+                    build_seconds: if fields.len() == 11 {
+                        number(10)? * 1e-9
+                    } else {
+                        0.0
+                    },
                     note: match (valid, solved) {
                         (false, _) => "start or goal in collision for the peer".into(),
                         (true, false) => "not solved by the peer".into(),
@@ -159,6 +187,89 @@ pub enum Obstacles {
     /// The obstacles VAMP plans among ([`vamp_world`]): its checks have no cylinder, so both
     /// planners face the same, larger, obstacles.
     AsVamp,
+    /// The scenes as a depth camera would see them ([`cloud_world`]), as VAMP's
+    /// `evaluate_mbm.py --pointcloud` makes them: `per_object` points on every object's
+    /// surface, thinned to [`CLOUD_SPACING`], each a ball of [`CLOUD_POINT_RADIUS`].
+    Cloud {
+        /// Points drawn on each object (VAMP's default: 10 000).
+        per_object: usize,
+    },
+}
+
+/// The spacing a benchmark's clouds are thinned to, m (VAMP's `filter_radius`).
+pub const CLOUD_SPACING: f64 = 0.02;
+
+/// The radius of a benchmark cloud's points, m (VAMP's `POINT_RADIUS`).
+pub const CLOUD_POINT_RADIUS: f64 = 0.0025;
+
+/// How a problem's point cloud was made ([`cloud_world`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CloudBuild {
+    /// Points drawn on the objects.
+    pub sampled: usize,
+    /// Points kept after thinning.
+    pub kept: usize,
+    /// Thinning them, s (done once; the peers get the thinned cloud).
+    pub thin_seconds: f64,
+    /// Building the world object (its exact bounding-volume tree) and compiling the screen's
+    /// grid for the robot, s.
+    pub build_seconds: f64,
+}
+
+/// `world` as a depth camera would see it: `per_object` points drawn on each object's surface
+/// (seeded by `seed`), thinned to [`CLOUD_SPACING`] ([`trm_collision::thin_points`]), one
+/// object `cloud` of points of radius [`CLOUD_POINT_RADIUS`]; `compile` (the screen's world
+/// compilation, timed with the build) may be `None`.
+pub fn cloud_world(
+    world: &World,
+    per_object: usize,
+    seed: u64,
+    compile: Option<&trm_collision::fast::FastModel>,
+) -> Result<(World, CloudBuild), MbmError> {
+    use rand::SeedableRng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut points = Vec::new();
+    for o in world.objects() {
+        let pose = o.pose();
+        points.extend(
+            o.shape()
+                .surface_samples(per_object, &mut rng)
+                .into_iter()
+                .map(|p| {
+                    <[f64; 3]>::from((pose * trm_kinematics::nalgebra::Point3::from(p)).coords)
+                }),
+        );
+    }
+    let began = std::time::Instant::now();
+    let kept = trm_collision::thin_points(&points, CLOUD_SPACING);
+    let thin_seconds = began.elapsed().as_secs_f64();
+    let build = CloudBuild {
+        sampled: points.len(),
+        kept: kept.len(),
+        thin_seconds,
+        ..Default::default()
+    };
+    let mut cloud = World::new();
+    if kept.is_empty() {
+        return Ok((cloud, build));
+    }
+    let began = std::time::Instant::now();
+    let shape = Shape::Points {
+        points: kept,
+        radius: CLOUD_POINT_RADIUS,
+    };
+    cloud.add("cloud", shape, Default::default())?;
+    if let Some(model) = compile {
+        std::hint::black_box(model.world(&cloud));
+    }
+    let build_seconds = began.elapsed().as_secs_f64();
+    Ok((
+        cloud,
+        CloudBuild {
+            build_seconds,
+            ..build
+        },
+    ))
 }
 
 /// `world` as VAMP's MotionBenchMaker loader gives it to VAMP's checks (which never read

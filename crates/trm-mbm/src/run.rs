@@ -90,9 +90,24 @@ pub fn benchmark(
     mut progress: impl FnMut(&str, usize, usize, &Problem),
 ) -> Result<Benchmark, MbmError> {
     let mut loaded = LoadedProblem::load_all(collision, problems)?;
-    if options.obstacles == crate::Obstacles::AsVamp {
-        for p in &mut loaded {
-            p.world = crate::vamp_world(&p.world, &p.problem.family);
+    match options.obstacles {
+        crate::Obstacles::AsGiven => {}
+        crate::Obstacles::AsVamp => {
+            for p in &mut loaded {
+                p.world = crate::vamp_world(&p.world, &p.problem.family);
+            }
+        }
+        crate::Obstacles::Cloud { per_object } => {
+            let screen = trm_collision::WorldChecker::screen_model(collision);
+            for p in &mut loaded {
+                let (world, build) = crate::cloud_world(
+                    &p.world,
+                    per_object,
+                    p.problem.index.into(),
+                    screen.as_deref(),
+                )?;
+                (p.world, p.cloud) = (world, Some(build));
+            }
         }
     }
     let (runs, with_maps) = run_set(robot, &loaded, options, |k, p| {

@@ -28,6 +28,9 @@ pub struct Outcome {
     /// Of [`Outcome::seconds`], the time spent simplifying the path (shortcutting and checking
     /// it again), s: the rest is planning alone.
     pub simplify_seconds: f64,
+    /// Building the obstacles' structures for this problem (a point cloud's: for trm the
+    /// world object and the screen's grid, for VAMP its CAPT), s; not in [`Outcome::seconds`].
+    pub build_seconds: f64,
     /// Path length, rad.
     pub length: f64,
     /// Waypoints of the path.
@@ -86,6 +89,7 @@ pub fn solve_with_maps(
     }
     let mut outcome = Outcome {
         note: problem.notes.join("; "),
+        build_seconds: problem.cloud.map_or(0.0, |c| c.build_seconds),
         ..Default::default()
     };
     // time spent finding a goal configuration for a task-space goal (part of the answer)

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use trm_collision::{CollisionModel, Shape, World};
 use trm_mbm::{LoadedProblem, Verdict, certify_path, find_problems, solve};
 use trm_moveit::MoveItError;
 use trm_moveit::{MotionPlanRequest, PlanningScene};
@@ -291,7 +292,7 @@ fn the_fetch_runs_from_its_files_only() {
 #[test]
 fn peer_problems_are_written_and_peer_results_read() {
     let problems = find_problems(&fixtures()).unwrap();
-    let text = trm_mbm::peer_problems("panda", &problems).unwrap();
+    let text = trm_mbm::peer_problems("panda", &problems, None).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("trm-mbm-problems 1"));
     assert_eq!(lines.next(), Some("robot panda"));
@@ -354,7 +355,7 @@ fn peer_problems_are_written_and_peer_results_read() {
         ),
         (
             "result box_panda 1 1 1 0 0 0 0 0",
-            "line 1: a result has 10 fields",
+            "line 1: a result has 10 or 11 fields",
         ),
         ("path 0 0", "line 1: a path line before any result"),
         (
@@ -868,4 +869,60 @@ fn leave_one_out_experience_never_sees_the_problem_s_own_path() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("paths for"), "{e}");
+}
+
+/// A set as point clouds: every problem's world is one cloud thinned to the spacing, trm
+/// plans among it, and the peers get the very points (`cloud N RADIUS` and a line per point),
+/// their build times read back from an 11th field.
+#[test]
+fn scenes_as_point_clouds_are_planned_in_and_handed_to_peers() {
+    let robot = trm_kinematics::RobotModel::load(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda_spherized.ron"),
+    )
+    .unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    let problems: Vec<_> = find_problems(&fixtures())
+        .unwrap()
+        .into_iter()
+        .take(3)
+        .collect();
+    let options = trm_mbm::BenchmarkOptions {
+        obstacles: trm_mbm::Obstacles::Cloud { per_object: 2000 },
+        ..Default::default()
+    };
+    let bench =
+        trm_mbm::benchmark(&robot, &collision, &problems, &options, |_, _, _, _| {}).unwrap();
+    for (p, run) in bench.problems.iter().zip(&bench.runs) {
+        let build = p.cloud.expect("a cloud");
+        assert!(build.kept > 100 && build.kept < build.sampled, "{build:?}");
+        let [cloud] = p.world.objects() else {
+            panic!("one cloud object");
+        };
+        let Shape::Points { points, radius } = cloud.shape() else {
+            panic!("points");
+        };
+        assert_eq!(
+            (points.len(), *radius),
+            (build.kept, trm_mbm::CLOUD_POINT_RADIUS)
+        );
+        assert!(run.outcome.build_seconds > 0.0);
+        assert!(run.outcome.solved, "{}", run.outcome.note);
+    }
+    let clouds: Vec<World> = bench.problems.iter().map(|p| p.world.clone()).collect();
+    let text = trm_mbm::peer_problems("panda", &problems, Some(&clouds)).unwrap();
+    let first = &bench.problems[0].world.objects()[0];
+    let Shape::Points { points, .. } = first.shape() else {
+        panic!("points");
+    };
+    let header = format!("cloud {} {}", points.len(), trm_mbm::CLOUD_POINT_RADIUS);
+    let at = text.find(&header).expect("the cloud's header");
+    let line = text[at..].lines().nth(1).unwrap();
+    assert_eq!(
+        line,
+        format!("{} {} {}", points[0][0], points[0][1], points[0][2])
+    );
+    let parsed =
+        trm_mbm::parse_peer_results("result box 1 1 1 1000 500 3.0 2.5 10 4 2500000\n").unwrap();
+    assert_eq!(parsed[0].2.build_seconds, 2.5e-3);
+    assert!(trm_mbm::parse_peer_results("result box 1 1 1 1000 500 3.0 2.5 10 4 2 3\n").is_err());
 }

@@ -66,6 +66,12 @@ pub struct Args {
     /// obstacles (trm_mbm::vamp_world)
     #[arg(long)]
     vamp_obstacles: bool,
+    /// Plan among the scenes as a depth camera would see them, as VAMP's evaluate_mbm.py
+    /// --pointcloud does: SAMPLES points on every object's surface (VAMP's: 10000), thinned to
+    /// 2 cm, points of 2.5 mm (trm_mbm::cloud_world); with --vamp, VAMP plans among the same
+    /// points (its CAPT). The clouds' build times are reported beside the planning times.
+    #[arg(long, value_name = "SAMPLES", conflicts_with = "vamp_obstacles", value_parser = crate::parse::count(1, 1_000_000))]
+    cloud: Option<usize>,
     /// Plan with certified edges: every edge the planner accepts is also proved free in
     /// continuous motion, so every returned path is (see --verify).
     #[arg(long)]
@@ -169,13 +175,21 @@ pub fn run(args: &Args) -> Result<()> {
         args.max_iterations,
         args.max_seconds
             .map_or(String::new(), |s| format!(", {s} s at most")),
-        if args.vamp_obstacles {
-            "; among VAMP's obstacles: cylinders as capsules, boxes in the box family"
-        } else {
-            ""
+        match (args.vamp_obstacles, args.cloud) {
+            (true, _) =>
+                "; among VAMP's obstacles: cylinders as capsules, boxes in the box family".into(),
+            (false, Some(n)) => format!(
+                "; among point clouds: {n} points on each object's surface, thinned to {} m, points of {} m",
+                trm_mbm::CLOUD_SPACING,
+                trm_mbm::CLOUD_POINT_RADIUS
+            ),
+            (false, None) => String::new(),
         }
     );
     md.push_str(&bench.markdown());
+    if args.cloud.is_some() {
+        md.push_str(&cloud_lines(&bench));
+    }
     print!("{md}");
     // every file is written at the end, once every part has run
     let mut files = vec![
@@ -208,6 +222,9 @@ pub fn run(args: &Args) -> Result<()> {
                 verdicts.into_iter(),
                 "VAMP's paths, in trm's model,",
             ));
+        }
+        if args.cloud.is_some() {
+            text.push_str(&with_build_line(&outcomes, &theirs));
         }
         let _ = write!(
             text,
@@ -291,10 +308,10 @@ fn run_benchmark(
             .iter()
             .map(|p| Roadmap::load(p).with_context(|| format!("--map {}", p.display())))
             .collect::<Result<_>>()?,
-        obstacles: if args.vamp_obstacles {
-            trm_mbm::Obstacles::AsVamp
-        } else {
-            trm_mbm::Obstacles::AsGiven
+        obstacles: match (args.vamp_obstacles, args.cloud) {
+            (true, _) => trm_mbm::Obstacles::AsVamp,
+            (false, Some(per_object)) => trm_mbm::Obstacles::Cloud { per_object },
+            (false, None) => trm_mbm::Obstacles::AsGiven,
         },
     };
     let mut bar: Option<(String, crate::progress::Progress)> = None;
@@ -378,6 +395,45 @@ fn times_plot(runs: &[trm_mbm::Run]) -> Result<String> {
     )
 }
 
+/// How the clouds of `--cloud` were made: points drawn and kept, thinning and build times
+/// (medians over the problems).
+fn cloud_lines(bench: &trm_mbm::Benchmark) -> String {
+    let builds: Vec<trm_mbm::CloudBuild> = bench.problems.iter().filter_map(|p| p.cloud).collect();
+    let median = |f: &dyn Fn(&trm_mbm::CloudBuild) -> f64| {
+        trm_mbm::quantile(&builds.iter().map(f).collect::<Vec<_>>(), 0.5).unwrap_or(0.0)
+    };
+    format!(
+        "\nPoint clouds (medians over {} problems): {:.0} points drawn, {:.0} kept after thinning ({:.2} ms); trm's build (world object with its exact tree, and the screen's grid): {:.3} ms\n",
+        builds.len(),
+        median(&|b| b.sampled as f64),
+        median(&|b| b.kept as f64),
+        1e3 * median(&|b| b.thin_seconds),
+        1e3 * median(&|b| b.build_seconds),
+    )
+}
+
+/// Medians of the build times and of planning plus build, on the problems both planners
+/// solve (`--cloud` with `--vamp`).
+fn with_build_line(ours: &[(&str, &Outcome)], theirs: &[(&str, &Outcome)]) -> String {
+    let both: Vec<(&Outcome, &Outcome)> = ours
+        .iter()
+        .zip(theirs)
+        .filter(|((_, a), (_, b))| a.solved && b.solved)
+        .map(|((_, a), (_, b))| (*a, *b))
+        .collect();
+    let median = |f: &dyn Fn(&(&Outcome, &Outcome)) -> f64| {
+        1e3 * trm_mbm::quantile(&both.iter().map(f).collect::<Vec<_>>(), 0.5).unwrap_or(0.0)
+    };
+    format!(
+        "\nCloud build, median over the {} problems both solve: trm {:.3} ms, VAMP's CAPT {:.3} ms; planning + build: trm {:.3} ms, VAMP {:.3} ms\n",
+        both.len(),
+        median(&|(a, _)| a.build_seconds),
+        median(&|(_, b)| b.build_seconds),
+        median(&|(a, _)| a.seconds + a.build_seconds),
+        median(&|(_, b)| b.seconds + b.build_seconds),
+    )
+}
+
 /// The OMPL side of `--ompl`, in the repository the tool was built from.
 fn ompl_script() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/python/mbm_ompl.py")
@@ -405,7 +461,11 @@ fn run_vamp(
     let problems = &problems[..];
     use std::io::Write as _;
     let vamp_robot = args.vamp_robot.as_deref().unwrap_or(robot.name());
-    let input = trm_mbm::peer_problems(vamp_robot, problems)?;
+    // with --cloud, the very points trm planned among
+    let clouds: Vec<trm_collision::World> =
+        bench.problems.iter().map(|p| p.world.clone()).collect();
+    let clouds = args.cloud.map(|_| &clouds[..]);
+    let input = trm_mbm::peer_problems(vamp_robot, problems, clouds)?;
     let exported = input.clone();
     println!(
         "\nrunning VAMP on {} problems of {}",

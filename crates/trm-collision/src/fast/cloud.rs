@@ -23,7 +23,7 @@ use super::{FAST_LANES, LaneMask};
 
 /// Cells at most per point of the cloud (and at least this many in all): a grid finer than
 /// this over a sparse, wide cloud is coarsened so that its cells stay cheap to build.
-const CELLS_PER_POINT: usize = 8;
+const CELLS_PER_POINT: usize = 32;
 
 /// A point cloud in a uniform grid, in the world frame, single precision.
 #[derive(Debug, Clone)]
@@ -35,6 +35,9 @@ pub(super) struct CloudGrid {
     dims: [usize; 3],
     /// Per cell (x fastest), the index of its first point; one more entry at the end.
     starts: Vec<u32>,
+    /// Per cell: no point of the cloud lies nearer than this to any place in the cell, m (from
+    /// the cells' Euclidean distance transform): most queries end at this one look-up.
+    clear: Vec<f32>,
     /// The points' coordinates, cell by cell.
     xyz: [Vec<f32>; 3],
     /// Added to every query's range: a few units of rounding of the largest coordinate, so
@@ -107,6 +110,7 @@ impl CloudGrid {
                 xyz[k][at] = p[k];
             }
         }
+        let clear = clearances(&starts, dims, cell);
         let largest = (0..3)
             .map(|k| lo[k].abs().max(hi[k].abs()))
             .fold(cell, f32::max);
@@ -116,6 +120,7 @@ impl CloudGrid {
             inv_cell,
             dims,
             starts,
+            clear,
             xyz,
             slack: 16.0 * f32::EPSILON * (largest + cell),
             center: std::array::from_fn(|k| 0.5 * (lo[k] + hi[k])),
@@ -163,6 +168,38 @@ impl CloudGrid {
         self.xyz[0].len()
     }
 
+    /// A distance within which no point of the cloud lies from `p` (0 where one may): the
+    /// clearance of the cell nearest `p` (every point lies in the grid's box, and `p`'s nearest
+    /// place in the box is at least as near every point as `p`).
+    #[inline(always)]
+    pub(super) fn clearance(&self, p: [f32; 3]) -> f32 {
+        let i: [usize; 3] = std::array::from_fn(|k| {
+            let v = ((p[k] - self.origin[k]) * self.inv_cell).floor();
+            if v >= 0.0 {
+                (v as usize).min(self.dims[k] - 1)
+            } else {
+                0
+            }
+        });
+        self.clear[i[0] + self.dims[0] * (i[1] + self.dims[1] * i[2])]
+    }
+
+    /// The lanes of `lanes` whose sphere at `c` of radius `reach` may touch a point's centre
+    /// (NaN lanes included).
+    pub(super) fn may_touch(&self, c: &[F; 3], reach: f32, lanes: LaneMask) -> LaneMask {
+        let mut out = 0;
+        for l in 0..FAST_LANES {
+            if lanes & (1 << l) == 0 {
+                continue;
+            }
+            let p = [c[0].0[l], c[1].0[l], c[2].0[l]];
+            if !p.iter().all(|v| v.is_finite()) || self.clearance(p) <= reach + self.slack {
+                out |= 1 << l;
+            }
+        }
+        out
+    }
+
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.
     #[inline(always)]
     fn cells(&self, k: usize, a: f32, b: f32) -> Option<(usize, usize)> {
@@ -205,6 +242,9 @@ impl CloudGrid {
         d2: impl Fn(f32, f32, f32) -> f32 + Copy,
     ) -> f32 {
         let range = range + self.slack;
+        if self.clearance(p) > range {
+            return f32::INFINITY;
+        }
         let range2 = range * range;
         let Some((k0, k1)) = self.cells(2, p[2] - range, p[2] + range) else {
             return f32::INFINITY;
@@ -284,6 +324,83 @@ impl CloudGrid {
             };
         }
         F(out)
+    }
+}
+
+/// Per cell of a grid of `dims` cells of side `cell` whose points start at `starts`: a
+/// distance from any place in the cell within which no point lies, m. The squared Euclidean
+/// distance transform of the occupied cells over cell indices (Felzenszwalb and Huttenlocher,
+/// 2012: the lower envelope of parabolas, one axis after the other), `d` cells to the nearest
+/// occupied one; two places in cells `d` apart are at least `(d − √3)` cells apart.
+fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
+    let n = dims[0] * dims[1] * dims[2];
+    let far = 1e20_f32;
+    let mut d2: Vec<f32> = (0..n)
+        .map(|c| if starts[c + 1] > starts[c] { 0.0 } else { far })
+        .collect();
+    let stride = [1, dims[0], dims[0] * dims[1]];
+    let (mut f, mut out) = (Vec::new(), Vec::new());
+    let (mut v, mut z) = (Vec::new(), Vec::new());
+    for axis in 0..3 {
+        let len = dims[axis];
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        for i in 0..dims[a] {
+            for j in 0..dims[b] {
+                let base = i * stride[a] + j * stride[b];
+                f.clear();
+                f.extend((0..len).map(|k| d2[base + k * stride[axis]]));
+                envelope(&f, &mut out, &mut v, &mut z);
+                for (k, value) in out.iter().enumerate() {
+                    d2[base + k * stride[axis]] = *value;
+                }
+            }
+        }
+    }
+    d2.iter()
+        .map(|&d| ((d.sqrt() - 3f32.sqrt()) * cell).max(0.0) * (1.0 - 1e-6))
+        .collect()
+}
+
+/// The 1-D squared distance transform of `f` (`out[q] = min_p f[p] + (q − p)²`).
+fn envelope(f: &[f32], out: &mut Vec<f32>, v: &mut Vec<usize>, z: &mut Vec<f32>) {
+    let n = f.len();
+    out.clear();
+    v.clear();
+    z.clear();
+    // parabolas of the lower envelope, and where each takes over
+    for q in 0..n {
+        if f[q] >= 1e20 {
+            continue;
+        }
+        loop {
+            let Some(&p) = v.last() else {
+                v.push(q);
+                z.push(f32::NEG_INFINITY);
+                break;
+            };
+            let s = ((f[q] + (q * q) as f32) - (f[p] + (p * p) as f32)) / (2.0 * (q - p) as f32);
+            if s <= *z.last().expect("one per parabola") {
+                v.pop();
+                z.pop();
+            } else {
+                v.push(q);
+                z.push(s);
+                break;
+            }
+        }
+    }
+    if v.is_empty() {
+        out.extend(std::iter::repeat_n(1e20, n));
+        return;
+    }
+    let mut k = 0;
+    for q in 0..n {
+        while k + 1 < v.len() && z[k + 1] < q as f32 {
+            k += 1;
+        }
+        let p = v[k];
+        let d = q as f32 - p as f32;
+        out.push(d * d + f[p]);
     }
 }
 
@@ -395,6 +512,12 @@ mod tests {
                     .map(|q| (0..3).map(|k| (q[k] - p[k]) * (q[k] - p[k])).sum::<f32>())
                     .fold(f32::INFINITY, f32::min);
                 let found = grid.nearest2(p, range, 0.0);
+                let clearance = grid.clearance(p);
+                assert!(
+                    clearance * clearance <= brute,
+                    "case {case}: clearance {clearance}, nearest {}",
+                    brute.sqrt()
+                );
                 if brute <= range * range {
                     assert_eq!(found, brute, "case {case}: {p:?} range {range}");
                 } else {

@@ -253,7 +253,7 @@ pub(super) fn object_link<const AVX: bool>(
     verdict: &mut impl Outcome,
 ) -> bool {
     let (m, group) = (world.margin, &model.groups[g]);
-    let near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
+    let mut near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
     if near == 0 {
         return false;
     }
@@ -261,6 +261,14 @@ pub(super) fn object_link<const AVX: bool>(
         Object::Cloud { index, radius, .. } => Some((&world.clouds[index as usize], radius)),
         _ => None,
     };
+    if let Some((grid, radius)) = cloud {
+        // the link's bounding sphere against the cells' clearances, past the cloud's box
+        let reach = group.bound.radius + m + radius + grid.gap;
+        near = grid.may_touch(&scratch.bounds[g], reach, near);
+        if near == 0 {
+            return false;
+        }
+    }
     let solids = match cloud {
         Some((cloud, radius)) => solids_against_cloud(model, cloud, radius, g, near, scratch, m),
         None => object_solids::<AVX>(model, object, g, scratch, m),

@@ -188,7 +188,7 @@ impl FastModel {
                             .iter()
                             .map(|p| to_f32((pose * Point3::from(*p)).coords))
                             .collect();
-                        let grid = CloudGrid::new(&points, 0.5 * (cloud_cell + *radius as f32));
+                        let grid = CloudGrid::new(&points, 0.25 * (cloud_cell + *radius as f32));
                         let object = Object::Cloud {
                             index: clouds.len() as u32,
                             center: grid.center,

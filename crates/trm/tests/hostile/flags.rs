@@ -351,6 +351,22 @@ pub fn cases(dir: &Path) -> Vec<Case> {
         "--smoothing",
         &["-1", "x", "NaN", "1001", "18446744073709551616"],
     ));
+    // point clouds: no samples, not a number, beyond the bound, with --vamp-obstacles
+    cases.extend(flag_cases(
+        &bench_refs,
+        "--cloud",
+        &["0", "-1", "x", "1000001"],
+    ));
+    let mut both = bench_args.clone();
+    both.push("--vamp-obstacles".into());
+    cases.push(Case {
+        what: "benchmark-mbm --cloud with --vamp-obstacles".into(),
+        args: both
+            .into_iter()
+            .chain(["--cloud".into(), "100".into()])
+            .collect(),
+        names: "--cloud".into(),
+    });
     let request = at("crates/trm-mbm/tests/fixtures/mbm/box_panda/request0001.yaml")
         .to_string_lossy()
         .to_string();
