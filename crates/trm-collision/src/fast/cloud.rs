@@ -309,8 +309,16 @@ impl CloudGrid {
     }
 
     /// Per lane of `lanes`, [`CloudGrid::nearest2`] of the point at `c` (NaN where `c` is not
-    /// finite: never certainly clear); infinity in the other lanes.
-    pub(super) fn distance2(&self, c: &[F; 3], range: f32, stop2: f32, lanes: LaneMask) -> F {
+    /// finite: never certainly clear); infinity in the other lanes, and with `first`, in the
+    /// lanes after the first one found below `stop2`.
+    pub(super) fn distance2(
+        &self,
+        c: &[F; 3],
+        range: f32,
+        stop2: f32,
+        lanes: LaneMask,
+        first: bool,
+    ) -> F {
         let mut out = [f32::INFINITY; FAST_LANES];
         for (l, d2) in out.iter_mut().enumerate() {
             if lanes & (1 << l) == 0 {
@@ -322,6 +330,9 @@ impl CloudGrid {
             } else {
                 f32::NAN
             };
+            if first && *d2 < stop2 {
+                break;
+            }
         }
         F(out)
     }

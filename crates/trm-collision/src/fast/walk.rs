@@ -85,7 +85,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         for g in (0..model.groups.len()).rev() {
             for (&o, object) in world.original.iter().zip(&world.objects) {
                 let o = o as usize;
-                if object_link::<AVX>(model, o, object, g, live, world, scratch, verdict) {
+                if object_link::<AVX, _>(model, o, object, g, live, world, scratch, verdict) {
                     return;
                 }
             }
@@ -110,7 +110,8 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                     }
                     WorldStep::Link(g) => {
                         let g = g as usize;
-                        if object_link::<AVX>(model, o, object, g, mask, world, scratch, verdict) {
+                        if object_link::<AVX, _>(model, o, object, g, mask, world, scratch, verdict)
+                        {
                             return;
                         }
                     }
@@ -178,7 +179,7 @@ pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
             .get(object as usize)
             .and_then(|&k| world.objects.get(k as usize))
             .is_some_and(|object_shape| {
-                object_link::<AVX>(
+                object_link::<AVX, _>(
                     model,
                     object as usize,
                     object_shape,
@@ -242,7 +243,7 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
 /// suspects.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub(super) fn object_link<const AVX: bool>(
+pub(super) fn object_link<const AVX: bool, O: Outcome>(
     model: &FastModel,
     o: usize,
     object: &Object,
@@ -250,7 +251,7 @@ pub(super) fn object_link<const AVX: bool>(
     live: LaneMask,
     world: &FastWorld,
     scratch: &mut FastScratch,
-    verdict: &mut impl Outcome,
+    verdict: &mut O,
 ) -> bool {
     let (m, group) = (world.margin, &model.groups[g]);
     let mut near = live & object.near::<AVX>(&scratch.bounds[g], group.bound.radius + m);
@@ -276,7 +277,7 @@ pub(super) fn object_link<const AVX: bool>(
     let (hit, close) = if let Some(contacts) = solids {
         contacts
     } else {
-        object_balls::<AVX>(model, world, object, g, near, scratch)
+        object_balls::<AVX>(model, world, object, g, near, scratch, O::STOPS_AT_FIRST)
     };
     let suspect = Suspect::Object {
         object: o as u32,
@@ -367,7 +368,8 @@ fn object_solids_in<const AVX: bool>(
 }
 
 /// The lanes in which a world object certainly collides with link group `g`'s spheres (the
-/// spheres inside its bodies, when they enclose them), and those within the margin of contact.
+/// spheres inside its bodies, when they enclose them), and those within the margin of contact
+/// (with `stop_at_hit`, possibly only some of them once one lane certainly collides).
 #[inline(always)]
 fn object_balls<const AVX: bool>(
     model: &FastModel,
@@ -376,13 +378,20 @@ fn object_balls<const AVX: bool>(
     g: usize,
     near: LaneMask,
     scratch: &mut FastScratch,
+    stop_at_hit: bool,
 ) -> (LaneMask, LaneMask) {
     let (m, group) = (world.margin, &model.groups[g]);
     place_balls::<AVX>(model, g, scratch);
     let mut contact = Contact::default();
+    // a point cloud costs per sphere and lane: where a certain collision ends the walk, the
+    // first one ends the link's spheres too (a sphere model's spheres are its bodies)
+    let stop = stop_at_hit && model.exact && matches!(object, Object::Cloud { .. });
     for i in group.balls.clone() {
         let r = model.balls[i].radius;
-        world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, near);
+        world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, near, stop);
+        if stop && contact.hit.mask::<AVX>() != 0 {
+            break;
+        }
     }
     let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
     if !model.exact {
@@ -391,7 +400,7 @@ fn object_balls<const AVX: bool>(
         if near & close != 0 {
             for i in group.inner.clone() {
                 let r = model.inner[i].radius;
-                world.test::<AVX>(object, &mut inside, &scratch.inner[i], r, m, near);
+                world.test::<AVX>(object, &mut inside, &scratch.inner[i], r, m, near, false);
             }
         }
         hit = inside.hit.mask::<AVX>();

@@ -99,18 +99,27 @@ impl FastWorld {
     /// [`Object::distance2`]), a point cloud's nearest point among those within `range` (or
     /// one nearer than `√stop2`).
     #[inline(always)]
-    fn distance2(&self, object: &Object, c: &[F; 3], range: f32, stop2: f32, lanes: LaneMask) -> F {
+    fn distance2(
+        &self,
+        object: &Object,
+        c: &[F; 3],
+        range: f32,
+        (stop2, first): (f32, bool),
+        lanes: LaneMask,
+    ) -> F {
         match *object {
             Object::Cloud { index, .. } => {
-                self.clouds[index as usize].distance2(c, range, stop2, lanes)
+                self.clouds[index as usize].distance2(c, range, stop2, lanes, first)
             }
             _ => object.distance2(c),
         }
     }
 
     /// [`Object::test`] for any object: a point cloud's nearest point, in the lanes of `lanes`
-    /// near its box, as a sphere of the points' radius.
+    /// near its box, as a sphere of the points' radius; with `first`, a cloud's lanes after the
+    /// first certainly colliding one are left out (for a walk that ends there).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn test<const AVX: bool>(
         &self,
         object: &Object,
@@ -119,6 +128,7 @@ impl FastWorld {
         r: f32,
         m: f32,
         lanes: LaneMask,
+        first: bool,
     ) {
         if let Object::Cloud { .. } = object {
             let reach = object.reach(r);
@@ -130,7 +140,7 @@ impl FastWorld {
                 let gap = self.clouds[index as usize].gap;
                 // a point certainly colliding settles the lane: the scan may stop there
                 let [inner2, _] = limits(reach, m);
-                let d2 = self.distance2(object, c, reach + gap + m, inner2, near);
+                let d2 = self.distance2(object, c, reach + gap + m, (inner2, first), near);
                 let outer = reach + gap + m;
                 contact.add_within(d2, [inner2, outer * outer]);
             }
