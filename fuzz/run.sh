@@ -16,7 +16,7 @@ cd "$(dirname "$0")"
 root=..
 
 targets=(urdf model_description task_spec world motion_spec taskmap_spec map checkpoint taskmap scene
-         configurations posture trajectory_csv trajectory_json srdf mesh moveit)
+         configurations posture trajectory_csv trajectory_json srdf mesh moveit points)
 
 # The seed files of a target, one per line: its globs in seeds.txt and the files in seeds/TARGET.
 seeds() {
@@ -33,7 +33,7 @@ seeds() {
 # explore faster.
 flags() {
   case "$1" in
-    model_description | scene | urdf | srdf | mesh | moveit) echo -max_len=8192 ;;
+    model_description | scene | urdf | srdf | mesh | moveit | points) echo -max_len=8192 ;;
   esac
 }
 

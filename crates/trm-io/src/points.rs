@@ -160,25 +160,7 @@ fn ply_points(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
     };
     let xyz = [column("x")?, column("y")?, column("z")?];
     match format.as_deref() {
-        Some("ascii") => {
-            let text = std::str::from_utf8(body).map_err(|_| "the ASCII body is not text")?;
-            let mut rows = text.lines().filter(|l| !l.trim().is_empty());
-            (0..count)
-                .map(|k| {
-                    let row = rows.next().ok_or_else(|| {
-                        format!("vertex {k}: the file ends before its {count} vertices")
-                    })?;
-                    let values: Vec<&str> = row.split_whitespace().collect();
-                    let value = |c: usize| {
-                        values
-                            .get(c)
-                            .and_then(|v| v.parse::<f64>().ok())
-                            .ok_or_else(|| format!("vertex {k}: `{row}` is not a row of numbers"))
-                    };
-                    Ok([value(xyz[0])?, value(xyz[1])?, value(xyz[2])?])
-                })
-                .collect()
-        }
+        Some("ascii") => ascii_rows(body, xyz, count, "vertex", "vertices"),
         Some(f @ ("binary_little_endian" | "binary_big_endian")) => {
             let numbers: Vec<Number> = properties.iter().map(|p| p.1).collect();
             binary_rows(body, &numbers, xyz, count, f == "binary_big_endian")
@@ -201,6 +183,34 @@ fn ply_number(kind: &str) -> Option<Number> {
         "double" | "float64" => Number::Float(8),
         _ => return None,
     })
+}
+
+/// `count` text rows of numbers, the coordinates at columns `xyz`; errors name the `row`
+/// (vertex, point) and say when the file ends before the `count` of `rows` it declares.
+fn ascii_rows(
+    body: &[u8],
+    xyz: [usize; 3],
+    count: usize,
+    row_name: &str,
+    rows_name: &str,
+) -> Result<Vec<[f64; 3]>, String> {
+    let text = std::str::from_utf8(body).map_err(|_| "the ASCII body is not text")?;
+    let mut rows = text.lines().filter(|l| !l.trim().is_empty());
+    (0..count)
+        .map(|k| {
+            let row = rows.next().ok_or_else(|| {
+                format!("{row_name} {k}: the file ends before its {count} {rows_name}")
+            })?;
+            let values: Vec<&str> = row.split_whitespace().collect();
+            let value = |c: usize| {
+                values
+                    .get(c)
+                    .and_then(|v| v.parse::<f64>().ok())
+                    .ok_or_else(|| format!("{row_name} {k}: `{row}` is not a row of numbers"))
+            };
+            Ok([value(xyz[0])?, value(xyz[1])?, value(xyz[2])?])
+        })
+        .collect()
 }
 
 /// `count` rows of fixed-size fields, the coordinates at field indices `xyz`.
@@ -287,27 +297,7 @@ fn pcd_points(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
     };
     let xyz = [column("x")?, column("y")?, column("z")?];
     match data {
-        "ascii" => {
-            let text = std::str::from_utf8(body).map_err(|_| "the ASCII body is not text")?;
-            let rows: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
-            if rows.len() < points {
-                return Err(format!("{} rows, short of the {points} POINTS", rows.len()));
-            }
-            rows[..points]
-                .iter()
-                .enumerate()
-                .map(|(k, row)| {
-                    let values: Vec<&str> = row.split_whitespace().collect();
-                    let value = |c: usize| {
-                        values
-                            .get(c)
-                            .and_then(|v| v.parse::<f64>().ok())
-                            .ok_or_else(|| format!("point {k}: `{row}` is not a row of numbers"))
-                    };
-                    Ok([value(xyz[0])?, value(xyz[1])?, value(xyz[2])?])
-                })
-                .collect()
-        }
+        "ascii" => ascii_rows(body, xyz, points, "point", "POINTS"),
         "binary" => binary_rows(body, &numbers, xyz, points, false),
         "binary_compressed" => Err(
             "DATA binary_compressed is not read: save the cloud as binary or ascii (pcl_convert_pcd_ascii_binary)"

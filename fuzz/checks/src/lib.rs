@@ -53,6 +53,7 @@ pub const TARGETS: &[(&str, Check)] = &[
     ("srdf", Check::Text(srdf)),
     ("mesh", Check::Bytes(mesh)),
     ("moveit", Check::Text(moveit)),
+    ("points", Check::Bytes(points)),
 ];
 
 /// The iCub upper body with its description, loaded once.
@@ -234,6 +235,19 @@ pub fn mesh(data: &[u8]) {
     }
 }
 
+/// Point-cloud bytes (PLY or PCD; the first byte picks the format) → finite points or an
+/// error, never a panic.
+pub fn points(data: &[u8]) {
+    let Some((&kind, bytes)) = data.split_first() else {
+        return;
+    };
+    let name = ["fuzz.ply", "fuzz.pcd"][usize::from(kind % 2)];
+    if let Ok(read) = trm_io::parse_points(bytes, Path::new(name)) {
+        assert!(!read.points.is_empty());
+        assert!(read.points.iter().flatten().all(|c| c.is_finite()));
+    }
+}
+
 /// MoveIt PlanningScene YAML: a scene that reads is written and read back with the same objects
 /// and allowed collisions; the text is also read as a MotionPlanRequest.
 pub fn moveit(text: &str) {
@@ -245,6 +259,7 @@ pub fn moveit(text: &str) {
             .expect("what the writer writes, the reader reads");
         assert_eq!(again.objects.len(), scene.objects.len());
         assert_eq!(again.allowed_collisions, scene.allowed_collisions);
+        assert_eq!(again.attached, scene.attached);
     }
     let _ = MotionPlanRequest::parse(text, Path::new("fuzz.yaml"));
 }
