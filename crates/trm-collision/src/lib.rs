@@ -31,6 +31,13 @@
 //! spheres that enclose it, tighter than one).
 //! [`generate_acm`] builds the matrix as MoveIt's setup assistant does.
 //!
+//! A [`World`] holds those shapes and what cameras and CAD give: point clouds
+//! ([`Shape::Points`], read from PLY and PCD files; [`thin_points`] thins them,
+//! [`CollisionModel::points_off_robot`] drops the robot's own points) and triangle meshes
+//! ([`Shape::Mesh`]). A robot holds objects ([`CollisionModel::with_attached`],
+//! [`AttachedObject`]): they move with their link and are checked against everything but their
+//! touch links.
+//!
 //! For sphere models (VAMP's spherized URDFs, or [`fit::urdf_with_spheres`]),
 //! [`fast::FastChecker`] checks eight configurations at once in single precision, deferring the
 //! few within rounding distance of contact to the exact check, so its answers are the exact

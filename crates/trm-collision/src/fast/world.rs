@@ -95,26 +95,6 @@ impl FastWorld {
         self.objects.is_empty()
     }
 
-    /// Squared distances from the point in every lane of `lanes` to `object`'s geometry (as
-    /// [`Object::distance2`]), a point cloud's nearest point among those within `range` (or
-    /// one nearer than `√stop2`).
-    #[inline(always)]
-    fn distance2(
-        &self,
-        object: &Object,
-        c: &[F; 3],
-        range: f32,
-        (stop2, first): (f32, bool),
-        lanes: LaneMask,
-    ) -> F {
-        match *object {
-            Object::Cloud { index, .. } => {
-                self.clouds[index as usize].distance2(c, range, stop2, lanes, first)
-            }
-            _ => object.distance2(c),
-        }
-    }
-
     /// [`Object::test`] for any object: a point cloud's nearest point, in the lanes of `lanes`
     /// near its box, as a sphere of the points' radius; with `first`, a cloud's lanes after the
     /// first certainly colliding one are left out (for a walk that ends there).
@@ -130,18 +110,15 @@ impl FastWorld {
         lanes: LaneMask,
         first: bool,
     ) {
-        if let Object::Cloud { .. } = object {
+        if let Object::Cloud { index, .. } = *object {
             let reach = object.reach(r);
             let near = lanes & object.near::<AVX>(c, r + m);
             if near != 0 {
-                let Object::Cloud { index, .. } = *object else {
-                    unreachable!()
-                };
-                let gap = self.clouds[index as usize].gap;
+                let grid = &self.clouds[index as usize];
+                let outer = reach + grid.gap + m;
                 // a point certainly colliding settles the lane: the scan may stop there
                 let [inner2, _] = limits(reach, m);
-                let d2 = self.distance2(object, c, reach + gap + m, (inner2, first), near);
-                let outer = reach + gap + m;
+                let d2 = grid.distance2(c, outer, inner2, near, first);
                 contact.add_within(d2, [inner2, outer * outer]);
             }
         } else {
