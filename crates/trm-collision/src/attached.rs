@@ -57,7 +57,8 @@ impl CollisionModel {
     /// Cheap next to building the model (fitted spheres are kept); compile planners again.
     ///
     /// Errors name what is wrong: an unknown link or touch link (with the nearest names), a
-    /// name already held or taken by a body, no shapes, a shape that is invalid or not convex.
+    /// name already held or taken by a body, no shapes, a pose that is not finite, a shape that
+    /// is invalid or not convex.
     pub fn with_attached(&self, object: AttachedObject) -> Result<Self> {
         let tree = self.robot().tree();
         let link_names = || tree.links.iter().map(|l| l.name.as_str());
@@ -80,6 +81,14 @@ impl CollisionModel {
             return Err(CollisionError::InvalidValue {
                 what,
                 problem: "it has no shape: give at least one".into(),
+            });
+        }
+        if let Some(k) = (object.shapes.iter()).position(|(_, p)| {
+            !(p.translation.vector.iter().chain(p.rotation.coords.iter())).all(|v| v.is_finite())
+        }) {
+            return Err(CollisionError::InvalidValue {
+                what,
+                problem: format!("the pose of shape {k} is not finite: give finite poses"),
             });
         }
         let names = object.body_names();

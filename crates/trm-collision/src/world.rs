@@ -484,6 +484,38 @@ mod tests {
             e.contains(":3: meshes[0] (\"fold\")") && e.contains("gone.stl"),
             "{e}"
         );
+        for (from, to, says) in [
+            (
+                "radius: 0.01",
+                "radius: -0.01",
+                "points radius -0.01 is not a positive",
+            ),
+            (
+                "radius: 0.01",
+                "radius: 0.0",
+                "points radius 0 is not a positive",
+            ),
+            (
+                "radius: 0.01",
+                "radius: inf",
+                "not a positive finite number",
+            ),
+            (
+                "name: \"fold\"",
+                "name: \"scan\"",
+                "names an earlier object too",
+            ),
+            ("file: \"fold.stl\"", "file: \".\"", "meshes[0]"),
+            (
+                "scale: (0.5, 0.5, 0.5)",
+                "scale: (1e9, 1, 1)",
+                "more than 1000 m",
+            ),
+        ] {
+            std::fs::write(&path, text.replace(from, to)).unwrap();
+            let e = World::load(&path).unwrap_err().to_string();
+            assert!(e.contains(says) && e.contains("world.ron:"), "{to}: {e}");
+        }
         std::fs::write(dir.join("scan.ply"), "ply\nformat ascii 1.0\n").unwrap();
         std::fs::write(&path, text).unwrap();
         let e = World::load(&path).unwrap_err().to_string();

@@ -175,6 +175,10 @@ fn bad_attachments_say_what_is_wrong() {
     assert!(e.contains("cannot be a points"), "{e}");
     let e = held.without_attached("rood").unwrap_err().to_string();
     assert!(e.contains("did you mean `rod`"), "{e}");
+    let mut lost = rod(&[]);
+    lost.shapes[0].1.translation.vector.x = f64::NAN;
+    let e = bare.with_attached(lost).unwrap_err().to_string();
+    assert!(e.contains("pose of shape 0 is not finite"), "{e}");
     let mut empty = rod(&[]);
     empty.shapes.clear();
     assert!(

@@ -230,7 +230,11 @@ fn binary_rows(
         })
         .collect();
     let stride: usize = numbers.iter().map(|n| n.size()).sum();
-    if body.len() < stride * count {
+    if stride == 0
+        || stride
+            .checked_mul(count)
+            .is_none_or(|need| body.len() < need)
+    {
         return Err(format!(
             "the body holds {} bytes, short of the {count} points of {stride} bytes declared",
             body.len()
@@ -285,6 +289,12 @@ fn pcd_points(bytes: &[u8]) -> Result<Vec<[f64; 3]>, String> {
         let count: usize = counts[k]
             .parse()
             .map_err(|_| format!("COUNT `{}`", counts[k]))?;
+        if count == 0 || count > 4096 {
+            return Err(format!(
+                "field `{}`: COUNT {count}; give 1 to 4096 numbers per field",
+                fields[k]
+            ));
+        }
         first_of.push(numbers.len());
         numbers.extend(std::iter::repeat_n(number, count));
     }
@@ -363,7 +373,7 @@ mod tests {
 
     #[test]
     fn bad_files_say_what_is_wrong() {
-        let cases: [(&str, &[u8], &str); 7] = [
+        let cases: [(&str, &[u8], &str); 12] = [
             ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n1 2\n", "no `z`"),
             ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n", "ends before its 3"),
             ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\n", "never ends"),
@@ -371,6 +381,11 @@ mod tests {
             ("a.pcd", b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA binary_compressed\n", "pcl_convert_pcd_ascii_binary"),
             ("a.pcd", b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\nnan 1 2\n", "no finite point"),
             ("a.pcd", b"FIELDS x y z\nSIZE 4 4\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 1 2\n", "differ in length"),
+            ("a.pcd", b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 0 0 0\nPOINTS 1\nDATA binary\n", "COUNT 0"),
+            ("a.pcd", b"FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 18446744073709551615\nDATA binary\n\x00", "short of the"),
+            ("a.ply", b"ply\nformat binary_big_endian 1.0\nelement vertex 9223372036854775807\nproperty double x\nproperty double y\nproperty double z\nend_header\n", "short of the"),
+            ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 inf 2\n", "no finite point"),
+            ("a.ply", b"", "never ends"),
         ];
         for (name, bytes, says) in cases {
             let e = read(name, bytes).unwrap_err();

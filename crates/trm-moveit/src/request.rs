@@ -424,6 +424,12 @@ impl MotionPlanRequest {
             problem: format!("not written: {problem}"),
             fix: "give one finite value (and two tolerances of 0 or more) per joint name".into(),
         };
+        crate::scene::check_attached(&self.attached).map_err(|p| MoveItError::Invalid {
+            path: self.origin.clone(),
+            line: 0,
+            problem: format!("not written: {p}"),
+            fix: "give held objects MoveIt's shapes at finite poses".into(),
+        })?;
         let (s, g) = (&self.start, &self.goal);
         if s.names.len() != s.positions.len() || s.positions.iter().any(|v| !v.is_finite()) {
             return Err(refuse("the start is not one finite value per name"));

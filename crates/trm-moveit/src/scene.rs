@@ -662,13 +662,15 @@ impl PlanningScene {
             fix: fix.into(),
         };
         self.to_world()?;
-        let held = self.attached.iter().map(|o| {
-            let shapes: Vec<&Shape> = o.shapes.iter().map(|(s, _)| s).collect();
-            (&o.name, shapes)
+        check_attached(&self.attached)
+            .map_err(|p| refuse(p, "give held objects MoveIt's shapes at finite poses"))?;
+        let world = (self.objects.iter()).map(|o| {
+            (
+                &o.id,
+                o.primitives.iter().map(|p| &p.shape).collect::<Vec<_>>(),
+            )
         });
-        let world =
-            (self.objects.iter()).map(|o| (&o.id, o.primitives.iter().map(|p| &p.shape).collect()));
-        for (id, shapes) in world.chain(held) {
+        for (id, shapes) in world {
             if shapes.is_empty() {
                 return Err(refuse(format!("object `{id}` has no shape"), "give it one"));
             }
@@ -765,6 +767,43 @@ fn list(v: &[f64]) -> String {
         .map(|x| format!("{x:?}"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Whether held objects can be written as MoveIt reads them: at least one shape each, every
+/// shape a valid box, sphere, cylinder or mesh, every pose finite; else what is wrong.
+pub(crate) fn check_attached(attached: &[AttachedObject]) -> Result<(), String> {
+    for o in attached {
+        let name = &o.name;
+        if o.shapes.is_empty() {
+            return Err(format!("held object `{name}` has no shape"));
+        }
+        for (shape, pose) in &o.shapes {
+            let movable = matches!(
+                shape,
+                Shape::Box { .. }
+                    | Shape::Sphere { .. }
+                    | Shape::Cylinder { .. }
+                    | Shape::Mesh { .. }
+            );
+            if !movable || shape.check().is_err() {
+                return Err(format!(
+                    "held object `{name}` holds a {} that MoveIt cannot carry or that is invalid",
+                    shape.kind()
+                ));
+            }
+            let numbers = pose
+                .translation
+                .vector
+                .iter()
+                .chain(pose.rotation.coords.iter());
+            if !numbers.into_iter().all(|v| v.is_finite()) {
+                return Err(format!(
+                    "held object `{name}` has a pose that is not finite"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `attached_collision_objects:` under a robot state (nothing when there are none).

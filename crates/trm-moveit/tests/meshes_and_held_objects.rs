@@ -109,6 +109,18 @@ fn scenes_with_meshes_and_held_objects_read_and_round_trip() {
     let written = parsed.to_yaml().unwrap();
     let back = MotionPlanRequest::parse(&written, Path::new("request.yaml")).unwrap();
     assert_eq!(back.attached, scene.attached);
+    // nothing is written that the reader refuses: a held object at a NaN pose, or a capsule
+    let mut lost = scene.clone();
+    lost.attached[0].shapes[0].1.translation.vector.z = f64::NAN;
+    let e = lost.to_yaml().unwrap_err().to_string();
+    assert!(e.contains("not written") && e.contains("not finite"), "{e}");
+    let mut odd = parsed.clone();
+    odd.attached[0].shapes[0].0 = Shape::Capsule {
+        radius: 0.1,
+        length: 0.1,
+    };
+    let e = odd.to_yaml().unwrap_err().to_string();
+    assert!(e.contains("not written") && e.contains("capsule"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
