@@ -1,15 +1,18 @@
 // The trm viewer: renders a `trm-scene` document (crates/trm-view) embedded in the page as
-// <script id="trm-scene" type="application/json">. Robot collision shapes per link, link poses
-// per frame (play, pause, scrub), world objects (moving ones posed per frame), roadmap points and
-// edges coloured by cost (black where a frame says they are blocked)
-// (click a point to see its posture), a task-space path. After the first render it writes what
-// it drew into <pre id="trm-report"> so that a headless browser test can check it.
+// <script id="trm-scene" type="application/json">. The robot as it looks (its URDF visuals, in
+// their colours) or its collision shapes, the objects it holds, link poses per frame (play,
+// pause, scrub), world objects (primitives, meshes, point clouds; moving ones posed per frame),
+// roadmap points and edges coloured by cost (black where a frame says they are blocked; click a
+// point to see its posture), a task-space path. After the first render it writes what it drew,
+// as JSON, into <script id="trm-report" type="application/json"> (not shown) so that a headless
+// browser test can check it.
 // URL parameters: ?frame=N opens paused at frame N; ?play=1 starts playing; ?pick=I shows map
 // point I's posture as a click on it does.
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { ConvexGeometry } from 'three/addons/geometries/ConvexGeometry.js';
+import { toCreasedNormals } from 'three/addons/utils/BufferGeometryUtils.js';
 
 const BACKGROUND = 0xf4f4f4;
 const scene3 = new THREE.Scene();
@@ -31,10 +34,9 @@ panel.appendChild(heading);
 const info = document.createElement('div');
 info.id = 'trm-info';
 info.style.cssText = 'margin-top:6px;color:#333;';
-const report = document.createElement('pre');
+const report = document.createElement('script');
 report.id = 'trm-report';
-report.style.cssText =
-  'position:absolute;bottom:0;right:4px;margin:0;font-size:10px;color:#888;max-width:60%;white-space:pre-wrap;';
+report.type = 'application/json';
 document.body.appendChild(report);
 
 function toggle(label, initial, onChange) {
@@ -51,6 +53,14 @@ function toggle(label, initial, onChange) {
 }
 
 // ---- shapes ------------------------------------------------------------------------------
+// a triangle mesh, shaded smooth within 30 degrees and sharp across creases (CAD parts)
+function meshGeometry(s) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(s.vertices.flat()), 3));
+  g.setIndex(s.triangles.flat());
+  return toCreasedNormals(g, Math.PI / 6);
+}
+
 // shapes as trm-collision writes them: {"Box": {"size": [...]}}, cylinders and capsules along z
 function geometry(shape) {
   const [kind, s] = Object.entries(shape)[0];
@@ -65,6 +75,8 @@ function geometry(shape) {
       return new THREE.CapsuleGeometry(s.radius, s.length, 8, 16).rotateX(Math.PI / 2);
     case 'Convex':
       return new ConvexGeometry(s.points.map((p) => new THREE.Vector3(p[0], p[1], p[2])));
+    case 'Mesh':
+      return meshGeometry(s);
     default:
       throw new Error('unknown shape ' + kind);
   }
@@ -86,26 +98,58 @@ function poseMatrix(p) {
 // ---- robot -------------------------------------------------------------------------------
 const robot = new THREE.Group();
 scene3.add(robot);
+// each link: what it looks like, its collision shapes, what it holds (each part toggled apart)
 const linkGroups = data.links.map(() => {
   const g = new THREE.Group();
   robot.add(g);
   return g;
 });
+const parts = { look: [], collision: [], held: [] }; // per kind, the group on each link (sparse)
+function partOf(kind, slot) {
+  if (!parts[kind][slot]) {
+    parts[kind][slot] = new THREE.Group();
+    linkGroups[slot].add(parts[kind][slot]);
+  }
+  return parts[kind][slot];
+}
+const HELD_COLOR = 0xd9822b;
 let meshes = 0;
-data.bodies.forEach((b, i) => {
-  const hue = (b.link * 0.137) % 1;
-  const material = new THREE.MeshStandardMaterial({
-    color: new THREE.Color().setHSL(hue, 0.45, 0.55),
-    roughness: 0.7,
-    transparent: true,
-    opacity: 0.85,
-  });
+let heldBodies = 0;
+data.bodies.forEach((b) => {
+  const held = b.held !== undefined && b.held !== null;
+  const color = held ? new THREE.Color(HELD_COLOR) : new THREE.Color().setHSL((b.link * 0.137) % 1, 0.45, 0.55);
+  const material = new THREE.MeshStandardMaterial({ color, roughness: 0.7, transparent: !held, opacity: held ? 1 : 0.85 });
   const mesh = new THREE.Mesh(geometry(b.shape), material);
   setPose(mesh, b.local);
   mesh.name = b.name;
-  linkGroups[b.link].add(mesh);
+  partOf(held ? 'held' : 'collision', b.link).add(mesh);
   meshes += 1;
+  if (held) heldBodies += 1;
 });
+const visuals = data.visuals || [];
+const missingVisuals = data.missing_visuals || [];
+let visualTriangles = 0;
+visuals.forEach((v) => {
+  const [r, g, b, a] = v.color;
+  const material = new THREE.MeshStandardMaterial({
+    color: new THREE.Color(r, g, b),
+    roughness: 0.55,
+    metalness: 0.05,
+    transparent: a < 1,
+    opacity: a,
+  });
+  const mesh = new THREE.Mesh(geometry(v.shape), material);
+  setPose(mesh, v.local);
+  partOf('look', v.link).add(mesh);
+  if (v.shape.Mesh) visualTriangles += v.shape.Mesh.triangles.length;
+});
+// the robot as it looks when all its visuals loaded; else its collision shapes
+const showLook = visuals.length > 0 && missingVisuals.length === 0;
+function showPart(kind, on) {
+  parts[kind].forEach((g) => { g.visible = on; });
+}
+showPart('look', showLook);
+showPart('collision', !showLook);
 
 // forward kinematics of the tree for a joint vector (root at `base`): world matrix of every link
 function forward(joints, base) {
@@ -154,14 +198,39 @@ function fkError() {
 // ---- world -------------------------------------------------------------------------------
 const world = new THREE.Group();
 scene3.add(world);
+// a point cloud: its points coloured by height (as RViz does), 3 pixels wide at any distance
+// (their collision radius is a few millimetres: a pixel or less)
+let cloudPoints = 0;
+function cloud(s) {
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(s.points.flat()), 3));
+  const zs = s.points.map((p) => p[2]);
+  const [lo, hi] = [Math.min(...zs), Math.max(...zs)];
+  const colors = new Float32Array(3 * s.points.length);
+  s.points.forEach((p, i) => {
+    const u = hi > lo ? (p[2] - lo) / (hi - lo) : 0.5;
+    const c = new THREE.Color().setHSL(0.7 - 0.6 * u, 0.75, 0.45);
+    colors.set([c.r, c.g, c.b], 3 * i);
+  });
+  g.setAttribute('color', new THREE.BufferAttribute(colors, 3));
+  cloudPoints += s.points.length;
+  return new THREE.Points(g, new THREE.PointsMaterial({ size: 3, sizeAttenuation: false, vertexColors: true }));
+}
 data.world.forEach((o) => {
-  const mesh = new THREE.Mesh(
-    geometry(o.shape),
-    new THREE.MeshStandardMaterial({ color: 0x8a8a8a, transparent: true, opacity: 0.45 }),
-  );
-  setPose(mesh, o.pose);
-  mesh.name = o.name;
-  world.add(mesh);
+  const object = o.shape.Points
+    ? cloud(o.shape.Points)
+    : new THREE.Mesh(
+      geometry(o.shape),
+      new THREE.MeshStandardMaterial({
+        color: 0x8a8a8a,
+        transparent: true,
+        opacity: 0.45,
+        side: o.shape.Mesh ? THREE.DoubleSide : THREE.FrontSide,
+      }),
+    );
+  setPose(object, o.pose);
+  object.name = o.name;
+  world.add(object);
 });
 const worldMeshes = world.children.slice();
 
@@ -310,7 +379,16 @@ slider.addEventListener('input', () => {
   showFrame(Number(slider.value));
 });
 
-toggle('collision shapes', true, (v) => { robot.visible = v; });
+if (visuals.length) toggle('robot as it looks', showLook, (v) => showPart('look', v));
+toggle('collision shapes', !showLook, (v) => showPart('collision', v));
+if (heldBodies) toggle(`held objects (${heldBodies} shape${heldBodies > 1 ? 's' : ''})`, true, (v) => showPart('held', v));
+if (missingVisuals.length) {
+  const note = document.createElement('div');
+  note.style.cssText = 'color:#8a4b00;margin:2px 0;';
+  note.textContent = `${missingVisuals.length} visual${missingVisuals.length > 1 ? 's' : ''} not loaded: collision shapes shown`;
+  note.title = missingVisuals.join('\n');
+  panel.appendChild(note);
+}
 if (data.world.length) toggle(`world (${data.world.length} objects)`, true, (v) => { world.visible = v; });
 if (mapPoints) {
   toggle(`map points (${map.points.length})`, true, (v) => { mapPoints.visible = v; });
@@ -403,6 +481,12 @@ report.textContent = JSON.stringify({
   format: data.format,
   version: data.version,
   bodies: meshes,
+  held: heldBodies,
+  visuals: visuals.length,
+  visual_triangles: visualTriangles,
+  look_shown: parts.look.some((g) => g && g.visible),
+  collision_shown: parts.collision.some((g) => g && g.visible),
+  cloud_points: cloudPoints,
   links: linkGroups.length,
   world: data.world.length,
   points: map ? map.points.length : 0,

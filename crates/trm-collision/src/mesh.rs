@@ -108,6 +108,83 @@ pub fn triangles_of_mesh_bytes(
     path: &Path,
     scale: [f64; 3],
 ) -> Result<Triangles, String> {
+    let no_materials = |p: &Path| -> std::io::Result<Vec<u8>> {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("{}: materials are not read", p.display()),
+        ))
+    };
+    let scene = load_scene(bytes, path, no_materials)?;
+    let (mut points, mut triangles) = (Vec::new(), Vec::new());
+    for mesh in &scene.meshes {
+        let base = points.len() as u32;
+        points.extend(mesh.vertices.iter().map(|v| scaled(v, scale)));
+        triangles.extend(mesh.faces.iter().map(|f| f.map(|i| base + i)));
+    }
+    check_vertices(&points)?;
+    Ok((points, triangles))
+}
+
+/// One part of a mesh file drawn in one material: its vertices (coincident ones merged), its
+/// triangles and the material's diffuse colour (RGBA in 0..=1), when the file gives one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshPart {
+    /// Vertices, m, scaled.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles as indices into `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+    /// The material's diffuse colour.
+    pub color: Option<[f32; 4]>,
+}
+
+/// Loads a mesh file for drawing (a URDF `<visual>`): one [`MeshPart`] per mesh of the file,
+/// with its material's colour (COLLADA effects, an OBJ's material library beside it). The
+/// checks of [`triangles_of_mesh`] apply.
+pub fn parts_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<MeshPart>, String> {
+    let bytes = trm_io::read_input_bytes(path).map_err(|e| e.to_string())?;
+    let library = |p: &Path| -> std::io::Result<Vec<u8>> {
+        trm_io::read_input_bytes(p).map_err(|e| std::io::Error::other(e.to_string()))
+    };
+    let scene = load_scene(&bytes, path, library)?;
+    let mut parts = Vec::new();
+    for (k, mesh) in scene.meshes.iter().enumerate() {
+        if mesh.faces.is_empty() {
+            continue;
+        }
+        // mesh-loader gives every corner its own vertex: merge those at one place
+        let mut index = std::collections::HashMap::new();
+        let mut vertices = Vec::new();
+        let mut corner = |v: &[f32; 3]| -> u32 {
+            *index.entry(v.map(f32::to_bits)).or_insert_with(|| {
+                vertices.push(scaled(v, scale));
+                vertices.len() as u32 - 1
+            })
+        };
+        let triangles: Vec<[u32; 3]> = mesh
+            .faces
+            .iter()
+            .filter(|f| f.iter().all(|&i| (i as usize) < mesh.vertices.len()))
+            .map(|f| f.map(|i| corner(&mesh.vertices[i as usize])))
+            .collect();
+        let color = scene.materials.get(k).and_then(|m| m.color.diffuse);
+        parts.push(MeshPart {
+            vertices,
+            triangles,
+            color,
+        });
+    }
+    let all: Vec<[f64; 3]> = parts.iter().flat_map(|p| p.vertices.clone()).collect();
+    check_vertices(&all)?;
+    Ok(parts)
+}
+
+/// The file read by mesh-loader (COLLADA's nesting checked first); `library` reads an OBJ's
+/// material library.
+fn load_scene(
+    bytes: &[u8],
+    path: &Path,
+    library: impl FnMut(&Path) -> std::io::Result<Vec<u8>> + std::panic::UnwindSafe,
+) -> Result<mesh_loader::Scene, String> {
     let collada = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("dae"))
@@ -116,31 +193,25 @@ pub fn triangles_of_mesh_bytes(
         trm_io::check_xml_nesting(bytes, trm_io::XML_NESTING_LIMIT)
             .map_err(|e| format!("{e}: flatten the COLLADA scene"))?;
     }
-    let no_materials = |p: &Path| -> std::io::Result<Vec<u8>> {
-        Err(std::io::Error::new(
-            std::io::ErrorKind::NotFound,
-            format!("{}: materials are not read", p.display()),
-        ))
-    };
     // mesh-loader panics on some malformed files (found by fuzzing: a COLLADA accessor
     // longer than its array): an error, not a crash
-    let scene = trm_kinematics::quietly(|| {
-        mesh_loader::Loader::default().load_from_slice_with_reader(bytes, path, no_materials)
+    trm_kinematics::quietly(|| {
+        mesh_loader::Loader::default().load_from_slice_with_reader(bytes, path, library)
     })
     .map_err(|_| "the mesh reader failed on this file (malformed mesh)".to_string())?
-    .map_err(|e| e.to_string())?;
-    let (mut points, mut triangles) = (Vec::new(), Vec::new());
-    for mesh in &scene.meshes {
-        let base = points.len() as u32;
-        points.extend(mesh.vertices.iter().map(|v| {
-            [
-                f64::from(v[0]) * scale[0],
-                f64::from(v[1]) * scale[1],
-                f64::from(v[2]) * scale[2],
-            ]
-        }));
-        triangles.extend(mesh.faces.iter().map(|f| f.map(|i| base + i)));
-    }
+    .map_err(|e| e.to_string())
+}
+
+fn scaled(v: &[f32; 3], scale: [f64; 3]) -> [f64; 3] {
+    [
+        f64::from(v[0]) * scale[0],
+        f64::from(v[1]) * scale[1],
+        f64::from(v[2]) * scale[2],
+    ]
+}
+
+/// Some vertices, all finite and within [`MAX_VERTEX_DISTANCE`] of the origin.
+fn check_vertices(points: &[[f64; 3]]) -> Result<(), String> {
     if points.is_empty() {
         return Err("the file holds no vertices".to_string());
     }
@@ -156,7 +227,7 @@ pub fn triangles_of_mesh_bytes(
             far[0], far[1], far[2]
         ));
     }
-    Ok((points, triangles))
+    Ok(())
 }
 
 #[cfg(test)]

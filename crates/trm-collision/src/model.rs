@@ -13,7 +13,7 @@ use crate::cull::Culling;
 use crate::error::{CollisionError, Result, unknown};
 use crate::mesh::{convex_hull_of_mesh, resolve_mesh};
 use crate::placed::{BodyPair, PlacedBodies};
-use crate::shape::{Compiled, Placed, Shape, from_urdf};
+use crate::shape::{Compiled, Placed, Shape};
 
 /// How to turn a URDF's `<collision>` elements into bodies.
 #[derive(Debug, Clone, Default)]
@@ -37,6 +37,20 @@ impl CollisionOptions {
             package_paths,
             ..Default::default()
         }
+    }
+
+    /// Where the mesh `uri` of `robot`'s URDF is: searched in these package paths, then the
+    /// description's, relative to [`CollisionOptions::urdf_dir`] or else the URDF's directory
+    /// ([`crate::mesh::mesh_candidates`]); on failure, every path tried.
+    pub fn find_mesh(&self, robot: &RobotModel, uri: &str) -> Result<PathBuf, Vec<PathBuf>> {
+        let urdf_dir = self.urdf_dir.clone().or_else(|| link_dir(robot.origin()));
+        let package_paths: Vec<PathBuf> = self
+            .package_paths
+            .iter()
+            .chain(robot.package_paths())
+            .cloned()
+            .collect();
+        resolve_mesh(uri, urdf_dir.as_deref(), &package_paths)
     }
 }
 
@@ -62,14 +76,24 @@ struct Inner {
     pairs: Vec<BodyPair>,
     link_pairs: usize,
     culling: Culling,
-    /// Objects the robot holds, their bodies among `bodies`.
-    attached: Vec<crate::AttachedObject>,
-    /// Every body's [`CollisionModel::enclosing_spheres`] and
-    /// [`CollisionModel::inscribed_spheres`], fitted on first use and shared by the models
-    /// [`CollisionModel::with_acm`] makes (fitting a mesh's cells takes milliseconds).
-    spheres: Arc<SphereSets>,
+    /// What the models made from this one keep.
+    kept: Kept,
     /// The model compiled for single-precision checks ([`crate::fast::FastModel::of`]).
     fast: OnceLock<Arc<crate::fast::FastModel>>,
+}
+
+/// What a model hands on to the models made from it ([`CollisionModel::with_acm`],
+/// [`CollisionModel::with_attached`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Kept {
+    /// Objects the robot holds, their bodies among the model's bodies.
+    pub(crate) attached: Vec<crate::AttachedObject>,
+    /// Every body's [`CollisionModel::enclosing_spheres`] and
+    /// [`CollisionModel::inscribed_spheres`], fitted on first use and shared (fitting a
+    /// mesh's cells takes milliseconds).
+    pub(crate) spheres: Arc<SphereSets>,
+    /// Where meshes were searched for.
+    pub(crate) options: CollisionOptions,
 }
 
 /// Per body, its spheres in its link's frame, each set fitted on first use.
@@ -134,7 +158,18 @@ impl CollisionModel {
         let bodies = bodies_from_urdf(robot, options)?;
         let has = has_geometry(robot.num_links(), &bodies);
         let acm = AllowedCollisionMatrix::from_model(robot, &has);
-        Self::from_bodies(robot, bodies, acm)
+        let kept = Kept {
+            options: options.clone(),
+            ..Kept::default()
+        };
+        Self::build(robot, bodies, acm, kept)
+    }
+
+    /// Where the model's meshes were searched for (the options it was built with; the
+    /// defaults for [`CollisionModel::from_bodies`]): the URDF's other meshes, its visuals
+    /// say, are found the same way.
+    pub fn options(&self) -> &CollisionOptions {
+        &self.inner.kept.options
     }
 
     /// A collision model from bodies of your own (e.g. simplified proxies) and a matrix.
@@ -143,18 +178,19 @@ impl CollisionModel {
         bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
     ) -> Result<Self> {
-        Self::build(robot, bodies, acm, Vec::new(), Default::default())
+        Self::build(robot, bodies, acm, Kept::default())
     }
 
-    /// [`CollisionModel::from_bodies`] holding `attached` objects (their bodies among
-    /// `bodies`), with the bodies' spheres, fitted or still to fit.
+    /// [`CollisionModel::from_bodies`] with what a model carries over to the models made
+    /// from it: the objects it holds (their bodies among `bodies`), the bodies' spheres
+    /// (fitted or still to fit) and its mesh search options.
     pub(crate) fn build(
         robot: &RobotModel,
         mut bodies: Vec<Body>,
         acm: AllowedCollisionMatrix,
-        attached: Vec<crate::AttachedObject>,
-        spheres: Arc<SphereSets>,
+        kept: Kept,
     ) -> Result<Self> {
+        let attached = &kept.attached;
         if acm.num_links() != robot.num_links() {
             return Err(CollisionError::InvalidValue {
                 what: "allowed-collision matrix".into(),
@@ -239,8 +275,7 @@ impl CollisionModel {
                 pairs,
                 link_pairs,
                 culling,
-                attached,
-                spheres,
+                kept,
                 fast: OnceLock::new(),
             }),
         })
@@ -252,8 +287,7 @@ impl CollisionModel {
             &self.inner.robot,
             self.inner.bodies.clone(),
             acm,
-            self.inner.attached.clone(),
-            self.inner.spheres.clone(),
+            self.inner.kept.clone(),
         )
     }
 
@@ -276,6 +310,7 @@ impl CollisionModel {
     pub fn enclosing_spheres(&self, body: usize) -> &[crate::Sphere] {
         let all = self
             .inner
+            .kept
             .spheres
             .enclosing
             .get_or_init(|| self.in_link_frames(crate::Shape::enclosing_spheres));
@@ -291,6 +326,7 @@ impl CollisionModel {
     pub fn inscribed_spheres(&self, body: usize) -> &[crate::Sphere] {
         let all = self
             .inner
+            .kept
             .spheres
             .inscribed
             .get_or_init(|| self.in_link_frames(crate::Shape::inscribed_spheres));
@@ -400,7 +436,7 @@ impl CollisionModel {
 
     /// The objects the robot holds ([`CollisionModel::with_attached`]).
     pub fn attached(&self) -> &[crate::AttachedObject] {
-        &self.inner.attached
+        &self.inner.kept.attached
     }
 
     /// Sphere sets for `bodies`: those already fitted for this model's bodies of the same
@@ -427,7 +463,7 @@ impl CollisionModel {
             }
             cell
         };
-        let spheres = &self.inner.spheres;
+        let spheres = &self.inner.kept.spheres;
         Arc::new(SphereSets {
             enclosing: carry(&spheres.enclosing, crate::Shape::enclosing_spheres),
             inscribed: carry(&spheres.inscribed, crate::Shape::inscribed_spheres),
@@ -444,9 +480,13 @@ impl CollisionModel {
         // in the order the model keeps them (by link), so that the spheres carried over line
         // up with the bodies
         bodies.sort_by_key(|b| b.link);
-        let spheres = self.carried_spheres(&bodies);
+        let kept = Kept {
+            attached,
+            spheres: self.carried_spheres(&bodies),
+            options: self.inner.kept.options.clone(),
+        };
         let acm = self.inner.acm.clone();
-        Self::build(&self.inner.robot, bodies, acm, attached, spheres)
+        Self::build(&self.inner.robot, bodies, acm, kept)
     }
 
     /// Where [`crate::fast::FastModel::of`] keeps this model's compilation.
@@ -499,16 +539,6 @@ fn body_pairs(bodies: &[Body], checked: impl Fn(usize, usize) -> bool) -> (Vec<B
 }
 
 fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Vec<Body>> {
-    let urdf_dir = options
-        .urdf_dir
-        .clone()
-        .or_else(|| link_dir(robot.origin()));
-    let package_paths: Vec<PathBuf> = options
-        .package_paths
-        .iter()
-        .chain(robot.package_paths())
-        .cloned()
-        .collect();
     let mut bodies = Vec::new();
     for (index, link) in robot.tree().links.iter().enumerate() {
         let several = link.collisions.len() > 1;
@@ -532,21 +562,22 @@ fn bodies_from_urdf(robot: &RobotModel, options: &CollisionOptions) -> Result<Ve
                     "write finite numbers".into(),
                 ));
             }
-            let shape = match from_urdf(&c.geometry) {
+            let shape = match Shape::from_urdf(&c.geometry) {
                 Some(s) => s,
                 None => {
                     let trm_kinematics::urdf_rs::Geometry::Mesh { filename, scale } = &c.geometry
                     else {
                         unreachable!("from_urdf converts every geometry but meshes")
                     };
-                    let path = resolve_mesh(filename, urdf_dir.as_deref(), &package_paths)
-                        .map_err(|tried| CollisionError::MeshNotFound {
+                    let path = options.find_mesh(robot, filename).map_err(|tried| {
+                        CollisionError::MeshNotFound {
                             origin: robot.origin().to_string(),
                             line: link.line,
                             element: element.clone(),
                             uri: filename.clone(),
                             tried,
-                        })?;
+                        }
+                    })?;
                     let scale = scale.map_or([1.0; 3], |s| s.0);
                     let points = convex_hull_of_mesh(&path, scale).map_err(|message| {
                         CollisionError::MeshUnreadable {

@@ -378,6 +378,18 @@ pub fn parse_versioned<T: serde::de::DeserializeOwned>(
     format: &'static str,
     version: u32,
 ) -> Result<T, FileError> {
+    parse_versioned_since(path, text, format, version, version)
+}
+
+/// [`parse_versioned`] of a format whose newer versions only add optional fields: any version
+/// from `oldest` to `version` is read.
+pub fn parse_versioned_since<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    text: &str,
+    format: &'static str,
+    oldest: u32,
+    version: u32,
+) -> Result<T, FileError> {
     let path_buf = || path.to_path_buf();
     let value: serde_json::Value = check_unique_keys(text)
         .and_then(|()| serde_json::from_str(text))
@@ -409,7 +421,9 @@ pub fn parse_versioned<T: serde::de::DeserializeOwned>(
         }
     }
     match value.get("version") {
-        Some(v) if v.as_u64() == Some(u64::from(version)) => {}
+        Some(v)
+            if v.as_u64()
+                .is_some_and(|v| (u64::from(oldest)..=u64::from(version)).contains(&v)) => {}
         found => {
             return Err(FileError::WrongVersion {
                 path: path_buf(),

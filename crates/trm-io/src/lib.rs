@@ -34,9 +34,9 @@ mod xml;
 
 pub use files::{
     FileError, MAX_INPUT_BYTES, StagedFile, binary_bytes, check_output, check_unique_keys,
-    json_text, load_versioned, parse_binary_versioned, parse_versioned, read_file, read_file_bytes,
-    read_input, read_input_bytes, save_json, unique_names, write_atomic, write_file,
-    write_file_bytes,
+    json_text, load_versioned, parse_binary_versioned, parse_versioned, parse_versioned_since,
+    read_file, read_file_bytes, read_input, read_input_bytes, save_json, unique_names,
+    write_atomic, write_file, write_file_bytes,
 };
 pub use names::closest_names;
 pub use points::{PointFile, parse_points, read_points};

@@ -80,6 +80,9 @@ pub struct Link {
     pub parent_joint: Option<usize>,
     /// The link's URDF `<collision>` elements, as written (mesh files are not opened here).
     pub collisions: Vec<urdf_rs::Collision>,
+    /// The link's URDF `<visual>` elements, as written, except that a material named without a
+    /// colour takes the colour of the robot-level `<material>` of that name.
+    pub visuals: Vec<urdf_rs::Visual>,
     /// Line of the `<link>` element in the URDF text, when known.
     pub line: Option<usize>,
     /// Mass properties (zero mass when the URDF gives no `<inertial>`).
@@ -400,6 +403,7 @@ impl Tree {
                 parent: parent_joint.map(|j| new_index[link_index[j.parent.link.as_str()]]),
                 parent_joint: parent_joint.map(|_| new - 1),
                 collisions: robot.links[old].collision.clone(),
+                visuals: visuals_of(robot, &robot.links[old]),
                 line: ctx
                     .source
                     .and_then(|src| line_of_element(src, "link", &robot.links[old].name)),
@@ -476,6 +480,20 @@ impl Tree {
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
     }
+}
+
+/// `link`'s visuals, each material named without a colour given the robot-level one's.
+fn visuals_of(robot: &urdf_rs::Robot, link: &urdf_rs::Link) -> Vec<urdf_rs::Visual> {
+    let mut visuals = link.visual.clone();
+    for m in visuals.iter_mut().filter_map(|v| v.material.as_mut()) {
+        if m.color.is_none() && m.texture.is_none() {
+            if let Some(global) = robot.materials.iter().find(|g| g.name == m.name) {
+                m.color.clone_from(&global.color);
+                m.texture.clone_from(&global.texture);
+            }
+        }
+    }
+    visuals
 }
 
 fn convert_joint(uj: &urdf_rs::Joint, parent: usize, child: usize, ctx: &Ctx) -> Result<Joint> {

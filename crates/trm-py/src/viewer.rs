@@ -8,9 +8,11 @@ use crate::*;
 /// `path` `(K, 3)` drawn as a line, and a `roadmap`'s points, edges and postures (as `trm view
 /// --map` draws them). `out` gets the page and `out` with `.json` the scene; the
 /// page loads three.js from a CDN unless `bundle` names a built viewer (viewer/dist/viewer.js)
-/// to inline. Returns the page's path.
+/// to inline. The robot is drawn as it looks (its URDF visual meshes, found as its collision
+/// meshes are: beside the URDF, in `package_paths`, in ROS_PACKAGE_PATH), or by its collision
+/// shapes when a visual cannot be loaded. Returns the page's path.
 #[pyfunction]
-#[pyo3(signature = (robot, out, frames = None, times = None, world = None, path = None, title = "trm", bundle = None, roadmap = None))]
+#[pyo3(signature = (robot, out, frames = None, times = None, world = None, path = None, title = "trm", bundle = None, roadmap = None, package_paths = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn view(
     robot: &Robot,
@@ -22,6 +24,7 @@ pub(crate) fn view(
     title: &str,
     bundle: Option<std::path::PathBuf>,
     roadmap: Option<&Roadmap>,
+    package_paths: Vec<std::path::PathBuf>,
 ) -> PyResult<std::path::PathBuf> {
     let n = robot.model.motors().len();
     let postures = match frames {
@@ -40,7 +43,8 @@ pub(crate) fn view(
             times.len()
         )));
     }
-    let collision = CollisionModel::new(&robot.model).map_err(err)?;
+    let options = trm_collision::CollisionOptions::with_ros_package_path(package_paths);
+    let collision = CollisionModel::with_options(&robot.model, &options).map_err(err)?;
     let mut scene = trm_view::Scene::new(title, &collision);
     if let Some(w) = world {
         scene.set_world(&w.world);

@@ -1,6 +1,7 @@
-//! Scenes for looking at what trm computes: a robot's collision shapes, link poses over time
-//! (postures or a motion), world objects, roadmap task points and edges coloured by cost, and a
-//! task-space path — as a versioned JSON document ([`Scene`], format `trm-scene` v1) and as one
+//! Scenes for looking at what trm computes: a robot as it looks (its URDF visuals, meshes in
+//! their materials' colours) and its collision shapes, the objects it holds, link poses over
+//! time (postures or a motion), world objects (primitives, meshes, point clouds), roadmap task
+//! points and edges coloured by cost, and a task-space path — as a versioned JSON document ([`Scene`], format `trm-scene` v1) and as one
 //! self-contained HTML page that renders it with three.js ([`Scene::to_html`]).
 //!
 //! The page's code lives in `viewer/` (an npm package: three.js and our `src/main.js`, bundled by
@@ -29,12 +30,17 @@ use trm_kinematics::nalgebra::Isometry3;
 use trm_kinematics::{PoseBuffer, RobotModel};
 
 mod subjects;
+mod visuals;
 pub use subjects::point3;
+pub use visuals::{DEFAULT_COLOR, SceneVisual};
 
 /// The scene format's name and version.
 pub const FORMAT: &str = "trm-scene";
-/// The scene format version this crate writes and reads.
-pub const VERSION: u32 = 1;
+/// The scene format version this crate writes (it reads this one and
+/// [`OLDEST_VERSION`] on: version 2 added the robot's visuals and held objects).
+pub const VERSION: u32 = 2;
+/// The oldest scene format version this crate reads.
+pub const OLDEST_VERSION: u32 = 1;
 /// The three.js version the page uses (the one `viewer/package.json` pins).
 pub const THREE_VERSION: &str = "0.187.0";
 /// The viewer's own code (bundled with three.js by `npm run build` in `viewer/`).
@@ -91,6 +97,9 @@ pub struct SceneBody {
     pub shape: Shape,
     /// Pose of the shape in the link frame.
     pub local: Pose,
+    /// The held object this body belongs to (a MoveIt attached object), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held: Option<String>,
 }
 
 /// One frame: the link poses at a time.
@@ -194,12 +203,19 @@ pub struct Scene {
     pub generator: String,
     /// Page title.
     pub title: String,
-    /// Names of the links that carry bodies (the order of every frame's poses).
+    /// Names of the links that carry bodies or visuals (the order of every frame's poses).
     pub links: Vec<String>,
     /// Tree index of each of [`Scene::links`].
     pub link_index: Vec<usize>,
     /// Collision bodies.
     pub bodies: Vec<SceneBody>,
+    /// The robot's look: its URDF visuals (empty when it has none, or in a version 1 scene).
+    #[serde(default)]
+    pub visuals: Vec<SceneVisual>,
+    /// The visuals that could not be loaded (a mesh file not found, say), one line each: the
+    /// page then shows the collision shapes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub missing_visuals: Vec<String>,
     /// Frames (one per posture or trajectory sample).
     pub frames: Vec<SceneFrame>,
     /// World objects.
@@ -223,29 +239,47 @@ pub fn pose(p: &Isometry3<f64>) -> Pose {
 }
 
 impl Scene {
-    /// An empty scene of `collision`'s robot: its bodies and tree, no frames yet.
+    /// An empty scene of `collision`'s robot: its bodies, the objects it holds, its visuals
+    /// (URDF `<visual>` meshes found as its collision meshes are; those that cannot be loaded
+    /// are listed in [`Scene::missing_visuals`]) and its tree; no frames yet.
     pub fn new(title: &str, collision: &CollisionModel) -> Self {
         let model = collision.robot().clone();
         let tree = model.tree();
         let mut links: Vec<String> = Vec::new();
         let mut link_index = Vec::new();
+        let mut slot_of = |link: usize| match link_index.iter().position(|&l| l == link) {
+            Some(s) => s,
+            None => {
+                link_index.push(link);
+                links.push(tree.links[link].name.clone());
+                links.len() - 1
+            }
+        };
         let mut bodies = Vec::new();
         for b in collision.bodies() {
-            let slot = match link_index.iter().position(|&l| l == b.link) {
-                Some(s) => s,
-                None => {
-                    link_index.push(b.link);
-                    links.push(tree.links[b.link].name.clone());
-                    links.len() - 1
-                }
-            };
             bodies.push(SceneBody {
                 name: b.name.clone(),
-                link: slot,
+                link: slot_of(b.link),
                 shape: b.shape.clone(),
                 local: pose(&b.local),
+                held: collision
+                    .attached()
+                    .iter()
+                    .find(|o| o.holds(&b.name))
+                    .map(|o| o.name.clone()),
             });
         }
+        let loaded = visuals::load(collision);
+        let visuals = loaded
+            .parts
+            .into_iter()
+            .map(|(link, shape, local, color)| SceneVisual {
+                link: slot_of(link),
+                shape,
+                local,
+                color,
+            })
+            .collect();
         let kinematics = SceneKinematics {
             links: tree.links.iter().map(|l| l.name.clone()).collect(),
             joints: tree
@@ -273,6 +307,8 @@ impl Scene {
             links,
             link_index,
             bodies,
+            visuals,
+            missing_visuals: loaded.missing,
             frames: Vec::new(),
             world: Vec::new(),
             map: None,
@@ -398,8 +434,8 @@ impl Scene {
         Ok(serde_json::to_string(self)?)
     }
 
-    /// Reads a scene, checking its format and version (the one versioned-JSON reader of trm,
-    /// [`trm_io::parse_versioned`]) and its content ([`Scene::check`]).
+    /// Reads a scene (of version [`OLDEST_VERSION`] to [`VERSION`]), checking its format and
+    /// version (the one versioned-JSON reader of trm, [`trm_io::parse_versioned_since`]) and its content ([`Scene::check`]).
     pub fn from_json(text: &str) -> Result<Self> {
         Self::parse(std::path::Path::new("<scene>"), text)
     }
@@ -415,7 +451,9 @@ impl Scene {
     }
 
     fn parse(path: &std::path::Path, text: &str) -> Result<Self> {
-        let scene: Scene = trm_io::parse_versioned(path, text, FORMAT, VERSION)?;
+        let mut scene: Scene =
+            trm_io::parse_versioned_since(path, text, FORMAT, OLDEST_VERSION, VERSION)?;
+        scene.version = VERSION;
         scene.check().map_err(|e| match e {
             ViewError::Invalid { what, problem } => ViewError::Invalid {
                 what: format!("{}: {what}", path.display()),
@@ -454,6 +492,26 @@ impl Scene {
                     "names no link or has a non-finite pose",
                 );
             }
+        }
+        for (i, v) in self.visuals.iter().enumerate() {
+            let color_ok = v.color.iter().all(|c| (0.0..=1.0).contains(c));
+            if v.link >= links || !finite(&v.local) || !color_ok {
+                return bad(
+                    format!("visuals[{i}]"),
+                    "names no link, or has a non-finite pose or a colour outside 0..=1",
+                );
+            }
+        }
+        let shapes = (self.bodies.iter().map(|b| ("bodies", &b.shape)))
+            .chain(self.visuals.iter().map(|v| ("visuals", &v.shape)))
+            .chain(self.world.iter().map(|o| ("world", &o.shape)));
+        let mut counts = std::collections::HashMap::new();
+        for (list, shape) in shapes {
+            let i = counts.entry(list).or_insert(0usize);
+            if let Err(p) = shape.check() {
+                return bad(format!("{list}[{i}].shape"), &p.problem);
+            }
+            *i += 1;
         }
         let coordinates = self
             .kinematics

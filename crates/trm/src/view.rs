@@ -224,6 +224,7 @@ mod tests {
     use std::process::Command;
 
     use trm_collision::{CollisionModel, World};
+    use trm_kinematics::nalgebra::Isometry3;
     use trm_view::Scene;
 
     /// 200 postures of the iCub around home.
@@ -328,41 +329,65 @@ mod tests {
         panic!("chromium failed three times; last: {last}");
     }
 
-    /// The page, opened at a fixed frame in headless Chromium with software WebGL, reports what
-    /// it drew; the report must match the scene. Runs where Chromium and the built viewer
-    /// bundle exist; `.ci/run` installs both and sets TRM_BROWSER_TEST=1, which makes their
-    /// absence a failure.
-    #[test]
-    #[ignore = "starts a browser (Chromium, software WebGL); CI runs it with --ignored"]
-    fn the_page_draws_the_scene_in_a_real_browser() {
-        let required = std::env::var_os("TRM_BROWSER_TEST").is_some_and(|v| v == "1");
+    /// `scene`'s page, written as `target/ci-artefacts/NAME.html` and opened at `query` in
+    /// headless Chromium with software WebGL: the report the page wrote (its counts and
+    /// pixels), and its screenshot saved as `NAME.png`. `None` where Chromium or the built
+    /// viewer bundle is missing; `.ci/run` installs both and sets TRM_BROWSER_TEST=1, which
+    /// makes their absence a failure.
+    fn open_in_browser(scene: &Scene, name: &str, query: &str) -> Option<serde_json::Value> {
         let repo = crate::models_dir().join("..");
         let bundle = trm_view::find_bundle(&repo).unwrap();
         let (Some(chromium), Some(bundle)) = (chromium(), bundle) else {
             assert!(
-                !required,
+                !browser_required(),
                 "TRM_BROWSER_TEST=1 but Chromium (/usr/bin/chromium or TRM_CHROMIUM) or viewer/dist/viewer.js is missing"
             );
             eprintln!("skipped: needs Chromium and `npm run build` in viewer/ (.ci/run does both)");
-            return;
+            return None;
         };
-        let scene = full_scene();
         let dir = repo.join("target/ci-artefacts");
         std::fs::create_dir_all(&dir).unwrap();
-        let page = dir.join("viewer.html");
+        let page = dir.join(format!("{name}.html"));
         std::fs::write(&page, scene.to_html(Some(&bundle)).unwrap()).unwrap();
-        let url = format!(
-            "file://{}?frame=3&pick=7",
-            page.canonicalize().unwrap().display()
-        );
-        let profile = std::env::temp_dir().join(format!("trm-chromium-{}", std::process::id()));
+        let url = format!("file://{}{query}", page.canonicalize().unwrap().display());
+        let profile =
+            std::env::temp_dir().join(format!("trm-chromium-{name}-{}", std::process::id()));
         let dom = headless(&chromium, &profile, &["--dump-dom"], &url);
+        // the report is JSON in a script element, not text on the page
         let start = dom
-            .find("<pre id=\"trm-report\"")
+            .find("<script id=\"trm-report\"")
             .expect("the page wrote its report");
         let json_start = dom[start..].find('>').unwrap() + start + 1;
-        let json_end = dom[json_start..].find("</pre>").unwrap() + json_start;
+        let json_end = dom[json_start..].find("</script>").unwrap() + json_start;
         let report: serde_json::Value = serde_json::from_str(&dom[json_start..json_end]).unwrap();
+        let shot = dir.join(format!("{name}.png"));
+        let arg = format!("--screenshot={}", shot.display());
+        headless(&chromium, &profile, &[&arg], &url);
+        assert!(std::fs::metadata(&shot).unwrap().len() > 10_000);
+        let _ = std::fs::remove_dir_all(&profile);
+        Some(report)
+    }
+
+    fn browser_required() -> bool {
+        std::env::var_os("TRM_BROWSER_TEST").is_some_and(|v| v == "1")
+    }
+
+    /// Non-background pixels: some, not all.
+    fn assert_drawn(report: &serde_json::Value) {
+        let pixels = report["pixels"].as_f64().unwrap();
+        let area = report["width"].as_f64().unwrap() * report["height"].as_f64().unwrap();
+        assert!(pixels > 0.05 * area && pixels < 0.9 * area, "{report}");
+    }
+
+    /// The page, opened at a fixed frame in headless Chromium with software WebGL, reports what
+    /// it drew; the report must match the scene.
+    #[test]
+    #[ignore = "starts a browser (Chromium, software WebGL); CI runs it with --ignored"]
+    fn the_page_draws_the_scene_in_a_real_browser() {
+        let scene = full_scene();
+        let Some(report) = open_in_browser(&scene, "viewer", "?frame=3&pick=7") else {
+            return;
+        };
         let map = scene.map.as_ref().unwrap();
         assert_eq!(report["bodies"], scene.bodies.len());
         assert_eq!(report["links"], scene.links.len());
@@ -373,6 +398,9 @@ mod tests {
         assert_eq!(report["frames"], scene.frames.len());
         assert_eq!(report["frame"], 3);
         assert!(report["fk_error"].as_f64().unwrap() < 1e-5, "{report}");
+        // a robot without visuals is shown by its collision shapes
+        assert_eq!(report["visuals"], 0);
+        assert_eq!(report["collision_shown"], true);
         // frame 3's moving world and map: one object hidden, 180 points drawn, 15 red
         let state = scene.frames[3].map.as_ref().unwrap();
         assert_eq!(report["objects_shown"], scene.world.len() - 1);
@@ -395,14 +423,142 @@ mod tests {
                 "{got} vs {want}"
             );
         }
-        let pixels = report["pixels"].as_f64().unwrap();
-        let area = report["width"].as_f64().unwrap() * report["height"].as_f64().unwrap();
-        assert!(pixels > 0.05 * area && pixels < 0.9 * area, "{report}");
-        let shot = dir.join("viewer.png");
-        let arg = format!("--screenshot={}", shot.display());
-        headless(&chromium, &profile, &[&arg], &url);
-        assert!(std::fs::metadata(&shot).unwrap().len() > 10_000);
-        let _ = std::fs::remove_dir_all(&profile);
+        assert_drawn(&report);
+    }
+
+    /// The Panda as it looks (example-robot-data's COLLADA visuals, in their colours) on a
+    /// table sensed as a point cloud, beside a scene mesh, holding a box. The visual meshes
+    /// come from PyPI's example-robot-data (`.ci/run` puts them under TRM_PANDA_VISUALS, a
+    /// package path).
+    #[test]
+    #[ignore = "starts a browser (Chromium, software WebGL); CI runs it with --ignored"]
+    fn the_page_shows_the_panda_as_it_looks_among_a_point_cloud() {
+        let Some(visuals) = std::env::var_os("TRM_PANDA_VISUALS").map(PathBuf::from) else {
+            assert!(
+                !browser_required(),
+                "TRM_BROWSER_TEST=1 but TRM_PANDA_VISUALS (a package path holding example-robot-data's Panda visual meshes) is not set"
+            );
+            eprintln!("skipped: set TRM_PANDA_VISUALS (.ci/run does)");
+            return;
+        };
+        let models = crate::models_dir();
+        let robot = trm_kinematics::RobotModel::load(models.join("panda/panda.ron")).unwrap();
+        let options = trm_collision::CollisionOptions {
+            package_paths: vec![visuals],
+            ..Default::default()
+        };
+        let collision = CollisionModel::with_options(&robot, &options)
+            .unwrap()
+            .with_attached(trm_collision::AttachedObject {
+                name: "box".into(),
+                link: "panda_hand".into(),
+                shapes: vec![(
+                    trm_collision::Shape::Box {
+                        size: [0.04, 0.04, 0.08],
+                    },
+                    Isometry3::translation(0.0, 0.0, 0.1),
+                )],
+                touch_links: vec!["panda_leftfinger".into(), "panda_rightfinger".into()],
+            })
+            .unwrap();
+        let mut scene = Scene::new("Panda among a point cloud", &collision);
+        assert!(
+            scene.missing_visuals.is_empty(),
+            "{:?}",
+            scene.missing_visuals
+        );
+        scene.add_frame(0.0, &super::home(&robot)).unwrap();
+        // a table, sensed: points on its surfaces, 8 mm apart
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
+        let table = trm_collision::Shape::Box {
+            size: [0.6, 1.0, 0.04],
+        };
+        let mut points: Vec<[f64; 3]> = table
+            .surface_samples(40_000, &mut rng)
+            .iter()
+            .map(|p| [p[0] + 0.55, p[1], p[2] - 0.02])
+            .collect();
+        points = trm_collision::thin_points(&points, 0.008);
+        let mut world = World::new();
+        world
+            .add(
+                "table (sensed)",
+                trm_collision::Shape::Points {
+                    points: points.clone(),
+                    radius: 0.004,
+                },
+                Isometry3::identity(),
+            )
+            .unwrap();
+        let (vertices, triangles) = bowl();
+        world
+            .add(
+                "bowl (mesh)",
+                trm_collision::Shape::Mesh {
+                    vertices,
+                    triangles,
+                },
+                Isometry3::translation(0.5, -0.3, 0.0),
+            )
+            .unwrap();
+        scene.set_world(&world);
+        let Some(report) = open_in_browser(&scene, "viewer-panda", "") else {
+            return;
+        };
+        assert_eq!(report["visuals"], scene.visuals.len());
+        let triangles: usize = scene
+            .visuals
+            .iter()
+            .map(|v| match &v.shape {
+                trm_collision::Shape::Mesh { triangles, .. } => triangles.len(),
+                _ => 0,
+            })
+            .sum();
+        assert!(triangles > 100_000, "{triangles}");
+        assert_eq!(report["visual_triangles"], triangles);
+        assert_eq!(report["look_shown"], true);
+        assert_eq!(report["collision_shown"], false);
+        assert_eq!(report["held"], 1);
+        assert_eq!(report["cloud_points"], points.len());
+        assert_eq!(report["objects_shown"], 2);
+        assert!(report["fk_error"].as_f64().unwrap() < 1e-5, "{report}");
+        assert_drawn(&report);
+    }
+
+    /// An open bowl: a hemisphere of triangles, 0.1 m across.
+    fn bowl() -> trm_collision::mesh::Triangles {
+        let (rings, sectors) = (6, 16);
+        let mut vertices = vec![[0.0, 0.0, 0.0]];
+        for r in 1..=rings {
+            let a = std::f64::consts::FRAC_PI_2 * r as f64 / rings as f64;
+            for s in 0..sectors {
+                let b = std::f64::consts::TAU * s as f64 / sectors as f64;
+                vertices.push([
+                    0.1 * a.sin() * b.cos(),
+                    0.1 * a.sin() * b.sin(),
+                    0.1 - 0.1 * a.cos(),
+                ]);
+            }
+        }
+        let at = |r: u32, s: u32| {
+            if r == 0 {
+                0
+            } else {
+                1 + (r - 1) * sectors + s % sectors
+            }
+        };
+        let mut triangles = Vec::new();
+        for r in 0..rings {
+            for s in 0..sectors {
+                if r == 0 {
+                    triangles.push([0, at(1, s), at(1, s + 1)]);
+                } else {
+                    triangles.push([at(r, s), at(r + 1, s), at(r + 1, s + 1)]);
+                    triangles.push([at(r, s), at(r + 1, s + 1), at(r, s + 1)]);
+                }
+            }
+        }
+        (vertices, triangles)
     }
 
     #[test]

@@ -100,6 +100,25 @@ fn problem(problem: impl Into<String>, fix: impl Into<String>) -> ShapeProblem {
 }
 
 impl Shape {
+    /// A URDF `<geometry>` primitive (box, cylinder, capsule, sphere) as a shape; `None` for a
+    /// mesh, which the caller loads ([`crate::mesh`]).
+    pub fn from_urdf(geometry: &trm_kinematics::urdf_rs::Geometry) -> Option<Shape> {
+        use trm_kinematics::urdf_rs::Geometry as G;
+        Some(match geometry {
+            G::Box { size } => Shape::Box { size: size.0 },
+            G::Cylinder { radius, length } => Shape::Cylinder {
+                radius: *radius,
+                length: *length,
+            },
+            G::Capsule { radius, length } => Shape::Capsule {
+                radius: *radius,
+                length: *length,
+            },
+            G::Sphere { radius } => Shape::Sphere { radius: *radius },
+            G::Mesh { .. } => return None,
+        })
+    }
+
     /// Volume, m³, of a primitive (`None` for a convex hull of points).
     pub fn volume(&self) -> Option<f64> {
         use std::f64::consts::PI;
@@ -351,24 +370,6 @@ pub(crate) fn spans_volume(points: &[Point3<f64>]) -> bool {
     let normal = normal.normalize();
     let (height, _) = farthest(&|p| (p - p0).dot(&normal).abs());
     height > 1e-9 * extent
-}
-
-/// Converts a URDF `<geometry>` into a [`Shape`]; meshes are loaded by the caller.
-pub(crate) fn from_urdf(geometry: &trm_kinematics::urdf_rs::Geometry) -> Option<Shape> {
-    use trm_kinematics::urdf_rs::Geometry as G;
-    Some(match geometry {
-        G::Box { size } => Shape::Box { size: size.0 },
-        G::Cylinder { radius, length } => Shape::Cylinder {
-            radius: *radius,
-            length: *length,
-        },
-        G::Capsule { radius, length } => Shape::Capsule {
-            radius: *radius,
-            length: *length,
-        },
-        G::Sphere { radius } => Shape::Sphere { radius: *radius },
-        G::Mesh { .. } => return None,
-    })
 }
 
 #[cfg(test)]

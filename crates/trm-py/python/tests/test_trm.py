@@ -1,6 +1,8 @@
 """The Python API end to end: kinematics (and against Pinocchio), collision, NGIK, optimisers,
 roadmaps and planning, and errors."""
 
+import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -236,6 +238,7 @@ def test_constrained_one_plus_one_keeps_to_the_feasible_side():
 
 def test_view_writes_the_page_and_its_scene(robot, tmp_path):
     import json
+import os
 
     home = robot.posture("home")
     lifted = home.copy()
@@ -249,6 +252,21 @@ def test_view_writes_the_page_and_its_scene(robot, tmp_path):
     assert len(scene["frames"]) == 2 and len(scene["world"]) == 1 and len(scene["path"]) == 2
     with pytest.raises(trm.TrmError, match="times"):
         trm.view(robot, str(tmp_path / "x.html"), frames=home, times=[0.0, 1.0])
+
+
+def test_a_page_shows_the_robot_as_it_looks(tmp_path):
+    # the Panda's visuals are example-robot-data's COLLADA meshes: drawn in their colours where
+    # a package path holds them (TRM_PANDA_VISUALS, as .ci/run sets it), else listed as missing
+    robot = trm.Robot.load(str(ROOT / "models" / "panda" / "panda.ron"))
+    visuals = os.environ.get("TRM_PANDA_VISUALS")
+    trm.view(robot, str(tmp_path / "panda.html"), package_paths=[visuals] if visuals else [])
+    scene = json.loads((tmp_path / "panda.json").read_text())
+    if visuals:
+        assert "missing_visuals" not in scene and len(scene["visuals"]) >= 10
+        colours = {tuple(v["color"]) for v in scene["visuals"]}
+        assert len(colours) > 2
+    else:
+        assert len(scene["missing_visuals"]) == 11 and scene["visuals"] == []
 
 
 def test_a_map_builds_saves_loads_and_plans(tmp_path):

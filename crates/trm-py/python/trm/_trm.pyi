@@ -251,4 +251,5 @@ def view(
     title: str = "trm",
     bundle: str | None = None,
     roadmap: Roadmap | None = None,
+    package_paths: Sequence[str] = (),
 ) -> str: ...

@@ -45,11 +45,18 @@ pub fn write_scene(scene: &Scene, out: &Path) -> Result<()> {
             trm_view::THREE_VERSION
         )
     };
+    if let Some(first) = scene.missing_visuals.first() {
+        eprintln!(
+            "note: {} of the robot's visuals not loaded, so the page shows its collision shapes; first: {first}\n  fix: give the directory holding the visuals' package with --package-path (or ROS_PACKAGE_PATH)",
+            scene.missing_visuals.len()
+        );
+    }
     eprintln!(
-        "wrote {} ({how}) and {}: {} bodies, {} frames{}",
+        "wrote {} ({how}) and {}: {} bodies, {} visuals, {} frames{}",
         out.display(),
         out.with_extension("json").display(),
         scene.bodies.len(),
+        scene.visuals.len(),
         scene.frames.len(),
         scene
             .map
