@@ -175,12 +175,18 @@ fn the_page_inlines_the_bundle_or_falls_back_to_the_pinned_cdn() {
 }
 
 /// A robot whose links look like something: a box in a colour named at robot level, a mesh
-/// whose material library gives two colours, and a mesh whose file is missing.
+/// whose material library gives two colours, a mesh whose file is missing and one that is
+/// malformed.
 fn looks_robot(dir: &std::path::Path) -> trm_kinematics::RobotModel {
     std::fs::create_dir_all(dir.join("meshes")).unwrap();
     std::fs::write(
         dir.join("meshes/part.obj"),
         "mtllib part.mtl\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nusemtl red\nf 1 3 2\nf 1 2 4\nusemtl blue\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("meshes/broken.dae"),
+        "<COLLADA><library_geometries>",
     )
     .unwrap();
     std::fs::write(
@@ -197,6 +203,7 @@ fn looks_robot(dir: &std::path::Path) -> trm_kinematics::RobotModel {
   <link name="arm">
     <visual><origin xyz="0 0 0.05"/><geometry><mesh filename="meshes/part.obj" scale="2 2 2"/></geometry></visual>
     <visual><geometry><mesh filename="meshes/gone.stl"/></geometry></visual>
+    <visual><geometry><mesh filename="meshes/broken.dae"/></geometry></visual>
   </link>
   <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
@@ -236,13 +243,20 @@ fn the_robot_looks_as_its_urdf_visuals_say() {
         assert!(vertices.len() <= 4);
         assert!(vertices.iter().flatten().any(|&c| c == 0.2));
     }
-    // the missing file is named with where it was looked for, not an error
-    assert_eq!(scene.missing_visuals.len(), 1);
+    // the missing file is named with where it was looked for, the malformed one with the
+    // reader's complaint: listed, not an error
+    assert_eq!(
+        scene.missing_visuals.len(),
+        2,
+        "{:?}",
+        scene.missing_visuals
+    );
     assert!(
         scene.missing_visuals[0].contains("gone.stl") && scene.missing_visuals[0].contains("arm"),
         "{:?}",
         scene.missing_visuals
     );
+    assert!(scene.missing_visuals[1].contains("broken.dae"));
     // and it all round-trips
     let back = Scene::from_json(&scene.to_json().unwrap()).unwrap();
     assert_eq!(back.visuals, scene.visuals);

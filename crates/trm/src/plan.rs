@@ -521,7 +521,9 @@ fn run_without_maps(args: &Args) -> Result<()> {
         );
     }
     if args.view {
-        let mut scene = trm_view::Scene::new("planned motion", &collision);
+        // the robot with what it holds, as the planner checked it
+        let collision = planner.objective().collision();
+        let mut scene = trm_view::Scene::new("planned motion", collision);
         for (t, q) in trajectory.times.iter().zip(&trajectory.positions) {
             scene.add_frame(*t, q)?;
         }

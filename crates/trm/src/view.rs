@@ -33,7 +33,8 @@ pub struct Args {
     /// `stand-up` write), or `plan`'s JSON (with its task-space path).
     #[arg(long)]
     traj: Option<PathBuf>,
-    /// World objects (RON, or a MoveIt planning scene .yaml), replacing the spec's.
+    /// World objects (RON, or a MoveIt planning scene .yaml, whose attached objects the robot
+    /// holds), replacing the spec's.
     #[arg(long)]
     world: Option<PathBuf>,
     /// The page; the JSON scene is written beside it.
@@ -168,10 +169,17 @@ pub fn run(args: &Args) -> Result<()> {
         None => None,
     };
     let mut s = subject(args, map.as_ref())?;
+    let mut collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
     if let Some(w) = &args.world {
-        s.world = trm_moveit::load_world(w)?;
+        // a MoveIt scene's objects, and the ones the robot holds in it
+        let scene = trm_moveit::load_scene(w, &collision)?;
+        s.world = scene.world;
+        for object in scene.attached {
+            collision = collision
+                .with_attached(object)
+                .with_context(|| format!("{}: attached_collision_objects", w.display()))?;
+        }
     }
-    let collision: CollisionModel = args.mesh.collision_model(&s.robot)?;
     let mut scene = Scene::new(&s.title, &collision);
     scene.set_world(&s.world);
     let base = |motors: &[f64]| {
@@ -559,6 +567,34 @@ mod tests {
             }
         }
         (vertices, triangles)
+    }
+
+    #[test]
+    fn a_robot_whose_visual_meshes_are_not_found_is_drawn_by_its_collision_shapes() {
+        let dir = crate::test_dir("view-visuals");
+        let out = dir.join("panda.html");
+        let args = super::Args {
+            input: Some(crate::models_dir().join("panda/panda.ron")),
+            postures: vec![],
+            map: None,
+            traj: None,
+            world: None,
+            out: out.clone(),
+            mesh: crate::MeshArgs::default(),
+        };
+        super::run(&args).unwrap();
+        let scene = Scene::from_json(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+            .unwrap();
+        // the Panda's 11 visuals name example-robot-data's COLLADA files, not shipped
+        assert_eq!(
+            scene.missing_visuals.len(),
+            11,
+            "{:?}",
+            scene.missing_visuals
+        );
+        assert!(scene.missing_visuals[0].contains("link0.dae"));
+        assert!(scene.visuals.is_empty() && !scene.bodies.is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

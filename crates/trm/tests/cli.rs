@@ -217,6 +217,69 @@ fn plan_without_maps_refuses_what_does_not_fit_and_writes_nothing() {
 }
 
 #[test]
+fn plan_and_view_draw_the_robot_with_what_it_holds() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-plan-held-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let [_, scene, request] = panda_problem();
+    // the sample scene with a small box held inside the hand (clear of the can it reaches for)
+    let mut held = trm_moveit::PlanningScene::load(&scene).unwrap();
+    held.attached.push(trm_collision::AttachedObject {
+        name: "box".into(),
+        link: "panda_hand".into(),
+        shapes: vec![(
+            trm_collision::Shape::Box {
+                size: [0.02, 0.02, 0.02],
+            },
+            trm_kinematics::nalgebra::Isometry3::translation(0.0, 0.0, 0.03),
+        )],
+        touch_links: vec!["panda_leftfinger".into(), "panda_rightfinger".into()],
+    });
+    let held_scene = dir.join("held.yaml");
+    std::fs::write(&held_scene, held.to_yaml().unwrap()).unwrap();
+    plan_panda(
+        &dir,
+        &held_scene,
+        &request,
+        &["--out", "traj.csv", "--view"],
+    );
+    let page = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.to_string_lossy().ends_with(".scene.json"))
+        .expect("--view wrote a scene");
+    // `trm view` of the scene holds it too
+    let [model, _, _] = panda_problem();
+    let out = trm(
+        &[
+            "view",
+            model.to_str().unwrap(),
+            "--world",
+            held_scene.to_str().unwrap(),
+            "--out",
+            "view.html",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for page in [page, dir.join("view.json")] {
+        let view = trm_view::Scene::load(&page).unwrap();
+        let box_ = view
+            .bodies
+            .iter()
+            .find(|b| b.held.as_deref() == Some("box"));
+        assert_eq!(
+            view.links[box_.expect("the held box is drawn").link],
+            "panda_hand"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn plan_keeps_experience_in_a_file_and_retrieves_it() {
     let dir = std::env::temp_dir().join(format!("trm-cli-experience-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
