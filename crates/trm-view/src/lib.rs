@@ -1,8 +1,9 @@
 //! Scenes for looking at what trm computes: a robot as it looks (its URDF visuals, meshes in
 //! their materials' colours) and its collision shapes, the objects it holds, link poses over
 //! time (postures or a motion), world objects (primitives, meshes, point clouds), roadmap task
-//! points and edges coloured by cost, and a task-space path — as a versioned JSON document ([`Scene`], format `trm-scene` v1) and as one
-//! self-contained HTML page that renders it with three.js ([`Scene::to_html`]).
+//! points and edges coloured by cost, and a task-space path — as a versioned JSON document
+//! ([`Scene`], format `trm-scene` v2) and as one self-contained HTML page that renders it with
+//! three.js ([`Scene::to_html`]).
 //!
 //! The page's code lives in `viewer/` (an npm package: three.js and our `src/main.js`, bundled by
 //! esbuild into `viewer/dist/viewer.js`). When the bundle has been built it is inlined, so the
@@ -273,11 +274,9 @@ impl Scene {
         let visuals = loaded
             .parts
             .into_iter()
-            .map(|(link, shape, local, color)| SceneVisual {
-                link: slot_of(link),
-                shape,
-                local,
-                color,
+            .map(|v| SceneVisual {
+                link: slot_of(v.link),
+                ..v
             })
             .collect();
         let kinematics = SceneKinematics {
@@ -435,7 +434,8 @@ impl Scene {
     }
 
     /// Reads a scene (of version [`OLDEST_VERSION`] to [`VERSION`]), checking its format and
-    /// version (the one versioned-JSON reader of trm, [`trm_io::parse_versioned_since`]) and its content ([`Scene::check`]).
+    /// version (the one versioned-JSON reader of trm, [`trm_io::parse_versioned_since`]) and
+    /// its content ([`Scene::check`]).
     pub fn from_json(text: &str) -> Result<Self> {
         Self::parse(std::path::Path::new("<scene>"), text)
     }

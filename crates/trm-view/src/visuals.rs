@@ -38,8 +38,8 @@ pub struct SceneVisual {
 /// A robot's visuals, and what could not be loaded.
 #[derive(Debug, Default)]
 pub(crate) struct Visuals {
-    /// Per tree link, its parts (the scene assigns the links' slots).
-    pub parts: Vec<(usize, Shape, Pose, [f32; 4])>,
+    /// The parts, each `link` a tree index (the scene gives the links their slots).
+    pub parts: Vec<SceneVisual>,
     /// One line per visual that could not be loaded: the link, the file, why.
     pub missing: Vec<String>,
 }
@@ -50,7 +50,8 @@ pub(crate) struct Visuals {
 pub(crate) fn load(collision: &CollisionModel) -> Visuals {
     let robot = collision.robot();
     let mut out = Visuals::default();
-    let mut files: HashMap<PathBuf, Result<Vec<MeshPart>, String>> = HashMap::new();
+    // each file read once per scale (a robot's two fingers share one mesh)
+    let mut files: HashMap<(PathBuf, [u64; 3]), Result<Vec<MeshPart>, String>> = HashMap::new();
     for (link, l) in robot.tree().links.iter().enumerate() {
         for v in &l.visuals {
             let (xyz, rpy) = (v.origin.xyz.0, v.origin.rpy.0);
@@ -66,12 +67,16 @@ pub(crate) fn load(collision: &CollisionModel) -> Visuals {
                 .material
                 .as_ref()
                 .and_then(|m| m.color.as_ref())
-                .map(|c| c.rgba.0.map(|x| x as f32))
-                .filter(|c| c.iter().all(|x| x.is_finite()));
+                .and_then(|c| rgba(c.rgba.0.map(|x| x as f32)));
             let color = urdf_color.unwrap_or(DEFAULT_COLOR);
             if let Some(shape) = Shape::from_urdf(&v.geometry) {
                 match shape.check() {
-                    Ok(()) => out.parts.push((link, shape, local, color)),
+                    Ok(()) => out.parts.push(SceneVisual {
+                        link,
+                        shape,
+                        local,
+                        color,
+                    }),
                     Err(p) => out.missing.push(format!(
                         "link `{}`: a <visual> {}: {}",
                         l.name,
@@ -100,15 +105,18 @@ pub(crate) fn load(collision: &CollisionModel) -> Visuals {
                 }
             };
             let scale = scale.map_or([1.0; 3], |s| s.0);
-            let key = path.join(format!("{scale:?}"));
             let parts = files
-                .entry(key)
+                .entry((path.clone(), scale.map(f64::to_bits)))
                 .or_insert_with(|| parts_of_mesh(&path, scale));
             match parts {
                 Ok(parts) => {
                     for (shape, part_color) in by_color(parts) {
-                        let color = part_color.or(urdf_color).unwrap_or(DEFAULT_COLOR);
-                        out.parts.push((link, shape, local, color));
+                        out.parts.push(SceneVisual {
+                            link,
+                            shape,
+                            local,
+                            color: part_color.or(urdf_color).unwrap_or(DEFAULT_COLOR),
+                        });
                     }
                 }
                 Err(e) => out.missing.push(format!(
@@ -128,7 +136,7 @@ pub(crate) fn load(collision: &CollisionModel) -> Visuals {
 fn by_color(parts: &[MeshPart]) -> Vec<(Shape, Option<[f32; 4]>)> {
     let mut groups: Vec<MeshPart> = Vec::new();
     for part in parts.iter().filter(|p| !p.triangles.is_empty()) {
-        let color = part.color.filter(|c| c.iter().all(|x| x.is_finite()));
+        let color = part.color.and_then(rgba);
         let k = match groups.iter().position(|g| g.color == color) {
             Some(k) => k,
             None => {
@@ -161,4 +169,12 @@ fn by_color(parts: &[MeshPart]) -> Vec<(Shape, Option<[f32; 4]>)> {
             (shape, g.color)
         })
         .collect()
+}
+
+/// A colour as drawn: finite components clamped into 0..=1 (files written for 0..=255 show
+/// saturated rather than failing, as RViz draws them); `None` when one is not a number.
+fn rgba(c: [f32; 4]) -> Option<[f32; 4]> {
+    c.iter()
+        .all(|x| x.is_finite())
+        .then(|| c.map(|x| x.clamp(0.0, 1.0)))
 }

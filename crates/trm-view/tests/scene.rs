@@ -198,6 +198,7 @@ fn looks_robot(dir: &std::path::Path) -> trm_kinematics::RobotModel {
   <material name="orange"><color rgba="1 0.5 0 1"/></material>
   <link name="base">
     <visual><geometry><box size="0.2 0.2 0.1"/></geometry><material name="orange"/></visual>
+    <visual><geometry><sphere radius="0.05"/></geometry><material name="bytes"><color rgba="255 128 0 1"/></material></visual>
     <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
   </link>
   <link name="arm">
@@ -225,11 +226,13 @@ fn the_robot_looks_as_its_urdf_visuals_say() {
     assert_eq!(scene.frames[0].poses.len(), 2);
     // the box in the robot-level colour; the mesh in its material library's two colours,
     // scaled, each part with its own vertices
-    assert_eq!(scene.visuals.len(), 3, "{:?}", scene.visuals);
+    assert_eq!(scene.visuals.len(), 4, "{:?}", scene.visuals);
     assert_eq!(scene.visuals[0].color, [1.0, 0.5, 0.0, 1.0]);
-    let colors: Vec<[f32; 4]> = scene.visuals[1..].iter().map(|v| v.color).collect();
+    // a colour written in 0..=255 is drawn saturated, not refused
+    assert_eq!(scene.visuals[1].color, [1.0, 1.0, 0.0, 1.0]);
+    let colors: Vec<[f32; 4]> = scene.visuals[2..].iter().map(|v| v.color).collect();
     assert!(colors.contains(&[1.0, 0.0, 0.0, 1.0]) && colors.contains(&[0.0, 0.0, 1.0, 1.0]));
-    for v in &scene.visuals[1..] {
+    for v in &scene.visuals[2..] {
         assert_eq!(v.link, 1);
         assert_eq!(v.local[2], 0.05);
         let trm_collision::Shape::Mesh {
@@ -271,12 +274,12 @@ fn the_robot_looks_as_its_urdf_visuals_say() {
             .contains("visuals[0]")
     );
     let mut bad = scene.clone();
-    if let trm_collision::Shape::Mesh { triangles, .. } = &mut bad.visuals[1].shape {
+    if let trm_collision::Shape::Mesh { triangles, .. } = &mut bad.visuals[2].shape {
         triangles[0][0] = 99;
     }
     let e = bad.to_json().unwrap_err().to_string();
     assert!(
-        e.contains("visuals[1].shape") && e.contains("beyond"),
+        e.contains("visuals[2].shape") && e.contains("beyond"),
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&dir);

@@ -346,13 +346,36 @@ impl CloudGrid {
 fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
     let n = dims[0] * dims[1] * dims[2];
     let far = 1e20_f32;
-    let mut d2: Vec<f32> = (0..n)
-        .map(|c| if starts[c + 1] > starts[c] { 0.0 } else { far })
-        .collect();
+    // along x, where cells are either occupied or not: the squared distance to the nearest
+    // occupied cell of the row, by one sweep each way
+    let mut d2 = vec![far; n];
+    for (r, row) in d2.chunks_mut(dims[0]).enumerate() {
+        let occupied = |x: usize| starts[r * dims[0] + x + 1] > starts[r * dims[0] + x];
+        let mut last: Option<usize> = None;
+        for x in 0..dims[0] {
+            if occupied(x) {
+                last = Some(x);
+            }
+            if let Some(l) = last {
+                row[x] = ((x - l) * (x - l)) as f32;
+            }
+        }
+        let mut last: Option<usize> = None;
+        for x in (0..dims[0]).rev() {
+            if occupied(x) {
+                last = Some(x);
+            }
+            if let Some(l) = last {
+                row[x] = row[x].min(((l - x) * (l - x)) as f32);
+            }
+        }
+    }
     let stride = [1, dims[0], dims[0] * dims[1]];
     let (mut f, mut out) = (Vec::new(), Vec::new());
     let (mut v, mut z) = (Vec::new(), Vec::new());
-    for axis in 0..3 {
+    // then along y and z: the lower envelope of parabolas; a line holding no finite value
+    // stays as it is
+    for axis in 1..3 {
         let len = dims[axis];
         let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
         for i in 0..dims[a] {
@@ -360,6 +383,9 @@ fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
                 let base = i * stride[a] + j * stride[b];
                 f.clear();
                 f.extend((0..len).map(|k| d2[base + k * stride[axis]]));
+                if f.iter().all(|&x| x >= far) {
+                    continue;
+                }
                 envelope(&f, &mut out, &mut v, &mut z);
                 for (k, value) in out.iter().enumerate() {
                     d2[base + k * stride[axis]] = *value;

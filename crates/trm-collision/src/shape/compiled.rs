@@ -2,8 +2,9 @@
 //! needed) and placed at a pose.
 
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
+use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::shape::{Ball, Capsule, Shape as ParryShape, SharedShape, SupportMap};
 
 use super::hull::HullWalk;
@@ -31,7 +32,7 @@ pub(crate) enum Geometry {
     /// against round shapes, which are tested analytically.
     General {
         local: Isometry3<f64>,
-        shape: SharedShape,
+        shape: LazyShape,
         half_extents: Option<Vector3<f64>>,
         /// Convex hulls: their vertex graph, for support points by hill climbing.
         walk: Option<Arc<HullWalk>>,
@@ -39,6 +40,72 @@ pub(crate) enum Geometry {
         /// holds, for exact answers against round shapes before GJK.
         axial: Option<Axial>,
     },
+}
+
+/// A parry shape, made when first used where that is dear: a point cloud's compound of balls
+/// (parry's BVH, about a millisecond per 5 000 points) is built by the first exact query that
+/// needs it — the f32 screen answers most queries from its own grid — so that a world holding
+/// a cloud is ready in the time the screen's grid takes. Clones share the one build.
+#[derive(Clone)]
+pub(crate) struct LazyShape {
+    shape: Arc<OnceLock<SharedShape>>,
+    /// The cloud to build from, when not built yet.
+    cloud: Option<Arc<super::Shape>>,
+    /// The box enclosing the shape in its own frame.
+    local_box: Aabb,
+}
+
+impl LazyShape {
+    /// A shape already made.
+    pub(crate) fn ready(shape: SharedShape) -> Self {
+        let local_box = shape.compute_local_aabb();
+        let cell = OnceLock::new();
+        let _ = cell.set(shape);
+        LazyShape {
+            shape: Arc::new(cell),
+            cloud: None,
+            local_box,
+        }
+    }
+
+    /// `cloud` (a valid [`super::Shape::Points`]), made into parry's form on first use.
+    pub(crate) fn cloud(cloud: super::Shape, local_box: Aabb) -> Self {
+        LazyShape {
+            shape: Arc::new(OnceLock::new()),
+            cloud: Some(Arc::new(cloud)),
+            local_box,
+        }
+    }
+
+    /// The parry shape (made now if it has not been).
+    pub(crate) fn get(&self) -> &SharedShape {
+        self.shape.get_or_init(|| {
+            let cloud = self.cloud.as_ref().expect("a shape not made has its cloud");
+            cloud.to_parry().expect("a checked cloud converts").1
+        })
+    }
+
+    /// Whether the parry shape has been made.
+    #[cfg(test)]
+    pub(crate) fn is_made(&self) -> bool {
+        self.shape.get().is_some()
+    }
+
+    /// The box enclosing the shape at `iso`, without making it.
+    pub(crate) fn compute_aabb(&self, iso: &Isometry3<f64>) -> Aabb {
+        match self.shape.get() {
+            Some(shape) => shape.compute_aabb(iso),
+            None => self.local_box.transform_by(iso),
+        }
+    }
+}
+
+impl std::ops::Deref for LazyShape {
+    type Target = SharedShape;
+
+    fn deref(&self) -> &SharedShape {
+        self.get()
+    }
 }
 
 /// A shape between two capsules of one radius about its local y axis (a cylinder of half

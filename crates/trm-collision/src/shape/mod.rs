@@ -19,7 +19,7 @@ mod segment_box;
 mod segment_lanes;
 mod spheres;
 
-pub(crate) use compiled::{Axial, Compiled, Geometry, Placed};
+pub(crate) use compiled::{Axial, Compiled, Geometry, LazyShape, Placed};
 pub(crate) use pair::{
     Closest, bounds_apart, intersects, proximity, signed_distance, sphere_apart,
 };
@@ -308,6 +308,32 @@ impl Shape {
         Some(match self {
             Shape::Sphere { radius } => round(0.0, *radius),
             Shape::Capsule { radius, length } => round(length / 2.0, *radius),
+            Shape::Points { points, radius } => {
+                // bounds from the points; parry's form waits for the first exact query
+                let corners: Vec<Point3<f64>> = points.iter().map(|p| Point3::from(*p)).collect();
+                let reach = Vector3::repeat(*radius);
+                let tight =
+                    parry3d_f64::bounding_volume::details::local_point_cloud_aabb_ref(&corners);
+                let local_box =
+                    parry3d_f64::bounding_volume::Aabb::new(tight.mins - reach, tight.maxs + reach);
+                let center = tight.center();
+                let bound = corners
+                    .iter()
+                    .map(|p| (p - center).norm())
+                    .fold(0.0, f64::max)
+                    + radius;
+                Compiled {
+                    center: local * center,
+                    bound,
+                    geometry: Geometry::General {
+                        local: *local,
+                        shape: LazyShape::cloud(self.clone(), local_box),
+                        half_extents: None,
+                        walk: None,
+                        axial: None,
+                    },
+                }
+            }
             _ => {
                 let (frame, shape) = self.to_parry()?;
                 let local = local * frame;
@@ -333,7 +359,7 @@ impl Shape {
                     bound: sphere.radius,
                     geometry: Geometry::General {
                         local,
-                        shape,
+                        shape: LazyShape::ready(shape),
                         half_extents,
                         walk,
                         axial,

@@ -261,3 +261,45 @@ mod general_pairs {
         }
     }
 }
+
+/// A point cloud's parry form (a BVH of balls, the dear part of adding a cloud to a world) is
+/// made by the first exact query that needs it, not when the cloud is compiled; its bounds
+/// and the answers are those of the form made at once.
+#[test]
+fn a_clouds_exact_form_waits_for_the_first_query_that_needs_it() {
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(3);
+    let cloud = Shape::Points {
+        points: Shape::Box {
+            size: [0.4, 0.3, 0.2],
+        }
+        .surface_samples(2000, &mut rng),
+        radius: 0.01,
+    };
+    let pose = Isometry3::new(Vector3::new(0.5, -0.1, 0.2), Vector3::new(0.3, 0.2, 0.1));
+    let (c, p) = placed(&cloud, pose);
+    let made = |c: &Compiled| match &c.geometry {
+        Geometry::General { shape, .. } => shape.is_made(),
+        Geometry::Round { .. } => unreachable!("a cloud is general"),
+    };
+    assert!(!made(&c));
+    let (_, parry) = cloud.to_parry().unwrap();
+    let eager = parry.compute_aabb(&p.iso);
+    let lazy = c.tight_box(&p);
+    assert!((eager.mins - lazy.mins).norm() < 1e-12 && (eager.maxs - lazy.maxs).norm() < 1e-12);
+    assert!(!made(&c));
+    let ball = Shape::Sphere { radius: 0.05 };
+    let Shape::Points { points, .. } = &cloud else {
+        unreachable!()
+    };
+    let on_surface = pose * Point3::from(points[0]);
+    for (centre, hit) in [(on_surface, true), (Point3::new(1.5, 0.0, 0.0), false)] {
+        let iso = at(centre.x, centre.y, centre.z);
+        let (b, q) = placed(&ball, iso);
+        let ball_parry = parry3d_f64::shape::Ball::new(0.05);
+        let want = query::distance(&iso, &ball_parry, &p.iso, parry.as_ref()).unwrap();
+        assert_eq!(intersects(&b, &q, &c, &p), hit);
+        let d = signed_distance(&b, &q, &c, &p);
+        assert!(hit || (d - want).abs() < 1e-9, "{d} vs {want}");
+    }
+    assert!(made(&c));
+}

@@ -237,9 +237,6 @@ def test_constrained_one_plus_one_keeps_to_the_feasible_side():
 
 
 def test_view_writes_the_page_and_its_scene(robot, tmp_path):
-    import json
-import os
-
     home = robot.posture("home")
     lifted = home.copy()
     lifted[robot.motor_names.index("r_shoulder_pitch")] -= 0.5
@@ -293,8 +290,6 @@ def test_a_map_builds_saves_loads_and_plans(tmp_path):
     with pytest.raises(trm.TrmError, match="the goal configuration has 3 values"):
         planner.plan([0.0, 0.0, 0.0], posture=True)
     # the plan drawn over its map, as `trm plan --view` draws it
-    import json
-
     page = trm.view(trm.Robot.icub(), str(tmp_path / "plan.html"),
                     frames=plan["positions"], times=plan["times"], roadmap=loaded)
     scene = json.loads((tmp_path / "plan.json").read_text())
