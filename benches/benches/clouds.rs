@@ -1,7 +1,7 @@
 //! Point clouds as obstacles (VAMP's spherized Panda, an MBM-like table scene): building a
-//! cloud (the world object, whose exact BVH waits for the first exact query, and the screen's
-//! grid, for 5 000 points on a board and for a whole thinned scene) and checking blocks of
-//! eight configurations among the cloud against the same scene as primitives.
+//! cloud (the world object with its exact grid — its BVH waits for a distance query — and the
+//! screen's grid, for 5 000 points on a board and for a whole thinned scene) and checking
+//! blocks of eight configurations among the cloud against the same scene as primitives.
 //! Targets: a 5 000-point cloud builds in ≤ 0.5 ms on one core; a block among the sampled
 //! scene costs no more than among its primitives.
 

@@ -211,9 +211,8 @@ pub struct CloudBuild {
     pub kept: usize,
     /// Thinning them, s (done once; the peers get the thinned cloud).
     pub thin_seconds: f64,
-    /// Building the world object (its exact bounding-volume tree is made by the first exact
-    /// query that needs it, so within planning) and compiling the screen's
-    /// grid for the robot, s.
+    /// Building the world object (with its exact grid; its bounding-volume tree waits for a
+    /// distance query) and compiling the screen's grid for the robot, s.
     pub build_seconds: f64,
 }
 

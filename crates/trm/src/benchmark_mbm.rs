@@ -403,7 +403,7 @@ fn cloud_lines(bench: &trm_mbm::Benchmark) -> String {
         trm_mbm::quantile(&builds.iter().map(f).collect::<Vec<_>>(), 0.5).unwrap_or(0.0)
     };
     format!(
-        "\nPoint clouds (medians over {} problems): {:.0} points drawn, {:.0} kept after thinning ({:.2} ms); trm's build (the world object and the screen's grid; the exact side's tree waits for the first exact query, inside planning): {:.3} ms\n",
+        "\nPoint clouds (medians over {} problems): {:.0} points drawn, {:.0} kept after thinning ({:.2} ms); trm's build (the world object with its exact grid, and the screen's grid): {:.3} ms\n",
         builds.len(),
         median(&|b| b.sampled as f64),
         median(&|b| b.kept as f64),

@@ -43,16 +43,117 @@ pub(crate) enum Geometry {
 }
 
 /// A parry shape, made when first used where that is dear: a point cloud's compound of balls
-/// (parry's BVH, about a millisecond per 5 000 points) is built by the first exact query that
-/// needs it — the f32 screen answers most queries from its own grid — so that a world holding
-/// a cloud is ready in the time the screen's grid takes. Clones share the one build.
+/// (parry's BVH, about a millisecond per 5 000 points) is built by the first distance query
+/// (intersection tests go through the cloud's [`PointGrid`]), so that a world holding a cloud
+/// is ready in the time the grids take. Clones share the one build.
 #[derive(Clone)]
 pub(crate) struct LazyShape {
     shape: Arc<OnceLock<SharedShape>>,
     /// The cloud to build from, when not built yet.
     cloud: Option<Arc<super::Shape>>,
+    /// A cloud's points in a grid: what intersection tests use, so that they never need the
+    /// tree.
+    pub(crate) grid: Option<Arc<PointGrid>>,
     /// The box enclosing the shape in its own frame.
     local_box: Aabb,
+}
+
+/// A cloud's points (radius `radius`, in the cloud's frame) counting-sorted into a uniform grid
+/// of about one cell per point: which points lie near a place, without a tree.
+#[derive(Debug)]
+pub(crate) struct PointGrid {
+    origin: Point3<f64>,
+    cell: f64,
+    dims: [usize; 3],
+    /// Cell `c`'s points are `points[starts[c]..starts[c + 1]]` (x fastest).
+    starts: Vec<u32>,
+    points: Vec<Point3<f64>>,
+    pub(crate) radius: f64,
+}
+
+impl PointGrid {
+    /// The grid of `points` (finite, at least one) inside `bounds`.
+    pub(crate) fn new(points: &[[f64; 3]], radius: f64, bounds: &Aabb) -> Self {
+        let extent = bounds.extents();
+        let budget = points.len().max(64) as f64;
+        let count = |cell: f64| -> [usize; 3] {
+            std::array::from_fn(|k| (extent[k] / cell).floor() as usize + 1)
+        };
+        // the cube root of the volume per point, coarsened until the cells fit the budget
+        let volume = extent.iter().map(|e| e.max(2.0 * radius)).product::<f64>();
+        let mut cell = (volume / budget).cbrt().max(2.0 * radius).max(1e-6);
+        while count(cell).iter().map(|&n| n as f64).product::<f64>() > budget {
+            cell *= 1.25;
+        }
+        let dims = count(cell);
+        let origin = bounds.mins;
+        let index = |p: &[f64; 3]| -> usize {
+            let i: [usize; 3] = std::array::from_fn(|k| {
+                (((p[k] - origin[k]) / cell).max(0.0) as usize).min(dims[k] - 1)
+            });
+            i[0] + dims[0] * (i[1] + dims[1] * i[2])
+        };
+        let cells = dims[0] * dims[1] * dims[2];
+        let mut starts = vec![0u32; cells + 1];
+        let homes: Vec<usize> = points.iter().map(index).collect();
+        for &h in &homes {
+            starts[h + 1] += 1;
+        }
+        for c in 0..cells {
+            starts[c + 1] += starts[c];
+        }
+        let mut next = starts[..cells].to_vec();
+        let mut sorted = vec![Point3::origin(); points.len()];
+        for (p, &h) in points.iter().zip(&homes) {
+            sorted[next[h] as usize] = Point3::from(*p);
+            next[h] += 1;
+        }
+        PointGrid {
+            origin,
+            cell,
+            dims,
+            starts,
+            points: sorted,
+            radius,
+        }
+    }
+
+    /// Whether `near` holds for a point within `reach` of `center` (both in the cloud's
+    /// frame): every such point is offered (and some farther ones), until one holds.
+    pub(crate) fn any_near(
+        &self,
+        center: &Point3<f64>,
+        reach: f64,
+        mut near: impl FnMut(&Point3<f64>) -> bool,
+    ) -> bool {
+        // a little over: the test decides, the grid only has to offer every point in reach
+        let reach = reach + 1e-9 * (1.0 + reach);
+        let range = |k: usize| -> Option<(usize, usize)> {
+            let lo = (center[k] - reach - self.origin[k]) / self.cell;
+            let hi = (center[k] + reach - self.origin[k]) / self.cell;
+            if hi < 0.0 || lo >= self.dims[k] as f64 {
+                return None;
+            }
+            Some((lo.max(0.0) as usize, (hi as usize).min(self.dims[k] - 1)))
+        };
+        let (Some(x), Some(y), Some(z)) = (range(0), range(1), range(2)) else {
+            return false;
+        };
+        for k in z.0..=z.1 {
+            for j in y.0..=y.1 {
+                // a row of cells is one run of points
+                let row = self.dims[0] * (j + self.dims[1] * k);
+                let (from, to) = (self.starts[row + x.0], self.starts[row + x.1 + 1]);
+                if self.points[from as usize..to as usize]
+                    .iter()
+                    .any(&mut near)
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
 }
 
 impl LazyShape {
@@ -64,15 +165,24 @@ impl LazyShape {
         LazyShape {
             shape: Arc::new(cell),
             cloud: None,
+            grid: None,
             local_box,
         }
     }
 
-    /// `cloud` (a valid [`super::Shape::Points`]), made into parry's form on first use.
+    /// `cloud` (a valid [`super::Shape::Points`], within `local_box`), its points in a grid
+    /// now and in parry's form on first use.
     pub(crate) fn cloud(cloud: super::Shape, local_box: Aabb) -> Self {
+        let grid = match &cloud {
+            super::Shape::Points { points, radius } => {
+                Some(Arc::new(PointGrid::new(points, *radius, &local_box)))
+            }
+            _ => None,
+        };
         LazyShape {
             shape: Arc::new(OnceLock::new()),
             cloud: Some(Arc::new(cloud)),
+            grid,
             local_box,
         }
     }

@@ -85,6 +85,9 @@ pub(crate) fn bounds_apart(p: &Placed, q: &Placed) -> bool {
 /// Whether two placed shapes touch or overlap (call after [`bounds_apart`] said no).
 #[inline]
 pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> bool {
+    if let Some(touch) = cloud_touches(c1, p1, c2, p2).or_else(|| cloud_touches(c2, p2, c1, p1)) {
+        return touch;
+    }
     match (&c1.geometry, &c2.geometry) {
         (Geometry::Round { radius: r1, .. }, Geometry::Round { radius: r2, .. }) => {
             let r = r1 + r2;
@@ -169,6 +172,37 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
             }
         }
     }
+}
+
+/// Whether `c1` touches the point cloud `c2` (a ball about each point), by the points near it
+/// in the cloud's grid: the shape's distance to each, exact (a segment's for round shapes,
+/// parry's point query for the others). `None` when `c2` is no cloud, or `c1` is one too.
+fn cloud_touches(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> Option<bool> {
+    let Geometry::General { shape, .. } = &c2.geometry else {
+        return None;
+    };
+    let grid = shape.grid.as_ref()?;
+    let r = grid.radius;
+    // the other shape's bounding sphere in the cloud's frame
+    let center = p2.iso.inverse_transform_point(&p1.center);
+    let reach = p1.bound + r;
+    Some(match &c1.geometry {
+        Geometry::Round { radius, .. } => {
+            let touch = (radius + r) * (radius + r);
+            grid.any_near(&center, reach, |q| {
+                let q = p2.iso * q;
+                segment_distance_squared(&p1.a, &p1.b, &q, &q) <= touch
+            })
+        }
+        Geometry::General { shape: s1, .. } => {
+            if s1.grid.is_some() {
+                return None;
+            }
+            grid.any_near(&center, reach, |q| {
+                s1.distance_to_point(&p1.iso, &(p2.iso * q), true) <= r
+            })
+        }
+    })
 }
 
 /// A hull's walked support points, else the shape's own support map (if it has one).

@@ -303,3 +303,85 @@ fn a_clouds_exact_form_waits_for_the_first_query_that_needs_it() {
     }
     assert!(made(&c));
 }
+
+/// Intersection with a cloud goes through its grid, never its tree, and answers as parry's
+/// compound of balls does, for every kind of shape, near the points and inside the cloud.
+#[test]
+fn shapes_touch_a_cloud_as_parry_says_without_its_tree() {
+    use rand::RngExt;
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(5);
+    let cloud = Shape::Points {
+        points: Shape::Cylinder {
+            radius: 0.2,
+            length: 0.5,
+        }
+        .surface_samples(3000, &mut rng),
+        radius: 0.004,
+    };
+    let pose = Isometry3::new(Vector3::new(0.3, 0.1, -0.2), Vector3::new(0.4, -0.3, 0.2));
+    let (c, p) = placed(&cloud, pose);
+    let (_, parry) = cloud.to_parry().unwrap();
+    let shapes = [
+        Shape::Sphere { radius: 0.03 },
+        Shape::Capsule {
+            radius: 0.02,
+            length: 0.15,
+        },
+        Shape::Box {
+            size: [0.1, 0.05, 0.2],
+        },
+        Shape::Cylinder {
+            radius: 0.04,
+            length: 0.1,
+        },
+        Shape::Convex {
+            points: vec![
+                [0.0, 0.0, 0.0],
+                [0.1, 0.0, 0.0],
+                [0.0, 0.08, 0.0],
+                [0.0, 0.0, 0.12],
+            ],
+        },
+    ];
+    let (mut touching, mut apart) = (0, 0);
+    for k in 0..2000 {
+        let shape = &shapes[k % shapes.len()];
+        let centre = Vector3::new(
+            rng.random_range(-0.1..0.7),
+            rng.random_range(-0.3..0.5),
+            rng.random_range(-0.6..0.2),
+        );
+        let axis = Vector3::new(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+        );
+        let at = Isometry3::new(centre, axis);
+        let (s, q) = placed(shape, at);
+        if bounds_apart(&q, &p) {
+            continue;
+        }
+        let (frame, own) = shape.to_parry().unwrap();
+        let want =
+            query::intersection_test(&(at * frame), own.as_ref(), &p.iso, parry.as_ref()).unwrap();
+        assert_eq!(
+            intersects(&s, &q, &c, &p),
+            want,
+            "case {k}: {shape:?} at {at}"
+        );
+        assert_eq!(intersects(&c, &p, &s, &q), want, "case {k}, swapped");
+        if want {
+            touching += 1;
+        } else {
+            apart += 1;
+        }
+    }
+    assert!(
+        touching > 100 && apart > 100,
+        "{touching} touching, {apart} apart"
+    );
+    let Geometry::General { shape, .. } = &c.geometry else {
+        unreachable!("a cloud is general")
+    };
+    assert!(!shape.is_made(), "the tree was not needed");
+}
