@@ -142,10 +142,20 @@ pub struct MeshPart {
 /// checks of [`triangles_of_mesh`] apply.
 pub fn parts_of_mesh(path: &Path, scale: [f64; 3]) -> Result<Vec<MeshPart>, String> {
     let bytes = trm_io::read_input_bytes(path).map_err(|e| e.to_string())?;
+    parts_of_mesh_bytes(&bytes, path, scale)
+}
+
+/// [`parts_of_mesh`] of a file's bytes; `path` gives the format (by extension, else by
+/// content), names the file in errors and locates an OBJ's material library.
+pub fn parts_of_mesh_bytes(
+    bytes: &[u8],
+    path: &Path,
+    scale: [f64; 3],
+) -> Result<Vec<MeshPart>, String> {
     let library = |p: &Path| -> std::io::Result<Vec<u8>> {
         trm_io::read_input_bytes(p).map_err(|e| std::io::Error::other(e.to_string()))
     };
-    let scene = load_scene(&bytes, path, library)?;
+    let scene = load_scene(bytes, path, library)?;
     let mut parts = Vec::new();
     for (k, mesh) in scene.meshes.iter().enumerate() {
         if mesh.faces.is_empty() {

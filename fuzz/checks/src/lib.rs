@@ -233,6 +233,14 @@ pub fn mesh(data: &[u8]) {
     {
         assert!(hull.len() >= 4 && hull.iter().flatten().all(|c| c.is_finite()));
     }
+    // read for drawing (a viewer's visuals): parts whose triangles name their own vertices
+    if let Ok(parts) = trm_collision::mesh::parts_of_mesh_bytes(bytes, Path::new(name), [1.0; 3]) {
+        for part in parts {
+            let n = part.vertices.len();
+            assert!(part.vertices.iter().flatten().all(|c| c.is_finite()));
+            assert!(part.triangles.iter().flatten().all(|&i| (i as usize) < n));
+        }
+    }
 }
 
 /// Point-cloud bytes (PLY or PCD; the first byte picks the format) → finite points or an
