@@ -204,8 +204,9 @@ let cloudPoints = 0;
 function cloud(s) {
   const g = new THREE.BufferGeometry();
   g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(s.points.flat()), 3));
-  const zs = s.points.map((p) => p[2]);
-  const [lo, hi] = [Math.min(...zs), Math.max(...zs)];
+  // (a loop: spreading a camera's hundreds of thousands of points as arguments overflows)
+  let [lo, hi] = [Infinity, -Infinity];
+  s.points.forEach((p) => { lo = Math.min(lo, p[2]); hi = Math.max(hi, p[2]); });
   const colors = new Float32Array(3 * s.points.length);
   s.points.forEach((p, i) => {
     const u = hi > lo ? (p[2] - lo) / (hi - lo) : 0.5;
