@@ -141,6 +141,76 @@ impl std::fmt::Display for SrdfReport {
     }
 }
 
+/// The URDF's names an SRDF is checked against: its links and joints (located errors with
+/// the nearest names), and the motors driving each joint.
+struct Names<'a> {
+    origin: &'a str,
+    robot: &'a RobotModel,
+    tree: &'a crate::Tree,
+    links: Vec<&'a str>,
+    joints: Vec<&'a str>,
+    /// The movable joints, in coupling order.
+    movable: Vec<&'a str>,
+}
+
+/// Per SRDF group, its URDF joints (`None` when it includes a group only the model
+/// description defines).
+type GroupJoints<'s> = BTreeMap<&'s str, Option<Vec<usize>>>;
+
+impl<'a> Names<'a> {
+    fn new(robot: &'a RobotModel, origin: &'a str) -> Self {
+        let tree = robot.tree();
+        Names {
+            origin,
+            robot,
+            tree,
+            links: tree.links.iter().map(|l| l.name.as_str()).collect(),
+            joints: tree.joints.iter().map(|j| j.name.as_str()).collect(),
+            movable: robot.joint_names().collect(),
+        }
+    }
+
+    /// Index of link `name` (named on SRDF line `line`).
+    fn link(&self, name: &str, line: usize) -> Result<usize> {
+        self.links.iter().position(|l| *l == name).ok_or_else(|| {
+            error(
+                self.origin,
+                line,
+                format!("link `{name}` is not in the URDF"),
+                did_you_mean(name, self.links.iter().copied(), "link"),
+            )
+        })
+    }
+
+    /// Index of joint `name` (named on SRDF line `line`).
+    fn joint(&self, name: &str, line: usize) -> Result<usize> {
+        self.joints.iter().position(|j| *j == name).ok_or_else(|| {
+            error(
+                self.origin,
+                line,
+                format!("joint `{name}` is not in the URDF"),
+                did_you_mean(name, self.joints.iter().copied(), "joint"),
+            )
+        })
+    }
+
+    /// The motors driving tree joint `j` (none for fixed joints).
+    fn motors_of(&self, j: usize) -> Vec<String> {
+        let Some(k) = self
+            .movable
+            .iter()
+            .position(|m| *m == self.tree.joints[j].name)
+        else {
+            return Vec::new();
+        };
+        self.robot.couplings()[k]
+            .terms
+            .iter()
+            .map(|&(m, _)| self.robot.motors()[m].name.clone())
+            .collect()
+    }
+}
+
 fn error(
     origin: &str,
     line: usize,
@@ -375,45 +445,10 @@ impl Srdf {
         robot: &RobotModel,
         base: &ModelDescription,
     ) -> Result<(ModelDescription, SrdfReport)> {
-        let origin = self.origin.as_str();
-        let tree = robot.tree();
-        let links: Vec<&str> = tree.links.iter().map(|l| l.name.as_str()).collect();
-        let all_joints: Vec<&str> = tree.joints.iter().map(|j| j.name.as_str()).collect();
-        let link = |name: &str, line: usize| -> Result<usize> {
-            links.iter().position(|l| *l == name).ok_or_else(|| {
-                error(
-                    origin,
-                    line,
-                    format!("link `{name}` is not in the URDF"),
-                    did_you_mean(name, links.iter().copied(), "link"),
-                )
-            })
-        };
-        let joint = |name: &str, line: usize| -> Result<usize> {
-            all_joints.iter().position(|j| *j == name).ok_or_else(|| {
-                error(
-                    origin,
-                    line,
-                    format!("joint `{name}` is not in the URDF"),
-                    did_you_mean(name, all_joints.iter().copied(), "joint"),
-                )
-            })
-        };
-        // motors driving tree joint j (none for fixed joints)
-        let movable: Vec<&str> = robot.joint_names().collect();
-        let motors_of = |j: usize| -> Vec<String> {
-            let Some(k) = movable.iter().position(|m| *m == tree.joints[j].name) else {
-                return Vec::new();
-            };
-            robot.couplings()[k]
-                .terms
-                .iter()
-                .map(|&(m, _)| robot.motors()[m].name.clone())
-                .collect()
-        };
+        let names = Names::new(robot, &self.origin);
         if self.robot != robot.name() {
             return Err(error(
-                origin,
+                names.origin,
                 self.robot_line,
                 format!(
                     "the SRDF describes robot `{}`, the URDF is robot `{}`",
@@ -428,17 +463,33 @@ impl Srdf {
             notes: self.notes.clone(),
             ..Default::default()
         };
+        self.take_virtual_joints(&names, &mut report)?;
+        let group_joints = self.take_groups(&names, &mut out, &mut report)?;
+        self.take_group_states(&names, &group_joints, &mut out, &mut report)?;
+        self.take_end_effectors(&names, &mut out, &mut report)?;
+        self.take_disabled(&names, &mut out, &mut report);
+        if !self.passive_joints.is_empty() {
+            report.notes.push(format!(
+                "{} passive joints: trm drives every joint through its motors",
+                self.passive_joints.len()
+            ));
+        }
+        Ok((out, report))
+    }
+
+    /// Virtual joints: on the URDF's root link; a moving one is noted (the root stays fixed).
+    fn take_virtual_joints(&self, names: &Names<'_>, report: &mut SrdfReport) -> Result<()> {
         for vj in &self.virtual_joints {
-            let child = link(&vj.child_link, vj.line)?;
-            if tree.links[child].parent.is_some() {
+            let child = names.link(&vj.child_link, vj.line)?;
+            if names.tree.links[child].parent.is_some() {
                 return Err(error(
-                    origin,
+                    names.origin,
                     vj.line,
                     format!(
                         "virtual joint `{}` attaches `{}`, which is not the URDF's root link",
                         vj.name, vj.child_link
                     ),
-                    format!("attach the root link `{}`", links[0]),
+                    format!("attach the root link `{}`", names.links[0]),
                 ));
             }
             if vj.kind != "fixed" {
@@ -448,6 +499,18 @@ impl Srdf {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Groups (after the groups they include) as motor groups of `out`, unless `out` has one
+    /// of the name; the URDF joints of each (`None` for a group including one only the
+    /// description defines).
+    fn take_groups<'s>(
+        &'s self,
+        names: &Names<'_>,
+        out: &mut ModelDescription,
+        report: &mut SrdfReport,
+    ) -> Result<GroupJoints<'s>> {
         // the URDF joints of each SRDF group (subgroups included), as MoveIt resolves them;
         // None for a group that includes one only the model description defines
         let mut group_joints: BTreeMap<&str, Option<Vec<usize>>> = BTreeMap::new();
@@ -471,20 +534,21 @@ impl Srdf {
         for g in order {
             let mut joints: Vec<usize> = Vec::new();
             for j in &g.joints {
-                joints.push(joint(j, g.line)?);
+                joints.push(names.joint(j, g.line)?);
             }
             for l in &g.links {
-                let i = link(l, g.line)?;
-                joints.extend(tree.links[i].parent_joint);
+                let i = names.link(l, g.line)?;
+                joints.extend(names.tree.links[i].parent_joint);
             }
             for (base_link, tip) in &g.chains {
-                let (b, mut t) = (link(base_link, g.line)?, link(tip, g.line)?);
+                let (b, mut t) = (names.link(base_link, g.line)?, names.link(tip, g.line)?);
                 let mut chain = Vec::new();
                 while t != b {
-                    let (Some(j), Some(p)) = (tree.links[t].parent_joint, tree.links[t].parent)
+                    let (Some(j), Some(p)) =
+                        (names.tree.links[t].parent_joint, names.tree.links[t].parent)
                     else {
                         return Err(error(
-                            origin,
+                            names.origin,
                             g.line,
                             format!("group `{}`: `{base_link}` is not above `{tip}`", g.name),
                             "give a chain from a link down to one of its descendants",
@@ -499,7 +563,7 @@ impl Srdf {
             for s in &g.subgroups {
                 if !defined.contains(s) && !left_out.contains(s) {
                     return Err(error(
-                        origin,
+                        names.origin,
                         g.line,
                         format!(
                             "group `{}` includes group `{s}`, which is not defined (or includes it in turn)",
@@ -522,7 +586,7 @@ impl Srdf {
                 continue;
             }
             let mut members: Vec<String> = Vec::new();
-            let own_motors = joints.iter().flat_map(|&j| motors_of(j));
+            let own_motors = joints.iter().flat_map(|&j| names.motors_of(j));
             let subgroups = g
                 .subgroups
                 .iter()
@@ -547,11 +611,28 @@ impl Srdf {
             defined.push(g.name.clone());
             report.counts[0] += 1;
         }
-        let motor_names: Vec<&str> = robot.motors().iter().map(|m| m.name.as_str()).collect();
+        Ok(group_joints)
+    }
+
+    /// Group states as postures of `out` (joints that are motors of their own), checked
+    /// against their groups' joints.
+    fn take_group_states(
+        &self,
+        names: &Names<'_>,
+        group_joints: &GroupJoints<'_>,
+        out: &mut ModelDescription,
+        report: &mut SrdfReport,
+    ) -> Result<()> {
+        let motor_names: Vec<&str> = names
+            .robot
+            .motors()
+            .iter()
+            .map(|m| m.name.as_str())
+            .collect();
         for s in &self.group_states {
             if !self.groups.iter().any(|g| g.name == s.group) {
                 return Err(error(
-                    origin,
+                    names.origin,
                     s.line,
                     format!(
                         "group state `{}` names group `{}`, which the SRDF does not define",
@@ -585,7 +666,7 @@ impl Srdf {
                 // a virtual joint's pose, or (Pinocchio's convention) the free-flyer `root_joint`
                 // that is not in the URDF
                 if self.virtual_joints.iter().any(|vj| &vj.name == j)
-                    || robot.joint_index(j).is_err()
+                    || names.robot.joint_index(j).is_err()
                 {
                     report.notes.push(format!(
                         "group state `{}`: the pose of the floating root `{j}` ({} values) is left out: trm keeps the root link fixed",
@@ -594,7 +675,7 @@ impl Srdf {
                     ));
                 } else {
                     return Err(error(
-                        origin,
+                        names.origin,
                         *line,
                         format!(
                             "group state `{}`: joint `{j}` has {} values; a URDF joint takes one",
@@ -607,11 +688,11 @@ impl Srdf {
             }
             let mut values = BTreeMap::new();
             for (j, v) in &s.values {
-                let index = joint(j, s.line)?;
+                let index = names.joint(j, s.line)?;
                 if let Some(Some(members)) = group_joints.get(s.group.as_str()) {
                     if !members.contains(&index) {
                         return Err(error(
-                            origin,
+                            names.origin,
                             s.line,
                             format!(
                                 "group state `{}` sets joint `{j}`, which is not in group `{}`",
@@ -619,7 +700,7 @@ impl Srdf {
                             ),
                             did_you_mean(
                                 j,
-                                members.iter().map(|&m| tree.joints[m].name.as_str()),
+                                members.iter().map(|&m| names.tree.joints[m].name.as_str()),
                                 "joint of the group",
                             ),
                         ));
@@ -637,10 +718,20 @@ impl Srdf {
             out.postures.push(PostureSpec { name, values });
             report.counts[1] += 1;
         }
+        Ok(())
+    }
+
+    /// End effectors as frames of `out` on their parent links, unless the name is taken.
+    fn take_end_effectors(
+        &self,
+        names: &Names<'_>,
+        out: &mut ModelDescription,
+        report: &mut SrdfReport,
+    ) -> Result<()> {
         for e in &self.end_effectors {
-            link(&e.parent_link, e.line)?;
-            let taken = links.contains(&e.name.as_str())
-                || robot.frame_names().any(|f| f == e.name)
+            names.link(&e.parent_link, e.line)?;
+            let taken = names.links.contains(&e.name.as_str())
+                || names.robot.frame_names().any(|f| f == e.name)
                 || out.frames.iter().any(|f| f.name == e.name);
             if taken {
                 report.notes.push(format!(
@@ -657,18 +748,29 @@ impl Srdf {
             });
             report.counts[2] += 1;
         }
+        Ok(())
+    }
+
+    /// Disabled pairs into `out`'s (once each); a pair naming a link the URDF lacks is
+    /// skipped and noted, as MoveIt skips it.
+    fn take_disabled(
+        &self,
+        names: &Names<'_>,
+        out: &mut ModelDescription,
+        report: &mut SrdfReport,
+    ) {
         for (d, line) in &self.disabled {
             // MoveIt skips a pair naming a link the URDF lacks (SRDFs written for another
             // variant of the robot, e.g. a spherized URDF); so does trm, saying so
             if let Some(missing) = [&d.a, &d.b]
                 .into_iter()
-                .find(|l| !links.contains(&l.as_str()))
+                .find(|l| !names.links.contains(&l.as_str()))
             {
                 report.notes.push(format!(
                     "line {line}: disabled pair ({}, {}) skipped: link `{missing}` is not in the URDF ({})",
                     d.a,
                     d.b,
-                    did_you_mean(missing, links.iter().copied(), "link")
+                    did_you_mean(missing, names.links.iter().copied(), "link")
                 ));
                 continue;
             }
@@ -680,13 +782,6 @@ impl Srdf {
                 report.counts[3] += 1;
             }
         }
-        if !self.passive_joints.is_empty() {
-            report.notes.push(format!(
-                "{} passive joints: trm drives every joint through its motors",
-                self.passive_joints.len()
-            ));
-        }
-        Ok((out, report))
     }
 
     /// The SRDF of `robot`: a group per motor group (the joints its motors drive), a group
