@@ -345,64 +345,11 @@ fn run_without_maps(args: &Args) -> Result<()> {
             .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
             .collect(),
     };
-    let active = match (&args.joints, &request) {
-        // the request's goal joints move, the other motors stay where its start puts them
-        (None, Some(r)) => r.active_set(&robot, &home)?,
-        (joints, _) => {
-            let names: Vec<String> = match joints {
-                Some(j) if !j.contains(',') && robot.group(j).is_ok() => robot
-                    .group(j)?
-                    .iter()
-                    .map(|&i| robot.motors()[i].name.clone())
-                    .collect(),
-                Some(j) => j.split(',').map(|n| n.trim().to_string()).collect(),
-                None => robot.motors().iter().map(|m| m.name.clone()).collect(),
-            };
-            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-            let fixed = match &request {
-                Some(r) => trm_moveit::motors_from_state(&robot, &r.start, &home).0,
-                None => home,
-            };
-            robot
-                .active_set(&refs, &fixed)
-                .context("--joints: give motor names of the model, or a group's name")?
-        }
-    };
+    let active = active_motors(args, &robot, request.as_ref(), home)?;
     // the motors that do not move, where the planner holds them
     let fixed = active.to_motors(&vec![0.0; active.len()]);
     let names: Vec<String> = active.names().map(str::to_string).collect();
-    let mut planner = Planner::new(
-        &trm_tasks::Objective::new(active.clone(), collision.clone(), Default::default()),
-        &[],
-    )?;
-    // what the robot holds: the scene's, then the request's start state's (by name, over them)
-    let mut held = Vec::new();
-    if let Some(world) = &args.world {
-        let scene = trm_moveit::load_scene(world, &collision)?;
-        for note in &scene.notes {
-            eprintln!("{}: {note}", world.display());
-        }
-        planner.set_world(scene.world);
-        planner.set_acm(scene.acm)?;
-        held = scene.attached;
-    }
-    for object in request.iter().flat_map(|r| r.attached.iter()) {
-        held.retain(|o: &trm_collision::AttachedObject| o.name != object.name);
-        held.push(object.clone());
-    }
-    planner
-        .set_attached(held)
-        .context("the objects the robot holds (attached_collision_objects)")?;
-    if let Some(file) = args.experience.as_ref().filter(|f| f.exists()) {
-        let paths = planner.load_experience(file)?;
-        println!("{}: {paths} kept paths", file.display());
-    }
-    for path in &args.with_maps {
-        let map = Roadmap::load(path).with_context(|| format!("--with-map {}", path.display()))?;
-        planner
-            .add_map(&map)
-            .with_context(|| format!("--with-map {}", path.display()))?;
-    }
+    let mut planner = planner_in_world(args, &collision, &active, request.as_ref())?;
     let configuration = |text: &str, what: &str| -> Result<Vec<f64>> {
         if text == "home" {
             return Ok(active.from_motors(&fixed));
@@ -439,24 +386,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         RequestGoal::Joints(q) => Some(q),
         RequestGoal::Pose(_) => None,
     };
-    for (what, q) in
-        std::iter::once(("start", &start)).chain(goal_configuration.map(|q| ("goal", q)))
-    {
-        if !planner.is_free(q) {
-            anyhow::bail!(
-                "the {what} collides{}: {}\n  fix: give a collision-free {what}",
-                args.world
-                    .as_ref()
-                    .map_or(String::new(), |w| format!(" in {}", w.display())),
-                planner
-                    .collisions(q)
-                    .into_iter()
-                    .take(5)
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            );
-        }
-    }
+    check_free(&mut planner, args, &start, goal_configuration)?;
     let connected = match &goal {
         RequestGoal::Joints(q) => planner.connect(&start, q, &options),
         RequestGoal::Pose(pose) => planner.connect_to_pose(&start, pose, &options),
@@ -475,23 +405,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
             (r.velocity_scaling, r.acceleration_scaling)
         }))?;
     let trajectory = planner.trajectory(&found.path, &timing)?;
-    let duration = |t: &trm_plan::Trajectory| t.times.last().copied().unwrap_or(0.0);
-    let timed = if timing.jerk_limited {
-        let optimal = trm_plan::Timing {
-            jerk_limited: false,
-            ..timing.clone()
-        };
-        format!(
-            "{:.2} s jerk-limited, stopping at each waypoint ({:.2} s time-optimal without a jerk limit)",
-            duration(&trajectory),
-            duration(&planner.trajectory(&found.path, &optimal)?)
-        )
-    } else {
-        format!(
-            "{:.2} s time-optimal within velocity and acceleration limits",
-            duration(&trajectory)
-        )
-    };
+    let timed = describe_motion(&mut planner, &found.path, &timing, &trajectory)?;
     println!(
         "{}: {} of {} motors move; world: {} objects",
         robot.name(),
@@ -536,4 +450,132 @@ fn run_without_maps(args: &Args) -> Result<()> {
         println!("kept the path in {}", file.display());
     }
     Ok(())
+}
+
+/// The motors that move: `--joints` (names or a group), else the request's goal joints, else
+/// every motor; the others stay where the request's start (else `home`) puts them.
+fn active_motors(
+    args: &Args,
+    robot: &trm_kinematics::RobotModel,
+    request: Option<&trm_moveit::MotionPlanRequest>,
+    home: Vec<f64>,
+) -> Result<trm_kinematics::ActiveSet> {
+    Ok(match (&args.joints, request) {
+        // the request's goal joints move, the other motors stay where its start puts them
+        (None, Some(r)) => r.active_set(robot, &home)?,
+        (joints, _) => {
+            let names: Vec<String> = match joints {
+                Some(j) if !j.contains(',') && robot.group(j).is_ok() => robot
+                    .group(j)?
+                    .iter()
+                    .map(|&i| robot.motors()[i].name.clone())
+                    .collect(),
+                Some(j) => j.split(',').map(|n| n.trim().to_string()).collect(),
+                None => robot.motors().iter().map(|m| m.name.clone()).collect(),
+            };
+            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+            let fixed = match request {
+                Some(r) => trm_moveit::motors_from_state(robot, &r.start, &home).0,
+                None => home,
+            };
+            robot
+                .active_set(&refs, &fixed)
+                .context("--joints: give motor names of the model, or a group's name")?
+        }
+    })
+}
+
+/// A planner for `active` in `--world` (with its allowed collisions), holding what the scene
+/// and the request's start state hold, with `--experience` and the `--with-map`s loaded.
+fn planner_in_world(
+    args: &Args,
+    collision: &trm_collision::CollisionModel,
+    active: &trm_kinematics::ActiveSet,
+    request: Option<&trm_moveit::MotionPlanRequest>,
+) -> Result<Planner> {
+    let mut planner = Planner::new(
+        &trm_tasks::Objective::new(active.clone(), collision.clone(), Default::default()),
+        &[],
+    )?;
+    // what the robot holds: the scene's, then the request's start state's (by name, over them)
+    let mut held = Vec::new();
+    if let Some(world) = &args.world {
+        let scene = trm_moveit::load_scene(world, collision)?;
+        for note in &scene.notes {
+            eprintln!("{}: {note}", world.display());
+        }
+        planner.set_world(scene.world);
+        planner.set_acm(scene.acm)?;
+        held = scene.attached;
+    }
+    for object in request.iter().flat_map(|r| r.attached.iter()) {
+        held.retain(|o: &trm_collision::AttachedObject| o.name != object.name);
+        held.push(object.clone());
+    }
+    planner
+        .set_attached(held)
+        .context("the objects the robot holds (attached_collision_objects)")?;
+    if let Some(file) = args.experience.as_ref().filter(|f| f.exists()) {
+        let paths = planner.load_experience(file)?;
+        println!("{}: {paths} kept paths", file.display());
+    }
+    for path in &args.with_maps {
+        let map = Roadmap::load(path).with_context(|| format!("--with-map {}", path.display()))?;
+        planner
+            .add_map(&map)
+            .with_context(|| format!("--with-map {}", path.display()))?;
+    }
+    Ok(planner)
+}
+
+/// An error naming the contacts when the start or the goal collides.
+fn check_free(
+    planner: &mut Planner,
+    args: &Args,
+    start: &[f64],
+    goal: Option<&Vec<f64>>,
+) -> Result<()> {
+    for (what, q) in std::iter::once(("start", start)).chain(goal.map(|q| ("goal", q.as_slice()))) {
+        if !planner.is_free(q) {
+            anyhow::bail!(
+                "the {what} collides{}: {}\n  fix: give a collision-free {what}",
+                args.world
+                    .as_ref()
+                    .map_or(String::new(), |w| format!(" in {}", w.display())),
+                planner
+                    .collisions(q)
+                    .into_iter()
+                    .take(5)
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            );
+        }
+    }
+    Ok(())
+}
+
+/// How long the motion takes, for the report (jerk-limited: with the time-optimal duration).
+fn describe_motion(
+    planner: &mut Planner,
+    path: &[Vec<f64>],
+    timing: &trm_plan::Timing,
+    trajectory: &trm_plan::Trajectory,
+) -> Result<String> {
+    let duration = |t: &trm_plan::Trajectory| t.times.last().copied().unwrap_or(0.0);
+    Ok(if timing.jerk_limited {
+        let optimal = trm_plan::Timing {
+            jerk_limited: false,
+            ..timing.clone()
+        };
+        format!(
+            "{:.2} s jerk-limited, stopping at each waypoint ({:.2} s time-optimal without a jerk limit)",
+            duration(trajectory),
+            duration(&planner.trajectory(path, &optimal)?)
+        )
+    } else {
+        format!(
+            "{:.2} s time-optimal within velocity and acceleration limits",
+            duration(trajectory)
+        )
+    })
 }
