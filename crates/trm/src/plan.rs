@@ -133,36 +133,12 @@ pub fn run(args: &Args) -> Result<()> {
         return run_without_maps(args);
     }
     let to = args.to.as_deref().unwrap_or_default();
-    let mut maps: Vec<Roadmap> = args
-        .maps
-        .iter()
-        .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
-        .collect::<Result<_>>()?;
     let world = args
         .world
         .as_ref()
         .map(trm_moveit::load_world)
         .transpose()?;
-    if let (true, Some(world)) = (args.repair, &world) {
-        for (map, path) in maps.iter_mut().zip(&args.maps) {
-            let problem = map
-                .problem_with(&trm_taskmap::loaders())
-                .with_context(|| format!("the spec stored in {}", path.display()))?;
-            let options = RepairOptions {
-                refill: false,
-                ..Default::default()
-            };
-            let started = std::time::Instant::now();
-            let (repaired, report) = trm_roadmap::repair(map, &problem, world, &options)?;
-            print!(
-                "{}: repaired in {:.2} s; ",
-                path.display(),
-                started.elapsed().as_secs_f64()
-            );
-            println!("{report}");
-            *map = repaired;
-        }
-    }
+    let maps = load_maps(args, world.as_ref())?;
     let first = &maps[0];
     let problem = first
         .problem_with(&trm_taskmap::loaders())
@@ -177,23 +153,7 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         posture(Path::new(&args.from), &problem)?
     };
-    let goal = if Path::new(to).is_file() {
-        Goal::Configuration(posture(Path::new(to), &problem)?)
-    } else {
-        let t = crate::numbers("--to", to, "\"x,y,z\" or a posture file")?;
-        let dim = first.points.first().map_or(t.len(), |p| p.t.len());
-        if t.len() != dim {
-            anyhow::bail!(
-                "--to `{}`: {} values for the map's {dim}-dimensional task space",
-                to,
-                t.len()
-            );
-        }
-        Goal::TaskPoint {
-            t,
-            tolerance: args.tolerance,
-        }
-    };
+    let goal = map_goal(args, to, first, &problem)?;
     let options = PlanOptions {
         seed: args.seed,
         timing: args.timing.timing((None, None))?,
@@ -286,6 +246,58 @@ pub fn run(args: &Args) -> Result<()> {
         write_view(scene, planner.world(), args.out.as_deref())?;
     }
     Ok(())
+}
+
+/// The `--map`s, each repaired for `world` first with `--repair`.
+fn load_maps(args: &Args, world: Option<&trm_collision::World>) -> Result<Vec<Roadmap>> {
+    let mut maps: Vec<Roadmap> = args
+        .maps
+        .iter()
+        .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
+        .collect::<Result<_>>()?;
+    if let (true, Some(world)) = (args.repair, world) {
+        for (map, path) in maps.iter_mut().zip(&args.maps) {
+            let problem = map
+                .problem_with(&trm_taskmap::loaders())
+                .with_context(|| format!("the spec stored in {}", path.display()))?;
+            let options = RepairOptions {
+                refill: false,
+                ..Default::default()
+            };
+            let started = std::time::Instant::now();
+            let (repaired, report) = trm_roadmap::repair(map, &problem, world, &options)?;
+            print!(
+                "{}: repaired in {:.2} s; ",
+                path.display(),
+                started.elapsed().as_secs_f64()
+            );
+            println!("{report}");
+            *map = repaired;
+        }
+    }
+    Ok(maps)
+}
+
+/// The goal `to` names for a map (`first`, of `problem`): a posture file, else a task point
+/// of the map's task space within `--tolerance`.
+fn map_goal(args: &Args, to: &str, first: &Roadmap, problem: &Problem) -> Result<Goal> {
+    Ok(if Path::new(to).is_file() {
+        Goal::Configuration(posture(Path::new(to), problem)?)
+    } else {
+        let t = crate::numbers("--to", to, "\"x,y,z\" or a posture file")?;
+        let dim = first.points.first().map_or(t.len(), |p| p.t.len());
+        if t.len() != dim {
+            anyhow::bail!(
+                "--to `{}`: {} values for the map's {dim}-dimensional task space",
+                to,
+                t.len()
+            );
+        }
+        Goal::TaskPoint {
+            t,
+            tolerance: args.tolerance,
+        }
+    })
 }
 
 /// Writes the 3-D view of a plan, `scene` in `world`, beside `out` (or as
