@@ -85,9 +85,7 @@ pub(crate) fn bounds_apart(p: &Placed, q: &Placed) -> bool {
 /// Whether two placed shapes touch or overlap (call after [`bounds_apart`] said no).
 #[inline]
 pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> bool {
-    if let Some(touch) = cloud_touches(c1, p1, c2, p2).or_else(|| cloud_touches(c2, p2, c1, p1)) {
-        return touch;
-    }
+    // (clouds are general shapes without box extents: only those arms ask for them)
     match (&c1.geometry, &c2.geometry) {
         (Geometry::Round { radius: r1, .. }, Geometry::Round { radius: r2, .. }) => {
             let r = r1 + r2;
@@ -117,6 +115,9 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
                 shape, walk, axial, ..
             },
         ) => {
+            if let Some(touch) = cloud_touches(c1, p1, c2, p2) {
+                return touch;
+            }
             if let Some(answer) = axial.and_then(|a| round_axial(p1, *radius, p2, &a)) {
                 return answer;
             }
@@ -132,6 +133,9 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
             },
             Geometry::Round { radius, .. },
         ) => {
+            if let Some(touch) = cloud_touches(c2, p2, c1, p1) {
+                return touch;
+            }
             if let Some(answer) = axial.and_then(|a| round_axial(p2, *radius, p1, &a)) {
                 return answer;
             }
@@ -155,6 +159,11 @@ pub(crate) fn intersects(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed)
                 ..
             },
         ) => {
+            if let Some(touch) =
+                cloud_touches(c1, p1, c2, p2).or_else(|| cloud_touches(c2, p2, c1, p1))
+            {
+                return touch;
+            }
             // boxes: each bounding sphere against the other's slabs before SAT/GJK
             let apart = h2.is_some_and(|h| sphere_box_apart(&p1.center, p1.bound, p2, &h))
                 || h1.is_some_and(|h| sphere_box_apart(&p2.center, p2.bound, p1, &h));
