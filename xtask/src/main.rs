@@ -1,16 +1,14 @@
-//! `cargo xtask <command>`: the repository's tooling (regenerating the iCub model, the paper
-//! studies that time builds or sweep sizes). Every other command is the `trm` tool's:
+//! `cargo xtask <command>`: the repository's tooling (regenerating the iCub model) and thin
+//! drivers of the paper studies (`trm-studies`, in studies/). Every other command is the `trm` tool's:
 //! `cargo xtask build-map specs/reach.ron` runs `trm build-map specs/reach.ron`.
 
 mod gen_icub;
-mod map_scaling;
-mod speedup;
-mod task_map_studies;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
+use trm_studies::{map_scaling, speedup, task_map_studies};
 
 #[derive(Parser)]
 #[command(

@@ -74,10 +74,7 @@ pub fn generate_acm(model: &CollisionModel, settings: &AcmOptions) -> Result<Acm
     let mut poses = robot.pose_buffer();
     let default = match &settings.default_posture {
         Some(q) => q.clone(),
-        None => robot
-            .posture("home")
-            .map(<[f64]>::to_vec)
-            .unwrap_or_else(|_| robot.neutral_motors()),
+        None => robot.home_motors(),
     };
     robot.forward_motors(&default, &mut poses)?;
     let probe = model.with_acm(acm.clone())?;

@@ -152,6 +152,16 @@ impl CollisionModel {
         Self::with_options(robot, &CollisionOptions::with_ros_package_path(Vec::new()))
     }
 
+    /// As [`CollisionModel::new`], `package://` meshes searched in `package_paths` first (then
+    /// the description's, then `ROS_PACKAGE_PATH`): what every `--package-path` flag and
+    /// Python's `package_paths=` give.
+    pub fn with_package_paths(robot: &RobotModel, package_paths: Vec<PathBuf>) -> Result<Self> {
+        Self::with_options(
+            robot,
+            &CollisionOptions::with_ros_package_path(package_paths),
+        )
+    }
+
     /// As [`CollisionModel::new`], with mesh search paths (searched before the description's
     /// `package_paths`; `ROS_PACKAGE_PATH` only as `options` give it).
     pub fn with_options(robot: &RobotModel, options: &CollisionOptions) -> Result<Self> {

@@ -1,7 +1,7 @@
 //! Writing files safely.
 
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The largest input file trm reads (1 GiB): anything bigger is refused rather than exhausting
 /// memory.
@@ -557,6 +557,24 @@ pub fn read_file_bytes(path: &Path) -> Result<Vec<u8>, FileError> {
 /// [`write_atomic`] with a [`FileError`] naming the file.
 pub fn write_file(path: &Path, text: &str) -> Result<(), FileError> {
     write_file_bytes(path, text.as_bytes())
+}
+
+/// Writes several files so that none is put in place unless all could be written: each is
+/// staged ([`StagedFile`]), then all are renamed into place. Errors name the file.
+pub fn write_files(files: &[(PathBuf, String)]) -> Result<(), FileError> {
+    let error = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| FileError::Io { path, source }
+    };
+    let staged = files
+        .iter()
+        .map(|(path, text)| StagedFile::new(path, text.as_bytes()).map_err(error(path)))
+        .collect::<Result<Vec<_>, _>>()?;
+    for file in staged {
+        let path = file.path().to_path_buf();
+        file.commit().map_err(error(&path))?;
+    }
+    Ok(())
 }
 
 /// [`write_atomic`] of bytes with a [`FileError`] naming the file.

@@ -36,7 +36,7 @@ pub use files::{
     FileError, MAX_INPUT_BYTES, StagedFile, binary_bytes, check_output, check_unique_keys,
     json_text, load_versioned, parse_binary_versioned, parse_versioned, parse_versioned_since,
     read_file, read_file_bytes, read_input, read_input_bytes, save_json, unique_names,
-    write_atomic, write_file, write_file_bytes,
+    write_atomic, write_file, write_file_bytes, write_files,
 };
 pub use names::closest_names;
 pub use points::{PointFile, parse_points, read_points};

@@ -19,10 +19,7 @@ fn main() -> Result<(), KinematicsError> {
         Some(path) => RobotModel::load(path)?,
         None => RobotModel::from_urdf_str(ARM, "<two-link arm>")?,
     };
-    let motors = match model.posture("home") {
-        Ok(home) => home.to_vec(),
-        Err(_) => model.neutral_motors(),
-    };
+    let motors = model.home_motors();
     let mut poses = model.pose_buffer();
     model.forward_motors(&motors, &mut poses)?;
     println!(

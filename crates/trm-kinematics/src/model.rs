@@ -506,6 +506,13 @@ impl RobotModel {
         &self.data.enabled_collisions
     }
 
+    /// The `home` posture's motor values, else [`RobotModel::neutral_motors`]: where the robot
+    /// rests when nothing says otherwise.
+    pub fn home_motors(&self) -> Vec<f64> {
+        self.posture("home")
+            .map_or_else(|_| self.neutral_motors(), <[f64]>::to_vec)
+    }
+
     /// The zero motor vector clamped into the motor limits (the default locked values).
     pub fn neutral_motors(&self) -> Vec<f64> {
         self.data

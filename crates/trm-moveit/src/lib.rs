@@ -29,6 +29,7 @@
 
 mod error;
 mod limits;
+mod planning;
 mod reader;
 mod request;
 mod response;
@@ -41,6 +42,7 @@ use trm_collision::{AllowedCollisionMatrix, CollisionModel, World};
 
 pub use error::{MoveItError, Result};
 pub use limits::JointLimitsFile;
+pub use planning::{TimingSettings, check_trajectory_out, describe_files, trajectory_files};
 pub use request::{
     JointGoal, JointState, LIMIT_SLACK, MotionPlanRequest, RequestGoal, motors_from_state,
 };

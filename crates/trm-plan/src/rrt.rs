@@ -188,6 +188,40 @@ pub const DOMAIN_ALPHA: f64 = 1e-4;
 /// Smallest domain radius, rad.
 pub const DOMAIN_MIN_RADIUS: f64 = 1.0;
 
+/// What a user sets for one query ([`crate::Planner::rrt_options_within`]); the rest of
+/// RRT-Connect's settings are sized for the robot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Budget {
+    /// Seed of the sampler.
+    pub seed: u64,
+    /// Time budget, s (`None`: only the sample budget; reproducible).
+    pub max_seconds: Option<f64>,
+    /// Most samples ([`RrtOptions::max_iterations`]).
+    pub max_samples: usize,
+    /// Largest gap between checked points of an edge, rad (`None`: sized for the robot).
+    pub resolution: Option<f64>,
+    /// Longest step a tree grows by, rad (`None`: sized for the robot).
+    pub range: Option<f64>,
+    /// Certified paths ([`RrtOptions::certified`]).
+    pub certified: bool,
+    /// Corner-cutting rounds ([`RrtOptions::smoothing`]).
+    pub smoothing: usize,
+}
+
+impl Default for Budget {
+    fn default() -> Self {
+        Budget {
+            seed: 0,
+            max_seconds: None,
+            max_samples: 1_000_000,
+            resolution: None,
+            range: None,
+            certified: false,
+            smoothing: SMOOTHING_ROUNDS,
+        }
+    }
+}
+
 impl Default for RrtOptions {
     fn default() -> Self {
         RrtOptions {

@@ -13,7 +13,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use trm_kinematics::RobotModel;
+use trm_kinematics::{ActiveSet, RobotModel};
 
 use crate::PlanError;
 
@@ -49,6 +49,25 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// A path of `active`'s motors (active values per waypoint) as full motor vectors, timed by
+    /// [`time_parametrise`] at `speed` rad/s for every moving motor (stopping at each waypoint;
+    /// no velocities, no task path): how an optimised motion's postures are written out.
+    pub fn at_joint_speed(active: &ActiveSet, path: &[Vec<f64>], speed: f64) -> Self {
+        Trajectory {
+            names: active
+                .model()
+                .motors()
+                .iter()
+                .map(|m| m.name.clone())
+                .collect(),
+            times: time_parametrise(path, &vec![speed; active.len()], None),
+            positions: path.iter().map(|q| active.to_motors(q)).collect(),
+            velocities: Vec::new(),
+            accelerations: Vec::new(),
+            task_path: Vec::new(),
+        }
+    }
+
     /// CSV: `time,<names…>` then one row per waypoint (shortest exact decimals). Refuses what
     /// the reader refuses ([`Trajectory::check`]); `path` names the file it is for.
     pub fn to_csv(&self, path: &Path) -> Result<String, PlanError> {

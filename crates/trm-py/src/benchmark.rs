@@ -69,7 +69,7 @@ pub(crate) fn benchmark_mbm<'py>(
     seed: u64,
     max_iterations: usize,
     verify: bool,
-    package_paths: Vec<String>,
+    package_paths: Vec<std::path::PathBuf>,
     task_space: Option<String>,
     position_tolerance: f64,
     orientation_tolerance: f64,
@@ -84,10 +84,7 @@ pub(crate) fn benchmark_mbm<'py>(
         orientation_tolerance,
     });
     let robot = trm_models::load(model, std::path::Path::new("")).map_err(err)?;
-    let options = trm_collision::CollisionOptions::with_ros_package_path(
-        package_paths.into_iter().map(Into::into).collect(),
-    );
-    let collision = CollisionModel::with_options(&robot, &options).map_err(err)?;
+    let collision = CollisionModel::with_package_paths(&robot, package_paths).map_err(err)?;
     let mut set = trm_mbm::ProblemSet::open(std::path::Path::new(path)).map_err(err)?;
     set.select(&families, per_family).map_err(err)?;
     let sized = trm_mbm::rrt_options_for(&robot, &collision, &set.problems).map_err(err)?;

@@ -207,11 +207,14 @@ impl Collision {
 
 #[pymethods]
 impl Collision {
-    /// The collision model of `robot` (its capsules and boxes, or meshes as convex hulls).
+    /// The collision model of `robot` (its capsules and boxes, or meshes as convex hulls);
+    /// `package://` meshes are looked for in `package_paths`, then ROS_PACKAGE_PATH, as
+    /// `--package-path` does for `trm`.
     #[new]
-    fn new(robot: &Robot) -> PyResult<Self> {
+    #[pyo3(signature = (robot, package_paths = Vec::new()))]
+    fn new(robot: &Robot, package_paths: Vec<std::path::PathBuf>) -> PyResult<Self> {
         Ok(Collision {
-            model: CollisionModel::new(&robot.model).map_err(err)?,
+            model: CollisionModel::with_package_paths(&robot.model, package_paths).map_err(err)?,
             robot: robot.model.clone(),
         })
     }

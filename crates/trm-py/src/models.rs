@@ -14,14 +14,11 @@ use crate::*;
 pub(crate) fn fit_proxies<'py>(
     py: Python<'py>,
     urdf: &str,
-    package_paths: Vec<String>,
+    package_paths: Vec<std::path::PathBuf>,
     out: Option<String>,
 ) -> PyResult<Bound<'py, PyList>> {
     let model = RobotModel::load(urdf).map_err(err)?;
-    let options = trm_collision::CollisionOptions::with_ros_package_path(
-        package_paths.into_iter().map(Into::into).collect(),
-    );
-    let collision = CollisionModel::with_options(&model, &options).map_err(err)?;
+    let collision = CollisionModel::with_package_paths(&model, package_paths).map_err(err)?;
     let fits = py
         .detach(|| trm_collision::fit::fit_model(&collision))
         .map_err(err)?;

@@ -2,6 +2,7 @@
 
 use crate::*;
 use trm_moveit::RequestGoal;
+use trm_plan::rrt::Budget;
 
 /// A planner for one robot, compiled once (`trm_plan::Planner`): worlds and planning scenes
 /// are set on it, maps and kept paths are optional, queries go without rebuilding anything.
@@ -99,7 +100,7 @@ pub(crate) struct Planner {
     /// Keep every path RRT-Connect finds as experience.
     experience: bool,
     /// How paths are timed (`set_timing`).
-    timing: trm_plan::Timing,
+    timing: trm_moveit::TimingSettings,
 }
 
 /// Runs a scenario (RON: objects that move, appear and vanish, goals that change; see
@@ -178,15 +179,11 @@ impl Planner {
                     "request: give it alone, or joints and posture (a request says both)",
                 ));
             }
+            // motor names or groups' names
             let names: Vec<String> = match joints {
                 None => model.motors().iter().map(|m| m.name.clone()).collect(),
                 Some(j) => match j.extract::<String>() {
-                    Ok(group) => {
-                        let ids = model.group(&group).map_err(err)?;
-                        ids.iter()
-                            .map(|&i| model.motors()[i].name.clone())
-                            .collect()
-                    }
+                    Ok(group) => vec![group],
                     Err(_) => j
                         .extract::<Vec<String>>()
                         .map_err(|_| err("joints: give a list of motor names or a group's name"))?,
@@ -194,23 +191,13 @@ impl Planner {
             };
             let fixed = match posture {
                 Some(p) => configurations(p, model.motors().len(), "posture")?.0,
-                None => match model.posture("home") {
-                    Ok(home) => home.to_vec(),
-                    Err(_) => model
-                        .motors()
-                        .iter()
-                        .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
-                        .collect(),
-                },
+                None => model.home_motors(),
             };
             let active = match request {
                 Some(path) => trm_moveit::MotionPlanRequest::load(path)
                     .and_then(|r| r.active_set(model, &fixed))
                     .map_err(err)?,
-                None => {
-                    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-                    model.active_set(&refs, &fixed).map_err(err)?
-                }
+                None => model.active_set(&names, &fixed).map_err(err)?,
             };
             let collision = match collision {
                 Some(c) => c.model.clone(),
@@ -224,7 +211,7 @@ impl Planner {
                 start: None,
                 task_dim: 0,
                 experience,
-                timing: trm_plan::Timing::default(),
+                timing: Default::default(),
             });
         }
         if joints.is_some() || posture.is_some() || request.is_some() || collision.is_some() {
@@ -254,7 +241,7 @@ impl Planner {
             start: Some(problem.start.clone()),
             task_dim: problem.objective.task().map_or(0, |t| t.dim()),
             experience,
-            timing: trm_plan::Timing::default(),
+            timing: Default::default(),
         })
     }
 
@@ -290,14 +277,7 @@ impl Planner {
     fn load_scene(&mut self, py: Python<'_>, path: &str) -> PyResult<Vec<String>> {
         let scene = trm_moveit::load_scene(path, &self.own).map_err(err)?;
         let planner = &mut self.planner;
-        py.detach(|| -> Result<(), trm_plan::PlanError> {
-            planner.set_world(scene.world);
-            planner.set_acm(scene.acm)?;
-            planner.set_attached(scene.attached)?;
-            Ok(())
-        })
-        .map_err(err)?;
-        Ok(scene.notes)
+        py.detach(|| scene.apply_to(planner)).map_err(err)
     }
 
     /// The names of the motors the planner moves (the order of its configurations' values).
@@ -354,17 +334,18 @@ impl Planner {
     /// How the next plans are timed: time-optimal within the joints' velocity and
     /// acceleration limits (the robot's; `joint_limits`, a MoveIt `joint_limits.yaml`, replaces
     /// them; `velocity` and `acceleration` where neither gives one), each scaled by its factor
-    /// in (0, 1] (a request's `max_*_scaling_factor` wins in `plan_request`), corners cut by
+    /// in (0, 1] (when absent: a request's `max_*_scaling_factor` in `plan_request`, else the
+    /// `joint_limits` file's default, else 1 — as `trm plan` resolves them), corners cut by
     /// blends of at most `max_deviation` rad that are collision-checked (0: stop at every
     /// waypoint), sampled every `sample_period` s. With `jerk_limited=True` the jerk is limited
     /// too (`joint_limits`' `max_jerk`, the model's, else `jerk` rad/s³) and the motion stops
     /// at every waypoint (a double-S profile per segment, no blends).
-    #[pyo3(signature = (*, velocity_scaling = 1.0, acceleration_scaling = 1.0, max_deviation = 0.2, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None, jerk_limited = false, jerk = 10.0))]
+    #[pyo3(signature = (*, velocity_scaling = None, acceleration_scaling = None, max_deviation = 0.2, sample_period = 0.01, velocity = 1.0, acceleration = 1.0, joint_limits = None, jerk_limited = false, jerk = 10.0))]
     #[allow(clippy::too_many_arguments)]
     fn set_timing(
         &mut self,
-        velocity_scaling: f64,
-        acceleration_scaling: f64,
+        velocity_scaling: Option<f64>,
+        acceleration_scaling: Option<f64>,
         max_deviation: f64,
         sample_period: f64,
         velocity: f64,
@@ -373,24 +354,27 @@ impl Planner {
         jerk_limited: bool,
         jerk: f64,
     ) -> PyResult<()> {
-        let limits = match joint_limits {
-            Some(path) => trm_moveit::JointLimitsFile::load(path).map_err(err)?.limits,
-            None => Default::default(),
+        let joint_limits = match joint_limits {
+            Some(path) => Some(trm_moveit::JointLimitsFile::load(path).map_err(err)?),
+            None => None,
         };
-        let timing = trm_plan::Timing {
-            default_velocity: velocity,
-            default_acceleration: acceleration,
-            default_jerk: jerk,
-            jerk_limited,
-            limits,
+        let settings = trm_moveit::TimingSettings {
+            timing: trm_plan::Timing {
+                default_velocity: velocity,
+                default_acceleration: acceleration,
+                default_jerk: jerk,
+                jerk_limited,
+                max_deviation,
+                sample_period,
+                ..Default::default()
+            },
+            joint_limits,
             velocity_scaling,
             acceleration_scaling,
-            max_deviation,
-            sample_period,
-            resolution: None,
         };
+        let timing = settings.timing(None);
         timing.joint_limits(self.planner.active()).map_err(err)?;
-        self.timing = timing;
+        self.timing = settings;
         Ok(())
     }
 
@@ -408,8 +392,11 @@ impl Planner {
     /// Returns a dict: `times (T,)`, `positions`, `velocities` and `accelerations` `(T, motors)`
     /// (every motor, sampled as `set_timing` says), `motor_names`, `waypoints (W, joints)` (the moved motors), `task_path` (map
     /// planners), `length` (rad), `seconds`, and for posture goals `source` (`straight`,
-    /// `graph`, `retrieved` or `sampled`), `checks` and `samples`.
-    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS))]
+    /// `graph`, `retrieved` or `sampled`), `checks` and `samples`. With `out` (a `.csv` path)
+    /// the trajectory is also written as `trm plan --out` writes it (CSV, JSON, a ROS 2
+    /// JointTrajectory `.ros.yaml`, a MoveIt MotionPlanResponse `.response.yaml`), the
+    /// files listed under `files`.
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, out = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &mut self,
@@ -426,7 +413,9 @@ impl Planner {
         range: Option<f64>,
         certified: bool,
         smoothing: usize,
+        out: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        check_out(out.as_deref())?;
         let dim = self.planner.active().len();
         let from = match (start, &self.start) {
             (Some(s), _) => configurations(s, dim, "start")?.0,
@@ -458,7 +447,7 @@ impl Planner {
                 certified,
                 smoothing,
             };
-            let timing = self.timing.clone();
+            let timing = self.timing.timing(None);
             self.connect(py, &d, from, RequestGoal::Joints(target), &budget, &timing)?
         } else {
             let goal = trm_plan::Goal::TaskPoint {
@@ -468,7 +457,7 @@ impl Planner {
             let options = trm_plan::PlanOptions {
                 seed,
                 exact_goal: exact,
-                timing: self.timing.clone(),
+                timing: self.timing.timing(None),
                 ..Default::default()
             };
             let planner = &mut self.planner;
@@ -482,6 +471,8 @@ impl Planner {
                 planned.stats.seconds,
             )
         };
+        let group = self.joint_names().join(",");
+        self.write(&d, &planned, &group, out.as_deref())?;
         self.fill(py, d, planned)
     }
 
@@ -490,8 +481,9 @@ impl Planner {
     /// task-space goal, met by IK for a collision-free configuration first; its
     /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
     /// its scene first (`load_scene`). Objects its start state holds are held from then on
-    /// (beside the scene's). Returns what `plan` returns.
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS))]
+    /// (beside the scene's). Returns what `plan` returns; `out` as for `plan` (the response
+    /// names the request's group).
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, out = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
         &mut self,
@@ -504,7 +496,9 @@ impl Planner {
         range: Option<f64>,
         certified: bool,
         smoothing: usize,
+        out: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        check_out(out.as_deref())?;
         let read;
         let request = match request.cast::<MotionPlanRequest>() {
             Ok(r) => &r.get().request,
@@ -516,14 +510,7 @@ impl Planner {
                 &read
             }
         };
-        if !request.attached.is_empty() {
-            let mut held = self.planner.attached().to_vec();
-            for object in &request.attached {
-                held.retain(|o| o.name != object.name);
-                held.push(object.clone());
-            }
-            self.planner.set_attached(held).map_err(err)?;
-        }
+        request.hold_on(&mut self.planner).map_err(err)?;
         let (start, goal) = request.query(self.planner.active()).map_err(err)?;
         let budget = Budget {
             seed,
@@ -535,16 +522,9 @@ impl Planner {
             smoothing,
         };
         let d = PyDict::new(py);
-        let timing = trm_plan::Timing {
-            velocity_scaling: request
-                .velocity_scaling
-                .unwrap_or(self.timing.velocity_scaling),
-            acceleration_scaling: request
-                .acceleration_scaling
-                .unwrap_or(self.timing.acceleration_scaling),
-            ..self.timing.clone()
-        };
+        let timing = self.timing.timing(Some(request));
         let planned = self.connect(py, &d, start, goal, &budget, &timing)?;
+        self.write(&d, &planned, &request.group, out.as_deref())?;
         self.fill(py, d, planned)
     }
 
@@ -596,23 +576,16 @@ impl Planner {
     }
 }
 
+/// Refuses an `out` the trajectory's JSON would overwrite, before planning.
+fn check_out(out: Option<&std::path::Path>) -> PyResult<()> {
+    out.map_or(Ok(()), |o| {
+        trm_moveit::check_trajectory_out("out", o).map_err(err)
+    })
+}
+
 /// A path, timed: the trajectory, the waypoints (moved motors), its length (rad) and the
 /// planning time (s).
 type Timed = (trm_plan::Trajectory, Vec<Vec<f64>>, f64, f64);
-
-/// A query's seed and budget as Python gives them (`None`: the planner's sized settings, the
-/// request's planning time).
-struct Budget {
-    seed: u64,
-    max_seconds: Option<f64>,
-    max_samples: usize,
-    resolution: Option<f64>,
-    range: Option<f64>,
-    /// Certified paths ([`trm_plan::rrt::RrtOptions::certified`]).
-    certified: bool,
-    /// Corner-cutting rounds ([`trm_plan::rrt::RrtOptions::smoothing`]).
-    smoothing: usize,
-}
 
 impl Planner {
     /// `from` joined to `goal` (a configuration or a task-space goal) by
@@ -628,24 +601,11 @@ impl Planner {
         budget: &Budget,
         timing: &trm_plan::Timing,
     ) -> PyResult<Timed> {
-        let sized = self.planner.rrt_options().map_err(err)?;
-        let rrt = trm_plan::rrt::RrtOptions {
-            seed: budget.seed,
-            max_seconds: budget.max_seconds,
-            max_iterations: budget.max_samples,
-            resolution: budget.resolution.unwrap_or(sized.resolution),
-            range: budget.range.unwrap_or(sized.range),
-            certified: budget.certified,
-            smoothing: budget.smoothing,
-            ..sized
-        };
+        let rrt = self.planner.rrt_options_within(budget).map_err(err)?;
         let (experience, planner) = (self.experience, &mut self.planner);
         let (found, trajectory) = py
             .detach(|| -> Result<_, trm_plan::PlanError> {
-                let found = match &goal {
-                    RequestGoal::Joints(q) => planner.connect(&from, q, &rrt)?,
-                    RequestGoal::Pose(pose) => planner.connect_to_pose(&from, pose, &rrt)?,
-                };
+                let found = goal.connect(planner, &from, &rrt)?;
                 if experience && found.source == trm_plan::Source::Sampled {
                     planner.add_path(&found.path)?;
                 }
@@ -658,6 +618,26 @@ impl Planner {
         d.set_item("samples", found.iterations)?;
         let length = trm_plan::rrt::path_length(&found.path);
         Ok((trajectory, found.path, length, found.seconds))
+    }
+
+    /// With `out`, the timed path written as `trm plan --out` writes it (for `group`), each
+    /// file whole or not at all, their paths under `files` in `d`.
+    fn write(
+        &self,
+        d: &Bound<'_, PyDict>,
+        planned: &Timed,
+        group: &str,
+        out: Option<&std::path::Path>,
+    ) -> PyResult<()> {
+        let Some(out) = out else { return Ok(()) };
+        let (trajectory, _, _, seconds) = planned;
+        let robot = self.planner.active().model();
+        let files = trm_moveit::trajectory_files(trajectory, robot, Some((group, *seconds)), out)
+            .map_err(err)?;
+        trm_io::write_files(&files).map_err(err)?;
+        let paths: Vec<&std::path::Path> = files.iter().map(|(p, _)| p.as_path()).collect();
+        d.set_item("files", paths)?;
+        Ok(())
     }
 
     /// `d` filled with a timed path: `times`, `positions`, `motor_names`, `waypoints`,

@@ -192,16 +192,9 @@ impl Problem {
             Some(s) => configurations(s, o.dim(), "start")?.0,
             None => self.problem.start.clone(),
         };
-        let mut solver = self.problem.spec.solver.clone();
-        if let Some(a) = algo {
-            solver.algo = a;
-        }
-        if let Some(s) = seed {
-            solver.seed = s;
-        }
-        if let Some(m) = max_evals {
-            solver.max_evaluations = m;
-        }
+        let solver = (self.problem.spec.solver)
+            .overridden(algo.as_deref(), seed, max_evals)
+            .map_err(err)?;
         let s = py.detach(|| trm_tasks::solve(o, &from, &solver));
         self.python_cost_error()?;
         let s = s.map_err(err)?;

@@ -86,36 +86,15 @@ pub(crate) fn reach_grasp<'py>(
     exact: bool,
     iterations: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(at.len() == 3 || at.len() == 4) || at.iter().any(|v| !v.is_finite()) {
-        return Err(err(format!(
-            "at {at:?}: give (x, y, z) or (x, y, z, yaw), finite"
-        )));
-    }
-    if iterations == 0 {
-        return Err(err("iterations 0: give at least 1"));
-    }
-    let place = Isometry3::new(
-        trm_kinematics::nalgebra::Vector3::new(at[0], at[1], at[2]),
-        trm_kinematics::nalgebra::Vector3::z() * at.get(3).copied().unwrap_or(0.0),
-    );
+    let place = trm_taskmap::placement(&at).map_err(err)?;
     let loaded = trm_taskmap::TaskMapSpec::load(spec).map_err(err)?;
     let explored = py.detach(|| loaded.explore()).map_err(err)?;
     let empty = World::new();
     let world = world.map_or(&empty, |w| &w.world);
-    let active = explored.reaching_set().map_err(err)?;
-    let centre = explored
-        .map
-        .center_grasp()
-        .ok_or_else(|| err("the task map is empty"))?;
-    let goal = if exact {
-        trm_taskmap::MotionGoal::Target(centre)
-    } else {
-        trm_taskmap::MotionGoal::Map(&explored.map)
-    };
-    let problem = explored
-        .reach_problem(&active, world, place, goal)
+    let reach = py
+        .detach(|| explored.reach(world, place, exact, iterations))
         .map_err(err)?;
-    let (m, _) = py.detach(|| problem.optimize(iterations));
+    let m = &reach.motion;
     let d = PyDict::new(py);
     for (key, value) in [
         ("cost", m.cost),
@@ -129,7 +108,7 @@ pub(crate) fn reach_grasp<'py>(
     }
     d.set_item("collisions", m.collisions)?;
     d.set_item("final_pose", shaped(py, None, &[6], m.final_pose.to_vec())?)?;
-    let motors: Vec<Vec<f64>> = m.trajectory.iter().map(|q| active.to_motors(q)).collect();
+    let motors = reach.motor_trajectory();
     let width = motors.first().map_or(0, Vec::len);
     d.set_item(
         "trajectory",

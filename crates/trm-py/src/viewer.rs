@@ -29,11 +29,7 @@ pub(crate) fn view(
     let n = robot.model.motors().len();
     let postures = match frames {
         Some(f) => configurations(f, n, "frames")?.0,
-        None => robot
-            .model
-            .posture("home")
-            .map(<[f64]>::to_vec)
-            .unwrap_or_else(|_| robot.model.neutral_motors()),
+        None => robot.model.home_motors(),
     };
     let count = postures.len() / n.max(1);
     let times = times.unwrap_or_else(|| (0..count).map(|k| k as f64 * 0.05).collect());
@@ -43,8 +39,7 @@ pub(crate) fn view(
             times.len()
         )));
     }
-    let options = trm_collision::CollisionOptions::with_ros_package_path(package_paths);
-    let collision = CollisionModel::with_options(&robot.model, &options).map_err(err)?;
+    let collision = CollisionModel::with_package_paths(&robot.model, package_paths).map_err(err)?;
     let mut scene = trm_view::Scene::new(title, &collision);
     if let Some(w) = world {
         scene.set_world(&w.world);
@@ -72,8 +67,6 @@ pub(crate) fn view(
         }
         None => None,
     };
-    let json = out.with_extension("json");
-    trm_io::write_file(&json, &scene.to_json().map_err(err)?).map_err(err)?;
-    trm_io::write_file(&out, &scene.to_html(code.as_deref()).map_err(err)?).map_err(err)?;
+    trm_io::write_files(&scene.page_files(&out, code.as_deref()).map_err(err)?).map_err(err)?;
     Ok(out)
 }

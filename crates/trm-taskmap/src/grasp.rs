@@ -121,10 +121,7 @@ impl Hand {
             .filter(|(_, b)| b.link == hand_link)
             .map(|(i, _)| i)
             .collect();
-        let mut open = model
-            .posture("home")
-            .map(<[f64]>::to_vec)
-            .unwrap_or_else(|_| model.neutral_motors());
+        let mut open = model.home_motors();
         for f in &fingers {
             for &k in &f.motors {
                 open[k] = model.motors()[k].limits.lower;

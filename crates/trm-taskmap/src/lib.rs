@@ -26,7 +26,9 @@ pub use explore::{ExploreOptions, explore};
 pub use grasp::{Finger, GraspResult, Hand, find_grasp};
 pub use map::{Metric, TaskMap, TaskMapError, TaskPoint, to_params, to_pose};
 pub use motion::{CostWeights, Motion, MotionGoal, MotionOptions, ReachProblem, grasp_axis};
-pub use spec::{ExploreSpec, Explored, LoadedTaskMapSpec, SearchSpec, TaskMapSpec};
+pub use spec::{
+    ExploreSpec, Explored, LoadedTaskMapSpec, Reach, SearchSpec, TaskMapSpec, placement,
+};
 
 /// The readers a task spec needs to name task maps (`TaskMap(file: …)` costs of trm-tasks, read
 /// as [`TaskMap`] files): pass them where the spec is resolved

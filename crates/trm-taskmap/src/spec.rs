@@ -111,6 +111,40 @@ pub struct Explored {
     pub seconds: f64,
 }
 
+/// Where an object stands in the robot's root frame from `(x, y, z)` or `(x, y, z, yaw)`
+/// (finite numbers; yaw about z, rad).
+pub fn placement(at: &[f64]) -> Result<nalgebra::Isometry3<f64>, TaskMapError> {
+    if !(at.len() == 3 || at.len() == 4) || at.iter().any(|v| !v.is_finite()) {
+        return Err(TaskMapError::Invalid {
+            what: "object placement".into(),
+            problem: format!("{at:?}: give (x, y, z) or (x, y, z, yaw), finite"),
+        });
+    }
+    Ok(nalgebra::Isometry3::new(
+        nalgebra::Vector3::new(at[0], at[1], at[2]),
+        nalgebra::Vector3::z() * at.get(3).copied().unwrap_or(0.0),
+    ))
+}
+
+/// A reaching motion optimised by [`Explored::reach`].
+#[derive(Debug, Clone)]
+pub struct Reach {
+    /// The motion and its costs.
+    pub motion: crate::Motion,
+    /// The best cost and its joint-limit part after each iteration, the start's first.
+    pub trace: Vec<(f64, f64)>,
+    /// The motors it moves (torso and right arm), the others at home.
+    pub active: trm_kinematics::ActiveSet,
+}
+
+impl Reach {
+    /// The motion's postures as full motor vectors.
+    pub fn motor_trajectory(&self) -> Vec<Vec<f64>> {
+        let path = &self.motion.trajectory;
+        path.iter().map(|q| self.active.to_motors(q)).collect()
+    }
+}
+
 impl Explored {
     /// The paper's reaching motion (Section III) of the iCub's right hand (torso and right arm
     /// moving, from the home posture) to grasp this map's object placed at `object` in
@@ -139,6 +173,45 @@ impl Explored {
             start: active.from_motors(self.model.posture("home")?),
             goal,
             settings: crate::MotionOptions::default(),
+        })
+    }
+
+    /// The reaching motion of `trm reach-grasp`: this map's object placed at `object` in
+    /// `world`, the right hand optimised for `iterations` iRprop− steps toward the whole map
+    /// (or, with `exact`, the map's grasp nearest the object's centre).
+    pub fn reach(
+        &self,
+        world: &World,
+        object: nalgebra::Isometry3<f64>,
+        exact: bool,
+        iterations: usize,
+    ) -> Result<Reach, TaskMapError> {
+        if iterations == 0 {
+            return Err(TaskMapError::Invalid {
+                what: "iterations".into(),
+                problem: "0: give at least 1".into(),
+            });
+        }
+        let active = self.reaching_set()?;
+        let centre = self
+            .map
+            .center_grasp()
+            .ok_or_else(|| TaskMapError::Invalid {
+                what: "task map".into(),
+                problem: "is empty: explore it with more points".into(),
+            })?;
+        let goal = if exact {
+            crate::MotionGoal::Target(centre)
+        } else {
+            crate::MotionGoal::Map(&self.map)
+        };
+        let (motion, trace) = self
+            .reach_problem(&active, world, object, goal)?
+            .optimize(iterations);
+        Ok(Reach {
+            motion,
+            trace,
+            active,
         })
     }
 

@@ -21,7 +21,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -589,6 +589,16 @@ impl Scene {
             return bad("path".into(), "holds a non-finite point");
         }
         Ok(())
+    }
+
+    /// The page at `out` ([`Scene::to_html`] with `bundle`) and the scene's JSON beside it
+    /// (`out` with `.json`), each with its contents, for the caller to write (together, as a
+    /// command puts its outputs in place): what `trm view` and Python's `trm.view` write.
+    pub fn page_files(&self, out: &Path, bundle: Option<&str>) -> Result<Vec<(PathBuf, String)>> {
+        Ok(vec![
+            (out.with_extension("json"), self.to_json()?),
+            (out.to_path_buf(), self.to_html(bundle)?),
+        ])
     }
 
     /// One self-contained HTML page that renders the scene. `bundle`: the built viewer

@@ -333,11 +333,8 @@ fn load_model(path: Option<&Path>) -> Result<RobotModel> {
 /// A trajectory `--out` must not end in `.json`: the CSV goes there and the JSON beside it, at
 /// the same name with `.json`.
 fn check_csv_out(out: Option<&Path>) -> Result<()> {
-    if let Some(out) = out.filter(|o| o.extension().is_some_and(|e| e == "json")) {
-        anyhow::bail!(
-            "--out {}: the trajectory CSV goes there and its JSON beside it with a .json extension\n  fix: give a .csv path",
-            out.display()
-        );
+    if let Some(out) = out {
+        trm_moveit::check_trajectory_out("--out", out)?;
     }
     Ok(())
 }
@@ -364,10 +361,9 @@ pub struct MeshArgs {
 impl MeshArgs {
     /// The model's collision model, meshes found through the package paths.
     fn collision_model(&self, model: &RobotModel) -> Result<trm_collision::CollisionModel> {
-        let options =
-            trm_collision::CollisionOptions::with_ros_package_path(self.package_paths.clone());
-        Ok(trm_collision::CollisionModel::with_options(
-            model, &options,
+        let paths = self.package_paths.clone();
+        Ok(trm_collision::CollisionModel::with_package_paths(
+            model, paths,
         )?)
     }
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use trm_moveit::RequestGoal;
-use trm_plan::rrt::RrtOptions;
+use trm_plan::rrt::Budget;
 use trm_plan::{ExactGoal, Goal, PlanOptions, Planner, Trajectory};
 use trm_roadmap::{RepairOptions, Roadmap};
 use trm_tasks::Problem;
@@ -156,7 +156,7 @@ pub fn run(args: &Args) -> Result<()> {
     let goal = map_goal(args, to, first, &problem)?;
     let options = PlanOptions {
         seed: args.seed,
-        timing: args.timing.timing((None, None))?,
+        timing: args.timing.settings()?.timing(None),
         exact_goal: !args.no_exact,
         exact_tolerance: args.exact_tolerance,
         ..Default::default()
@@ -221,7 +221,7 @@ pub fn run(args: &Args) -> Result<()> {
             .names()
             .collect::<Vec<_>>()
             .join(",");
-        let written = write_trajectory(&plan.trajectory, &problem.robot, &group, s.seconds, out)?;
+        let written = write_trajectory(&plan.trajectory, &problem.robot, (&group, s.seconds), out)?;
         let svg = out.with_extension("svg");
         crate::write_atomic(
             &svg,
@@ -312,31 +312,20 @@ fn write_view(
     crate::support::scene::write_scene(&scene, &crate::support::scene::scene_path(&out))
 }
 
-/// Writes `trajectory` to `out` (CSV) and beside it as JSON, a ROS 2 JointTrajectory
-/// (`.ros.yaml`) and a MoveIt MotionPlanResponse (`.response.yaml`, for `group`, planned in
-/// `seconds`); each file written whole or not at all. Returns the files' names, for the report.
+/// Writes `trajectory` as [`trm_moveit::trajectory_files`] (with a MoveIt response for the
+/// group, planned in the seconds of `response`), each file whole or not at all. Returns the
+/// files' names, for the report.
 fn write_trajectory(
     trajectory: &Trajectory,
     robot: &trm_kinematics::RobotModel,
-    group: &str,
-    seconds: f64,
+    response: (&str, f64),
     out: &Path,
 ) -> Result<String> {
-    crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;
-    let json = out.with_extension("json");
-    crate::write_atomic(&json, trajectory.to_json(&json)?.as_bytes())?;
-    let ros = out.with_extension("ros.yaml");
-    crate::write_atomic(&ros, trajectory.to_ros_yaml(robot, &ros)?.as_bytes())?;
-    let response = out.with_extension("response.yaml");
-    let yaml = trm_moveit::motion_plan_response_yaml(trajectory, robot, group, seconds, &response)?;
-    crate::write_atomic(&response, yaml.as_bytes())?;
-    Ok(format!(
-        "{}, {}, {} (ROS 2 JointTrajectory), {} (MoveIt MotionPlanResponse)",
-        out.display(),
-        json.display(),
-        ros.display(),
-        response.display()
-    ))
+    let files = trm_moveit::trajectory_files(trajectory, robot, Some(response), out)?;
+    for (path, text) in &files {
+        crate::write_atomic(path, text.as_bytes())?;
+    }
+    Ok(trm_moveit::describe_files(&files))
 }
 
 /// `plan` without maps: one planner for the robot, the world (and a scene's matrix) set on it,
@@ -349,14 +338,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         .as_ref()
         .map(trm_moveit::MotionPlanRequest::load)
         .transpose()?;
-    let home: Vec<f64> = match robot.posture("home") {
-        Ok(home) => home.to_vec(),
-        Err(_) => robot
-            .motors()
-            .iter()
-            .map(|m| 0.0f64.clamp(m.limits.lower, m.limits.upper))
-            .collect(),
-    };
+    let home = robot.home_motors();
     let active = active_motors(args, &robot, request.as_ref(), home)?;
     // the motors that do not move, where the planner holds them
     let fixed = active.to_motors(&vec![0.0; active.len()]);
@@ -381,29 +363,23 @@ fn run_without_maps(args: &Args) -> Result<()> {
             )?),
         ),
     };
-    let sized = planner.rrt_options()?;
-    let options = RrtOptions {
+    let options = planner.rrt_options_within(&Budget {
         seed: args.seed,
         max_seconds: args
             .max_seconds
             .or(request.as_ref().and_then(|r| r.planning_time)),
-        max_iterations: args.max_samples,
-        resolution: args.resolution.unwrap_or(sized.resolution),
-        range: args.range.unwrap_or(sized.range),
+        max_samples: args.max_samples,
+        resolution: args.resolution,
+        range: args.range,
         certified: args.certified,
         smoothing: args.smoothing,
-        ..sized
-    };
+    })?;
     let goal_configuration = match &goal {
         RequestGoal::Joints(q) => Some(q),
         RequestGoal::Pose(_) => None,
     };
     check_free(&mut planner, args, &start, goal_configuration)?;
-    let connected = match &goal {
-        RequestGoal::Joints(q) => planner.connect(&start, q, &options),
-        RequestGoal::Pose(pose) => planner.connect_to_pose(&start, pose, &options),
-    };
-    let found = match connected {
+    let found = match goal.connect(&mut planner, &start, &options) {
         Ok(found) => found,
         Err(e @ trm_plan::PlanError::Unreachable { .. }) => anyhow::bail!(
             "{e}\n  fix: a larger budget (--max-samples {}, --max-seconds), or a goal the robot can reach in this world",
@@ -411,11 +387,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
         ),
         Err(e) => return Err(e.into()),
     };
-    let timing = args
-        .timing
-        .timing(request.as_ref().map_or((None, None), |r| {
-            (r.velocity_scaling, r.acceleration_scaling)
-        }))?;
+    let timing = args.timing.settings()?.timing(request.as_ref());
     let trajectory = planner.trajectory(&found.path, &timing)?;
     let timed = describe_motion(&mut planner, &found.path, &timing, &trajectory)?;
     println!(
@@ -443,7 +415,7 @@ fn run_without_maps(args: &Args) -> Result<()> {
             .map_or_else(|| names.join(","), |r| r.group.clone());
         println!(
             "wrote {}",
-            write_trajectory(&trajectory, &robot, &group, found.seconds, out)?
+            write_trajectory(&trajectory, &robot, (&group, found.seconds), out)?
         );
     }
     if args.view {
@@ -476,22 +448,17 @@ fn active_motors(
         // the request's goal joints move, the other motors stay where its start puts them
         (None, Some(r)) => r.active_set(robot, &home)?,
         (joints, _) => {
-            let names: Vec<String> = match joints {
-                Some(j) if !j.contains(',') && robot.group(j).is_ok() => robot
-                    .group(j)?
-                    .iter()
-                    .map(|&i| robot.motors()[i].name.clone())
-                    .collect(),
-                Some(j) => j.split(',').map(|n| n.trim().to_string()).collect(),
-                None => robot.motors().iter().map(|m| m.name.clone()).collect(),
+            // motor names or groups' names
+            let names: Vec<&str> = match joints {
+                Some(j) => j.split(',').map(str::trim).collect(),
+                None => robot.motors().iter().map(|m| m.name.as_str()).collect(),
             };
-            let refs: Vec<&str> = names.iter().map(String::as_str).collect();
             let fixed = match request {
                 Some(r) => trm_moveit::motors_from_state(robot, &r.start, &home).0,
                 None => home,
             };
             robot
-                .active_set(&refs, &fixed)
+                .active_set(&names, &fixed)
                 .context("--joints: give motor names of the model, or a group's name")?
         }
     })
@@ -510,23 +477,19 @@ fn planner_in_world(
         &[],
     )?;
     // what the robot holds: the scene's, then the request's start state's (by name, over them)
-    let mut held = Vec::new();
     if let Some(world) = &args.world {
         let scene = trm_moveit::load_scene(world, collision)?;
-        for note in &scene.notes {
+        let notes = scene
+            .apply_to(&mut planner)
+            .context("the objects the robot holds (attached_collision_objects)")?;
+        for note in &notes {
             eprintln!("{}: {note}", world.display());
         }
-        planner.set_world(scene.world);
-        planner.set_acm(scene.acm)?;
-        held = scene.attached;
     }
-    for object in request.iter().flat_map(|r| r.attached.iter()) {
-        held.retain(|o: &trm_collision::AttachedObject| o.name != object.name);
-        held.push(object.clone());
+    if let Some(r) = request {
+        r.hold_on(&mut planner)
+            .context("the objects the robot holds (attached_collision_objects)")?;
     }
-    planner
-        .set_attached(held)
-        .context("the objects the robot holds (attached_collision_objects)")?;
     if let Some(file) = args.experience.as_ref().filter(|f| f.exists()) {
         let paths = planner.load_experience(file)?;
         println!("{}: {paths} kept paths", file.display());

@@ -9,9 +9,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use trm_collision::World;
-use trm_kinematics::nalgebra::{Isometry3, Vector3};
-use trm_plan::{Trajectory, time_parametrise};
-use trm_taskmap::MotionGoal;
+use trm_plan::Trajectory;
 
 use crate::support::taskmap::explore_spec;
 
@@ -42,35 +40,20 @@ pub fn run(args: &Args) -> Result<()> {
     crate::check_csv_out(args.out.as_deref())?;
     let e = explore_spec(&args.spec)?;
     let v = crate::numbers("--at", &args.at, "\"x,y,z\" or \"x,y,z,yaw\"")?;
-    anyhow::ensure!(
-        v.len() == 3 || v.len() == 4,
-        "--at `{}`: expected 3 or 4 numbers",
-        args.at
-    );
-    let at = Isometry3::new(
-        Vector3::new(v[0], v[1], v[2]),
-        Vector3::z() * v.get(3).copied().unwrap_or(0.0),
-    );
+    let at = trm_taskmap::placement(&v).with_context(|| format!("--at `{}`", args.at))?;
     let world = match &args.world {
         Some(w) => trm_moveit::load_world(w)?,
         None => World::new(),
     };
-    let active = e.reaching_set()?;
-    let centre = e.map.center_grasp().context("the task map is empty")?;
-    let goal = if args.exact {
-        MotionGoal::Target(centre)
-    } else {
-        MotionGoal::Map(&e.map)
-    };
-    let problem = e.reach_problem(&active, &world, at, goal)?;
     let started = std::time::Instant::now();
-    let (m, trace) = problem.optimize(args.iterations);
+    let reach = e.reach(&world, at, args.exact, args.iterations)?;
+    let m = &reach.motion;
     println!(
         "{} goal, {} map grasps: cost {:.4} (from {:.4}), joint-limit cost {:.4}, closest approach {:.3} m ({} steps in contact), path {:.3} rad, end speed {:.3} m/s, end cost {:.5}; {:.2} s",
         if args.exact { "exact" } else { "task-map" },
         e.map.points.len(),
         m.cost,
-        trace[0].0,
+        reach.trace[0].0,
         m.limits,
         m.min_distance,
         m.collisions,
@@ -81,27 +64,12 @@ pub fn run(args: &Args) -> Result<()> {
     );
     println!("final hand pose in the object frame: {:.4?}", m.final_pose);
     if let Some(out) = &args.out {
-        let velocity = vec![1.0; active.len()];
-        let times = time_parametrise(&m.trajectory, &velocity, None);
-        let trajectory = Trajectory {
-            names: e.model.motors().iter().map(|m| m.name.clone()).collect(),
-            times,
-            positions: m.trajectory.iter().map(|q| active.to_motors(q)).collect(),
-            velocities: Vec::new(),
-            accelerations: Vec::new(),
-            task_path: Vec::new(),
-        };
-        crate::write_atomic(out, trajectory.to_csv(out)?.as_bytes())?;
-        let json = out.with_extension("json");
-        crate::write_atomic(&json, trajectory.to_json(&json)?.as_bytes())?;
-        let ros = out.with_extension("ros.yaml");
-        crate::write_atomic(&ros, trajectory.to_ros_yaml(&e.model, &ros)?.as_bytes())?;
-        println!(
-            "wrote {}, {} and {} (ROS 2 JointTrajectory)",
-            out.display(),
-            json.display(),
-            ros.display()
-        );
+        let trajectory = Trajectory::at_joint_speed(&reach.active, &m.trajectory, 1.0);
+        let files = trm_moveit::trajectory_files(&trajectory, &e.model, None, out)?;
+        for (path, text) in &files {
+            crate::write_atomic(path, text.as_bytes())?;
+        }
+        println!("wrote {}", trm_moveit::describe_files(&files));
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde_json::json;
 use trm_tasks::{Problem, solve};
 
@@ -27,27 +27,10 @@ pub struct Args {
 
 /// Solves and reports.
 pub fn run(args: &Args) -> Result<()> {
-    if let Some(a) = args
-        .algo
-        .as_ref()
-        .filter(|a| !trm_optim::ALGORITHMS.contains(&a.as_str()))
-    {
-        anyhow::bail!(
-            "--algo {a}: unknown algorithm\n  fix: give one of {}",
-            trm_optim::ALGORITHMS.join(", ")
-        );
-    }
     let problem = Problem::load_with(&args.spec, &trm_taskmap::loaders())?;
-    let mut solver = problem.spec.solver.clone();
-    if let Some(a) = &args.algo {
-        solver.algo = a.clone();
-    }
-    if let Some(s) = args.seed {
-        solver.seed = s;
-    }
-    if let Some(m) = args.max_evals {
-        solver.max_evaluations = m;
-    }
+    let solver = (problem.spec.solver)
+        .overridden(args.algo.as_deref(), args.seed, args.max_evals)
+        .context("--algo")?;
     let objective = &problem.objective;
     let mut scratch = objective.scratch();
     let start_cost = objective.eval(&problem.start, &mut scratch);

@@ -107,7 +107,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             } else {
                 let robot = crate::load_model(Some(path))?;
                 Ok(Subject {
-                    start: home(&robot),
+                    start: robot.home_motors(),
                     active: None,
                     world: World::new(),
                     robot,
@@ -129,7 +129,7 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
         (None, None) => {
             let robot = trm_models::icub_upper_body();
             Ok(Subject {
-                start: home(&robot),
+                start: robot.home_motors(),
                 active: None,
                 world: World::new(),
                 robot,
@@ -138,13 +138,6 @@ fn subject(args: &Args, map: Option<&Roadmap>) -> Result<Subject> {
             })
         }
     }
-}
-
-fn home(robot: &RobotModel) -> Vec<f64> {
-    robot
-        .posture("home")
-        .map(|p| p.to_vec())
-        .unwrap_or_else(|_| robot.neutral_motors())
 }
 
 /// Timed postures (time, motor values).
@@ -238,7 +231,7 @@ mod tests {
     /// 200 postures of the iCub around home.
     fn full_postures() -> Vec<Vec<f64>> {
         let model = trm_models::icub_upper_body();
-        let home = super::home(&model);
+        let home = model.home_motors();
         (0..200)
             .map(|i| {
                 let mut q = home.clone();
@@ -475,7 +468,7 @@ mod tests {
             "{:?}",
             scene.missing_visuals
         );
-        scene.add_frame(0.0, &super::home(&robot)).unwrap();
+        scene.add_frame(0.0, &robot.home_motors()).unwrap();
         // a table, sensed: points on its surfaces, 8 mm apart
         let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
         let table = trm_collision::Shape::Box {

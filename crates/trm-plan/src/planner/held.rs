@@ -44,4 +44,15 @@ impl Planner {
         }
         self.set_collision(&model)
     }
+
+    /// Holds `objects` as well as what the robot already holds, each replacing a held object
+    /// of the same name (a MoveIt request's start state over its scene's). Whether it changed.
+    pub fn hold(&mut self, objects: &[AttachedObject]) -> Result<bool, PlanError> {
+        let mut held = self.attached().to_vec();
+        for object in objects {
+            held.retain(|o| o.name != object.name);
+            held.push(object.clone());
+        }
+        self.set_attached(held)
+    }
 }

@@ -12,7 +12,7 @@ use trm_tasks::Objective;
 
 use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
-use crate::rrt::{GOAL_COLLIDES, RrtOptions};
+use crate::rrt::{Budget, GOAL_COLLIDES, RrtOptions};
 use crate::trajectory::Trajectory;
 
 mod connect;
@@ -275,6 +275,21 @@ impl Planner {
         }
         let options = RrtOptions::for_robot(self.objective.collision(), &self.active)?;
         Ok(self.rrt.get_or_init(|| options).clone())
+    }
+
+    /// RRT-Connect's settings for one query: [`Planner::rrt_options`] with what `budget` sets.
+    pub fn rrt_options_within(&self, budget: &Budget) -> Result<RrtOptions, PlanError> {
+        let sized = self.rrt_options()?;
+        Ok(RrtOptions {
+            seed: budget.seed,
+            max_seconds: budget.max_seconds,
+            max_iterations: budget.max_samples,
+            resolution: budget.resolution.unwrap_or(sized.resolution),
+            range: budget.range.unwrap_or(sized.range),
+            certified: budget.certified,
+            smoothing: budget.smoothing,
+            ..sized
+        })
     }
 
     /// The active motors the planner moves (its configurations' coordinates).

@@ -301,7 +301,7 @@ MBM = ROOT / "crates" / "trm-mbm" / "tests" / "fixtures" / "mbm"
 PANDA = str(ROOT / "models" / "panda-mbm" / "panda_spherized.ron")
 
 
-def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
+def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does(tmp_path):
     robot = trm.Robot.load(PANDA)
     requests = sorted(MBM.glob("*/request*.yaml"))
     planner = trm.Planner(robot, request=str(requests[0]))
@@ -361,6 +361,16 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does():
         planner.set_timing(velocity_scaling=1.5)
     with pytest.raises(ValueError, match="no_such.yaml"):
         planner.set_timing(joint_limits="no_such.yaml")
+    # the motion written as `trm plan --out` writes it; a CSV path its JSON would overwrite
+    # is refused before planning
+    r = planner.plan_request(str(requests[0]), out=tmp_path / "motion.csv")
+    names = ["motion.csv", "motion.json", "motion.ros.yaml", "motion.response.yaml"]
+    assert [Path(f).name for f in r["files"]] == names
+    assert (tmp_path / "motion.csv").read_text().startswith("time,panda_joint1,")
+    assert 'group_name: "panda_arm"' in (tmp_path / "motion.response.yaml").read_text()
+    with pytest.raises(ValueError, match="out .*m.json.*give a .csv path"):
+        planner.plan_request(str(requests[0]), out=tmp_path / "m.json")
+    assert not (tmp_path / "m.json").exists()
 
 
 def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
@@ -673,6 +683,11 @@ def test_proxies_fitted_from_python_are_written_into_the_urdf(tmp_path):
     assert all(f["primitive"] == "box" and f["worst_outside"] <= 1e-9 for f in fits)
     fitted = trm.CollisionModel(trm.Robot.load(str(out)))
     assert len(fitted.body_names) == 2
+    # the meshed model itself: its package found through package_paths, as --package-path
+    meshed = trm.Robot.load(str(urdf))
+    with pytest.raises(trm.TrmError, match="demo_pkg"):
+        trm.CollisionModel(meshed)
+    assert len(trm.CollisionModel(meshed, package_paths=[fixtures]).body_names) == 2
     with pytest.raises(trm.TrmError, match="no link has mesh collisions"):
         trm.fit_proxies(str(out))
 

@@ -1,6 +1,7 @@
 """Type stubs of trm's native module (see the docstrings for details); the package `trm`
 and its submodules re-export these names."""
 
+import os
 from typing import Callable, Sequence
 
 import numpy as np
@@ -61,7 +62,7 @@ class World:
     def __len__(self) -> int: ...
 
 class CollisionModel:
-    def __init__(self, robot: Robot) -> None: ...
+    def __init__(self, robot: Robot, package_paths: Sequence[str | os.PathLike] = ()) -> None: ...
     @property
     def body_names(self) -> list[str]: ...
     def count(self, q: ArrayLike, world: World | None = None) -> int | Array: ...
@@ -170,8 +171,8 @@ class Planner:
     def set_timing(
         self,
         *,
-        velocity_scaling: float = 1.0,
-        acceleration_scaling: float = 1.0,
+        velocity_scaling: float | None = None,
+        acceleration_scaling: float | None = None,
         max_deviation: float = 0.2,
         sample_period: float = 0.01,
         velocity: float = 1.0,
@@ -195,6 +196,7 @@ class Planner:
         range: float | None = None,
         certified: bool = False,
         smoothing: int = 5,
+        out: str | os.PathLike | None = None,
     ) -> dict: ...
     def plan_request(
         self,
@@ -207,6 +209,7 @@ class Planner:
         range: float | None = None,
         certified: bool = False,
         smoothing: int = 5,
+        out: str | os.PathLike | None = None,
     ) -> dict: ...
 
 class TaskMap:

@@ -328,6 +328,43 @@ pub struct SolverSpec {
     pub seed: u64,
 }
 
+impl SolverSpec {
+    /// These settings with a caller's choices over them (`None`: the spec's): what `trm solve
+    /// --algo --seed --max-evals` and Python's `Problem.solve(algo=, seed=, max_evals=)` do.
+    /// An unknown algorithm or a zero budget is refused, naming the nearest algorithm.
+    pub fn overridden(
+        &self,
+        algo: Option<&str>,
+        seed: Option<u64>,
+        max_evaluations: Option<u64>,
+    ) -> crate::Result<Self> {
+        if let Some(a) = algo.filter(|a| !trm_optim::ALGORITHMS.contains(a)) {
+            let near = trm_io::closest_names(a, trm_optim::ALGORITHMS.iter().copied());
+            let hint = if near.is_empty() {
+                format!("give one of {}", trm_optim::ALGORITHMS.join(", "))
+            } else {
+                format!("did you mean `{}`?", near.join("`, `"))
+            };
+            return Err(crate::TaskError::Invalid {
+                what: format!("algorithm `{a}`"),
+                problem: format!("unknown\n  fix: {hint}"),
+            });
+        }
+        if max_evaluations == Some(0) {
+            return Err(crate::TaskError::Invalid {
+                what: "evaluation budget 0".into(),
+                problem: "nothing would be evaluated\n  fix: give at least 1".into(),
+            });
+        }
+        Ok(SolverSpec {
+            algo: algo.map_or_else(|| self.algo.clone(), str::to_string),
+            seed: seed.unwrap_or(self.seed),
+            max_evaluations: max_evaluations.unwrap_or(self.max_evaluations),
+            ..self.clone()
+        })
+    }
+}
+
 impl Default for SolverSpec {
     fn default() -> Self {
         SolverSpec {

@@ -114,10 +114,7 @@ impl Problem {
         let robot = load_model(&spec.model, base, &ctx)?;
         let robot = with_frames(robot, &spec.frames, &ctx)?;
         let mut motors = match &spec.start {
-            None => robot
-                .posture("home")
-                .map(<[f64]>::to_vec)
-                .unwrap_or_else(|_| robot.neutral_motors()),
+            None => robot.home_motors(),
             Some(start) => robot.posture(start).map(<[f64]>::to_vec).map_err(|_| {
                 ctx.err(
                     "start",

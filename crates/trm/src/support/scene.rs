@@ -35,8 +35,9 @@ pub fn write_scene(scene: &Scene, out: &Path) -> Result<()> {
     }
     let repo = crate::models_dir().join("..");
     let bundle = trm_view::find_bundle(&repo)?;
-    crate::write_atomic(&out.with_extension("json"), scene.to_json()?.as_bytes())?;
-    crate::write_atomic(out, scene.to_html(bundle.as_deref())?.as_bytes())?;
+    for (path, text) in scene.page_files(out, bundle.as_deref())? {
+        crate::write_atomic(&path, text.as_bytes())?;
+    }
     let how = if bundle.is_some() {
         "three.js inlined, works offline".to_string()
     } else {

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use trm_moveit::TimingSettings;
 use trm_plan::Timing;
 
 /// How the path becomes a trajectory: time-optimal within the joints' velocity and
@@ -44,36 +45,28 @@ pub struct TimingArgs {
 }
 
 impl TimingArgs {
-    /// The timing; `request` gives a MoveIt request's scaling factors (velocity, acceleration).
-    pub fn timing(&self, request: (Option<f64>, Option<f64>)) -> Result<Timing> {
-        let file = match &self.joint_limits {
+    /// The settings these flags give (the joint-limits file read).
+    pub fn settings(&self) -> Result<TimingSettings> {
+        let joint_limits = match &self.joint_limits {
             Some(path) => Some(
                 trm_moveit::JointLimitsFile::load(path)
                     .with_context(|| format!("--joint-limits {}", path.display()))?,
             ),
             None => None,
         };
-        let from_file =
-            |f: fn(&trm_moveit::JointLimitsFile) -> Option<f64>| file.as_ref().and_then(f);
-        Ok(Timing {
-            default_velocity: self.velocity,
-            default_acceleration: self.acceleration,
-            default_jerk: self.jerk,
-            jerk_limited: self.jerk_limited,
-            velocity_scaling: self
-                .velocity_scaling
-                .or(request.0)
-                .or_else(|| from_file(|f| f.velocity_scaling))
-                .unwrap_or(1.0),
-            acceleration_scaling: self
-                .acceleration_scaling
-                .or(request.1)
-                .or_else(|| from_file(|f| f.acceleration_scaling))
-                .unwrap_or(1.0),
-            limits: file.map(|f| f.limits).unwrap_or_default(),
-            max_deviation: self.max_deviation,
-            sample_period: self.sample_period,
-            resolution: None,
+        Ok(TimingSettings {
+            timing: Timing {
+                default_velocity: self.velocity,
+                default_acceleration: self.acceleration,
+                default_jerk: self.jerk,
+                jerk_limited: self.jerk_limited,
+                max_deviation: self.max_deviation,
+                sample_period: self.sample_period,
+                ..Timing::default()
+            },
+            joint_limits,
+            velocity_scaling: self.velocity_scaling,
+            acceleration_scaling: self.acceleration_scaling,
         })
     }
 }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
-use trm_plan::{Trajectory, time_parametrise};
+use trm_plan::Trajectory;
 use trm_taskmap::{Motion, MotionGoal};
 
 use trm_taskmap::{Explored, TaskMapSpec};
@@ -103,18 +103,7 @@ fn reach(
     let (motion, trace) = problem.optimize(iterations);
     let seconds = started.elapsed().as_secs_f64();
     let csv = out_dir.join(format!("{name}.csv"));
-    let trajectory = Trajectory {
-        names: e.model.motors().iter().map(|m| m.name.clone()).collect(),
-        times: time_parametrise(&motion.trajectory, &vec![1.0; active.len()], None),
-        positions: motion
-            .trajectory
-            .iter()
-            .map(|q| active.to_motors(q))
-            .collect(),
-        velocities: Vec::new(),
-        accelerations: Vec::new(),
-        task_path: Vec::new(),
-    };
+    let trajectory = Trajectory::at_joint_speed(&active, &motion.trajectory, 1.0);
     trm::write_atomic(&csv, trajectory.to_csv(&csv)?.as_bytes())?;
     let world = scene(obstacles, e, &at)?;
     let ron = ron::ser::to_string_pretty(&world.to_spec(), Default::default())?;
@@ -129,7 +118,7 @@ fn reach(
 
 /// Runs both studies and writes the tables, the plots, the trajectories and the worlds.
 pub fn run(args: &Args) -> Result<()> {
-    let specs = crate::models_dir().join("../specs/taskmaps");
+    let specs = crate::repo_dir().join("specs/taskmaps");
     let started = std::time::Instant::now();
     let out = &args.out_dir;
     let stick = TaskMapSpec::load(specs.join("stick.ron"))?.explore()?;
