@@ -155,3 +155,14 @@ fn the_analytic_gradient_matches_central_differences() {
         );
     }
 }
+
+#[test]
+fn an_object_is_placed_from_three_or_four_finite_numbers() {
+    let at = trm_taskmap::placement(&[0.1, 0.2, 0.3, std::f64::consts::FRAC_PI_2]).unwrap();
+    assert!((at.translation.vector - Vector3::new(0.1, 0.2, 0.3)).norm() < 1e-15);
+    assert!((at.rotation.angle() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    for bad in [&[0.0, 0.0][..], &[0.0, f64::NAN, 0.0], &[0.0; 5]] {
+        let e = trm_taskmap::placement(bad).unwrap_err().to_string();
+        assert!(e.contains("(x, y, z) or (x, y, z, yaw)"), "{e}");
+    }
+}

@@ -288,3 +288,20 @@ fn a_task_map_cost_without_a_reader_says_what_to_pass() {
         "{e}"
     );
 }
+
+#[test]
+fn a_callers_solver_choices_override_the_spec_and_unknown_algorithms_get_a_suggestion() {
+    let spec = trm_tasks::spec::SolverSpec::default();
+    let s = spec.overridden(Some("cmaes"), Some(7), None).unwrap();
+    assert_eq!((s.algo.as_str(), s.seed), ("cmaes", 7));
+    assert_eq!(s.max_evaluations, spec.max_evaluations);
+    assert_eq!(spec.overridden(None, None, None).unwrap(), spec);
+    let e = spec
+        .overridden(Some("xnse"), None, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`xnse`") && e.contains("did you mean `xnes`"),
+        "{e}"
+    );
+}

@@ -368,7 +368,7 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does(tmp_pat
     assert [Path(f).name for f in r["files"]] == names
     assert (tmp_path / "motion.csv").read_text().startswith("time,panda_joint1,")
     assert 'group_name: "panda_arm"' in (tmp_path / "motion.response.yaml").read_text()
-    with pytest.raises(ValueError, match="out .*m.json.*give a .csv path"):
+    with pytest.raises(ValueError, match="out .*m.json is the trajectory CSV's path"):
         planner.plan_request(str(requests[0]), out=tmp_path / "m.json")
     assert not (tmp_path / "m.json").exists()
 

@@ -331,7 +331,7 @@ pub struct SolverSpec {
 impl SolverSpec {
     /// These settings with a caller's choices over them (`None`: the spec's): what `trm solve
     /// --algo --seed --max-evals` and Python's `Problem.solve(algo=, seed=, max_evals=)` do.
-    /// An unknown algorithm or a zero budget is refused, naming the nearest algorithm.
+    /// An unknown algorithm is refused, naming the nearest (the solver checks the rest).
     pub fn overridden(
         &self,
         algo: Option<&str>,
@@ -348,12 +348,6 @@ impl SolverSpec {
             return Err(crate::TaskError::Invalid {
                 what: format!("algorithm `{a}`"),
                 problem: format!("unknown\n  fix: {hint}"),
-            });
-        }
-        if max_evaluations == Some(0) {
-            return Err(crate::TaskError::Invalid {
-                what: "evaluation budget 0".into(),
-                problem: "nothing would be evaluated\n  fix: give at least 1".into(),
             });
         }
         Ok(SolverSpec {
