@@ -216,6 +216,202 @@ fn geometry_numbers(g: &urdf_rs::Geometry) -> Vec<f64> {
     }
 }
 
+/// Each link's index in the document, the robot given at least one link and names unique.
+fn link_index<'a>(robot: &'a urdf_rs::Robot, ctx: &Ctx) -> Result<HashMap<&'a str, usize>> {
+    if robot.links.is_empty() {
+        return Err(ctx.invalid(
+            "robot",
+            &robot.name,
+            "has no <link>",
+            "add at least one <link>",
+        ));
+    }
+    let mut link_index: HashMap<&str, usize> = HashMap::new();
+    for (i, l) in robot.links.iter().enumerate() {
+        if link_index.insert(l.name.as_str(), i).is_some() {
+            return Err(ctx.invalid(
+                "link",
+                &l.name,
+                "is defined twice",
+                "give every <link> a unique name",
+            ));
+        }
+    }
+    Ok(link_index)
+}
+
+/// Every link's numbers finite (inertia, origins, geometry) and its mass ≥ 0.
+fn check_links(robot: &urdf_rs::Robot, ctx: &Ctx) -> Result<()> {
+    for l in &robot.links {
+        let i = &l.inertial;
+        let t = &i.inertia;
+        check_finite(
+            ctx,
+            "link",
+            &l.name,
+            "inertial",
+            &[i.mass.value, t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz],
+        )?;
+        check_finite(
+            ctx,
+            "link",
+            &l.name,
+            "inertial origin",
+            &pose_numbers(&i.origin),
+        )?;
+        let shapes = (l
+            .collision
+            .iter()
+            .map(|c| ("collision", &c.origin, &c.geometry)))
+        .chain(l.visual.iter().map(|v| ("visual", &v.origin, &v.geometry)));
+        for (what, origin, geometry) in shapes {
+            check_finite(
+                ctx,
+                "link",
+                &l.name,
+                &format!("{what} origin"),
+                &pose_numbers(origin),
+            )?;
+            // (sizes are checked where shapes are made: trm-collision)
+            let size = geometry_numbers(geometry);
+            check_finite(ctx, "link", &l.name, &format!("{what} geometry"), &size)?;
+        }
+        if i.mass.value < 0.0 {
+            return Err(ctx.invalid(
+                "link",
+                &l.name,
+                format!("mass {} is negative", i.mass.value),
+                "give a mass ≥ 0 in kg",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Per link: its parent joint (none for the root) and its child joints.
+type Joined = (Vec<Option<usize>>, Vec<Vec<usize>>);
+
+/// Each link's parent joint and each link's child joints, every joint joining two defined,
+/// different links, each link the child of one joint at most.
+fn connect(
+    robot: &urdf_rs::Robot,
+    link_index: &HashMap<&str, usize>,
+    ctx: &Ctx,
+) -> Result<Joined> {
+    let mut joint_names: HashMap<&str, ()> = HashMap::new();
+    let mut parent_of: Vec<Option<usize>> = vec![None; robot.links.len()];
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
+    for (j, joint) in robot.joints.iter().enumerate() {
+        if joint_names.insert(joint.name.as_str(), ()).is_some() {
+            return Err(ctx.invalid(
+                "joint",
+                &joint.name,
+                "is defined twice",
+                "give every <joint> a unique name",
+            ));
+        }
+        let find = |link: &str, role: &str| {
+            link_index.get(link).copied().ok_or_else(|| {
+                let near = trm_io::closest_names(link, robot.links.iter().map(|l| l.name.as_str()));
+                ctx.invalid(
+                    "joint",
+                    &joint.name,
+                    format!("its {role} link `{link}` is not defined"),
+                    if near.is_empty() {
+                        format!("add <link name=\"{link}\"/> or correct the <{role}> element")
+                    } else {
+                        format!(
+                            "did you mean `{}`? otherwise add <link name=\"{link}\"/>",
+                            near.join("`, `")
+                        )
+                    },
+                )
+            })
+        };
+        let parent = find(&joint.parent.link, "parent")?;
+        let child = find(&joint.child.link, "child")?;
+        if parent == child {
+            return Err(ctx.invalid(
+                "joint",
+                &joint.name,
+                "connects a link to itself",
+                "use two different links",
+            ));
+        }
+        if let Some(previous) = parent_of[child] {
+            return Err(ctx.invalid(
+                "joint",
+                &joint.name,
+                format!(
+                    "link `{}` already has parent joint `{}`; a URDF must be a tree",
+                    joint.child.link, robot.joints[previous].name
+                ),
+                "remove one of the two joints (closed chains are not supported)",
+            ));
+        }
+        parent_of[child] = Some(j);
+        children[parent].push(j);
+    }
+    Ok((parent_of, children))
+}
+
+/// The links in depth-first pre-order from the one root (children in document order); an
+/// error when there is no single root or a link is unreachable.
+fn depth_first(
+    robot: &urdf_rs::Robot,
+    link_index: &HashMap<&str, usize>,
+    parent_of: &[Option<usize>],
+    children: &[Vec<usize>],
+    ctx: &Ctx,
+) -> Result<Vec<usize>> {
+    let roots: Vec<usize> = (0..robot.links.len())
+        .filter(|&i| parent_of[i].is_none())
+        .collect();
+    if roots.len() != 1 {
+        let names: Vec<&str> = roots
+            .iter()
+            .map(|&i| robot.links[i].name.as_str())
+            .collect();
+        return Err(if roots.is_empty() {
+            ctx.invalid(
+                "robot",
+                &robot.name,
+                "has no root link: the joints form a cycle",
+                "break the cycle",
+            )
+        } else {
+            ctx.invalid(
+                "robot",
+                &robot.name,
+                format!("has {} root links ({}); a URDF tree has exactly one", roots.len(), names.join(", ")),
+                "connect the extra roots to the tree with joints (a <fixed> joint if they do not move)",
+            )
+        });
+    }
+    // Depth-first pre-order, children in document order.
+    let mut order: Vec<usize> = Vec::with_capacity(robot.links.len());
+    let mut stack = vec![roots[0]];
+    while let Some(l) = stack.pop() {
+        order.push(l);
+        for &j in children[l].iter().rev() {
+            stack.push(link_index[robot.joints[j].child.link.as_str()]);
+        }
+    }
+    if order.len() != robot.links.len() {
+        let reached: std::collections::HashSet<usize> = order.iter().copied().collect();
+        let lost = (0..robot.links.len())
+            .find(|i| !reached.contains(i))
+            .unwrap_or(0);
+        return Err(ctx.invalid(
+            "link",
+            &robot.links[lost].name,
+            "is part of a cycle of joints, unreachable from the root",
+            "break the cycle",
+        ));
+    }
+    Ok(order)
+}
+
 /// The pose a URDF `<origin xyz rpy>` describes (R = Rz(yaw)·Ry(pitch)·Rx(roll)).
 pub fn pose_from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -227,168 +423,10 @@ pub fn pose_from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Isometry3<f64> {
 impl Tree {
     /// Builds and validates the tree. `source` (the URDF text), when given, lets errors name lines.
     pub(crate) fn from_urdf(robot: &urdf_rs::Robot, ctx: &Ctx) -> Result<Tree> {
-        if robot.links.is_empty() {
-            return Err(ctx.invalid(
-                "robot",
-                &robot.name,
-                "has no <link>",
-                "add at least one <link>",
-            ));
-        }
-        let mut link_index: HashMap<&str, usize> = HashMap::new();
-        for (i, l) in robot.links.iter().enumerate() {
-            if link_index.insert(l.name.as_str(), i).is_some() {
-                return Err(ctx.invalid(
-                    "link",
-                    &l.name,
-                    "is defined twice",
-                    "give every <link> a unique name",
-                ));
-            }
-        }
-        let mut joint_names: HashMap<&str, ()> = HashMap::new();
-        let mut parent_of: Vec<Option<usize>> = vec![None; robot.links.len()];
-        let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];
-        for l in &robot.links {
-            let i = &l.inertial;
-            let t = &i.inertia;
-            check_finite(
-                ctx,
-                "link",
-                &l.name,
-                "inertial",
-                &[i.mass.value, t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz],
-            )?;
-            check_finite(
-                ctx,
-                "link",
-                &l.name,
-                "inertial origin",
-                &pose_numbers(&i.origin),
-            )?;
-            let shapes = (l
-                .collision
-                .iter()
-                .map(|c| ("collision", &c.origin, &c.geometry)))
-            .chain(l.visual.iter().map(|v| ("visual", &v.origin, &v.geometry)));
-            for (what, origin, geometry) in shapes {
-                check_finite(
-                    ctx,
-                    "link",
-                    &l.name,
-                    &format!("{what} origin"),
-                    &pose_numbers(origin),
-                )?;
-                // (sizes are checked where shapes are made: trm-collision)
-                let size = geometry_numbers(geometry);
-                check_finite(ctx, "link", &l.name, &format!("{what} geometry"), &size)?;
-            }
-            if i.mass.value < 0.0 {
-                return Err(ctx.invalid(
-                    "link",
-                    &l.name,
-                    format!("mass {} is negative", i.mass.value),
-                    "give a mass ≥ 0 in kg",
-                ));
-            }
-        }
-        for (j, joint) in robot.joints.iter().enumerate() {
-            if joint_names.insert(joint.name.as_str(), ()).is_some() {
-                return Err(ctx.invalid(
-                    "joint",
-                    &joint.name,
-                    "is defined twice",
-                    "give every <joint> a unique name",
-                ));
-            }
-            let find = |link: &str, role: &str| {
-                link_index.get(link).copied().ok_or_else(|| {
-                    let near =
-                        trm_io::closest_names(link, robot.links.iter().map(|l| l.name.as_str()));
-                    ctx.invalid(
-                        "joint",
-                        &joint.name,
-                        format!("its {role} link `{link}` is not defined"),
-                        if near.is_empty() {
-                            format!("add <link name=\"{link}\"/> or correct the <{role}> element")
-                        } else {
-                            format!(
-                                "did you mean `{}`? otherwise add <link name=\"{link}\"/>",
-                                near.join("`, `")
-                            )
-                        },
-                    )
-                })
-            };
-            let parent = find(&joint.parent.link, "parent")?;
-            let child = find(&joint.child.link, "child")?;
-            if parent == child {
-                return Err(ctx.invalid(
-                    "joint",
-                    &joint.name,
-                    "connects a link to itself",
-                    "use two different links",
-                ));
-            }
-            if let Some(previous) = parent_of[child] {
-                return Err(ctx.invalid(
-                    "joint",
-                    &joint.name,
-                    format!(
-                        "link `{}` already has parent joint `{}`; a URDF must be a tree",
-                        joint.child.link, robot.joints[previous].name
-                    ),
-                    "remove one of the two joints (closed chains are not supported)",
-                ));
-            }
-            parent_of[child] = Some(j);
-            children[parent].push(j);
-        }
-        let roots: Vec<usize> = (0..robot.links.len())
-            .filter(|&i| parent_of[i].is_none())
-            .collect();
-        if roots.len() != 1 {
-            let names: Vec<&str> = roots
-                .iter()
-                .map(|&i| robot.links[i].name.as_str())
-                .collect();
-            return Err(if roots.is_empty() {
-                ctx.invalid(
-                    "robot",
-                    &robot.name,
-                    "has no root link: the joints form a cycle",
-                    "break the cycle",
-                )
-            } else {
-                ctx.invalid(
-                    "robot",
-                    &robot.name,
-                    format!("has {} root links ({}); a URDF tree has exactly one", roots.len(), names.join(", ")),
-                    "connect the extra roots to the tree with joints (a <fixed> joint if they do not move)",
-                )
-            });
-        }
-        // Depth-first pre-order, children in document order.
-        let mut order: Vec<usize> = Vec::with_capacity(robot.links.len());
-        let mut stack = vec![roots[0]];
-        while let Some(l) = stack.pop() {
-            order.push(l);
-            for &j in children[l].iter().rev() {
-                stack.push(link_index[robot.joints[j].child.link.as_str()]);
-            }
-        }
-        if order.len() != robot.links.len() {
-            let reached: std::collections::HashSet<usize> = order.iter().copied().collect();
-            let lost = (0..robot.links.len())
-                .find(|i| !reached.contains(i))
-                .unwrap_or(0);
-            return Err(ctx.invalid(
-                "link",
-                &robot.links[lost].name,
-                "is part of a cycle of joints, unreachable from the root",
-                "break the cycle",
-            ));
-        }
+        let link_index = link_index(robot, ctx)?;
+        check_links(robot, ctx)?;
+        let (parent_of, children) = connect(robot, &link_index, ctx)?;
+        let order = depth_first(robot, &link_index, &parent_of, &children, ctx)?;
         let mut new_index = vec![0usize; robot.links.len()];
         for (new, &old) in order.iter().enumerate() {
             new_index[old] = new;

@@ -106,14 +106,8 @@ fn bad(what: &str, problem: String) -> MbmError {
     }
 }
 
-/// Generates the set for `spec` (its world is replaced by each scene). `progress(done, total)`
-/// is called after each problem. A problem for which `tries` scenes and targets give no
-/// collision-free goal within the tolerance (or a start that collides) is an error naming it.
-pub fn generate(
-    spec: &TaskProblem,
-    options: &SetOptions,
-    mut progress: impl FnMut(usize, usize),
-) -> Result<Vec<Generated>, MbmError> {
+/// The options in range and a spec whose task is a position.
+fn check(spec: &TaskProblem, options: &SetOptions) -> Result<(), MbmError> {
     if options.per_family == 0 || options.per_family > 10_000 {
         return Err(bad(
             "per_family",
@@ -152,8 +146,7 @@ pub fn generate(
             ));
         }
     }
-    let objective = &spec.objective;
-    if objective.task().is_none_or(|t| t.dim() != 3) {
+    if spec.objective.task().is_none_or(|t| t.dim() != 3) {
         return Err(bad(
             "spec",
             format!(
@@ -162,6 +155,71 @@ pub fn generate(
             ),
         ));
     }
+    Ok(())
+}
+
+/// `scene` with every primitive grown by [`CLEARANCE`].
+fn padded_scene(scene: &PlanningScene) -> PlanningScene {
+    PlanningScene {
+        objects: scene
+            .objects
+            .iter()
+            .map(|o| CollisionObject {
+                primitives: o
+                    .primitives
+                    .iter()
+                    .map(|p| Primitive {
+                        shape: padded(&p.shape, CLEARANCE),
+                        pose: p.pose,
+                    })
+                    .collect(),
+                ..o.clone()
+            })
+            .collect(),
+        ..scene.clone()
+    }
+}
+
+/// A request from `from` (the moving motors' values, the others at the start) to `goal`.
+fn request(
+    origin: String,
+    motor_names: Vec<String>,
+    active: &trm_kinematics::ActiveSet,
+    from: Vec<f64>,
+    active_names: Vec<String>,
+    goal: Vec<f64>,
+) -> MotionPlanRequest {
+    MotionPlanRequest {
+        origin: origin.into(),
+        start: JointState {
+            names: motor_names,
+            positions: active.to_motors(&from),
+        },
+        attached: Vec::new(),
+        goal: JointGoal {
+            names: active_names,
+            tolerances: vec![(0.0, 0.0); goal.len()],
+            positions: goal,
+        },
+        group: String::new(),
+        planning_time: Some(10.0),
+        pose_goal: Default::default(),
+        velocity_scaling: None,
+        acceleration_scaling: None,
+    }
+}
+
+/// Generates the set for `spec` (its world is replaced by each scene). `progress(done, total)`
+/// is called after each problem. A problem for which `tries` scenes and targets give no
+/// collision-free goal within the tolerance (or a start that collides) is an error naming it.
+pub fn generate(
+    spec: &TaskProblem,
+    options: &SetOptions,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Vec<Generated>, MbmError> {
+    check(spec, options)?;
+    let objective = &spec.objective;
+    let norm = options.facing[0].hypot(options.facing[1]);
     let robot = &spec.robot;
     let mut scratch = objective.scratch();
     let start = spec.start.clone();
@@ -175,6 +233,7 @@ pub fn generate(
     ]);
     let motor_names: Vec<String> = robot.motors().iter().map(|m| m.name.clone()).collect();
     let active_names: Vec<String> = objective.active().names().map(String::from).collect();
+    let active = objective.active();
     let total = options.families.len() * options.per_family;
     let mut set = Vec::with_capacity(total);
     for (f, family) in options.families.iter().enumerate() {
@@ -217,25 +276,7 @@ pub fn generate(
                 };
                 // starts and goals keep CLEARANCE from every object (a posture that only just
                 // touches may collide once the scene is written and read back)
-                let world = PlanningScene {
-                    objects: scene
-                        .objects
-                        .iter()
-                        .map(|o| CollisionObject {
-                            primitives: o
-                                .primitives
-                                .iter()
-                                .map(|p| Primitive {
-                                    shape: padded(&p.shape, CLEARANCE),
-                                    pose: p.pose,
-                                })
-                                .collect(),
-                            ..o.clone()
-                        })
-                        .collect(),
-                    ..scene.clone()
-                }
-                .to_world()?;
+                let world = padded_scene(&scene).to_world()?;
                 // NGIK from the start posture to a point of the scene frame
                 let mut reach = |local: Vector3<f64>| -> Result<Option<Vec<f64>>, MbmError> {
                     let t = frame * nalgebra::Point3::from(local);
@@ -287,24 +328,14 @@ pub fn generate(
                     origin: format!("{}", scene.origin.display()).into(),
                     ..scene
                 },
-                request: MotionPlanRequest {
-                    origin: origin.into(),
-                    start: JointState {
-                        names: motor_names.clone(),
-                        positions: objective.active().to_motors(&from),
-                    },
-                    attached: Vec::new(),
-                    goal: JointGoal {
-                        names: active_names.clone(),
-                        tolerances: vec![(0.0, 0.0); goal.len()],
-                        positions: goal,
-                    },
-                    group: String::new(),
-                    planning_time: Some(10.0),
-                    pose_goal: Default::default(),
-                    velocity_scaling: None,
-                    acceleration_scaling: None,
-                },
+                request: request(
+                    origin,
+                    motor_names.clone(),
+                    &active,
+                    from,
+                    active_names.clone(),
+                    goal,
+                ),
                 target,
             });
             progress(set.len(), total);
@@ -323,166 +354,179 @@ type Layout = (
 );
 
 fn layout(family: &str, rng: &mut ChaCha8Rng) -> Layout {
-    let boxed = |x: f64, y: f64, z: f64| Shape::Box { size: [x, y, z] };
     match family {
-        "table" => {
-            let top = -0.10 - rng.random_range(0.0..0.05);
-            let can = Vector3::new(
-                rng.random_range(0.02..0.16),
-                rng.random_range(-0.15..0.15),
-                top + 0.075,
-            );
-            let block = Vector3::new(
-                rng.random_range(0.05..0.2),
-                can.y + if can.y > 0.0 { -0.12 } else { 0.12 },
-                top + 0.055,
-            );
-            // from above the block to beside the can, on its near side
-            let from = Vector3::new(block.x, block.y, top + 0.2 + rng.random_range(0.0..0.05));
-            let to = Vector3::new(
-                can.x - 0.07,
-                can.y,
-                top + 0.07 + rng.random_range(0.0..0.03),
-            );
-            (
-                vec![
-                    (
-                        "table_top",
-                        boxed(0.4, 0.7, 0.03),
-                        Vector3::new(0.12, 0.0, top - 0.015),
-                    ),
-                    (
-                        "can",
-                        Shape::Cylinder {
-                            radius: 0.03,
-                            length: 0.12,
-                        },
-                        can + Vector3::new(0.0, 0.0, -0.015),
-                    ),
-                    (
-                        "block",
-                        boxed(0.05, 0.05, 0.08),
-                        block - Vector3::new(0.0, 0.0, 0.015),
-                    ),
-                ],
-                from,
-                to,
-            )
-        }
-        "shelf" => {
-            // from one compartment to the other, over the middle board
-            let (low, high) = (
-                -0.14 - rng.random_range(0.0..0.02),
-                0.2 + rng.random_range(0.0..0.02),
-            );
-            let mid = (low + high) / 2.0 + rng.random_range(-0.01..0.01);
-            let inside = |rng: &mut ChaCha8Rng, floor: f64, ceiling: f64| {
-                Vector3::new(
-                    rng.random_range(0.05..0.14),
-                    rng.random_range(-0.12..0.12),
-                    (floor + ceiling) / 2.0 + rng.random_range(-0.01..0.01),
-                )
-            };
-            let (lower, upper) = (inside(rng, low, mid), inside(rng, mid, high));
-            let (from, to) = if rng.random_bool(0.5) {
-                (upper, lower)
-            } else {
-                (lower, upper)
-            };
-            (
-                vec![
-                    (
-                        "shelf_low",
-                        boxed(0.3, 0.6, 0.02),
-                        Vector3::new(0.17, 0.0, low),
-                    ),
-                    (
-                        "shelf_mid",
-                        boxed(0.3, 0.6, 0.02),
-                        Vector3::new(0.17, 0.0, mid),
-                    ),
-                    (
-                        "shelf_high",
-                        boxed(0.3, 0.6, 0.02),
-                        Vector3::new(0.17, 0.0, high),
-                    ),
-                    (
-                        "shelf_back",
-                        boxed(0.02, 0.6, 0.6),
-                        Vector3::new(0.33, 0.0, 0.02),
-                    ),
-                    (
-                        "shelf_left",
-                        boxed(0.3, 0.02, 0.6),
-                        Vector3::new(0.17, 0.31, 0.02),
-                    ),
-                    (
-                        "shelf_right",
-                        boxed(0.3, 0.02, 0.6),
-                        Vector3::new(0.17, -0.31, 0.02),
-                    ),
-                ],
-                from,
-                to,
-            )
-        }
-        _ => {
-            let (depth, width, height) = (
-                0.32 + rng.random_range(0.0..0.04),
-                0.42 + rng.random_range(0.0..0.06),
-                0.30 + rng.random_range(0.0..0.04),
-            );
-            // from above the cage into it, through its open side
-            let from = Vector3::new(
-                rng.random_range(0.04..0.14),
-                rng.random_range(-width * 0.25..width * 0.25),
-                height / 2.0 + rng.random_range(0.05..0.08),
-            );
-            let to = Vector3::new(
-                rng.random_range(0.06..depth * 0.45),
-                rng.random_range(-width * 0.25..width * 0.25),
-                rng.random_range(-height * 0.2..height * 0.1),
-            );
-            let mid = depth / 2.0;
-            // the cage sits a little low, so that the hand reaches above it
-            let low = -0.06;
-            let (from, to) = (
-                from + Vector3::new(0.0, 0.0, low),
-                to + Vector3::new(0.0, 0.0, low),
-            );
-            (
-                vec![
-                    (
-                        "cage_bottom",
-                        boxed(depth, width, 0.02),
-                        Vector3::new(mid, 0.0, low - height / 2.0),
-                    ),
-                    (
-                        "cage_top",
-                        boxed(depth, width, 0.02),
-                        Vector3::new(mid, 0.0, low + height / 2.0),
-                    ),
-                    (
-                        "cage_back",
-                        boxed(0.02, width, height),
-                        Vector3::new(depth, 0.0, low),
-                    ),
-                    (
-                        "cage_left",
-                        boxed(depth, 0.02, height),
-                        Vector3::new(mid, width / 2.0, low),
-                    ),
-                    (
-                        "cage_right",
-                        boxed(depth, 0.02, height),
-                        Vector3::new(mid, -width / 2.0, low),
-                    ),
-                ],
-                from,
-                to,
-            )
-        }
+        "table" => table(rng),
+        "shelf" => shelf(rng),
+        _ => cage(rng),
     }
+}
+
+/// A box of these sides.
+fn boxed(x: f64, y: f64, z: f64) -> Shape {
+    Shape::Box { size: [x, y, z] }
+}
+
+/// A table with a can and a block: from above the block to beside the can.
+fn table(rng: &mut ChaCha8Rng) -> Layout {
+    let top = -0.10 - rng.random_range(0.0..0.05);
+    let can = Vector3::new(
+        rng.random_range(0.02..0.16),
+        rng.random_range(-0.15..0.15),
+        top + 0.075,
+    );
+    let block = Vector3::new(
+        rng.random_range(0.05..0.2),
+        can.y + if can.y > 0.0 { -0.12 } else { 0.12 },
+        top + 0.055,
+    );
+    // from above the block to beside the can, on its near side
+    let from = Vector3::new(block.x, block.y, top + 0.2 + rng.random_range(0.0..0.05));
+    let to = Vector3::new(
+        can.x - 0.07,
+        can.y,
+        top + 0.07 + rng.random_range(0.0..0.03),
+    );
+    (
+        vec![
+            (
+                "table_top",
+                boxed(0.4, 0.7, 0.03),
+                Vector3::new(0.12, 0.0, top - 0.015),
+            ),
+            (
+                "can",
+                Shape::Cylinder {
+                    radius: 0.03,
+                    length: 0.12,
+                },
+                can + Vector3::new(0.0, 0.0, -0.015),
+            ),
+            (
+                "block",
+                boxed(0.05, 0.05, 0.08),
+                block - Vector3::new(0.0, 0.0, 0.015),
+            ),
+        ],
+        from,
+        to,
+    )
+}
+
+/// A shelf of two compartments: from one to the other, over the middle board.
+fn shelf(rng: &mut ChaCha8Rng) -> Layout {
+    // from one compartment to the other, over the middle board
+    let (low, high) = (
+        -0.14 - rng.random_range(0.0..0.02),
+        0.2 + rng.random_range(0.0..0.02),
+    );
+    let mid = (low + high) / 2.0 + rng.random_range(-0.01..0.01);
+    let inside = |rng: &mut ChaCha8Rng, floor: f64, ceiling: f64| {
+        Vector3::new(
+            rng.random_range(0.05..0.14),
+            rng.random_range(-0.12..0.12),
+            (floor + ceiling) / 2.0 + rng.random_range(-0.01..0.01),
+        )
+    };
+    let (lower, upper) = (inside(rng, low, mid), inside(rng, mid, high));
+    let (from, to) = if rng.random_bool(0.5) {
+        (upper, lower)
+    } else {
+        (lower, upper)
+    };
+    (
+        vec![
+            (
+                "shelf_low",
+                boxed(0.3, 0.6, 0.02),
+                Vector3::new(0.17, 0.0, low),
+            ),
+            (
+                "shelf_mid",
+                boxed(0.3, 0.6, 0.02),
+                Vector3::new(0.17, 0.0, mid),
+            ),
+            (
+                "shelf_high",
+                boxed(0.3, 0.6, 0.02),
+                Vector3::new(0.17, 0.0, high),
+            ),
+            (
+                "shelf_back",
+                boxed(0.02, 0.6, 0.6),
+                Vector3::new(0.33, 0.0, 0.02),
+            ),
+            (
+                "shelf_left",
+                boxed(0.3, 0.02, 0.6),
+                Vector3::new(0.17, 0.31, 0.02),
+            ),
+            (
+                "shelf_right",
+                boxed(0.3, 0.02, 0.6),
+                Vector3::new(0.17, -0.31, 0.02),
+            ),
+        ],
+        from,
+        to,
+    )
+}
+
+/// A cage open towards the robot: from above it into it.
+fn cage(rng: &mut ChaCha8Rng) -> Layout {
+    let (depth, width, height) = (
+        0.32 + rng.random_range(0.0..0.04),
+        0.42 + rng.random_range(0.0..0.06),
+        0.30 + rng.random_range(0.0..0.04),
+    );
+    // from above the cage into it, through its open side
+    let from = Vector3::new(
+        rng.random_range(0.04..0.14),
+        rng.random_range(-width * 0.25..width * 0.25),
+        height / 2.0 + rng.random_range(0.05..0.08),
+    );
+    let to = Vector3::new(
+        rng.random_range(0.06..depth * 0.45),
+        rng.random_range(-width * 0.25..width * 0.25),
+        rng.random_range(-height * 0.2..height * 0.1),
+    );
+    let mid = depth / 2.0;
+    // the cage sits a little low, so that the hand reaches above it
+    let low = -0.06;
+    let (from, to) = (
+        from + Vector3::new(0.0, 0.0, low),
+        to + Vector3::new(0.0, 0.0, low),
+    );
+    (
+        vec![
+            (
+                "cage_bottom",
+                boxed(depth, width, 0.02),
+                Vector3::new(mid, 0.0, low - height / 2.0),
+            ),
+            (
+                "cage_top",
+                boxed(depth, width, 0.02),
+                Vector3::new(mid, 0.0, low + height / 2.0),
+            ),
+            (
+                "cage_back",
+                boxed(0.02, width, height),
+                Vector3::new(depth, 0.0, low),
+            ),
+            (
+                "cage_left",
+                boxed(depth, 0.02, height),
+                Vector3::new(mid, width / 2.0, low),
+            ),
+            (
+                "cage_right",
+                boxed(depth, 0.02, height),
+                Vector3::new(mid, -width / 2.0, low),
+            ),
+        ],
+        from,
+        to,
+    )
 }
 
 /// Writes `set` under `dir` in MotionBenchMaker's layout (`<family>/sceneNNNN.yaml`,

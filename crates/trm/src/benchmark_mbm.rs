@@ -159,33 +159,7 @@ pub fn run(args: &Args) -> Result<()> {
         ..Default::default()
     };
     let bench = run_benchmark(args, &robot, &collision, &problems, &options)?;
-    let mut md = format!(
-        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{})\n\n",
-        args.dir.display(),
-        args.model.display(),
-        options.smoothing,
-        args.seed,
-        options.range,
-        1.0 / options.resolution,
-        if args.range.is_none() || args.resolution.is_none() {
-            " (sized by the robot's lever arms where not given)"
-        } else {
-            ""
-        },
-        args.max_iterations,
-        args.max_seconds
-            .map_or(String::new(), |s| format!(", {s} s at most")),
-        match (args.vamp_obstacles, args.cloud) {
-            (true, _) =>
-                "; among VAMP's obstacles: cylinders as capsules, boxes in the box family".into(),
-            (false, Some(n)) => format!(
-                "; among point clouds: {n} points on each object's surface, thinned to {} m, points of {} m",
-                trm_mbm::CLOUD_SPACING,
-                trm_mbm::CLOUD_POINT_RADIUS
-            ),
-            (false, None) => String::new(),
-        }
-    );
+    let mut md = header(args, &options);
     md.push_str(&bench.markdown());
     if args.cloud.is_some() {
         md.push_str(&cloud_lines(&bench));
@@ -246,32 +220,7 @@ pub fn run(args: &Args) -> Result<()> {
         md.push_str(&text);
     }
     if let Some(limit) = args.ompl {
-        let script = ompl_script();
-        let python = std::env::var("TRM_PYTHON").unwrap_or_else(|_| "python3".into());
-        let mut command = std::process::Command::new(python);
-        command.arg(&script).arg(set.root()).args([
-            "--time-limit",
-            &limit.to_string(),
-            "--seed",
-            &args.seed.to_string(),
-        ]);
-        if let Some(n) = args.per_family {
-            command.args(["--per-family", &n.to_string()]);
-        }
-        println!("\nrunning OMPL on the same problems");
-        let output = command
-            .stderr(std::process::Stdio::inherit())
-            .output()
-            .map_err(|e| anyhow::anyhow!("--ompl: starting {}: {e}", script.display()))?;
-        anyhow::ensure!(
-            output.status.success(),
-            "--ompl: {} failed ({})\n  fix: python3 -m pip install ompl pin pyyaml numpy",
-            script.display(),
-            output.status
-        );
-        let text = format!("\n{}", String::from_utf8_lossy(&output.stdout));
-        print!("{text}");
-        md.push_str(&text);
+        md.push_str(&run_ompl(args, &set, limit)?);
     }
     files.push(("results.md", md.into_bytes()));
     std::fs::create_dir_all(&args.out_dir)?;
@@ -281,6 +230,68 @@ pub fn run(args: &Args) -> Result<()> {
     let names: Vec<&str> = files.iter().map(|f| f.0).collect();
     println!("wrote {}/{{{}}}", args.out_dir.display(), names.join(", "));
     Ok(())
+}
+
+/// The report's first line: the set, the model and the planner's settings.
+fn header(args: &Args, options: &RrtOptions) -> String {
+    format!(
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{})\n\n",
+        args.dir.display(),
+        args.model.display(),
+        options.smoothing,
+        args.seed,
+        options.range,
+        1.0 / options.resolution,
+        if args.range.is_none() || args.resolution.is_none() {
+            " (sized by the robot's lever arms where not given)"
+        } else {
+            ""
+        },
+        args.max_iterations,
+        args.max_seconds
+            .map_or(String::new(), |s| format!(", {s} s at most")),
+        match (args.vamp_obstacles, args.cloud) {
+            (true, _) =>
+                "; among VAMP's obstacles: cylinders as capsules, boxes in the box family".into(),
+            (false, Some(n)) => format!(
+                "; among point clouds: {n} points on each object's surface, thinned to {} m, points of {} m",
+                trm_mbm::CLOUD_SPACING,
+                trm_mbm::CLOUD_POINT_RADIUS
+            ),
+            (false, None) => String::new(),
+        }
+    )
+}
+
+/// OMPL's RRTConnect on the same problems (its Python bindings, `limit` seconds each): its
+/// report, printed.
+fn run_ompl(args: &Args, set: &ProblemSet, limit: f64) -> Result<String> {
+    let script = ompl_script();
+    let python = std::env::var("TRM_PYTHON").unwrap_or_else(|_| "python3".into());
+    let mut command = std::process::Command::new(python);
+    command.arg(&script).arg(set.root()).args([
+        "--time-limit",
+        &limit.to_string(),
+        "--seed",
+        &args.seed.to_string(),
+    ]);
+    if let Some(n) = args.per_family {
+        command.args(["--per-family", &n.to_string()]);
+    }
+    println!("\nrunning OMPL on the same problems");
+    let output = command
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| anyhow::anyhow!("--ompl: starting {}: {e}", script.display()))?;
+    anyhow::ensure!(
+        output.status.success(),
+        "--ompl: {} failed ({})\n  fix: python3 -m pip install ompl pin pyyaml numpy",
+        script.display(),
+        output.status
+    );
+    let text = format!("\n{}", String::from_utf8_lossy(&output.stdout));
+    print!("{text}");
+    Ok(text)
 }
 
 /// The set run as `args` say, with progress bars.

@@ -132,64 +132,8 @@ pub fn run(args: &Args) -> Result<()> {
     );
     println!("  root (world frame): {}", tree.links[0].name);
 
-    println!(
-        "\nmotors ({}), limits in degrees (metres, marked m, for prismatic joints):",
-        model.motors().len()
-    );
-    println!(
-        "  {:>3}  {:<28} {:>9} {:>9}  drives",
-        "#", "name", "lower", "upper"
-    );
-    for (i, m) in model.motors().iter().enumerate() {
-        let driven: Vec<usize> = (model.couplings().iter().enumerate())
-            .filter(|(_, c)| c.terms.iter().any(|&(k, _)| k == i))
-            .map(|(j, _)| j)
-            .collect();
-        let prismatic = driven
-            .iter()
-            .any(|&j| model.joint(j).kind == JointKind::Prismatic);
-        let driven: Vec<&str> = driven
-            .iter()
-            .map(|&j| model.joint(j).name.as_str())
-            .collect();
-        let driven = if driven.len() == 1 && driven[0] == m.name {
-            String::from("(itself)")
-        } else {
-            driven.join(", ")
-        };
-        println!(
-            "  {i:>3}  {:<28} {:>9} {:>9}  {driven}",
-            m.name,
-            limit(m.limits.lower, prismatic),
-            limit(m.limits.upper, prismatic)
-        );
-    }
-
-    println!("\nmovable joints ({}):", model.num_joints());
-    println!(
-        "  {:>3}  {:<28} {:<10} {:>9} {:>9}  value",
-        "#", "name", "type", "lower", "upper"
-    );
-    for j in 0..model.num_joints() {
-        let joint = model.joint(j);
-        let kind = match joint.kind {
-            JointKind::Revolute => "revolute",
-            JointKind::Continuous => "continuous",
-            JointKind::Prismatic => "prismatic",
-            JointKind::Fixed => "fixed",
-        };
-        println!(
-            "  {j:>3}  {:<28} {kind:<10} {:>9} {:>9}  {}",
-            joint.name,
-            limit(joint.limits.lower, joint.kind == JointKind::Prismatic),
-            limit(joint.limits.upper, joint.kind == JointKind::Prismatic),
-            coupling_formula(&model, j)
-        );
-    }
-    if model.is_coupled() {
-        println!("  (value: the joint as a function of the motors, angles in rad)");
-    }
-
+    print_motors(&model);
+    print_joints(&model);
     if args.links {
         println!("\nlinks ({}), parent joint → link:", model.num_links());
         for link in &tree.links {
@@ -236,6 +180,70 @@ pub fn run(args: &Args) -> Result<()> {
         Err(e) => println!("\ncollision bodies: cannot be built: {e:#}"),
     }
     Ok(())
+}
+
+/// The motors, their limits and the joints each drives.
+fn print_motors(model: &RobotModel) {
+    println!(
+        "\nmotors ({}), limits in degrees (metres, marked m, for prismatic joints):",
+        model.motors().len()
+    );
+    println!(
+        "  {:>3}  {:<28} {:>9} {:>9}  drives",
+        "#", "name", "lower", "upper"
+    );
+    for (i, m) in model.motors().iter().enumerate() {
+        let driven: Vec<usize> = (model.couplings().iter().enumerate())
+            .filter(|(_, c)| c.terms.iter().any(|&(k, _)| k == i))
+            .map(|(j, _)| j)
+            .collect();
+        let prismatic = driven
+            .iter()
+            .any(|&j| model.joint(j).kind == JointKind::Prismatic);
+        let driven: Vec<&str> = driven
+            .iter()
+            .map(|&j| model.joint(j).name.as_str())
+            .collect();
+        let driven = if driven.len() == 1 && driven[0] == m.name {
+            String::from("(itself)")
+        } else {
+            driven.join(", ")
+        };
+        println!(
+            "  {i:>3}  {:<28} {:>9} {:>9}  {driven}",
+            m.name,
+            limit(m.limits.lower, prismatic),
+            limit(m.limits.upper, prismatic)
+        );
+    }
+}
+
+/// The movable joints, their limits and (coupled models) their values as motor formulas.
+fn print_joints(model: &RobotModel) {
+    println!("\nmovable joints ({}):", model.num_joints());
+    println!(
+        "  {:>3}  {:<28} {:<10} {:>9} {:>9}  value",
+        "#", "name", "type", "lower", "upper"
+    );
+    for j in 0..model.num_joints() {
+        let joint = model.joint(j);
+        let kind = match joint.kind {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+        };
+        println!(
+            "  {j:>3}  {:<28} {kind:<10} {:>9} {:>9}  {}",
+            joint.name,
+            limit(joint.limits.lower, joint.kind == JointKind::Prismatic),
+            limit(joint.limits.upper, joint.kind == JointKind::Prismatic),
+            coupling_formula(model, j)
+        );
+    }
+    if model.is_coupled() {
+        println!("  (value: the joint as a function of the motors, angles in rad)");
+    }
 }
 
 fn shape_text(shape: &Shape) -> String {

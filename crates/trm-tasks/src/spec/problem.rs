@@ -113,71 +113,8 @@ impl Problem {
         let ctx = Ctx { origin, text };
         let robot = load_model(&spec.model, base, &ctx)?;
         let robot = with_frames(robot, &spec.frames, &ctx)?;
-        let mut motors = match &spec.start {
-            None => robot.home_motors(),
-            Some(start) => robot.posture(start).map(<[f64]>::to_vec).map_err(|_| {
-                ctx.err(
-                    "start",
-                    format!("`{start}` is no posture of the model"),
-                    ctx.suggest(
-                        start,
-                        robot.posture_names(),
-                        "use a posture of the model description",
-                    ),
-                )
-            })?,
-        };
-        for (name, v) in &spec.start_values {
-            let i = robot.motor_index(name).map_err(|_| {
-                ctx.err(
-                    &format!("start_values.{name}"),
-                    format!("`{name}` is no motor"),
-                    ctx.suggest(
-                        name,
-                        robot.motors().iter().map(|m| m.name.as_str()),
-                        "use motor names",
-                    ),
-                )
-            })?;
-            let limits = &robot.motors()[i].limits;
-            if !(v.is_finite() && *v >= limits.lower && *v <= limits.upper) {
-                return Err(ctx.err(
-                    &format!("start_values.{name}"),
-                    format!(
-                        "{v} is outside `{name}`'s limits [{}, {}]",
-                        limits.lower, limits.upper
-                    ),
-                    "give a start value within the motor's limits",
-                ));
-            }
-            motors[i] = *v;
-        }
-        let active = if spec.active.is_empty() {
-            robot.all_active()
-        } else {
-            for (i, name) in spec.active.iter().enumerate() {
-                if let Some(first) = spec.active[..i].iter().position(|n| n == name) {
-                    return Err(ctx.err(
-                        &format!("active[{i}]"),
-                        format!("`{name}` is given twice (also active[{first}])"),
-                        "name each motor or group once (groups that share motors are joined)",
-                    ));
-                }
-                if robot.select_motors(&[name]).is_err() {
-                    let candidates = robot
-                        .motors()
-                        .iter()
-                        .map(|m| m.name.as_str())
-                        .chain(robot.groups().map(|(g, _)| g));
-                    return Err(ctx.err(
-                        &format!("active[{i}]"),
-                        format!("`{name}` is no motor or group"),
-                        ctx.suggest(name, candidates, "use motor or group names"),
-                    ));
-                }
-            }
-            robot.active_set(&spec.active, &motors)?
-        };
+        let motors = start_motors(&spec, &robot, &ctx)?;
+        let active = active_motors(&spec, &robot, &motors, &ctx)?;
         let world = World::from_spec_in(&spec.world, origin, text, "world.objects")?;
         let collision = CollisionModel::new(&robot)?;
         let start = active.from_motors(&motors);
@@ -227,24 +164,7 @@ impl Problem {
             }
             objective.set_noise(n.samples, n.sigma, n.seed)?;
         }
-        if !trm_optim::ALGORITHMS.contains(&spec.solver.algo.as_str()) {
-            return Err(ctx.err(
-                "solver.algo",
-                format!("unknown algorithm `{}`", spec.solver.algo),
-                ctx.suggest(
-                    &spec.solver.algo,
-                    trm_optim::ALGORITHMS,
-                    "use one of trm_optim::ALGORITHMS",
-                ),
-            ));
-        }
-        if !(spec.solver.sigma.is_finite() && spec.solver.sigma > 0.0) {
-            return Err(ctx.err(
-                "solver.sigma",
-                "must be positive",
-                "give an initial step in radians",
-            ));
-        }
+        check_solver(&spec, &ctx)?;
         check_numbers(&spec, &ctx)?;
         Ok(Problem {
             origin: origin.to_string(),
@@ -255,6 +175,110 @@ impl Problem {
             start,
         })
     }
+}
+
+/// The start's motor values: the spec's `start` posture (else `home`, else neutral) with its
+/// `start_values` over it, each within its motor's limits.
+fn start_motors(spec: &Spec, robot: &RobotModel, ctx: &Ctx) -> Result<Vec<f64>> {
+    let mut motors = match &spec.start {
+        None => robot.home_motors(),
+        Some(start) => robot.posture(start).map(<[f64]>::to_vec).map_err(|_| {
+            ctx.err(
+                "start",
+                format!("`{start}` is no posture of the model"),
+                ctx.suggest(
+                    start,
+                    robot.posture_names(),
+                    "use a posture of the model description",
+                ),
+            )
+        })?,
+    };
+    for (name, v) in &spec.start_values {
+        let i = robot.motor_index(name).map_err(|_| {
+            ctx.err(
+                &format!("start_values.{name}"),
+                format!("`{name}` is no motor"),
+                ctx.suggest(
+                    name,
+                    robot.motors().iter().map(|m| m.name.as_str()),
+                    "use motor names",
+                ),
+            )
+        })?;
+        let limits = &robot.motors()[i].limits;
+        if !(v.is_finite() && *v >= limits.lower && *v <= limits.upper) {
+            return Err(ctx.err(
+                &format!("start_values.{name}"),
+                format!(
+                    "{v} is outside `{name}`'s limits [{}, {}]",
+                    limits.lower, limits.upper
+                ),
+                "give a start value within the motor's limits",
+            ));
+        }
+        motors[i] = *v;
+    }
+    Ok(motors)
+}
+
+/// The moving motors: the spec's `active` motors and groups (each named once), the others
+/// locked at `motors`; every motor when the list is empty.
+fn active_motors(
+    spec: &Spec,
+    robot: &RobotModel,
+    motors: &[f64],
+    ctx: &Ctx,
+) -> Result<trm_kinematics::ActiveSet> {
+    Ok(if spec.active.is_empty() {
+        robot.all_active()
+    } else {
+        for (i, name) in spec.active.iter().enumerate() {
+            if let Some(first) = spec.active[..i].iter().position(|n| n == name) {
+                return Err(ctx.err(
+                    &format!("active[{i}]"),
+                    format!("`{name}` is given twice (also active[{first}])"),
+                    "name each motor or group once (groups that share motors are joined)",
+                ));
+            }
+            if robot.select_motors(&[name]).is_err() {
+                let candidates = robot
+                    .motors()
+                    .iter()
+                    .map(|m| m.name.as_str())
+                    .chain(robot.groups().map(|(g, _)| g));
+                return Err(ctx.err(
+                    &format!("active[{i}]"),
+                    format!("`{name}` is no motor or group"),
+                    ctx.suggest(name, candidates, "use motor or group names"),
+                ));
+            }
+        }
+        robot.active_set(&spec.active, motors)?
+    })
+}
+
+/// The solver's algorithm (a known one) and initial step (positive).
+fn check_solver(spec: &Spec, ctx: &Ctx) -> Result<()> {
+    if !trm_optim::ALGORITHMS.contains(&spec.solver.algo.as_str()) {
+        return Err(ctx.err(
+            "solver.algo",
+            format!("unknown algorithm `{}`", spec.solver.algo),
+            ctx.suggest(
+                &spec.solver.algo,
+                trm_optim::ALGORITHMS,
+                "use one of trm_optim::ALGORITHMS",
+            ),
+        ));
+    }
+    if !(spec.solver.sigma.is_finite() && spec.solver.sigma > 0.0) {
+        return Err(ctx.err(
+            "solver.sigma",
+            "must be positive",
+            "give an initial step in radians",
+        ));
+    }
+    Ok(())
 }
 
 /// Range checks of the solver's and the map's numbers, each error at its field.
