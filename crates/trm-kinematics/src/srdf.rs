@@ -247,6 +247,104 @@ fn did_you_mean<'a>(
     }
 }
 
+/// An SRDF document being read: element lines and attributes with located errors.
+struct Reader<'a, 'input> {
+    doc: &'a roxmltree::Document<'input>,
+    origin: &'a str,
+}
+
+impl Reader<'_, '_> {
+    /// The line an element starts on.
+    fn line(&self, n: roxmltree::Node) -> usize {
+        self.doc.text_pos_at(n.range().start).row as usize
+    }
+
+    /// An attribute the element must have.
+    fn attr(&self, n: roxmltree::Node, a: &str) -> Result<String> {
+        n.attribute(a).map(str::to_string).ok_or_else(|| {
+            error(
+                self.origin,
+                self.line(n),
+                format!("<{}> has no `{a}` attribute", n.tag_name().name()),
+                format!("give <{}> its `{a}`", n.tag_name().name()),
+            )
+        })
+    }
+
+    /// A `<group>` and its members; elements that are no members noted and skipped.
+    fn group(&self, n: roxmltree::Node, notes: &mut Vec<String>) -> Result<SrdfGroup> {
+        let (attr, line) = (|n, a| self.attr(n, a), |n| self.line(n));
+        let mut g = SrdfGroup {
+            name: attr(n, "name")?,
+            line: line(n),
+            ..Default::default()
+        };
+        for m in n.children().filter(|m| m.is_element()) {
+            match m.tag_name().name() {
+                        "joint" => g.joints.push(attr(m, "name")?),
+                        "link" => g.links.push(attr(m, "name")?),
+                        "chain" => g.chains.push((attr(m, "base_link")?, attr(m, "tip_link")?)),
+                        "group" => g.subgroups.push(attr(m, "name")?),
+                        // MoveIt's reader skips other elements (SRDFs in the wild put
+                        // <passive_joint> there); so does trm, saying so
+                        other => notes.push(format!(
+                            "line {}: <{other}> in group `{}` skipped (a group holds <joint>, <link>, <chain> and <group> members)",
+                            line(m),
+                            g.name
+                        )),
+                    }
+        }
+        Ok(g)
+    }
+
+    /// A `<group_state>`: one finite value per joint (several for a multi-coordinate joint).
+    fn group_state(&self, n: roxmltree::Node) -> Result<GroupState> {
+        let (attr, line, origin) = (|n, a| self.attr(n, a), |n| self.line(n), self.origin);
+        let mut s = GroupState {
+            name: attr(n, "name")?,
+            group: attr(n, "group")?,
+            line: line(n),
+            ..Default::default()
+        };
+        for j in n.children().filter(|j| j.has_tag_name("joint")) {
+            let name = attr(j, "name")?;
+            let text = attr(j, "value")?;
+            // a joint with several coordinates lists them space-separated
+            let values: Option<Vec<f64>> = text
+                .split_whitespace()
+                .map(|v| v.parse().ok().filter(|v: &f64| v.is_finite()))
+                .collect();
+            let value = match values.as_deref() {
+                Some([v]) => *v,
+                Some(many) if many.len() > 1 => {
+                    s.multi.push((name.clone(), many.to_vec(), line(j)));
+                    continue;
+                }
+                _ => {
+                    return Err(error(
+                        origin,
+                        line(j),
+                        format!(
+                            "group state `{}`: joint `{name}` has value `{text}`",
+                            s.name
+                        ),
+                        "give finite numbers (rad or m), space-separated for a joint with several coordinates",
+                    ));
+                }
+            };
+            if s.values.insert(name.clone(), value).is_some() {
+                return Err(error(
+                    origin,
+                    line(j),
+                    format!("group state `{}` gives joint `{name}` twice", s.name),
+                    "give each joint once",
+                ));
+            }
+        }
+        Ok(s)
+    }
+}
+
 impl Srdf {
     /// Parses SRDF text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
@@ -267,8 +365,9 @@ impl Srdf {
                 "write the SRDF as MoveIt's setup assistant does",
             )
         })?;
+        let read = Reader { doc: &doc, origin };
+        let (attr, line) = (|n, a| read.attr(n, a), |n| read.line(n));
         let root = doc.root_element();
-        let line = |n: roxmltree::Node| doc.text_pos_at(n.range().start).row as usize;
         if root.tag_name().name() != "robot" {
             return Err(error(
                 origin,
@@ -277,16 +376,6 @@ impl Srdf {
                 "an SRDF's root element is <robot name=\"…\">",
             ));
         }
-        let attr = |n: roxmltree::Node, a: &str| -> Result<String> {
-            n.attribute(a).map(str::to_string).ok_or_else(|| {
-                error(
-                    origin,
-                    line(n),
-                    format!("<{}> has no `{a}` attribute", n.tag_name().name()),
-                    format!("give <{}> its `{a}`", n.tag_name().name()),
-                )
-            })
-        };
         let mut srdf = Srdf {
             origin: origin.to_string(),
             robot: attr(root, "name")?,
@@ -303,72 +392,10 @@ impl Srdf {
                     line: line(n),
                 }),
                 "group" => {
-                    let mut g = SrdfGroup {
-                        name: attr(n, "name")?,
-                        line: line(n),
-                        ..Default::default()
-                    };
-                    for m in n.children().filter(|m| m.is_element()) {
-                        match m.tag_name().name() {
-                            "joint" => g.joints.push(attr(m, "name")?),
-                            "link" => g.links.push(attr(m, "name")?),
-                            "chain" => g.chains.push((attr(m, "base_link")?, attr(m, "tip_link")?)),
-                            "group" => g.subgroups.push(attr(m, "name")?),
-                            // MoveIt's reader skips other elements (SRDFs in the wild put
-                            // <passive_joint> there); so does trm, saying so
-                            other => srdf.notes.push(format!(
-                                "line {}: <{other}> in group `{}` skipped (a group holds <joint>, <link>, <chain> and <group> members)",
-                                line(m),
-                                g.name
-                            )),
-                        }
-                    }
-                    srdf.groups.push(g);
+                    let group = read.group(n, &mut srdf.notes)?;
+                    srdf.groups.push(group);
                 }
-                "group_state" => {
-                    let mut s = GroupState {
-                        name: attr(n, "name")?,
-                        group: attr(n, "group")?,
-                        line: line(n),
-                        ..Default::default()
-                    };
-                    for j in n.children().filter(|j| j.has_tag_name("joint")) {
-                        let name = attr(j, "name")?;
-                        let text = attr(j, "value")?;
-                        // a joint with several coordinates lists them space-separated
-                        let values: Option<Vec<f64>> = text
-                            .split_whitespace()
-                            .map(|v| v.parse().ok().filter(|v: &f64| v.is_finite()))
-                            .collect();
-                        let value = match values.as_deref() {
-                            Some([v]) => *v,
-                            Some(many) if many.len() > 1 => {
-                                s.multi.push((name.clone(), many.to_vec(), line(j)));
-                                continue;
-                            }
-                            _ => {
-                                return Err(error(
-                                    origin,
-                                    line(j),
-                                    format!(
-                                        "group state `{}`: joint `{name}` has value `{text}`",
-                                        s.name
-                                    ),
-                                    "give finite numbers (rad or m), space-separated for a joint with several coordinates",
-                                ));
-                            }
-                        };
-                        if s.values.insert(name.clone(), value).is_some() {
-                            return Err(error(
-                                origin,
-                                line(j),
-                                format!("group state `{}` gives joint `{name}` twice", s.name),
-                                "give each joint once",
-                            ));
-                        }
-                    }
-                    srdf.group_states.push(s);
-                }
+                "group_state" => srdf.group_states.push(read.group_state(n)?),
                 "end_effector" => srdf.end_effectors.push(EndEffector {
                     name: attr(n, "name")?,
                     parent_link: attr(n, "parent_link")?,
@@ -397,8 +424,15 @@ impl Srdf {
                 _ => {} // sphere approximations and other MoveIt extensions
             }
         }
-        for (k, g) in srdf.groups.iter().enumerate() {
-            if let Some(first) = srdf.groups[..k].iter().find(|o| o.name == g.name) {
+        srdf.check_unique()?;
+        Ok(srdf)
+    }
+
+    /// Groups, and group states within a group, each defined once.
+    fn check_unique(&self) -> Result<()> {
+        let origin = self.origin.as_str();
+        for (k, g) in self.groups.iter().enumerate() {
+            if let Some(first) = self.groups[..k].iter().find(|o| o.name == g.name) {
                 return Err(error(
                     origin,
                     g.line,
@@ -410,8 +444,8 @@ impl Srdf {
                 ));
             }
         }
-        for (k, s) in srdf.group_states.iter().enumerate() {
-            let twin = srdf.group_states[..k]
+        for (k, s) in self.group_states.iter().enumerate() {
+            let twin = self.group_states[..k]
                 .iter()
                 .find(|o| o.name == s.name && o.group == s.group);
             if let Some(first) = twin {
@@ -426,7 +460,7 @@ impl Srdf {
                 ));
             }
         }
-        Ok(srdf)
+        Ok(())
     }
 
     /// Reads an SRDF file.

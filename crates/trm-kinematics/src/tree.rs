@@ -293,11 +293,7 @@ type Joined = (Vec<Option<usize>>, Vec<Vec<usize>>);
 
 /// Each link's parent joint and each link's child joints, every joint joining two defined,
 /// different links, each link the child of one joint at most.
-fn connect(
-    robot: &urdf_rs::Robot,
-    link_index: &HashMap<&str, usize>,
-    ctx: &Ctx,
-) -> Result<Joined> {
+fn connect(robot: &urdf_rs::Robot, link_index: &HashMap<&str, usize>, ctx: &Ctx) -> Result<Joined> {
     let mut joint_names: HashMap<&str, ()> = HashMap::new();
     let mut parent_of: Vec<Option<usize>> = vec![None; robot.links.len()];
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); robot.links.len()];

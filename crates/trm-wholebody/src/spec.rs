@@ -198,6 +198,9 @@ pub const MAX_STEPS: usize = 1_000_000;
 /// the stand-up spec's 1.65 million.
 pub const MAX_TOTAL_STEPS: u64 = 50_000_000;
 
+/// A located spec error from a field, a problem and its fix.
+type Err<'a> = dyn Fn(&str, String, &str) -> WholeBodyError + 'a;
+
 impl MotionSpec {
     /// Reads and checks a spec file.
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, String)> {
@@ -222,18 +225,26 @@ impl MotionSpec {
     /// Checks the numbers and structure (what [`MotionSpec::from_ron`] checks), errors located
     /// in `text`: for a spec changed after parsing, e.g. its budgets replaced.
     pub fn check(&self, text: &str, origin: &str) -> Result<()> {
-        let spec = self;
         let err = |field: &str, problem: String, fix: &str| {
             WholeBodyError::spec(text, origin, field, problem, fix)
         };
+        self.check_numbers(&err)?;
+        self.check_phases(&err)?;
+        self.check_sizes(&err)?;
+        self.check_parameters(&err)?;
+        self.check_supports(&err)
+    }
+
+    /// Gains, sizes and weights in range; a support polygon left inside the margin.
+    fn check_numbers(&self, err: &Err<'_>) -> Result<()> {
         let positive = [
-            ("dt", spec.dt),
-            ("sole[0]", spec.sole.0),
-            ("sole[1]", spec.sole.1),
-            ("controller.com_gain", spec.controller.com_gain),
-            ("controller.damping", spec.controller.damping),
-            ("optimiser.exploration", spec.optimiser.exploration),
-            ("weights.backward_max", spec.weights.backward_max),
+            ("dt", self.dt),
+            ("sole[0]", self.sole.0),
+            ("sole[1]", self.sole.1),
+            ("controller.com_gain", self.controller.com_gain),
+            ("controller.damping", self.controller.damping),
+            ("optimiser.exploration", self.optimiser.exploration),
+            ("weights.backward_max", self.weights.backward_max),
         ];
         for (field, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -244,11 +255,11 @@ impl MotionSpec {
                 ));
             }
         }
-        let w = &spec.weights;
+        let w = &self.weights;
         let non_negative = [
-            ("support_margin", spec.support_margin),
-            ("controller.posture_gain", spec.controller.posture_gain),
-            ("controller.smoothing", spec.controller.smoothing),
+            ("support_margin", self.support_margin),
+            ("controller.posture_gain", self.controller.posture_gain),
+            ("controller.smoothing", self.controller.smoothing),
             ("weights.com_error", w.com_error),
             ("weights.effort", w.effort),
             ("weights.backward", w.backward),
@@ -262,27 +273,32 @@ impl MotionSpec {
                 ));
             }
         }
-        if 2.0 * spec.support_margin >= spec.sole.0.min(spec.sole.1) {
+        if 2.0 * self.support_margin >= self.sole.0.min(self.sole.1) {
             return Err(err(
                 "support_margin",
                 "leaves no support polygon".into(),
                 "use a margin below half the sole width",
             ));
         }
-        if spec.rbfs == 0 {
+        if self.rbfs == 0 {
             return Err(err(
                 "rbfs",
                 "need at least one RBF".into(),
                 "the paper uses 5",
             ));
         }
-        if spec.phases.is_empty() {
+        Ok(())
+    }
+
+    /// Phases: at least one, ends increasing, names unique.
+    fn check_phases(&self, err: &Err<'_>) -> Result<()> {
+        if self.phases.is_empty() {
             return Err(err("phases", "no phase".into(), "add at least one phase"));
         }
-        let ends: Vec<f64> = spec.phases.iter().map(|p| p.end).collect();
+        let ends: Vec<f64> = self.phases.iter().map(|p| p.end).collect();
         check_ends(&ends).map_err(|p| err("phases", p, "phase ends must increase from > 0"))?;
-        for (i, p) in spec.phases.iter().enumerate() {
-            if spec.phases[..i].iter().any(|q| q.name == p.name) {
+        for (i, p) in self.phases.iter().enumerate() {
+            if self.phases[..i].iter().any(|q| q.name == p.name) {
                 return Err(err(
                     &format!("phases[{i}].name"),
                     format!("`{}` names two phases", p.name),
@@ -290,33 +306,39 @@ impl MotionSpec {
                 ));
             }
         }
-        if spec.rbfs > 1000 {
+        Ok(())
+    }
+
+    /// RBF and rollout counts, the hand-tuned ends, and the control steps a run takes, bounded.
+    fn check_sizes(&self, err: &Err<'_>) -> Result<()> {
+        let ends: Vec<f64> = self.phases.iter().map(|p| p.end).collect();
+        if self.rbfs > 1000 {
             return Err(err(
                 "rbfs",
-                format!("{} RBFs", spec.rbfs),
+                format!("{} RBFs", self.rbfs),
                 "give at most 1000 (the paper uses 5)",
             ));
         }
         for (field, n) in [
             (
                 "optimiser.bootstrap_rollouts",
-                spec.optimiser.bootstrap_rollouts,
+                self.optimiser.bootstrap_rollouts,
             ),
-            ("optimiser.rollouts", spec.optimiser.rollouts),
+            ("optimiser.rollouts", self.optimiser.rollouts),
         ] {
             if n > 10_000_000 {
                 return Err(err(field, format!("{n} rollouts"), "give at most 10000000"));
             }
         }
-        check_ends(&spec.hand_tuned.ends)
+        check_ends(&self.hand_tuned.ends)
             .map_err(|p| err("hand_tuned.ends", p, "ends must increase from > 0"))?;
-        if spec.hand_tuned.ends.len() != spec.phases.len() {
+        if self.hand_tuned.ends.len() != self.phases.len() {
             return Err(err(
                 "hand_tuned.ends",
                 format!(
                     "{} ends for {} phases",
-                    spec.hand_tuned.ends.len(),
-                    spec.phases.len()
+                    self.hand_tuned.ends.len(),
+                    self.phases.len()
                 ),
                 "give one end time per phase",
             ));
@@ -325,38 +347,43 @@ impl MotionSpec {
         // bootstrap_rollouts + rollouts of them, and the hand-tuned motion once
         let duration = ends
             .iter()
-            .chain(&spec.hand_tuned.ends)
+            .chain(&self.hand_tuned.ends)
             .fold(0.0f64, |a, &b| a.max(b));
-        let steps = duration / spec.dt;
+        let steps = duration / self.dt;
         if steps > MAX_STEPS as f64 {
             return Err(err(
                 "dt",
                 format!(
                     "{duration} s in steps of {} s is {steps:.3e} control steps",
-                    spec.dt
+                    self.dt
                 ),
                 &format!(
                     "give a time step that makes at most {MAX_STEPS} steps per rollout (the paper uses 0.01 s)"
                 ),
             ));
         }
-        let rollouts = spec.optimiser.bootstrap_rollouts + spec.optimiser.rollouts + 1;
+        let rollouts = self.optimiser.bootstrap_rollouts + self.optimiser.rollouts + 1;
         let total = steps * rollouts as f64;
         if total > MAX_TOTAL_STEPS as f64 {
             return Err(err(
                 "dt",
                 format!(
                     "{rollouts} rollouts of {steps:.3e} control steps ({duration} s in steps of {} s) are {total:.3e} steps in all",
-                    spec.dt
+                    self.dt
                 ),
                 &format!(
                     "give a larger time step or fewer rollouts: at most {MAX_TOTAL_STEPS} steps in all (the paper: 0.01 s, 1000 rollouts)"
                 ),
             ));
         }
-        let n = 3 * spec.rbfs;
-        let params = std::iter::once(("hand_tuned.params", Some(&spec.hand_tuned.params))).chain(
-            std::iter::once(("optimiser.start", spec.optimiser.start.as_ref())),
+        Ok(())
+    }
+
+    /// The hand-tuned and start parameters: 3 × rbfs finite values each.
+    fn check_parameters(&self, err: &Err<'_>) -> Result<()> {
+        let n = 3 * self.rbfs;
+        let params = std::iter::once(("hand_tuned.params", Some(&self.hand_tuned.params))).chain(
+            std::iter::once(("optimiser.start", self.optimiser.start.as_ref())),
         );
         for (field, p) in params {
             if let Some(p) = p {
@@ -369,8 +396,13 @@ impl MotionSpec {
                 }
             }
         }
-        if let Some(seat) = &spec.seat {
-            match spec.world.objects.iter().find(|o| o.name == seat.object) {
+        Ok(())
+    }
+
+    /// The seat (an axis-aligned box of the world, present when a phase sits) and the reach.
+    fn check_supports(&self, err: &Err<'_>) -> Result<()> {
+        if let Some(seat) = &self.seat {
+            match self.world.objects.iter().find(|o| o.name == seat.object) {
                 Some(o) if matches!(o.shape, Shape::Box { .. }) && o.rpy == [0.0; 3] => {}
                 _ => {
                     return Err(err(
@@ -381,8 +413,8 @@ impl MotionSpec {
                 }
             }
         }
-        if spec.seat.is_none()
-            && spec
+        if self.seat.is_none()
+            && self
                 .phases
                 .iter()
                 .any(|p| p.support == Support::FeetAndSeat)
@@ -393,9 +425,9 @@ impl MotionSpec {
                 "add `seat: Some((object: ..., contacts: [...]))` or use `support: Feet`",
             ));
         }
-        if let Some(r) = &spec.reach {
-            if !spec.phases.iter().any(|p| p.name == r.phase) {
-                let names: Vec<&str> = spec.phases.iter().map(|p| p.name.as_str()).collect();
+        if let Some(r) = &self.reach {
+            if !self.phases.iter().any(|p| p.name == r.phase) {
+                let names: Vec<&str> = self.phases.iter().map(|p| p.name.as_str()).collect();
                 return Err(err(
                     "reach.phase",
                     format!("no phase named `{}`", r.phase),

@@ -115,6 +115,95 @@ impl Resolver<'_> {
         }
     }
 
+    /// The home-posture cost: a named posture (else the start) with per-motor weights (motors
+    /// or groups; 1 by default).
+    fn home_posture(
+        &self,
+        posture: Option<&str>,
+        weights: &std::collections::BTreeMap<String, f64>,
+        active: &ActiveSet,
+        motors: &[f64],
+        field: &str,
+    ) -> Result<HomePosture> {
+        let home_motors = match posture {
+            None => motors.to_vec(),
+            Some(p) => self.robot.posture(p).map(<[f64]>::to_vec).map_err(|_| {
+                self.ctx.err(
+                    &format!("{field}.cost.posture"),
+                    format!("`{p}` is no posture"),
+                    self.ctx
+                        .suggest(p, self.robot.posture_names(), "use a posture of the model"),
+                )
+            })?,
+        };
+        let mut w = vec![1.0; active.len()];
+        for (name, value) in weights {
+            if !(value.is_finite() && *value >= 0.0) {
+                return Err(self.ctx.err(
+                    &format!("{field}.cost.weights.{name}"),
+                    format!("weight {value} is not a finite number ≥ 0"),
+                    "use non-negative weights",
+                ));
+            }
+            let members = self.robot.select_motors(&[name]).map_err(|_| {
+                let candidates = self
+                    .robot
+                    .motors()
+                    .iter()
+                    .map(|m| m.name.as_str())
+                    .chain(self.robot.groups().map(|(g, _)| g));
+                self.ctx.err(
+                    &format!("{field}.cost.weights.{name}"),
+                    format!("`{name}` is no motor or group"),
+                    self.ctx
+                        .suggest(name, candidates, "use motor or group names"),
+                )
+            })?;
+            for m in members {
+                if let Some(i) = active.motor_indices().iter().position(|a| *a == m) {
+                    w[i] = *value;
+                }
+            }
+        }
+        Ok(HomePosture {
+            home: active.from_motors(&home_motors),
+            weights: w,
+        })
+    }
+
+    /// A position cost's target region.
+    fn region(&self, target: &TargetSpec, field: &str) -> Result<Region> {
+        Ok(match target {
+            TargetSpec::Part(p) => Region::Point(Anchor::Frame(
+                self.frame(p, &format!("{field}.cost.target"))?,
+            )),
+            TargetSpec::Object(o) => Region::Point(Anchor::Object(
+                self.object(o, &format!("{field}.cost.target"))?,
+            )),
+            TargetSpec::Point(p) => Region::Point(Anchor::Point(
+                self.finite(*p, &format!("{field}.cost.target"))?,
+            )),
+            TargetSpec::Box { min, max } => {
+                let (min, max) = (
+                    self.finite(*min, &format!("{field}.cost.target.min"))?,
+                    self.finite(*max, &format!("{field}.cost.target.max"))?,
+                );
+                if (0..3).any(|i| min[i] > max[i]) {
+                    return Err(self.ctx.err(
+                        &format!("{field}.cost.target.min"),
+                        "a box min exceeds its max",
+                        "swap the corners",
+                    ));
+                }
+                Region::Box { min, max }
+            }
+            TargetSpec::Sphere { center, radius } => Region::Sphere {
+                center: self.anchor(center, &format!("{field}.cost.target.center"))?,
+                radius: self.positive(*radius, &format!("{field}.cost.target.radius"))?,
+            },
+        })
+    }
+
     pub(super) fn cost(
         &self,
         c: &CostKind,
@@ -126,53 +215,7 @@ impl Resolver<'_> {
         let field = format!("costs[{k}]");
         Ok(match c {
             CostKind::HomePosture { posture, weights } => {
-                let home_motors = match posture {
-                    None => motors.to_vec(),
-                    Some(p) => self.robot.posture(p).map(<[f64]>::to_vec).map_err(|_| {
-                        self.ctx.err(
-                            &format!("{field}.cost.posture"),
-                            format!("`{p}` is no posture"),
-                            self.ctx.suggest(
-                                p,
-                                self.robot.posture_names(),
-                                "use a posture of the model",
-                            ),
-                        )
-                    })?,
-                };
-                let mut w = vec![1.0; active.len()];
-                for (name, value) in weights {
-                    if !(value.is_finite() && *value >= 0.0) {
-                        return Err(self.ctx.err(
-                            &format!("{field}.cost.weights.{name}"),
-                            format!("weight {value} is not a finite number ≥ 0"),
-                            "use non-negative weights",
-                        ));
-                    }
-                    let members = self.robot.select_motors(&[name]).map_err(|_| {
-                        let candidates = self
-                            .robot
-                            .motors()
-                            .iter()
-                            .map(|m| m.name.as_str())
-                            .chain(self.robot.groups().map(|(g, _)| g));
-                        self.ctx.err(
-                            &format!("{field}.cost.weights.{name}"),
-                            format!("`{name}` is no motor or group"),
-                            self.ctx
-                                .suggest(name, candidates, "use motor or group names"),
-                        )
-                    })?;
-                    for m in members {
-                        if let Some(i) = active.motor_indices().iter().position(|a| *a == m) {
-                            w[i] = *value;
-                        }
-                    }
-                }
-                Box::new(HomePosture {
-                    home: active.from_motors(&home_motors),
-                    weights: w,
-                })
+                Box::new(self.home_posture(posture.as_deref(), weights, active, motors, &field)?)
             }
             CostKind::Collision {
                 self_collision,
@@ -182,35 +225,7 @@ impl Resolver<'_> {
                 world: *world,
             }),
             CostKind::Position { part, target, mask } => {
-                let target = match target {
-                    TargetSpec::Part(p) => Region::Point(Anchor::Frame(
-                        self.frame(p, &format!("{field}.cost.target"))?,
-                    )),
-                    TargetSpec::Object(o) => Region::Point(Anchor::Object(
-                        self.object(o, &format!("{field}.cost.target"))?,
-                    )),
-                    TargetSpec::Point(p) => Region::Point(Anchor::Point(
-                        self.finite(*p, &format!("{field}.cost.target"))?,
-                    )),
-                    TargetSpec::Box { min, max } => {
-                        let (min, max) = (
-                            self.finite(*min, &format!("{field}.cost.target.min"))?,
-                            self.finite(*max, &format!("{field}.cost.target.max"))?,
-                        );
-                        if (0..3).any(|i| min[i] > max[i]) {
-                            return Err(self.ctx.err(
-                                &format!("{field}.cost.target.min"),
-                                "a box min exceeds its max",
-                                "swap the corners",
-                            ));
-                        }
-                        Region::Box { min, max }
-                    }
-                    TargetSpec::Sphere { center, radius } => Region::Sphere {
-                        center: self.anchor(center, &format!("{field}.cost.target.center"))?,
-                        radius: self.positive(*radius, &format!("{field}.cost.target.radius"))?,
-                    },
-                };
+                let target = self.region(target, &field)?;
                 Box::new(Position {
                     part: self.frame(part, &format!("{field}.cost.part"))?,
                     part_name: part.clone(),
