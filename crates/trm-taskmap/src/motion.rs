@@ -225,6 +225,14 @@ fn wrap(angle: f64) -> f64 {
 }
 
 /// Per-step quantities the backward pass needs.
+/// The end cost's derivatives at the final posture: the hand's end velocity (whose square is
+/// penalised) and the end cost's gradient in the hand's position and orientation.
+struct EndGradient {
+    velocity: Vector3<f64>,
+    position: Vector3<f64>,
+    orientation: Vector3<f64>,
+}
+
 struct Step {
     /// Control-task Jacobian at q_{t−1} (5 × n).
     jacobian: DMatrix<f64>,
@@ -513,20 +521,9 @@ impl ReachProblem<'_> {
             // ∂/∂q_{t−1} of q_{t−1} + J⁺ e − α (I − J⁺J) ∇H, column by column
             let mut step_derivative = DMatrix::zeros(if backward { n } else { 0 }, n);
             if backward {
-                self.active
-                    .jacobian_derivatives(&poses, self.hand, &mut djac);
-                let (jg, pj_cols) = (&j * &limit_grad, &pinv * &j);
-                for k in 0..n {
-                    let dj = self.control_jacobian_derivative(&hand, &jac, &djac[k], k);
-                    let dp = dj.transpose() * &gram_inv
-                        - &pinv * (&dj * j.transpose() + &j * dj.transpose()) * &gram_inv;
-                    let dn_g = -(&dp * &jg + &pinv * (&dj * &limit_grad));
-                    let mut col = &dp * &e - pj_cols.column(k);
-                    col -= s.limit_gain * dn_g;
-                    col -= (s.limit_gain * limit_hess[k]) * (-pj_cols.column(k));
-                    col[k] += 1.0 - s.limit_gain * limit_hess[k];
-                    step_derivative.set_column(k, &col);
-                }
+                let limits = (&limit_grad, &limit_hess);
+                let solve = (&j, &pinv, &gram_inv, &e);
+                step_derivative = self.step_derivative(&poses, &jac, &mut djac, solve, limits);
             }
             hand_before = hand.translation.vector;
             let mut free = vec![1.0; n];
@@ -618,14 +615,69 @@ impl ReachProblem<'_> {
         if !backward || record.len() != steps {
             return (m, None);
         }
+        let end = EndGradient {
+            velocity,
+            position: gp,
+            orientation: go,
+        };
+        let grad = self.backward(&mut record, &poses, &end, &m.trajectory, attractors.len());
+        (m, Some(grad))
+    }
+
+    /// ∂q_t/∂q_{t−1} of the resolved-rate step q_{t−1} + J⁺ e − α (I − J⁺J) ∇H, the change of
+    /// J⁺ with q included (`solve`: J, J⁺, (JJᵀ + λ²I)⁻¹ and e; `limits`: ∇H and H's diagonal
+    /// Hessian), at the poses of q_{t−1} with the hand Jacobian `jac`.
+    fn step_derivative(
+        &self,
+        poses: &PoseBuffer,
+        jac: &Matrix6xX<f64>,
+        djac: &mut Vec<Matrix6xX<f64>>,
+        solve: (&DMatrix<f64>, &DMatrix<f64>, &DMatrix<f64>, &DVector<f64>),
+        limits: (&DVector<f64>, &DVector<f64>),
+    ) -> DMatrix<f64> {
+        let (s, n) = (&self.settings, self.active.len());
+        let ((j, pinv, gram_inv, e), (limit_grad, limit_hess)) = (solve, limits);
+        let hand = *poses.pose(self.hand);
+        let mut derivative = DMatrix::zeros(n, n);
+        self.active.jacobian_derivatives(poses, self.hand, djac);
+        let (jg, pj_cols) = (j * limit_grad, pinv * j);
+        for k in 0..n {
+            let dj = self.control_jacobian_derivative(&hand, jac, &djac[k], k);
+            let dp = dj.transpose() * gram_inv
+                - pinv * (&dj * j.transpose() + j * dj.transpose()) * gram_inv;
+            let dn_g = -(&dp * &jg + pinv * (&dj * limit_grad));
+            let mut col = &dp * e - pj_cols.column(k);
+            col -= s.limit_gain * dn_g;
+            col -= (s.limit_gain * limit_hess[k]) * (-pj_cols.column(k));
+            col[k] += 1.0 - s.limit_gain * limit_hess[k];
+            derivative.set_column(k, &col);
+        }
+        derivative
+    }
+
+    /// The backward pass of [`ReachProblem::run`]: the cost's gradient with respect to the
+    /// attractors (`attractors` values), from the forward pass's `record` of a full motion, its
+    /// `trajectory`, the final `poses` and the end cost's derivatives `end`.
+    fn backward(
+        &self,
+        record: &mut [Step],
+        poses: &PoseBuffer,
+        end: &EndGradient,
+        trajectory: &[Vec<f64>],
+        attractors: usize,
+    ) -> Vec<f64> {
         // ∂/∂q_T of the end cost (eq. 20–21 continue through J⁺ in the backward pass)
-        self.active.jacobian(&poses, self.hand, &mut jac);
-        let v_grad = velocity * (2.0 * w.end_velocity / s.dt);
+        let (s, n, steps) = (&self.settings, self.active.len(), record.len());
+        let w = &s.weights;
+        let mut jac = Matrix6xX::zeros(n);
+        self.active.jacobian(poses, self.hand, &mut jac);
+        let v_grad = end.velocity * (2.0 * w.end_velocity / s.dt);
         let last = record.len() - 1;
         for c in 0..n {
             let jv = Vector3::new(jac[(0, c)], jac[(1, c)], jac[(2, c)]);
             let jw = Vector3::new(jac[(3, c)], jac[(4, c)], jac[(5, c)]);
-            record[last].direct[c] += w.end * (gp.dot(&jv) + go.dot(&jw)) + v_grad.dot(&jv);
+            record[last].direct[c] +=
+                w.end * (end.position.dot(&jv) + end.orientation.dot(&jw)) + v_grad.dot(&jv);
             // the hand velocity's other end, q_{T−1}: its Jacobian's position rows
             if last > 0 {
                 let jp = &record[last].jacobian;
@@ -637,8 +689,8 @@ impl ReachProblem<'_> {
         let (a, b, lambda) = (s.gain, s.carry, s.smoothing);
         let mut q_bar = DVector::<f64>::zeros(n);
         let mut x_bar = vec![Vector5::<f64>::zeros(); steps + 2];
-        let mut grad = vec![0.0; attractors.len()];
-        let traj = &m.trajectory;
+        let mut grad = vec![0.0; attractors];
+        let traj = trajectory;
         for t in (1..=steps).rev() {
             let step = &record[t - 1];
             // direct terms, the path term's two ends, and what q_{t+1} passes back
@@ -671,7 +723,7 @@ impl ReachProblem<'_> {
                 }
             }
         }
-        (m, Some(grad))
+        grad
     }
 
     /// Optimises the attractors with iRprop− on the analytic gradient for `iterations`; returns

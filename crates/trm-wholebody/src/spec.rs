@@ -199,7 +199,7 @@ pub const MAX_STEPS: usize = 1_000_000;
 pub const MAX_TOTAL_STEPS: u64 = 50_000_000;
 
 /// A located spec error from a field, a problem and its fix.
-type Err<'a> = dyn Fn(&str, String, &str) -> WholeBodyError + 'a;
+pub(crate) type SpecErr<'a> = dyn Fn(&str, String, &str) -> WholeBodyError + 'a;
 
 impl MotionSpec {
     /// Reads and checks a spec file.
@@ -236,7 +236,7 @@ impl MotionSpec {
     }
 
     /// Gains, sizes and weights in range; a support polygon left inside the margin.
-    fn check_numbers(&self, err: &Err<'_>) -> Result<()> {
+    fn check_numbers(&self, err: &SpecErr<'_>) -> Result<()> {
         let positive = [
             ("dt", self.dt),
             ("sole[0]", self.sole.0),
@@ -291,7 +291,7 @@ impl MotionSpec {
     }
 
     /// Phases: at least one, ends increasing, names unique.
-    fn check_phases(&self, err: &Err<'_>) -> Result<()> {
+    fn check_phases(&self, err: &SpecErr<'_>) -> Result<()> {
         if self.phases.is_empty() {
             return Err(err("phases", "no phase".into(), "add at least one phase"));
         }
@@ -310,7 +310,7 @@ impl MotionSpec {
     }
 
     /// RBF and rollout counts, the hand-tuned ends, and the control steps a run takes, bounded.
-    fn check_sizes(&self, err: &Err<'_>) -> Result<()> {
+    fn check_sizes(&self, err: &SpecErr<'_>) -> Result<()> {
         let ends: Vec<f64> = self.phases.iter().map(|p| p.end).collect();
         if self.rbfs > 1000 {
             return Err(err(
@@ -380,7 +380,7 @@ impl MotionSpec {
     }
 
     /// The hand-tuned and start parameters: 3 × rbfs finite values each.
-    fn check_parameters(&self, err: &Err<'_>) -> Result<()> {
+    fn check_parameters(&self, err: &SpecErr<'_>) -> Result<()> {
         let n = 3 * self.rbfs;
         let params = std::iter::once(("hand_tuned.params", Some(&self.hand_tuned.params))).chain(
             std::iter::once(("optimiser.start", self.optimiser.start.as_ref())),
@@ -400,7 +400,7 @@ impl MotionSpec {
     }
 
     /// The seat (an axis-aligned box of the world, present when a phase sits) and the reach.
-    fn check_supports(&self, err: &Err<'_>) -> Result<()> {
+    fn check_supports(&self, err: &SpecErr<'_>) -> Result<()> {
         if let Some(seat) = &self.seat {
             match self.world.objects.iter().find(|o| o.name == seat.object) {
                 Some(o) if matches!(o.shape, Shape::Box { .. }) && o.rpy == [0.0; 3] => {}

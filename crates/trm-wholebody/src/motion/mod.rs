@@ -18,7 +18,7 @@ use trm_kinematics::{ActiveSet, FrameId, RobotModel};
 use trm_trajectory::{RbfTrajectory, TimeLaw};
 
 use crate::Result;
-use crate::spec::{MotionSpec, Support};
+use crate::spec::{MotionSpec, SpecErr, Support};
 
 mod constraints;
 mod frame;
@@ -77,6 +77,125 @@ fn deg_map(
     q
 }
 
+/// The start posture, each phase's keyframe, and the motor limits they keep to.
+struct Postures {
+    start: Vec<f64>,
+    keyframes: Vec<Vec<f64>>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+}
+
+/// The start posture and each phase's keyframe (motor values; a keyframe's unnamed motors where
+/// the previous left them), all within the motor limits; and the limits.
+fn postures(spec: &MotionSpec, model: &RobotModel, spec_err: &SpecErr<'_>) -> Result<Postures> {
+    let neutral = model.neutral_motors();
+    let start = deg_map(model, &neutral, &spec.start);
+    let mut keyframes = Vec::new();
+    let mut previous = start.clone();
+    for p in &spec.phases {
+        let k = deg_map(model, &previous, &p.keyframe);
+        previous = k.clone();
+        keyframes.push(k);
+    }
+    let (lower, upper): (Vec<f64>, Vec<f64>) = model
+        .motors()
+        .iter()
+        .map(|m| (m.limits.lower, m.limits.upper))
+        .unzip();
+    for (field, (name, q)) in std::iter::once(("start".to_string(), ("start", &start))).chain(
+        spec.phases
+            .iter()
+            .zip(&keyframes)
+            .enumerate()
+            .map(|(i, (p, k))| (format!("phases[{i}].keyframe"), (p.name.as_str(), k))),
+    ) {
+        for (i, v) in q.iter().enumerate() {
+            if *v < lower[i] - 1e-9 || *v > upper[i] + 1e-9 {
+                return Err(spec_err(
+                    &format!("{field}.{}", model.motors()[i].name),
+                    format!(
+                        "posture `{name}` puts `{}` at {:.1}°, outside [{:.1}°, {:.1}°]",
+                        model.motors()[i].name,
+                        v.to_degrees(),
+                        lower[i].to_degrees(),
+                        upper[i].to_degrees()
+                    ),
+                    "keep postures inside the motor limits",
+                ));
+            }
+        }
+    }
+    Ok(Postures {
+        start,
+        keyframes,
+        lower,
+        upper,
+    })
+}
+
+/// Each motor's velocity limit: the spec's, else the model's (finite and positive).
+fn velocity_limits(
+    spec: &MotionSpec,
+    model: &RobotModel,
+    spec_err: &SpecErr<'_>,
+) -> Result<Vec<f64>> {
+    let mut velocity = Vec::with_capacity(model.motors().len());
+    for m in model.motors() {
+        let model_limit = Some(m.limits.velocity).filter(|v| v.is_finite());
+        match spec.limits.velocity.get(&m.name).copied().or(model_limit) {
+            Some(v) if v > 0.0 => velocity.push(v),
+            _ => {
+                return Err(spec_err(
+                    "limits.velocity",
+                    format!("no velocity limit for motor `{}`", m.name),
+                    "add it to limits.velocity (rad/s)",
+                ));
+            }
+        }
+    }
+    Ok(velocity)
+}
+
+/// The ground frame in the left sole's frame (midway between the sole centres, z up along the
+/// sole normal, x along the sole's forward axis) at the start posture, and half the gap between
+/// the soles; an error when the soles are not side by side on one plane.
+fn ground_frame(
+    active: &ActiveSet,
+    start: &[f64],
+    feet: (FrameId, FrameId),
+    spec_err: &SpecErr<'_>,
+) -> Result<(Isometry3<f64>, f64)> {
+    // the ground frame from the start posture: midway between the sole centres, z along
+    // the sole normal, x along the sole's forward axis
+    let mut poses = active.model().pose_buffer();
+    active.forward(start, &mut poses)?;
+    let (left, right) = (poses.pose(feet.0), poses.pose(feet.1));
+    let offset = left.inverse_transform_point(&Point3::from(right.translation.vector));
+    // (the iCub's legs are symmetric to 0.1 mm)
+    if offset.z.abs() > 1e-3 || offset.x.abs() > 1e-3 {
+        return Err(spec_err(
+            "feet",
+            format!(
+                "the soles are not side by side on one plane at the start posture (right sole at {:?} in the left sole frame)",
+                offset.coords.as_slice()
+            ),
+            "choose frames on both soles of a symmetric posture",
+        ));
+    }
+    // z up: if the sole frame's z points into the ground, turn it about x (keeping x, the
+    // toe direction)
+    let pelvis = left.inverse_transform_point(&Point3::origin());
+    let turn = if pelvis.z < 0.0 {
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    } else {
+        UnitQuaternion::identity()
+    };
+    let sole_to_ground =
+        Isometry3::from_parts(Translation3::new(offset.x / 2.0, offset.y / 2.0, 0.0), turn);
+    let half_gap = offset.y.abs() / 2.0;
+    Ok((sole_to_ground, half_gap))
+}
+
 impl WholeBody {
     /// Loads a spec file (the model path is relative to it).
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
@@ -115,57 +234,13 @@ impl WholeBody {
         let n = active.len();
         let collision = CollisionModel::new(&model)?;
         let feet = (model.frame_id(&spec.feet.0)?, model.frame_id(&spec.feet.1)?);
-        let neutral = model.neutral_motors();
-        let start = deg_map(&model, &neutral, &spec.start);
-        let mut keyframes = Vec::new();
-        let mut previous = start.clone();
-        for p in &spec.phases {
-            let k = deg_map(&model, &previous, &p.keyframe);
-            previous = k.clone();
-            keyframes.push(k);
-        }
-        let (lower, upper): (Vec<f64>, Vec<f64>) = model
-            .motors()
-            .iter()
-            .map(|m| (m.limits.lower, m.limits.upper))
-            .unzip();
-        for (field, (name, q)) in std::iter::once(("start".to_string(), ("start", &start))).chain(
-            spec.phases
-                .iter()
-                .zip(&keyframes)
-                .enumerate()
-                .map(|(i, (p, k))| (format!("phases[{i}].keyframe"), (p.name.as_str(), k))),
-        ) {
-            for (i, v) in q.iter().enumerate() {
-                if *v < lower[i] - 1e-9 || *v > upper[i] + 1e-9 {
-                    return Err(spec_err(
-                        &format!("{field}.{}", model.motors()[i].name),
-                        format!(
-                            "posture `{name}` puts `{}` at {:.1}°, outside [{:.1}°, {:.1}°]",
-                            model.motors()[i].name,
-                            v.to_degrees(),
-                            lower[i].to_degrees(),
-                            upper[i].to_degrees()
-                        ),
-                        "keep postures inside the motor limits",
-                    ));
-                }
-            }
-        }
-        let mut velocity = Vec::with_capacity(n);
-        for m in model.motors() {
-            let model_limit = Some(m.limits.velocity).filter(|v| v.is_finite());
-            match spec.limits.velocity.get(&m.name).copied().or(model_limit) {
-                Some(v) if v > 0.0 => velocity.push(v),
-                _ => {
-                    return Err(spec_err(
-                        "limits.velocity",
-                        format!("no velocity limit for motor `{}`", m.name),
-                        "add it to limits.velocity (rad/s)",
-                    ));
-                }
-            }
-        }
+        let Postures {
+            start,
+            keyframes,
+            lower,
+            upper,
+        } = postures(&spec, &model, &spec_err)?;
+        let velocity = velocity_limits(&spec, &model, &spec_err)?;
         let torque: Vec<f64> = model
             .motors()
             .iter()
@@ -192,34 +267,7 @@ impl WholeBody {
                     .collect()
             })
             .collect();
-        // the ground frame from the start posture: midway between the sole centres, z along
-        // the sole normal, x along the sole's forward axis
-        let mut poses = model.pose_buffer();
-        active.forward(&start, &mut poses)?;
-        let (left, right) = (poses.pose(feet.0), poses.pose(feet.1));
-        let offset = left.inverse_transform_point(&Point3::from(right.translation.vector));
-        // (the iCub's legs are symmetric to 0.1 mm)
-        if offset.z.abs() > 1e-3 || offset.x.abs() > 1e-3 {
-            return Err(spec_err(
-                "feet",
-                format!(
-                    "the soles are not side by side on one plane at the start posture (right sole at {:?} in the left sole frame)",
-                    offset.coords.as_slice()
-                ),
-                "choose frames on both soles of a symmetric posture",
-            ));
-        }
-        // z up: if the sole frame's z points into the ground, turn it about x (keeping x, the
-        // toe direction)
-        let pelvis = left.inverse_transform_point(&Point3::origin());
-        let turn = if pelvis.z < 0.0 {
-            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
-        } else {
-            UnitQuaternion::identity()
-        };
-        let sole_to_ground =
-            Isometry3::from_parts(Translation3::new(offset.x / 2.0, offset.y / 2.0, 0.0), turn);
-        let half_gap = offset.y.abs() / 2.0;
+        let (sole_to_ground, half_gap) = ground_frame(&active, &start, feet, &spec_err)?;
         let (length, width) = spec.sole;
         let feet_box = [
             -length / 2.0,

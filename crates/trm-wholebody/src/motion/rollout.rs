@@ -224,18 +224,7 @@ impl WholeBody {
             for k in 0..n {
                 qdot[k] += filter * (command[k] - qdot[k]);
             }
-            // static torques per joint: the motors hold the robot's weight, ∂(m g z_com)/∂q
-            // (legs resting on the seat carry nothing while it supports them)
-            let jn = &frame.com_jacobian;
-            let torque: Vec<f64> = (0..n)
-                .map(|k| {
-                    if locked[k] {
-                        0.0
-                    } else {
-                        self.mass * G * jn[(2, k)] / self.joints_per_motor[k]
-                    }
-                })
-                .collect();
+            let torque = self.static_torques(&frame, locked);
             // constraints at this sample (ZMP after the loop: it needs the CoM acceleration)
             g.fill(0.0);
             for k in 0..n {
@@ -271,6 +260,18 @@ impl WholeBody {
                 q[k] += qdot[k] * dt;
             }
         }
+        self.add_zmp(&mut out, n, dt);
+        out.costs = costs(&out);
+        if let (Some((_, target, _)), Some(h)) = (self.reach, out.hand.last()) {
+            out.costs.reach = (Vector2::new(h[0], h[2]) - target).norm();
+        }
+        Ok(out)
+    }
+
+    /// The ZMP of the cart-table model at every sample, from the CoM's acceleration (central
+    /// differences), with its support-polygon constraints; `fallen` when it leaves the real
+    /// polygon.
+    fn add_zmp(&self, out: &mut Rollout, n: usize, dt: f64) {
         // ZMP of the cart-table model from the CoM's acceleration (central differences)
         let zi = 4 * n;
         for i in 0..out.com.len() {
@@ -293,17 +294,27 @@ impl WholeBody {
                     out.violated_samples[zi + c] += 1;
                 }
             }
-            let real = self.real_polygon(spec.phases[out.phase[i]].support);
+            let real = self.real_polygon(self.spec.phases[out.phase[i]].support);
             if zmp[0] < real[0] || zmp[0] > real[1] || zmp[1] < real[2] || zmp[1] > real[3] {
                 out.fallen = true;
             }
             out.zmp.push(zmp);
         }
-        out.costs = costs(&out);
-        if let (Some((_, target, _)), Some(h)) = (self.reach, out.hand.last()) {
-            out.costs.reach = (Vector2::new(h[0], h[2]) - target).norm();
-        }
-        Ok(out)
+    }
+
+    /// Static torques per motor: the motors hold the robot's weight, ∂(m g z_com)/∂q (legs
+    /// resting on the seat, `locked`, carry nothing while it supports them).
+    fn static_torques(&self, frame: &Frame, locked: &[bool]) -> Vec<f64> {
+        let jn = &frame.com_jacobian;
+        (0..self.active.len())
+            .map(|k| {
+                if locked[k] {
+                    0.0
+                } else {
+                    self.mass * G * jn[(2, k)] / self.joints_per_motor[k]
+                }
+            })
+            .collect()
     }
 
     /// The hand-tuned reference rollout.
