@@ -401,15 +401,14 @@ pub struct ScenarioRun {
     pub map: Roadmap,
 }
 
-/// Runs `scenario` on `map` (built for `problem`, its `Roadmap::problem`), from the problem's
-/// start posture; see the module documentation. Deterministic for a given map and options
-/// unless a time budget cuts a repair short.
-pub fn run_scenario(
+/// The options in range, the goals in the map's task space, the scenario's objects named apart
+/// from the map's world's, and none present at the start on the robot's start posture.
+fn check_scenario(
     map: &Roadmap,
     problem: &Problem,
     scenario: &Scenario,
     options: &ScenarioOptions,
-) -> Result<ScenarioRun, ScenarioError> {
+) -> Result<(), ScenarioError> {
     options.plan.check()?;
     for (what, v) in [
         ("tolerance", options.tolerance),
@@ -435,8 +434,7 @@ pub fn run_scenario(
         ));
     }
     let objective = &problem.objective;
-    let active = objective.active();
-    let base = objective.world().clone();
+    let base = objective.world();
     if let Some(i) = scenario
         .objects
         .iter()
@@ -454,7 +452,7 @@ pub fn run_scenario(
     // an object present at the start must leave the robot's start posture free (one that
     // swallows the robot later makes the steps report a failed plan and the robot stay)
     let mut scratch = objective.scratch();
-    let start_free = objective.is_collision_free_in(&problem.start, &base, &mut scratch);
+    let start_free = objective.is_collision_free_in(&problem.start, base, &mut scratch);
     for (i, o) in scenario.objects.iter().enumerate() {
         if !start_free || o.appear > 0.0 || o.vanish.is_some_and(|v| v <= 0.0) {
             continue;
@@ -473,6 +471,69 @@ pub fn run_scenario(
             ));
         }
     }
+    Ok(())
+}
+
+/// Why the robot must plan again at this step, if it must: a new goal, a goal the last
+/// attempt failed to reach (tried again), the rest of the motion blocked in the current world,
+/// or the motion ended short of the goal.
+fn why_replan(
+    motion: Option<&Motion>,
+    goal: Option<&[f64]>,
+    tried: Option<&[f64]>,
+    q: &[f64],
+    checker: &mut trm_collision::WorldChecker,
+    problem: &Problem,
+    options: &ScenarioOptions,
+) -> Option<String> {
+    let objective = &problem.objective;
+    match (motion, goal) {
+        (_, None) => None,
+        (None, Some(goal)) if tried == Some(goal) => Some("trying again".to_string()),
+        (None, Some(_)) => Some("a new goal".to_string()),
+        (Some(m), Some(goal)) if m.goal != goal => Some("a new goal".to_string()),
+        (Some(m), Some(_)) => {
+            let next = m
+                .times
+                .iter()
+                .position(|&s| s > m.clock)
+                .unwrap_or(m.times.len());
+            let mut from = q.to_vec();
+            let blocked = m.waypoints[next..].iter().any(|w| {
+                let free = checker.span_free(&from, w, options.plan.resolution);
+                from.clone_from(w);
+                !free
+            });
+            let ended = next == m.times.len();
+            let off = |goal: &[f64]| {
+                let task = objective.task_value(q, &mut objective.scratch());
+                distance(&task, goal) > options.reached
+            };
+            if blocked {
+                Some("the rest of the motion is blocked".to_string())
+            } else if ended && goal.is_some_and(off) {
+                Some("the motion ended short of the goal".to_string())
+            } else {
+                None
+            }
+        }
+    }
+}
+
+/// Runs `scenario` on `map` (built for `problem`, its `Roadmap::problem`), from the problem's
+/// start posture; see the module documentation. Deterministic for a given map and options
+/// unless a time budget cuts a repair short.
+pub fn run_scenario(
+    map: &Roadmap,
+    problem: &Problem,
+    scenario: &Scenario,
+    options: &ScenarioOptions,
+) -> Result<ScenarioRun, ScenarioError> {
+    check_scenario(map, problem, scenario, options)?;
+    let objective = &problem.objective;
+    let active = objective.active();
+    let base = objective.world().clone();
+    let mut scratch = objective.scratch();
     let mut live = LiveMap::new(map, problem)?;
     let dt = 1.0 / scenario.rate;
     let repair = RepairOptions {
@@ -504,37 +565,15 @@ pub fn run_scenario(
         let goal = scenario.goal_at(t).map(<[f64]>::to_vec);
         // replan when the goal changed, the rest of the motion is blocked, or it ended short
         let started = Instant::now();
-        let why = match (&motion, &goal) {
-            (_, None) => None,
-            (None, Some(goal)) if tried.as_ref() == Some(goal) => Some("trying again".to_string()),
-            (None, Some(_)) => Some("a new goal".to_string()),
-            (Some(m), Some(goal)) if &m.goal != goal => Some("a new goal".to_string()),
-            (Some(m), Some(_)) => {
-                let next = m
-                    .times
-                    .iter()
-                    .position(|&s| s > m.clock)
-                    .unwrap_or(m.times.len());
-                let mut from = q.clone();
-                let blocked = m.waypoints[next..].iter().any(|w| {
-                    let free = checker.span_free(&from, w, options.plan.resolution);
-                    from.clone_from(w);
-                    !free
-                });
-                let ended = next == m.times.len();
-                let off = |goal: &[f64]| {
-                    let task = objective.task_value(&q, &mut scratch);
-                    distance(&task, goal) > options.reached
-                };
-                if blocked {
-                    Some("the rest of the motion is blocked".to_string())
-                } else if ended && goal.as_deref().is_some_and(off) {
-                    Some("the motion ended short of the goal".to_string())
-                } else {
-                    None
-                }
-            }
-        };
+        let why = why_replan(
+            motion.as_ref(),
+            goal.as_deref(),
+            tried.as_deref(),
+            &q,
+            &mut checker,
+            problem,
+            options,
+        );
         let action = match (why, &goal) {
             (Some(why), Some(goal)) => {
                 tried = Some(goal.clone());

@@ -145,6 +145,26 @@ pub struct Motion {
     pub final_pose: [f64; 6],
 }
 
+impl Motion {
+    /// A motion standing at `q` (task point `x`), no cost yet; `clearance` is the closest
+    /// approach counted from.
+    fn at(q: Vec<f64>, x: [f64; 5], clearance: f64) -> Self {
+        Motion {
+            cost: 0.0,
+            limits: 0.0,
+            proximity: 0.0,
+            min_distance: clearance,
+            collisions: 0,
+            length: 0.0,
+            end_speed: 0.0,
+            end: 0.0,
+            trajectory: vec![q],
+            task_path: vec![x],
+            final_pose: [0.0; 6],
+        }
+    }
+}
+
 /// A reaching problem: robot, hand frame and grasp axis, object pose, world, start and goal.
 pub struct ReachProblem<'a> {
     /// Active motors.
@@ -244,6 +264,23 @@ struct Step {
     step: DMatrix<f64>,
     /// ∂C/∂q_t of the terms that depend on q_t alone.
     direct: DVector<f64>,
+}
+
+/// Takes `q` by `dq`, each value clamped to its limits; returns 1 per value left free (0 where
+/// clamped) and the step's squared length.
+fn clamped_step(q: &mut [f64], dq: &[f64], lower: &[f64], upper: &[f64]) -> (Vec<f64>, f64) {
+    let mut free = vec![1.0; q.len()];
+    let mut step_sq = 0.0;
+    for i in 0..q.len() {
+        let v = q[i] + dq[i];
+        let c = v.clamp(lower[i], upper[i]);
+        if c != v {
+            free[i] = 0.0;
+        }
+        step_sq += (c - q[i]).powi(2);
+        q[i] = c;
+    }
+    (free, step_sq)
 }
 
 /// Joint-limit proximity H(q) = (1/n) Σ ((q − mid)/range)², its gradient and its (diagonal)
@@ -478,19 +515,7 @@ impl ReachProblem<'_> {
             .map(|c| Vector5::from_fn(|i, _| c.get(i).copied().unwrap_or(0.0)))
             .collect();
         let (mut r, mut x, mut x_prev) = (x0, x0, x0);
-        let mut m = Motion {
-            cost: 0.0,
-            limits: 0.0,
-            proximity: 0.0,
-            min_distance: s.safety_distance,
-            collisions: 0,
-            length: 0.0,
-            end_speed: 0.0,
-            end: 0.0,
-            trajectory: vec![q.clone()],
-            task_path: vec![x0.into()],
-            final_pose: [0.0; 6],
-        };
+        let mut m = Motion::at(q.clone(), x0.into(), s.safety_distance);
         let mut path_cost = 0.0;
         let mut record: Vec<Step> = Vec::with_capacity(if backward { steps } else { 0 });
         let mut hand_before = poses.pose(self.hand).translation.vector;
@@ -526,17 +551,7 @@ impl ReachProblem<'_> {
                 step_derivative = self.step_derivative(&poses, &jac, &mut djac, solve, limits);
             }
             hand_before = hand.translation.vector;
-            let mut free = vec![1.0; n];
-            let mut step_sq = 0.0;
-            for i in 0..n {
-                let v = q[i] + dq[i];
-                let c = v.clamp(lower[i], upper[i]);
-                if c != v {
-                    free[i] = 0.0;
-                }
-                step_sq += (c - q[i]).powi(2);
-                q[i] = c;
-            }
+            let (free, step_sq) = clamped_step(&mut q, dq.as_slice(), &lower, &upper);
             m.length += step_sq.sqrt();
             path_cost += step_sq;
             self.active.forward_unchecked(&q, &mut poses);
