@@ -331,7 +331,7 @@ pub fn generate(
                 request: request(
                     origin,
                     motor_names.clone(),
-                    &active,
+                    active,
                     from,
                     active_names.clone(),
                     goal,
