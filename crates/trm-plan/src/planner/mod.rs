@@ -13,12 +13,12 @@ use trm_tasks::Objective;
 use crate::PlanError;
 use crate::query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 use crate::rrt::{Budget, GOAL_COLLIDES, RrtOptions};
-use crate::trajectory::Trajectory;
 
 mod connect;
 mod experience;
 mod held;
 mod search;
+mod timed;
 pub use connect::{
     Connection, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Source,
 };
@@ -903,62 +903,6 @@ impl Planner {
                 waypoints.drain(i + 1..j);
             }
         }
-    }
-
-    /// [`Planner::trajectory`] of `waypoints`, or (while [`Planner::time_paths`] is off) the
-    /// waypoints alone, untimed.
-    fn timed_if_asked(
-        &mut self,
-        waypoints: &[Vec<f64>],
-        timing: &crate::Timing,
-    ) -> Result<Trajectory, PlanError> {
-        if self.time_paths {
-            return self.trajectory(waypoints, timing);
-        }
-        Ok(Trajectory {
-            names: self
-                .active
-                .model()
-                .motors()
-                .iter()
-                .map(|m| m.name.clone())
-                .collect(),
-            times: Vec::new(),
-            positions: waypoints.iter().map(|q| self.active.to_motors(q)).collect(),
-            velocities: Vec::new(),
-            accelerations: Vec::new(),
-            task_path: Vec::new(),
-        })
-    }
-
-    /// A path (active values, collision-checked) as a trajectory the robot can execute:
-    /// corners blended where the blends are free in the current world, timed time-optimally
-    /// within the motors' limits, sampled with velocities and accelerations
-    /// ([`crate::timing::timed`]), with its task-space path where the planner has a task.
-    pub fn trajectory(
-        &mut self,
-        waypoints: &[Vec<f64>],
-        timing: &crate::Timing,
-    ) -> Result<Trajectory, PlanError> {
-        let resolution = match timing.resolution {
-            Some(r) => r,
-            None => self.rrt_options()?.resolution,
-        };
-        let active = self.active.clone();
-        let checker = &mut self.checker;
-        let mut trajectory =
-            crate::timing::timed(&active, waypoints, timing, resolution, |a, b| {
-                checker.segment_free(a, b, resolution)
-            })?;
-        if self.objective.task().is_some() {
-            let samples: Vec<Vec<f64>> = trajectory
-                .positions
-                .iter()
-                .map(|m| active.from_motors(m))
-                .collect();
-            trajectory.task_path = samples.iter().map(|q| self.task_of(q)).collect();
-        }
-        Ok(trajectory)
     }
 }
 
