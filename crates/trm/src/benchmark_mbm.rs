@@ -1,4 +1,4 @@
-//! `cargo xtask benchmark-mbm DIR --model MODEL [--package-path DIR] [--per-family N]`: a
+//! `trm benchmark-mbm DIR --model MODEL [--package-path DIR] [--per-family N]`: a
 //! MotionBenchMaker set (a folder per family of `sceneNNNN.yaml` + `requestNNNN.yaml`, e.g.
 //! VAMP's `resources/panda/problems.tar.bz2` unpacked) solved problem by problem
 //! (`trm_mbm::solve`, RRT-Connect); per family: valid, solved, median and p95 time, path

@@ -1,6 +1,6 @@
-//! `cargo xtask build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]
-//! [--checkpoint-every N [--checkpoint FILE]]`, `cargo xtask build-map --resume FILE` and
-//! `cargo xtask map-info FILE`.
+//! `trm build-map SPEC [--out FILE] [--points N] [--threads T] [--searches P] [--seed S]
+//! [--checkpoint-every N [--checkpoint FILE]]`, `trm build-map --resume FILE` and
+//! `trm map-info FILE`.
 
 use std::path::{Path, PathBuf};
 

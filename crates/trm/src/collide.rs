@@ -1,4 +1,4 @@
-//! `cargo xtask collide [MODEL] --configs IN.json [--world WORLD.ron]`: colliding pairs and the
+//! `trm collide [MODEL] --configs IN.json [--world WORLD.ron]`: colliding pairs and the
 //! minimum self-distance of each configuration.
 
 use std::path::PathBuf;

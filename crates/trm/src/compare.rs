@@ -1,4 +1,4 @@
-//! `cargo xtask compare-optimisers`: Table III of Stollenga et al. (IROS 2013) — NGIK's xNES
+//! `trm compare-optimisers`: Table III of Stollenga et al. (IROS 2013) — NGIK's xNES
 //! against SIR, SIRD, Metropolis–Hastings and Nelder–Mead (plus CMA-ES and (1+1)-CMA-ES) on the
 //! two postures of Fig. 5, 30 seeded runs each: a markdown table, a CSV of every run and a
 //! convergence plot.

@@ -1,4 +1,4 @@
-//! `cargo xtask explore-task-map SPEC [--out FILE]`: the map of feasible grasps of an object
+//! `trm explore-task-map SPEC [--out FILE]`: the map of feasible grasps of an object
 //! (Gienger et al., Section II), explored with an RRT from a first grasp (given, or found by
 //! random search), with restarts for disjoint clusters; a file and an SVG of the explored hand
 //! positions relative to the object (the paper's Fig. 3).

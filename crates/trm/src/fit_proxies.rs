@@ -1,4 +1,4 @@
-//! `cargo xtask fit-proxies MODEL.urdf [--package-path DIR] [--out FILE.urdf] [--compare MODEL]`:
+//! `trm fit-proxies MODEL.urdf [--package-path DIR] [--out FILE.urdf] [--compare MODEL]`:
 //! a sphere, capsule or box fitted around each link's collision meshes (`trm_collision::fit`),
 //! with the volume against the meshes' convex hulls; optionally the URDF with the meshes
 //! replaced by the fitted primitives, and a comparison with another model's primitives.

@@ -1,4 +1,4 @@
-//! `cargo xtask fk [MODEL] --configs IN.json --out OUT.json`.
+//! `trm fk [MODEL] --configs IN.json --out OUT.json`.
 
 use std::path::PathBuf;
 

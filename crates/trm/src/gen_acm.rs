@@ -1,4 +1,4 @@
-//! `cargo xtask gen-acm MODEL [--posture NAME] [--write-description OUT]`: the
+//! `trm gen-acm MODEL [--posture NAME] [--write-description OUT]`: the
 //! `disabled_collisions` section of a model description, generated as MoveIt's setup assistant
 //! does (adjacent, default-posture, never and always colliding pairs) for the model's collision
 //! geometry (fitted proxies collide where meshes do not), to paste into the description or, with

@@ -1,4 +1,4 @@
-//! `cargo xtask gen-mbm SPEC --out DIR`: a MotionBenchMaker-like problem set for the spec's
+//! `trm gen-mbm SPEC --out DIR`: a MotionBenchMaker-like problem set for the spec's
 //! robot (`trm_mbm::generate`): seeded table, shelf and cage scenes in front of it, reaching
 //! goals inside them found by NGIK, written as MoveIt scenes and requests.
 

@@ -1,4 +1,4 @@
-//! `cargo xtask model-info [MODEL]`.
+//! `trm model-info [MODEL]`.
 
 use std::path::PathBuf;
 

@@ -1,4 +1,4 @@
-//! `cargo xtask optimise --algo A --function F --dim D --target T --runs R --seed S`: evaluations
+//! `trm optimise --algo A --function F --dim D --target T --runs R --seed S`: evaluations
 //! to target per run and a summary, as a table or JSON.
 
 use anyhow::{Context, Result};

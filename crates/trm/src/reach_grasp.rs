@@ -1,4 +1,4 @@
-//! `cargo xtask reach-grasp SPEC [--at "x,y,z[,yaw]"] [--world W.ron] [--exact] [--iterations N]
+//! `trm reach-grasp SPEC [--at "x,y,z[,yaw]"] [--world W.ron] [--exact] [--iterations N]
 //! [--out traj.csv]`: a reaching motion of the right hand to the object of a task-map spec
 //! (Gienger et al.: 12 attractors in the hand's position and grasp-axis task, iRprop− on the
 //! analytic gradient), optimised with its task map (or, with `--exact`, to the map's grasp

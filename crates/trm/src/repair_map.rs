@@ -1,4 +1,4 @@
-//! `cargo xtask repair-map MAP --world W.ron [--out FILE] [--compare-rebuild]`: a map repaired
+//! `trm repair-map MAP --world W.ron [--out FILE] [--compare-rebuild]`: a map repaired
 //! for a world that changed (`trm_roadmap::repair`).
 
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! `cargo xtask scenario SPEC --map MAP [--out-dir DIR] [--repair-ms MS | --repair-evaluations N]`:
+//! `trm scenario SPEC --map MAP [--out-dir DIR] [--repair-ms MS | --repair-evaluations N]`:
 //! a map in a moving world (`trm_plan::run_scenario`), step by step.
 
 use std::fmt::Write as _;

@@ -1,4 +1,4 @@
-//! `cargo xtask solve SPEC [--algo A] [--seed S] [--out posture.json]`: NGIK on a task spec.
+//! `trm solve SPEC [--algo A] [--seed S] [--out posture.json]`: NGIK on a task spec.
 
 use std::path::PathBuf;
 

@@ -1,4 +1,4 @@
-//! `cargo xtask stand-up`: the safe trajectory optimisation of Modugno et al. on the iCub
+//! `trm stand-up`: the safe trajectory optimisation of Modugno et al. on the iCub
 //! standing up from a chair — Table II, Fig. 3 and Fig. 4 — and the optimised trajectory.
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,4 @@
-//! `cargo xtask view [MODEL|SPEC] [--posture P.json]… [--map FILE] [--traj T.csv|.json]
+//! `trm view [MODEL|SPEC] [--posture P.json]… [--map FILE] [--traj T.csv|.json]
 //! [--world W.ron] [--out scene.html]`: a JSON scene and a self-contained three.js page of a
 //! robot, its world, a roadmap and a motion. The other commands' `--view` flags use
 //! [`write_scene`].
