@@ -3,7 +3,8 @@
 //! screen's grid, for 5 000 points on a board and for a whole thinned scene) and checking
 //! blocks of eight configurations among the cloud against the same scene as primitives.
 //! Targets: a 5 000-point cloud builds in ≤ 0.5 ms on one core; a block among the sampled
-//! scene costs no more than among its primitives.
+//! scene costs no more than among its primitives. Also: one box moved in a world holding the
+//! scene cloud and a mesh (the screen compiles again only what changed).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use nalgebra::Isometry3;
@@ -42,6 +43,36 @@ fn sampled(per_object: usize) -> World {
         world.add(o.name(), cloud, *o.pose()).expect("valid");
     }
     world
+}
+
+/// A closed triangle mesh of a ball: `n` bands of latitude, `2n` of longitude.
+fn ball_mesh(radius: f64, n: u32) -> Shape {
+    let mut vertices = vec![[0.0, 0.0, radius], [0.0, 0.0, -radius]];
+    for i in 1..n {
+        let polar = std::f64::consts::PI * f64::from(i) / f64::from(n);
+        for j in 0..2 * n {
+            let azimuth = std::f64::consts::PI * f64::from(j) / f64::from(n);
+            vertices.push([
+                radius * polar.sin() * azimuth.cos(),
+                radius * polar.sin() * azimuth.sin(),
+                radius * polar.cos(),
+            ]);
+        }
+    }
+    let at = |i: u32, j: u32| 2 + (i - 1) * 2 * n + j % (2 * n);
+    let mut triangles = Vec::new();
+    for j in 0..2 * n {
+        triangles.push([0, at(1, j), at(1, j + 1)]);
+        triangles.push([1, at(n - 1, j + 1), at(n - 1, j)]);
+        for i in 1..n - 1 {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Shape::Mesh {
+        vertices,
+        triangles,
+    }
 }
 
 fn clouds(c: &mut Criterion) {
@@ -105,6 +136,36 @@ fn clouds(c: &mut Criterion) {
         .expect("valid");
     group.bench_function(BenchmarkId::new("build_screen_grid_scene", n), |b| {
         b.iter(|| checker.model().world(black_box(&scene)))
+    });
+    // a box moved in a world that also holds the sensed scene and a mesh: what the screen
+    // compiles again (a world checker set to the other world, back and forth)
+    let bowl = ball_mesh(0.12, 32);
+    let mut busy = scene.clone();
+    busy.add("bowl", bowl, Isometry3::translation(0.5, -0.3, 0.3))
+        .expect("valid");
+    for (name, world) in primitives().objects().iter().map(|o| (o.name(), o)) {
+        busy.add(
+            &format!("{name}_solid"),
+            world.shape().clone(),
+            *world.pose(),
+        )
+        .expect("valid");
+    }
+    let mut moved = busy.clone();
+    moved
+        .set_pose("box_solid", Isometry3::translation(0.45, 0.25, 0.325))
+        .expect("an object of the world");
+    let mut world_checker =
+        trm_collision::WorldChecker::new(&collision, &active, busy.clone()).expect("shipped");
+    let mut flip = false;
+    group.bench_function(BenchmarkId::new("move_one_box", busy.len()), |b| {
+        b.iter(|| {
+            flip = !flip;
+            world_checker.set_world(black_box(if flip { moved.clone() } else { busy.clone() }));
+        })
+    });
+    group.bench_function(BenchmarkId::new("clone_world", busy.len()), |b| {
+        b.iter(|| black_box(&moved).clone())
     });
     let qs: Vec<f64> = random_configurations(&active, 8 * 256, 3).concat();
     let d = active.len();

@@ -124,11 +124,12 @@ impl WorldChecker {
         &self.world
     }
 
-    /// Replaces the world (compiled again for the screen).
+    /// Replaces the world: the screen compiles again only the objects that were added, moved or
+    /// reshaped ([`crate::fast::FastModel::world_after`]).
     pub fn set_world(&mut self, world: World) {
         if let Engine::Screen(screen) = &mut self.engine {
             let (checker, fast_world) = &mut **screen;
-            *fast_world = checker.model().world(&world);
+            *fast_world = checker.model().world_after(&world, &self.world, fast_world);
         }
         self.world = world;
     }

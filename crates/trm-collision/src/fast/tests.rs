@@ -465,3 +465,116 @@ fn solid_kernels_are_sound_at_contact() {
         "{far_uncertain} of {far_lanes} lanes beyond ten tolerances of contact left uncertain"
     );
 }
+
+/// A world compiled after another takes what did not change (a cloud's grid shared, not built
+/// again) and is otherwise the world compiled afresh: moved, added, removed and reshaped
+/// objects, a renamed one, and a world rebuilt in another order.
+#[test]
+fn a_world_compiled_after_another_is_the_world_compiled_afresh() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/panda-mbm/panda_spherized.ron"
+    );
+    let robot = trm_kinematics::RobotModel::load(file).unwrap();
+    let model = FastModel::new(&CollisionModel::new(&robot).unwrap()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let board = Shape::Box {
+        size: [0.6, 0.8, 0.02],
+    };
+    let cloud = Shape::Points {
+        points: board.surface_samples(2000, &mut rng),
+        radius: 0.003,
+    };
+    let tetra = Shape::Mesh {
+        vertices: vec![[0.0; 3], [0.2, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.2]],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    };
+    let at = |x: f64, y: f64, z: f64| nalgebra::Isometry3::translation(x, y, z);
+    let mut before = World::new();
+    before
+        .add("scan", cloud.clone(), at(0.5, 0.0, 0.3))
+        .unwrap();
+    before
+        .add("bowl", tetra.clone(), at(0.4, 0.3, 0.4))
+        .unwrap();
+    before
+        .add("crate", board.clone(), at(0.6, -0.3, 0.2))
+        .unwrap();
+    before
+        .add("ball", Shape::Sphere { radius: 0.05 }, at(0.3, 0.2, 0.6))
+        .unwrap();
+    let compiled = model.world(&before);
+    let same = |a: &FastWorld, b: &FastWorld| {
+        format!(
+            "{:?} {:?} {:?} {:?} {:?}",
+            a.objects, a.original, a.compiled_of, a.margin, a.limits
+        ) == format!(
+            "{:?} {:?} {:?} {:?} {:?}",
+            b.objects, b.original, b.compiled_of, b.margin, b.limits
+        ) && a.clouds.len() == b.clouds.len()
+            && a.clouds
+                .iter()
+                .zip(&b.clouds)
+                .all(|(x, y)| format!("{x:?}") == format!("{y:?}"))
+    };
+    let mut changes: Vec<(&str, World)> = Vec::new();
+    let mut moved = before.clone();
+    moved.set_pose("crate", at(0.65, -0.3, 0.25)).unwrap();
+    changes.push(("a box moved", moved));
+    let mut removed = before.clone();
+    removed.remove("ball").unwrap();
+    changes.push(("a ball removed", removed));
+    let mut added = before.clone();
+    added
+        .add(
+            "cup",
+            Shape::Cylinder {
+                radius: 0.04,
+                length: 0.1,
+            },
+            at(0.5, 0.1, 0.5),
+        )
+        .unwrap();
+    changes.push(("a cylinder added", added));
+    let mut reshaped = World::new();
+    for o in before.objects() {
+        let shape = match o.name() {
+            "scan" => Shape::Points {
+                points: board.surface_samples(2000, &mut rng),
+                radius: 0.003,
+            },
+            _ => o.shape().clone(),
+        };
+        reshaped.add(o.name(), shape, *o.pose()).unwrap();
+    }
+    changes.push(("a new scan", reshaped));
+    let mut renamed = World::new();
+    for o in before.objects().iter().rev() {
+        let name = if o.name() == "bowl" { "dish" } else { o.name() };
+        renamed.add(name, o.shape().clone(), *o.pose()).unwrap();
+    }
+    changes.push(("reordered, the mesh renamed", renamed));
+    for (what, world) in &changes {
+        let after = model.world_after(world, &before, &compiled);
+        assert!(same(&after, &model.world(world)), "{what}");
+    }
+    // an unchanged cloud's grid is shared, not built again; a new scan's is its own
+    let scan_grid = |w: &FastWorld, world: &World| {
+        let k = w.compiled_of[world.index("scan").unwrap()] as usize;
+        match w.objects[k] {
+            Object::Cloud { index, .. } => std::sync::Arc::clone(&w.clouds[index as usize]),
+            _ => panic!("the scan is a cloud"),
+        }
+    };
+    let original = scan_grid(&compiled, &before);
+    let moved = model.world_after(&changes[0].1, &before, &compiled);
+    assert!(std::sync::Arc::ptr_eq(
+        &original,
+        &scan_grid(&moved, &changes[0].1)
+    ));
+    let rescanned = model.world_after(&changes[3].1, &before, &compiled);
+    assert!(!std::sync::Arc::ptr_eq(
+        &original,
+        &scan_grid(&rescanned, &changes[3].1)
+    ));
+}

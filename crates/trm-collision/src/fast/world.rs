@@ -11,6 +11,7 @@ use super::outcome::Contact;
 use crate::shape::Shape;
 use crate::world::World;
 use nalgebra::{Point3, Vector3};
+use std::sync::Arc;
 
 /// The world's axes, as rows of a rotation.
 const IDENTITY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -68,8 +69,9 @@ pub struct FastWorld {
     pub(super) margin: f32,
     /// Per ball pair of the model ([`FastModel::pairs`]): its [`limits`] with this margin.
     pub(super) limits: Vec<[f32; 2]>,
-    /// The point clouds' grids ([`Object::Cloud`]).
-    pub(super) clouds: Vec<CloudGrid>,
+    /// The point clouds' grids ([`Object::Cloud`]), shared with the worlds compiled from this
+    /// one ([`FastModel::world_after`]).
+    pub(super) clouds: Vec<Arc<CloudGrid>>,
 }
 
 impl FastWorld {
@@ -130,6 +132,18 @@ impl FastWorld {
 impl FastModel {
     /// `world` compiled for [`FastModel::check`], with its margin (see [`FastWorld::margin`]).
     pub fn world(&self, world: &World) -> FastWorld {
+        self.compile_world(world, None)
+    }
+
+    /// `world` compiled as [`FastModel::world`] does, taking from `compiled` (this model's
+    /// compilation of `before`) every object that has not changed (the same name, shape and
+    /// pose): only what was added, moved or reshaped is compiled again (a point cloud's or a
+    /// mesh's grid is the costly part). The result is the one [`FastModel::world`] gives.
+    pub fn world_after(&self, world: &World, before: &World, compiled: &FastWorld) -> FastWorld {
+        self.compile_world(world, Some((before, compiled)))
+    }
+
+    fn compile_world(&self, world: &World, reuse: Option<(&World, &FastWorld)>) -> FastWorld {
         let mut farthest: f64 = 0.0;
         // a point cloud's cells: as wide as the largest sphere's reach
         let cloud_cell = (self.balls.iter().chain(&self.inner))
@@ -144,6 +158,31 @@ impl FastModel {
                 let bounds = o.bounding_box();
                 let (mins, maxs) = (bounds.mins, bounds.maxs);
                 farthest = farthest.max(mins.coords.amax()).max(maxs.coords.amax());
+                if let Some((object, compiled)) = reuse.and_then(|(before, compiled)| {
+                    let k = before.index(o.name()).ok()?;
+                    let old = &before.objects()[k];
+                    (old.pose() == pose && old.shape() == o.shape())
+                        .then(|| (compiled.objects[compiled.compiled_of[k] as usize], compiled))
+                }) {
+                    // unchanged: its compiled form, its grid shared
+                    return match object {
+                        Object::Cloud {
+                            index,
+                            center,
+                            half,
+                            radius,
+                        } => {
+                            clouds.push(Arc::clone(&compiled.clouds[index as usize]));
+                            Object::Cloud {
+                                index: clouds.len() as u32 - 1,
+                                center,
+                                half,
+                                radius,
+                            }
+                        }
+                        other => other,
+                    };
+                }
                 let t = pose.translation.vector;
                 match o.shape() {
                     Shape::Sphere { radius } => Object::Round {
@@ -182,7 +221,7 @@ impl FastModel {
                             half: grid.half,
                             radius: *radius as f32,
                         };
-                        clouds.push(grid);
+                        clouds.push(Arc::new(grid));
                         object
                     }
                     Shape::Mesh {
@@ -201,7 +240,7 @@ impl FastModel {
                             half: grid.half,
                             radius: 0.0,
                         };
-                        clouds.push(grid);
+                        clouds.push(Arc::new(grid));
                         object
                     }
                     Shape::Convex { .. } | Shape::Mesh { .. } => {
