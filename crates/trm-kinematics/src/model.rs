@@ -506,6 +506,11 @@ impl RobotModel {
         &self.data.enabled_collisions
     }
 
+    /// Every motor's name, in motor order (the columns of a full configuration).
+    pub fn motor_names(&self) -> Vec<String> {
+        self.data.motors.iter().map(|m| m.name.clone()).collect()
+    }
+
     /// The `home` posture's motor values, else [`RobotModel::neutral_motors`]: where the robot
     /// rests when nothing says otherwise.
     pub fn home_motors(&self) -> Vec<f64> {

@@ -231,7 +231,7 @@ pub fn generate(
         home[1] + 0.08 * facing[1],
         home[2],
     ]);
-    let motor_names: Vec<String> = robot.motors().iter().map(|m| m.name.clone()).collect();
+    let motor_names: Vec<String> = robot.motor_names();
     let active_names: Vec<String> = objective.active().names().map(String::from).collect();
     let active = objective.active();
     let total = options.families.len() * options.per_family;

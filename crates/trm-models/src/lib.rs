@@ -155,12 +155,7 @@ mod tests {
         let description = ModelDescription::from_ron(super::ICUB_UPPER_BODY_RON, "d.ron").unwrap();
         let described = bare.with_description(&description, None).unwrap();
         let shipped = super::icub_upper_body();
-        let names = |m: &RobotModel| {
-            m.motors()
-                .iter()
-                .map(|m| m.name.clone())
-                .collect::<Vec<_>>()
-        };
+        let names = |m: &RobotModel| m.motor_names();
         assert_eq!(names(&described), names(&shipped));
         assert_eq!(
             described.frame_names().count(),

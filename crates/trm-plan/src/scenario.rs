@@ -650,12 +650,7 @@ pub fn run_scenario(
         worlds.push(world);
     }
     let motion = Trajectory {
-        names: active
-            .model()
-            .motors()
-            .iter()
-            .map(|m| m.name.clone())
-            .collect(),
+        names: active.model().motor_names(),
         task_path: postures
             .iter()
             .map(|m| objective.task_value(&active.from_motors(m), &mut scratch))

@@ -198,7 +198,7 @@ pub fn timed(
         full
     };
     Ok(Trajectory {
-        names: model.motors().iter().map(|m| m.name.clone()).collect(),
+        names: model.motor_names(),
         times: samples.iter().map(|s| s.time).collect(),
         positions: samples
             .iter()

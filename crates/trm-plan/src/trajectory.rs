@@ -54,12 +54,7 @@ impl Trajectory {
     /// no velocities, no task path): how an optimised motion's postures are written out.
     pub fn at_joint_speed(active: &ActiveSet, path: &[Vec<f64>], speed: f64) -> Self {
         Trajectory {
-            names: active
-                .model()
-                .motors()
-                .iter()
-                .map(|m| m.name.clone())
-                .collect(),
+            names: active.model().motor_names(),
             times: time_parametrise(path, &vec![speed; active.len()], None),
             positions: path.iter().map(|q| active.to_motors(q)).collect(),
             velocities: Vec::new(),

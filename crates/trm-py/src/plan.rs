@@ -181,7 +181,7 @@ impl Planner {
             }
             // motor names or groups' names
             let names: Vec<String> = match joints {
-                None => model.motors().iter().map(|m| m.name.clone()).collect(),
+                None => model.motor_names(),
                 Some(j) => match j.extract::<String>() {
                     Ok(group) => vec![group],
                     Err(_) => j

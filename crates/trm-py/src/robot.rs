@@ -64,7 +64,7 @@ impl Robot {
     /// Motor names (the columns of every configuration).
     #[getter]
     fn motor_names(&self) -> Vec<String> {
-        self.model.motors().iter().map(|m| m.name.clone()).collect()
+        self.model.motor_names()
     }
 
     /// Number of motors.

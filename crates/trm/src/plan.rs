@@ -45,8 +45,8 @@ pub struct Args {
     #[arg(long, value_name = "FILE", conflicts_with = "maps")]
     experience: Option<PathBuf>,
     /// The current world (RON, or a MoveIt planning scene .yaml), replacing the one the maps
-    /// were built in. Without maps, a scene's allowed-collision matrix applies over the
-    /// model's own.
+    /// were built in; a scene's allowed-collision matrix applies over the model's own and the
+    /// robot holds its attached objects (with maps or without).
     #[arg(long)]
     world: Option<PathBuf>,
     /// Repair the maps for --world before planning: park what it blocks, bring back parked
@@ -133,20 +133,29 @@ pub fn run(args: &Args) -> Result<()> {
         return run_without_maps(args);
     }
     let to = args.to.as_deref().unwrap_or_default();
-    let world = args
-        .world
-        .as_ref()
-        .map(trm_moveit::load_world)
-        .transpose()?;
-    let maps = load_maps(args, world.as_ref())?;
-    let first = &maps[0];
-    let problem = first
+    let mut maps = load_maps(args)?;
+    let problem = maps[0]
         .problem_with(&trm_taskmap::loaders())
         .with_context(|| format!("the spec stored in {}", args.maps[0].display()))?;
+    // the world as the map-free path reads it: a scene's objects, its allowed collisions and
+    // what the robot holds in it
+    let scene = match &args.world {
+        Some(path) => Some(trm_moveit::load_scene(path, problem.objective.collision())?),
+        None => None,
+    };
+    if let (true, Some(scene)) = (args.repair, &scene) {
+        repair_maps(args, &mut maps, &scene.world)?;
+    }
+    let first = &maps[0];
     let refs: Vec<&Roadmap> = maps.iter().collect();
     let mut planner = Planner::new(&problem.objective, &refs)?;
-    if let Some(world) = world {
-        planner.set_world(world);
+    if let (Some(scene), Some(path)) = (scene, &args.world) {
+        let notes = scene
+            .apply_to(&mut planner)
+            .context("the objects the robot holds (attached_collision_objects)")?;
+        for note in &notes {
+            eprintln!("{}: {note}", path.display());
+        }
     }
     let start = if args.from == "home" {
         problem.start.clone()
@@ -154,6 +163,11 @@ pub fn run(args: &Args) -> Result<()> {
         posture(Path::new(&args.from), &problem)?
     };
     let goal = map_goal(args, to, first, &problem)?;
+    let goal_configuration = match &goal {
+        Goal::Configuration(q) => Some(q),
+        _ => None,
+    };
+    check_free(&mut planner, args, &start, goal_configuration)?;
     let options = PlanOptions {
         seed: args.seed,
         timing: args.timing.settings()?.timing(None),
@@ -248,34 +262,35 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// The `--map`s, each repaired for `world` first with `--repair`.
-fn load_maps(args: &Args, world: Option<&trm_collision::World>) -> Result<Vec<Roadmap>> {
-    let mut maps: Vec<Roadmap> = args
-        .maps
+/// The `--map`s.
+fn load_maps(args: &Args) -> Result<Vec<Roadmap>> {
+    args.maps
         .iter()
         .map(|p| Roadmap::load(p).with_context(|| format!("loading {}", p.display())))
-        .collect::<Result<_>>()?;
-    if let (true, Some(world)) = (args.repair, world) {
-        for (map, path) in maps.iter_mut().zip(&args.maps) {
-            let problem = map
-                .problem_with(&trm_taskmap::loaders())
-                .with_context(|| format!("the spec stored in {}", path.display()))?;
-            let options = RepairOptions {
-                refill: false,
-                ..Default::default()
-            };
-            let started = std::time::Instant::now();
-            let (repaired, report) = trm_roadmap::repair(map, &problem, world, &options)?;
-            print!(
-                "{}: repaired in {:.2} s; ",
-                path.display(),
-                started.elapsed().as_secs_f64()
-            );
-            println!("{report}");
-            *map = repaired;
-        }
+        .collect()
+}
+
+/// Each map repaired for `world` (`--repair`).
+fn repair_maps(args: &Args, maps: &mut [Roadmap], world: &trm_collision::World) -> Result<()> {
+    for (map, path) in maps.iter_mut().zip(&args.maps) {
+        let problem = map
+            .problem_with(&trm_taskmap::loaders())
+            .with_context(|| format!("the spec stored in {}", path.display()))?;
+        let options = RepairOptions {
+            refill: false,
+            ..Default::default()
+        };
+        let started = std::time::Instant::now();
+        let (repaired, report) = trm_roadmap::repair(map, &problem, world, &options)?;
+        print!(
+            "{}: repaired in {:.2} s; ",
+            path.display(),
+            started.elapsed().as_secs_f64()
+        );
+        println!("{report}");
+        *map = repaired;
     }
-    Ok(maps)
+    Ok(())
 }
 
 /// The goal `to` names for a map (`first`, of `problem`): a posture file, else a task point

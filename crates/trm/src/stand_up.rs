@@ -269,12 +269,7 @@ fn write_figures(problem: &WholeBody, result: &StandUpResult, out: &Path) -> Res
         zmp,
     )?;
     // Fig. 3 B: joint positions, one panel per solution
-    let names: Vec<String> = problem
-        .model()
-        .motors()
-        .iter()
-        .map(|m| m.name.clone())
-        .collect();
+    let names: Vec<String> = problem.model().motor_names();
     let joints_svg = per_motor_panels(
         result,
         &names,

@@ -379,3 +379,71 @@ fn a_repair_world_covering_the_start_is_named() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `trm plan` through a map in a MoveIt scene reads the scene as the map-free path does: the
+/// objects the robot holds in it are held (here a plank in the right hand that runs through the
+/// body at the start), not dropped.
+#[test]
+fn plan_through_a_map_holds_what_the_scene_holds() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-held-map-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let spec = root.join("specs/reach.ron");
+    let built = trm(
+        &[
+            "build-map",
+            spec.to_str().unwrap(),
+            "--points",
+            "20",
+            "--out",
+            "map.json",
+        ],
+        &dir,
+    );
+    assert!(
+        built.status.success(),
+        "{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    // a scene whose robot state holds `held` (attached collision objects)
+    let scene = |held: &str| {
+        format!(
+            "name: kitchen\nrobot_state:\n  attached_collision_objects: {held}\nworld:\n  collision_objects:\n    - id: far_box\n      primitives: [{{type: box, dimensions: [0.1, 0.1, 0.1]}}]\n      primitive_poses: [{{position: [3, 3, 3], orientation: [0, 0, 0, 1]}}]\n"
+        )
+    };
+    let plank = "\n    - link_name: r_hand\n      object:\n        header: {frame_id: r_hand}\n        id: plank\n        primitives: [{type: box, dimensions: [1.0, 1.0, 1.0]}]\n        primitive_poses: [{position: [0, 0, 0], orientation: [0, 0, 0, 1]}]";
+    std::fs::write(dir.join("holding.yaml"), scene(plank)).unwrap();
+    std::fs::write(dir.join("empty.yaml"), scene("[]")).unwrap();
+    let plan = |world: &str| {
+        trm(
+            // (a goal any node of the small map meets)
+            &[
+                "plan",
+                "--map",
+                "map.json",
+                "--world",
+                world,
+                "--to",
+                "0.25,-0.15,0.1",
+                "--tolerance",
+                "2",
+            ],
+            &dir,
+        )
+    };
+    let free = plan("empty.yaml");
+    assert!(
+        free.status.success(),
+        "{}",
+        String::from_utf8_lossy(&free.stderr)
+    );
+    let held = plan("holding.yaml");
+    let stderr = String::from_utf8_lossy(&held.stderr);
+    assert!(
+        !held.status.success(),
+        "{}",
+        String::from_utf8_lossy(&held.stdout)
+    );
+    assert!(stderr.contains("plank"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -16,13 +16,7 @@ impl Planner {
             return self.trajectory(waypoints, timing);
         }
         Ok(Trajectory {
-            names: self
-                .active
-                .model()
-                .motors()
-                .iter()
-                .map(|m| m.name.clone())
-                .collect(),
+            names: self.active.model().motor_names(),
             times: Vec::new(),
             positions: waypoints.iter().map(|q| self.active.to_motors(q)).collect(),
             velocities: Vec::new(),
