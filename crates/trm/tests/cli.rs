@@ -63,6 +63,28 @@ fn bad_flags_name_the_flag_and_failed_commands_write_nothing() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Builds a reach map of `points` points as `dir/map.json`.
+fn reach_map(dir: &std::path::Path, points: usize) {
+    let spec = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron");
+    let points = points.to_string();
+    let built = trm(
+        &[
+            "build-map",
+            spec.to_str().unwrap(),
+            "--points",
+            &points,
+            "--out",
+            "map.json",
+        ],
+        dir,
+    );
+    assert!(
+        built.status.success(),
+        "{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+}
+
 /// A MotionBenchMaker sample problem's scene and request (crates/trm-mbm's fixtures) and the
 /// Panda they were made for.
 fn panda_problem() -> [std::path::PathBuf; 3] {
@@ -334,23 +356,7 @@ fn plan_answers_a_task_space_request() {
 fn a_repair_world_covering_the_start_is_named() {
     let dir = std::env::temp_dir().join(format!("trm-cli-repair-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let spec = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../specs/reach.ron");
-    let built = trm(
-        &[
-            "build-map",
-            spec.to_str().unwrap(),
-            "--points",
-            "4",
-            "--out",
-            "map.json",
-        ],
-        &dir,
-    );
-    assert!(
-        built.status.success(),
-        "{}",
-        String::from_utf8_lossy(&built.stderr)
-    );
+    reach_map(&dir, 4);
     std::fs::write(
         dir.join("swallow.ron"),
         "(objects: [(name: \"blob\", shape: Sphere(radius: 0.6), xyz: (0.0, 0.0, 0.0))])",
@@ -387,24 +393,7 @@ fn a_repair_world_covering_the_start_is_named() {
 fn plan_through_a_map_holds_what_the_scene_holds() {
     let dir = std::env::temp_dir().join(format!("trm-cli-held-map-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let spec = root.join("specs/reach.ron");
-    let built = trm(
-        &[
-            "build-map",
-            spec.to_str().unwrap(),
-            "--points",
-            "20",
-            "--out",
-            "map.json",
-        ],
-        &dir,
-    );
-    assert!(
-        built.status.success(),
-        "{}",
-        String::from_utf8_lossy(&built.stderr)
-    );
+    reach_map(&dir, 20);
     // a scene whose robot state holds `held` (attached collision objects)
     let scene = |held: &str| {
         format!(
