@@ -243,7 +243,7 @@ pub type PoseLanes32 = [[f32; BLOCK_LANES]; 7];
 /// configurations at once (made by [`RobotModel::pose_block`](crate::RobotModel::pose_block)):
 /// for consumers that do not need double precision, such as collision screens with a stated
 /// rounding margin. Joint values and the reduction of their half angles to [-π/4, π/4] are
-/// computed in `f64`, sines and cosines in `f32` ([`sin_cos_block`], within 2⁻²³); the chain is
+/// computed in `f64`, sines and cosines in `f32` (`sin_cos_block`, within 2⁻²³); the chain is
 /// composed in `f32` (each step adds a few units of 2⁻²⁴ of relative error).
 #[derive(Debug, Clone)]
 pub struct PoseBlock {

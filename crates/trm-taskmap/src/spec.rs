@@ -14,7 +14,7 @@ fn right() -> String {
     "r".into()
 }
 
-/// A task-map spec (format in the [module docs](self)).
+/// A task-map spec (format: [`crate::formats::task_map_spec`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TaskMapSpec {
