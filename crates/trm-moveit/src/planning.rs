@@ -81,14 +81,30 @@ impl TimingSettings {
     }
 }
 
-/// Refuses a trajectory output its own JSON would overwrite: the CSV goes to `out`, the JSON
-/// beside it with a `.json` extension. `setting` names where `out` was given (`--out`).
+/// Refuses, before any planning, a trajectory output that cannot be written: an empty path, a
+/// `.json` path (the CSV goes to `out`, its JSON beside it with a `.json` extension), or a
+/// place where any of [`trajectory_files`]' files cannot go (a directory or a symlink there, a
+/// directory that cannot be written in). `setting` names where `out` was given (`--out`).
 pub fn check_trajectory_out(setting: &str, out: &Path) -> Result<(), PlanError> {
+    let invalid = |problem: &str| PlanError::InvalidOptions {
+        what: format!("{setting} {}", out.display()),
+        problem: format!("{problem}\n  fix: give a .csv path"),
+    };
+    if out.as_os_str().is_empty() {
+        return Err(invalid("is empty"));
+    }
     if out.extension().is_some_and(|e| e == "json") {
-        return Err(PlanError::InvalidOptions {
-            what: format!("{setting} {}", out.display()),
-            problem: "is the trajectory CSV's path and its JSON goes beside it with a .json extension\n  fix: give a .csv path".into(),
-        });
+        return Err(invalid(
+            "is the trajectory CSV's path and its JSON goes beside it with a .json extension",
+        ));
+    }
+    for path in [
+        out.to_path_buf(),
+        out.with_extension("json"),
+        out.with_extension("ros.yaml"),
+        out.with_extension("response.yaml"),
+    ] {
+        trm_io::check_output(&path).map_err(|source| PlanError::Io { path, source })?;
     }
     Ok(())
 }

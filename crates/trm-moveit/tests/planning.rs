@@ -136,4 +136,34 @@ fn a_motion_is_written_as_trm_plan_writes_it() {
         "{e}"
     );
     assert!(check_trajectory_out("--out", out).is_ok());
+    // an empty path, and a directory or a symlink where a file goes: refused before planning,
+    // each naming the path
+    let e = check_trajectory_out("out", Path::new(""))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("is empty") && e.contains("fix: give a .csv path"),
+        "{e}"
+    );
+    let dir = std::env::temp_dir().join(format!("trm-moveit-out-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("motion.ros.yaml")).unwrap();
+    let e = check_trajectory_out("--out", &dir.join("motion.csv"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("motion.ros.yaml") && e.contains("directory"),
+        "{e}"
+    );
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.join("elsewhere"), dir.join("linked.csv")).unwrap();
+        let e = check_trajectory_out("--out", &dir.join("linked.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("linked.csv") && e.contains("symbolic link"),
+            "{e}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

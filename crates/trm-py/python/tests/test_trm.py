@@ -371,6 +371,11 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does(tmp_pat
     with pytest.raises(ValueError, match="out .*m.json is the trajectory CSV's path"):
         planner.plan_request(str(requests[0]), out=tmp_path / "m.json")
     assert not (tmp_path / "m.json").exists()
+    (tmp_path / "taken.csv").mkdir()
+    for out in ["", tmp_path / "taken.csv"]:
+        with pytest.raises(ValueError, match="out|taken.csv"):
+            planner.plan_request(str(requests[0]), out=out)
+    assert not (tmp_path / "taken.json").exists()
 
 
 def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
