@@ -134,7 +134,7 @@ fn run_batch(plan: &Plan, inputs: &[f64], stride: usize, batch: &mut PoseBatch) 
         let v: Lanes =
             std::array::from_fn(|l| affine(constant, terms, &inputs[l * stride..(l + 1) * stride]));
         *out = if revolute {
-            let (s, c) = sin_cos(v.map(|x| 0.5 * x));
+            let (s, c) = sin_cos(v);
             [s, c, [0.0; LANES]]
         } else {
             [[0.0; LANES], [1.0; LANES], v]
@@ -247,13 +247,17 @@ pub type PoseLanes32 = [[f32; BLOCK_LANES]; 7];
 /// composed in `f32` (each step adds a few units of 2⁻²⁴ of relative error).
 #[derive(Debug, Clone)]
 pub struct PoseBlock {
+    /// The inputs transposed: per input value, its lanes.
+    inputs: Vec<[f64; BLOCK_LANES]>,
     slots: Vec<[[f32; BLOCK_LANES]; 3]>,
     poses: Vec<PoseLanes32>,
 }
 
 impl PoseBlock {
-    pub(crate) fn new(num_joints: usize, num_frames: usize) -> Self {
+    /// A block for passes of at most `num_inputs` input values.
+    pub(crate) fn new(num_inputs: usize, num_joints: usize, num_frames: usize) -> Self {
         PoseBlock {
+            inputs: vec![[0.0; BLOCK_LANES]; num_inputs],
             slots: vec![
                 [[0.0; BLOCK_LANES], [1.0; BLOCK_LANES], [0.0; BLOCK_LANES]];
                 num_joints + 1
@@ -284,6 +288,18 @@ impl Plan {
     }
 }
 
+/// `out[k][l] = inputs[l * out.len() + k]`: [`BLOCK_LANES`] inputs of `out.len()` values
+/// each, transposed.
+#[inline(always)]
+fn transpose(inputs: &[f64], out: &mut [[f64; BLOCK_LANES]]) {
+    let stride = out.len();
+    for (l, input) in inputs.chunks_exact(stride).take(BLOCK_LANES).enumerate() {
+        for (lanes, &v) in out.iter_mut().zip(input) {
+            lanes[l] = v;
+        }
+    }
+}
+
 /// [`Plan::run_block`], compiled for several instruction sets with the best one chosen at run
 /// time.
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
@@ -292,19 +308,34 @@ fn run_block(plan: &Plan, inputs: &[f64], stride: usize, block: &mut PoseBlock) 
     // the AVX paths need AVX2 and FMA: the plain-AVX clone goes without them
     const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
         && multiversion::target::selected_target!().supports_feature_str("fma");
+    // the inputs transposed once (each value's lanes side by side), so that every slot's
+    // affine map is a few vector multiply-adds instead of a scalar sum per lane
+    let lanes = &mut block.inputs[..stride];
+    let inputs = &inputs[..BLOCK_LANES * stride];
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: as below
+        #[allow(unsafe_code)]
+        unsafe {
+            avx::transpose(inputs, lanes)
+        };
+    } else {
+        transpose(inputs, lanes);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    transpose(inputs, lanes);
     let slots = &mut block.slots[..plan.rows.len()];
     for ((out, &(constant, start, end)), &revolute) in
         slots.iter_mut().zip(&plan.rows).zip(&plan.revolute)
     {
-        let terms = &plan.terms[start as usize..end as usize];
-        let mut v = [0.0; BLOCK_LANES];
-        for (l, v) in v.iter_mut().enumerate() {
-            *v = affine(constant, terms, &inputs[l * stride..(l + 1) * stride]);
+        let mut v = [constant; BLOCK_LANES];
+        for &(k, f) in &plan.terms[start as usize..end as usize] {
+            let x = &block.inputs[k];
+            for l in 0..BLOCK_LANES {
+                v[l] += f * x[l];
+            }
         }
         if revolute {
-            for v in &mut v {
-                *v *= 0.5;
-            }
             #[cfg(target_arch = "x86_64")]
             let (s, c) = if AVX {
                 // SAFETY: as below
@@ -347,6 +378,42 @@ mod avx {
     use std::arch::x86_64::*;
 
     const _: () = assert!(BLOCK_LANES == 8, "one 8-lane AVX register per block");
+
+    /// [`super::transpose`] in 4 × 4 tiles: four values of four inputs loaded, transposed in
+    /// registers and stored as four values' lanes.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) fn transpose(inputs: &[f64], out: &mut [[f64; BLOCK_LANES]]) {
+        let stride = out.len();
+        assert!(inputs.len() >= BLOCK_LANES * stride);
+        let tiles = stride / 4 * 4;
+        for k in (0..tiles).step_by(4) {
+            for l0 in [0, 4] {
+                // SAFETY: lane `l0 + i`'s values `k..k + 4` lie within `inputs` (asserted
+                // above, `k + 4 <= stride`); `out[k + j]` has eight lanes
+                unsafe {
+                    let row =
+                        |i: usize| _mm256_loadu_pd(inputs.as_ptr().add((l0 + i) * stride + k));
+                    let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
+                    let (t0, t1) = (_mm256_unpacklo_pd(r0, r1), _mm256_unpackhi_pd(r0, r1));
+                    let (t2, t3) = (_mm256_unpacklo_pd(r2, r3), _mm256_unpackhi_pd(r2, r3));
+                    let columns = [
+                        _mm256_permute2f128_pd::<0x20>(t0, t2),
+                        _mm256_permute2f128_pd::<0x20>(t1, t3),
+                        _mm256_permute2f128_pd::<0x31>(t0, t2),
+                        _mm256_permute2f128_pd::<0x31>(t1, t3),
+                    ];
+                    for (j, c) in columns.into_iter().enumerate() {
+                        _mm256_storeu_pd(out[k + j].as_mut_ptr().add(l0), c);
+                    }
+                }
+            }
+        }
+        for k in tiles..stride {
+            for l in 0..BLOCK_LANES {
+                out[k][l] = inputs[l * stride + k];
+            }
+        }
+    }
 
     /// Eight lanes as one register.
     #[target_feature(enable = "avx")]
@@ -454,7 +521,13 @@ mod avx {
             );
             let along = |t: f32, a: f32| _mm256_fmadd_ps(d, _mm256_set1_ps(a), _mm256_set1_ps(t));
             let (t, a) = (k.translation, k.axis_in_parent);
-            let (tx, ty, tz) = (along(t[0], a[0]), along(t[1], a[1]), along(t[2], a[2]));
+            // revolute joints and fixed transforms do not move along an axis
+            let (tx, ty, tz) = if a == [0.0; 3] {
+                let set = _mm256_set1_ps;
+                (set(t[0]), set(t[1]), set(t[2]))
+            } else {
+                (along(t[0], a[0]), along(t[1], a[1]), along(t[2], a[2]))
+            };
             // parent rotation applied to the local translation: v + w·u + q×u, u = 2 q×v
             let cross = |a: __m256, b: __m256, c: __m256, e: __m256| {
                 _mm256_fmsub_ps(a, b, _mm256_mul_ps(c, e))
@@ -465,24 +538,29 @@ mod avx {
             let moved = |p: __m256, t: __m256, u: __m256, q: __m256| {
                 _mm256_add_ps(_mm256_add_ps(p, t), _mm256_fmadd_ps(w, u, q))
             };
-            let mut child = identity;
+            let child = &mut poses[step.child as usize];
             store(moved(px, tx, ux, cross(y, uz, z, uy)), &mut child[4]);
             store(moved(py, ty, uy, cross(z, ux, x, uz)), &mut child[5]);
             store(moved(pz, tz, uz, cross(x, uy, y, ux)), &mut child[6]);
-            // parent rotation ⊗ local rotation
-            let product = |a: __m256, b: __m256, c: __m256, e: __m256| {
-                _mm256_fmadd_ps(
-                    w,
-                    a,
-                    _mm256_fmadd_ps(x, b, _mm256_fmadd_ps(y, c, _mm256_mul_ps(z, e))),
-                )
-            };
-            let neg = |v: __m256| _mm256_sub_ps(_mm256_set1_ps(0.0), v);
-            store(product(lw, neg(li), neg(lj), neg(lk)), &mut child[0]);
-            store(product(li, lw, lk, neg(lj)), &mut child[1]);
-            store(product(lj, neg(lk), lw, li), &mut child[2]);
-            store(product(lk, lj, neg(li), lw), &mut child[3]);
-            poses[step.child as usize] = child;
+            // parent rotation ⊗ local rotation, the signs in fused (negated) multiply-adds
+            let (add, sub) = (_mm256_fmadd_ps, _mm256_fnmadd_ps);
+            let w_times = |v: __m256| _mm256_mul_ps(w, v);
+            store(
+                sub(z, lk, sub(y, lj, sub(x, li, w_times(lw)))),
+                &mut child[0],
+            );
+            store(
+                sub(z, lj, add(y, lk, add(x, lw, w_times(li)))),
+                &mut child[1],
+            );
+            store(
+                add(z, li, add(y, lw, sub(x, lk, w_times(lj)))),
+                &mut child[2],
+            );
+            store(
+                add(z, lw, sub(y, li, add(x, lj, w_times(lk)))),
+                &mut child[3],
+            );
         }
     }
 }
@@ -578,6 +656,29 @@ mod tests {
 
     fn ulps(a: f64, b: f64) -> f64 {
         (a - b).abs() / f64::EPSILON.max(b.abs() * f64::EPSILON)
+    }
+
+    /// The AVX transposition (4 × 4 tiles and a scalar remainder) equals the plain one, for
+    /// input lengths below, at and past a tile.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn tiled_transposition_equals_the_plain_one() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        for stride in 1..14 {
+            let inputs: Vec<f64> = (0..BLOCK_LANES * stride).map(|i| i as f64 * 0.5).collect();
+            let mut plain = vec![[f64::NAN; BLOCK_LANES]; stride];
+            let mut tiled = plain.clone();
+            transpose(&inputs, &mut plain);
+            // SAFETY: the CPU has AVX2 and FMA (checked above)
+            #[allow(unsafe_code)]
+            unsafe {
+                avx::transpose(&inputs, &mut tiled)
+            };
+            assert_eq!(plain, tiled, "stride {stride}");
+            assert_eq!(plain[stride - 1][BLOCK_LANES - 1], inputs[inputs.len() - 1]);
+        }
     }
 
     #[test]

@@ -66,7 +66,7 @@ pub(crate) fn affine(constant: f64, terms: &[(usize, f64)], input: &[f64]) -> f6
 /// A compiled FK pass: an affine map from an input vector to slot values, and the steps.
 #[derive(Debug, Clone)]
 pub(crate) struct Plan {
-    /// Per slot: constant and range into `terms`.
+    /// Per slot: constant and range into `terms` (of the half angle for revolute slots).
     pub(crate) rows: Vec<(f64, u32, u32)>,
     /// `(input index, factor)`.
     pub(crate) terms: Vec<(usize, f64)>,
@@ -142,10 +142,15 @@ impl Plan {
                     let slot = *slot_of
                         .entry((row.constant.to_bits(), key, revolute))
                         .or_insert_with(|| {
+                            // a revolute slot's value is its half angle (what its sine and
+                            // cosine take): the halves of the constant and factors give it
+                            // exactly (halving is exact in binary floating point)
+                            let scale = if revolute { 0.5 } else { 1.0 };
                             let start = plan.terms.len() as u32;
-                            plan.terms.extend_from_slice(row.terms);
-                            plan.rows
-                                .push((row.constant, start, plan.terms.len() as u32));
+                            plan.terms
+                                .extend(row.terms.iter().map(|&(k, f)| (k, scale * f)));
+                            let end = plan.terms.len() as u32;
+                            plan.rows.push((scale * row.constant, start, end));
                             plan.revolute.push(revolute);
                             plan.rows.len() as u32 - 1
                         });
@@ -235,7 +240,7 @@ impl Plan {
         {
             let v = affine(constant, &self.terms[start as usize..end as usize], input);
             *out = if revolute {
-                let (s, c) = (0.5 * v).sin_cos();
+                let (s, c) = v.sin_cos();
                 [s, c, 0.0]
             } else {
                 [0.0, 1.0, v]

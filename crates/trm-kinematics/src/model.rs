@@ -579,7 +579,9 @@ impl RobotModel {
     /// A single-precision pose block sized for this model
     /// ([`BLOCK_LANES`](crate::BLOCK_LANES) configurations at once).
     pub fn pose_block(&self) -> crate::PoseBlock {
-        crate::PoseBlock::new(self.num_joints(), self.num_frames())
+        // a pass's inputs are joint values or motor values (all or the active ones)
+        let inputs = self.num_joints().max(self.motors().len());
+        crate::PoseBlock::new(inputs, self.num_joints(), self.num_frames())
     }
 
     pub(crate) fn check_block_buffer(&self, block: &crate::PoseBlock) -> Result<()> {

@@ -12,10 +12,10 @@ use trm_kinematics::PoseLanes32;
 use std::arch::x86_64::{
     __m256, __m256i, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_ps, _mm256_and_ps,
     _mm256_and_si256, _mm256_castps_si256, _mm256_castsi256_ps, _mm256_cmp_ps, _mm256_fmadd_ps,
-    _mm256_fnmadd_ps, _mm256_load_ps, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
-    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_epi32, _mm256_set1_ps,
-    _mm256_setzero_ps, _mm256_slli_epi32, _mm256_sqrt_ps, _mm256_store_ps, _mm256_sub_ps,
-    _mm256_testz_ps,
+    _mm256_fmsub_ps, _mm256_fnmadd_ps, _mm256_load_ps, _mm256_loadu_ps, _mm256_max_ps,
+    _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_set1_epi32,
+    _mm256_set1_ps, _mm256_setzero_ps, _mm256_slli_epi32, _mm256_sqrt_ps, _mm256_store_ps,
+    _mm256_sub_ps, _mm256_testz_ps,
 };
 
 const _: () = assert!(FAST_LANES == 8, "one 8-lane AVX register per block");
@@ -356,12 +356,12 @@ pub(super) fn transform(rot: &[__m256; 9], t: &[__m256; 3], p: [f32; 3]) -> [__m
     [row(0), row(1), row(2)]
 }
 
-/// [`super::place`] written out: each link's rotation matrix from its quaternion, and its
-/// bounding sphere's centre.
+/// [`super::place`] written out: each link's bounding sphere's centre (rotated by its
+/// quaternion), and its pose kept for [`super::frame`].
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(super) fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
-    let (one, two) = (_mm256_set1_ps(1.0), _mm256_set1_ps(2.0));
+    let two = _mm256_set1_ps(2.0);
     for (g, group) in model.groups.iter().enumerate() {
         let p = &poses[group.frame];
         // no array `map` here: its closures would be compiled without AVX
@@ -372,41 +372,34 @@ pub(super) fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut Fast
             load_lanes(&p[3]),
         );
         let t = [load_lanes(&p[4]), load_lanes(&p[5]), load_lanes(&p[6])];
-        let (xx, yy, zz) = (
-            _mm256_mul_ps(x, x),
-            _mm256_mul_ps(y, y),
-            _mm256_mul_ps(z, z),
-        );
-        let (xy, xz, yz) = (
-            _mm256_mul_ps(x, y),
-            _mm256_mul_ps(x, z),
-            _mm256_mul_ps(y, z),
-        );
-        let (wx, wy, wz) = (
-            _mm256_mul_ps(w, x),
-            _mm256_mul_ps(w, y),
-            _mm256_mul_ps(w, z),
-        );
-        let diagonal = |a: __m256, b: __m256| _mm256_fnmadd_ps(two, _mm256_add_ps(a, b), one);
-        let twice = |a: __m256| _mm256_mul_ps(two, a);
-        let rot = [
-            diagonal(yy, zz),
-            twice(_mm256_sub_ps(xy, wz)),
-            twice(_mm256_add_ps(xz, wy)),
-            twice(_mm256_add_ps(xy, wz)),
-            diagonal(xx, zz),
-            twice(_mm256_sub_ps(yz, wx)),
-            twice(_mm256_sub_ps(xz, wy)),
-            twice(_mm256_add_ps(yz, wx)),
-            diagonal(xx, yy),
+        // the centre c moved: t + c + w·u + q×u, u = 2 q×c
+        let c = group.bound.center;
+        let c = [
+            _mm256_set1_ps(c[0]),
+            _mm256_set1_ps(c[1]),
+            _mm256_set1_ps(c[2]),
         ];
-        scratch.bounds[g] = store3(transform(&rot, &t, group.bound.center));
+        let cross =
+            |a: __m256, b: __m256, d: __m256, e: __m256| _mm256_fmsub_ps(a, b, _mm256_mul_ps(d, e));
+        let u = [
+            _mm256_mul_ps(two, cross(y, c[2], z, c[1])),
+            _mm256_mul_ps(two, cross(z, c[0], x, c[2])),
+            _mm256_mul_ps(two, cross(x, c[1], y, c[0])),
+        ];
+        let moved = |t: __m256, c: __m256, u: __m256, q: __m256| {
+            _mm256_add_ps(_mm256_add_ps(t, c), _mm256_fmadd_ps(w, u, q))
+        };
+        scratch.bounds[g] = store3([
+            moved(t[0], c[0], u[0], cross(y, u[2], z, u[1])),
+            moved(t[1], c[1], u[1], cross(z, u[0], x, u[2])),
+            moved(t[2], c[2], u[2], cross(x, u[1], y, u[0])),
+        ]);
         let frame = &mut scratch.frames[g];
-        for k in 0..9 {
-            frame.0[k] = store(rot[k]);
-        }
+        frame.0[0] = store(w);
+        frame.0[1] = store(x);
+        frame.0[2] = store(y);
+        frame.0[3] = store(z);
         frame.1 = store3(t);
-        scratch.placed[g] = false;
     }
 }
 

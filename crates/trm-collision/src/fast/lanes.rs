@@ -166,26 +166,15 @@ impl Flags {
     }
 }
 
-/// Rotation matrix (row-major) and translation of link `frame` in every lane, in `f32`.
+/// The rotation (row-major) of unit quaternion `w, x, y, z` in every lane.
 #[inline(always)]
-pub(super) fn link_frame(poses: &[PoseLanes32], frame: usize) -> ([F; 9], [F; 3]) {
-    let p = &poses[frame];
-    let q = [
-        F(p[0]),
-        F(p[1]),
-        F(p[2]),
-        F(p[3]),
-        F(p[4]),
-        F(p[5]),
-        F(p[6]),
-    ];
-    let [w, x, y, z, tx, ty, tz] = q;
+pub(super) fn rotation(w: F, x: F, y: F, z: F) -> [F; 9] {
     let two = F::splat(2.0);
     let one = F::splat(1.0);
     let (xx, yy, zz) = (x * x, y * y, z * z);
     let (xy, xz, yz) = (x * y, x * z, y * z);
     let (wx, wy, wz) = (w * x, w * y, w * z);
-    let r = [
+    [
         one - two * (yy + zz),
         two * (xy - wz),
         two * (xz + wy),
@@ -195,8 +184,27 @@ pub(super) fn link_frame(poses: &[PoseLanes32], frame: usize) -> ([F; 9], [F; 3]
         two * (xz - wy),
         two * (yz + wx),
         one - two * (xx + yy),
-    ];
-    (r, [tx, ty, tz])
+    ]
+}
+
+/// Point `c` of a link's frame in the world, in every lane of the link's pose `p` (quaternion
+/// `w, x, y, z`, translation): `t + c + w·u + q×u` with `u = 2 q×c`.
+#[inline(always)]
+pub(super) fn pose_point(p: &PoseLanes32, c: [f32; 3]) -> [F; 3] {
+    let (w, x, y, z) = (F(p[0]), F(p[1]), F(p[2]), F(p[3]));
+    let (tx, ty, tz) = (F(p[4]), F(p[5]), F(p[6]));
+    let (cx, cy, cz) = (F::splat(c[0]), F::splat(c[1]), F::splat(c[2]));
+    let two = F::splat(2.0);
+    let (ux, uy, uz) = (
+        two * (y * cz - z * cy),
+        two * (z * cx - x * cz),
+        two * (x * cy - y * cx),
+    );
+    [
+        tx + cx + w * ux + (y * uz - z * uy),
+        ty + cy + w * uy + (z * ux - x * uz),
+        tz + cz + w * uz + (x * uy - y * ux),
+    ]
 }
 
 /// `rot · p + t` in every lane.

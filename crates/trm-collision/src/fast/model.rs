@@ -89,8 +89,10 @@ pub(super) enum CullStep {
         reach: f32,
         end: u32,
     },
-    /// A link pair: an index into [`FastModel::group_pairs`].
-    Pair(u32),
+    /// A link pair: `k` an index into [`FastModel::group_pairs`], `a` and `b` its groups
+    /// (their bounding spheres' indices into [`FastScratch::bounds`]) and `reach` the sum of
+    /// those spheres' radii, so that the walk tests them without reading the pair.
+    Pair { k: u32, a: u32, b: u32, reach: f32 },
 }
 
 /// One step of a world object's walk, in the order of [`crate::cull`]'s world steps.
@@ -225,6 +227,7 @@ impl FastModel {
             bounds: vec![[F::default(); 3]; self.groups.len() + self.origins.len()],
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
+            framed: vec![false; self.groups.len()],
             suspects: Vec::with_capacity(self.group_pairs.len() + self.groups.len()),
             last_hit: None,
         }
@@ -509,9 +512,15 @@ impl Walks {
                     // a block of one checked link pair: `by_pair` made its group pair
                     crate::cull::Step::Test { start, .. } => {
                         let p = model.pairs()[start as usize];
-                        CullStep::Pair(
-                            index[&(group_of_body[p.a as usize], group_of_body[p.b as usize])],
-                        )
+                        let k = index[&(group_of_body[p.a as usize], group_of_body[p.b as usize])];
+                        let gp = &group_pairs[k as usize];
+                        let (ga, gb) = (&groups[gp.a], &groups[gp.b]);
+                        CullStep::Pair {
+                            k,
+                            a: gp.a as u32,
+                            b: gp.b as u32,
+                            reach: ga.bound.radius + gb.bound.radius,
+                        }
                     }
                 })
                 .collect()

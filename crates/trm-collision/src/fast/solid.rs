@@ -304,9 +304,17 @@ fn in_box(c: &[F; 3], b: &Placed) -> [F; 3] {
 
 compiled_per_isa! {
     /// A capsule (or sphere) against a box of half sizes `half`, in every lane: certainly
-    /// colliding lanes and lanes within the tolerance of contact (or NaN).
-    round_box => round_box_in(p: &Placed, round: Round, b: &Placed, half: [f32; 3], tol: f32)
-        -> (Flags, Flags)
+    /// colliding lanes and lanes within the tolerance of contact (or NaN). With `settle`
+    /// false, once some lane certainly collides the lanes still undecided are left *close*
+    /// (for a walk that stops at the first collision).
+    round_box => round_box_in(
+        p: &Placed,
+        round: Round,
+        b: &Placed,
+        half: [f32; 3],
+        tol: f32,
+        settle: bool,
+    ) -> (Flags, Flags)
 }
 
 #[inline(always)]
@@ -316,6 +324,7 @@ fn round_box_in<const AVX: bool>(
     b: &Placed,
     half: [f32; 3],
     tol: f32,
+    settle: bool,
 ) -> (Flags, Flags) {
     let zero = F::splat(0.0);
     let h = [F::splat(half[0]), F::splat(half[1]), F::splat(half[2])];
@@ -329,6 +338,14 @@ fn round_box_in<const AVX: bool>(
     }
     let dir = sub(&p[1], &p[0]);
     let dir = [dot(&dir, &b[1]), dot(&dir, &b[2]), dot(&dir, &b[3])];
+    // the separating axes of the segment and the box first (the box's normals, the segment's
+    // direction across the box's edges): they are cheap, and clear most pairs a walk meets;
+    // where the segment runs along a face they also clear the lanes whose projections below
+    // converge slowly
+    let apart = segment_box_gap(&start, &dir, &h, r, la).above(tol);
+    if apart.0.iter().all(|&v| v != 0) {
+        return (Flags::default(), Flags::default());
+    }
     let inv = F::splat(1.0 / la);
     // the segment point nearest the centre, then alternately the box point nearest the
     // segment point and the segment point nearest that box point
@@ -343,12 +360,35 @@ fn round_box_in<const AVX: bool>(
         s = clamp01(dot(&sub(&q, &start), &dir) * inv);
     }
     let (hit, close) = segment_box_verdict(&start, &dir, s, &h, r, tol);
-    // where the segment runs along a face the projections converge slowly: the separating
-    // axes of the segment and the box (the box's normals, the segment's direction across the
-    // box's edges) clear most of those lanes
+    let close = and_not(close, apart);
+    if and_not(close, hit).0.iter().all(|&v| v == 0) || !settle && hit.0.iter().any(|&v| v != 0) {
+        return (hit, close);
+    }
+    // lanes still undecided (a segment's end near a box's edge or corner, where projections
+    // converge slowly): the segment parameter where the derivative of the distance changes
+    // sign, by bisection (the derivative is monotone: the distance is convex along the segment)
+    let half = F::splat(0.5);
+    let (mut lo, mut hi) = (zero, F::splat(1.0));
+    for _ in 0..BISECTIONS {
+        let mid = (lo + hi) * half;
+        let out = beyond(&along(&start, &dir, mid), &h);
+        let rising = dot(&out, &dir).above(0.0);
+        hi = select(rising, mid, hi);
+        lo = select(rising, lo, mid);
+    }
+    let (hit2, close2) = segment_box_verdict(&start, &dir, (lo + hi) * half, &h, r, tol);
+    (or(hit, hit2), and(close, close2))
+}
+
+/// The largest gap, less the radius `r`, between a segment (`start`, `dir` in a box's frame;
+/// `la` its squared length) and the box of half sizes `h` along their separating axes: the
+/// box's normals and the segment's direction across each of the box's edges (cross axes
+/// normalised by an upper bound of their length, so the gap is a lower bound).
+#[inline(always)]
+fn segment_box_gap(start: &[F; 3], dir: &[F; 3], h: &[F; 3], r: f32, la: f32) -> F {
     let half = F::splat(0.5);
     let e = [dir[0] * half, dir[1] * half, dir[2] * half];
-    let mid = along(&start, &e, F::splat(1.0));
+    let mid = along(start, &e, F::splat(1.0));
     let rr = F::splat(r);
     let mut gap = abs(mid[0]) - h[0] - abs(e[0]) - rr;
     gap = max(gap, abs(mid[1]) - h[1] - abs(e[1]) - rr);
@@ -361,23 +401,7 @@ fn round_box_in<const AVX: bool>(
             abs(mid[k1] * e[k2] - mid[k2] * e[k1]) - h[k1] * abs(e[k2]) - h[k2] * abs(e[k1]);
         gap = max(gap, across * inv_e - rr);
     }
-    let close = and_not(close, gap.above(tol));
-    if and_not(close, hit).0.iter().all(|&v| v == 0) {
-        return (hit, close);
-    }
-    // lanes still undecided (a segment's end near a box's edge or corner, where projections
-    // converge slowly): the segment parameter where the derivative of the distance changes
-    // sign, by bisection (the derivative is monotone: the distance is convex along the segment)
-    let (mut lo, mut hi) = (zero, F::splat(1.0));
-    for _ in 0..BISECTIONS {
-        let mid = (lo + hi) * half;
-        let out = beyond(&along(&start, &dir, mid), &h);
-        let rising = dot(&out, &dir).above(0.0);
-        hi = select(rising, mid, hi);
-        lo = select(rising, lo, mid);
-    }
-    let (hit2, close2) = segment_box_verdict(&start, &dir, (lo + hi) * half, &h, r, tol);
-    (or(hit, hit2), and(close, close2))
+    gap
 }
 
 /// The verdict of a capsule's segment (`start`, `dir` in a box's frame) against the box of half

@@ -392,7 +392,7 @@ fn solid_kernels_are_sound_at_contact() {
                             },
                         ) => round_round::<AVX>(pa, (*a, *b, *radius), pb, (*c, *d, *r), tol),
                         (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
-                            round_box::<AVX>(pa, (*a, *b, *radius), pb, *half, tol)
+                            round_box::<AVX>(pa, (*a, *b, *radius), pb, *half, tol, true)
                         }
                         (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
                             box_box::<AVX>(pa, *half, pb, *other, tol)

@@ -4,7 +4,8 @@ use super::avx;
 use super::cloud::solids_against_cloud;
 use super::kdop::kdop_clear;
 use super::lanes::{
-    F, PORTABLE, compiled_per_isa, distance2, inverse_transform, link_frame, splat, transform,
+    F, Flags, PORTABLE, compiled_per_isa, distance2, inverse_transform, pose_point, rotation,
+    splat, transform,
 };
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
@@ -24,8 +25,11 @@ pub struct FastScratch {
     /// Per link group: whether its solids are placed for the current block.
     pub(super) solid_placed: Vec<bool>,
     pub(super) bounds: Vec<[F; 3]>,
-    /// Per link group: its frame (rotation rows, translation) in every lane.
+    /// Per link group: its frame (rotation rows, translation) in every lane; until
+    /// [`frame`] makes the rotation (`framed`), the first four rows hold the quaternion.
     pub(super) frames: Vec<([F; 9], [F; 3])>,
+    /// Per link group: whether its frame's rotation is made for the current block.
+    pub(super) framed: Vec<bool>,
     /// Per link group: whether its balls are placed for the current block.
     pub(super) placed: Vec<bool>,
     /// What left lanes uncertain in the last check, and in which lanes.
@@ -148,10 +152,17 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                 }
                 mask = nest.open(end, mask, near);
             }
-            CullStep::Pair(k) => {
-                let gp = &model.group_pairs[k as usize];
-                if link_pair::<AVX>(model, gp, k as usize, mask, world, scratch, verdict) {
-                    return;
+            CullStep::Pair { k, a, b, reach } => {
+                let (ca, cb) = (&scratch.bounds[a as usize], &scratch.bounds[b as usize]);
+                let reach = reach + m;
+                let near = mask & distance2(ca, cb).within(reach * reach).mask::<AVX>();
+                if near != 0 {
+                    let gp = &model.group_pairs[k as usize];
+                    if near_link_pair::<AVX, _>(
+                        model, gp, k as usize, near, world, scratch, verdict,
+                    ) {
+                        return;
+                    }
                 }
             }
         }
@@ -272,7 +283,7 @@ pub(super) fn object_link<const AVX: bool, O: Outcome>(
     }
     let solids = match cloud {
         Some((cloud, radius)) => solids_against_cloud(model, cloud, radius, g, near, scratch, m),
-        None => object_solids::<AVX>(model, object, g, scratch, m),
+        None => object_solids::<AVX>(model, object, g, scratch, m, !O::STOPS_AT_FIRST),
     };
     let (hit, close) = if let Some(contacts) = solids {
         contacts
@@ -299,13 +310,15 @@ pub(super) fn object_link<const AVX: bool, O: Outcome>(
 compiled_per_isa! {
     /// The lanes in which a world object certainly collides with link group `g`'s solids, and
     /// those within their tolerance of contact: `None` unless the link is solids
-    /// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box.
+    /// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box. With
+    /// `settle` false, the first solid that certainly collides in some lane ends the tests.
     object_solids => object_solids_in(
         model: &FastModel,
         object: &Object,
         g: usize,
         scratch: &mut FastScratch,
         m: f32,
+        settle: bool,
     ) -> Option<(LaneMask, LaneMask)>
 }
 
@@ -316,6 +329,7 @@ fn object_solids_in<const AVX: bool>(
     g: usize,
     scratch: &mut FastScratch,
     m: f32,
+    settle: bool,
 ) -> Option<(LaneMask, LaneMask)> {
     let range = model.groups[g].solids.clone()?;
     let (placed, extent) = match *object {
@@ -351,10 +365,10 @@ fn object_solids_in<const AVX: bool>(
                 },
             ) => round_round::<AVX>(p, (a, b, radius), &placed, (c, d, r), tol),
             (Solid::Round { a, b, radius }, Object::Box { half, .. }) => {
-                round_box::<AVX>(p, (a, b, radius), &placed, half, tol)
+                round_box::<AVX>(p, (a, b, radius), &placed, half, tol, settle)
             }
             (Solid::Box { half, .. }, Object::Round { a, b, radius }) => {
-                round_box::<AVX>(&placed, (a, b, radius), p, half, tol)
+                round_box::<AVX>(&placed, (a, b, radius), p, half, tol, settle)
             }
             (Solid::Box { half, .. }, Object::Box { half: other, .. }) => {
                 box_box::<AVX>(p, half, &placed, other, tol)
@@ -363,6 +377,9 @@ fn object_solids_in<const AVX: bool>(
         };
         contact.hit = contact.hit | hit;
         contact.close = contact.close | close;
+        if !settle && contact.hit != Flags::default() {
+            break;
+        }
     }
     Some((contact.hit.mask::<AVX>(), contact.close.mask::<AVX>()))
 }
@@ -429,15 +446,28 @@ pub(super) fn link_pair<const AVX: bool>(
         & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
             .within(reach * reach)
             .mask::<AVX>();
-    if near == 0 {
-        return false;
-    }
+    near != 0 && near_link_pair::<AVX, _>(model, gp, k, near, world, scratch, verdict)
+}
+
+/// [`link_pair`] in the lanes of `near`, where the links' bounding spheres come near.
+#[inline(always)]
+pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    gp: &GroupPair,
+    k: usize,
+    near: LaneMask,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) -> bool {
+    let m = world.margin;
     let (hit, close) = if !gp.solid_pairs.is_empty() {
         // the bodies themselves
-        solid_contacts::<AVX>(model, gp, scratch, m)
+        solid_contacts::<AVX>(model, gp, scratch, m, !O::STOPS_AT_FIRST)
     } else if let Some((s, o)) = gp.solid {
         // the other link's spheres in the box link's frame, against the box itself
         place_balls::<AVX>(model, o, scratch);
+        frame(scratch, s);
         let (box_, group, frame) = (&model.groups[s].solid, &model.groups[o], &scratch.frames[s]);
         let Some(box_) = box_ else { return false };
         let mut contact = Contact::default();
@@ -489,11 +519,14 @@ compiled_per_isa! {
     /// The lanes in which link pair `gp`'s solids ([`GroupPair::solid_pairs`]) certainly
     /// collide (placing them first), and those in which they come within their tolerance of
     /// contact (or NaN).
+    /// With `settle` false, the first pair that certainly collides in some lane ends the
+    /// tests (for a walk that stops at the first collision).
     solid_contacts => solid_contacts_in(
         model: &FastModel,
         gp: &GroupPair,
         scratch: &mut FastScratch,
         m: f32,
+        settle: bool,
     ) -> (LaneMask, LaneMask)
 }
 
@@ -503,6 +536,7 @@ fn solid_contacts_in<const AVX: bool>(
     gp: &GroupPair,
     scratch: &mut FastScratch,
     m: f32,
+    settle: bool,
 ) -> (LaneMask, LaneMask) {
     place_solids(model, gp.a, scratch);
     place_solids(model, gp.b, scratch);
@@ -529,10 +563,10 @@ fn solid_contacts_in<const AVX: bool>(
                 },
             ) => round_round::<AVX>(pa, (a, b, radius), pb, (c, d, r), tol),
             (Solid::Round { a, b, radius }, Solid::Box { half, .. }) => {
-                round_box::<AVX>(pa, (a, b, radius), pb, half, tol)
+                round_box::<AVX>(pa, (a, b, radius), pb, half, tol, settle)
             }
             (Solid::Box { half, .. }, Solid::Round { a, b, radius }) => {
-                round_box::<AVX>(pb, (a, b, radius), pa, half, tol)
+                round_box::<AVX>(pb, (a, b, radius), pa, half, tol, settle)
             }
             (Solid::Box { half, .. }, Solid::Box { half: other, .. }) => {
                 box_box::<AVX>(pa, half, pb, other, tol)
@@ -540,6 +574,9 @@ fn solid_contacts_in<const AVX: bool>(
         };
         contact.hit = contact.hit | hit;
         contact.close = contact.close | close;
+        if !settle && several && contact.hit != Flags::default() {
+            break;
+        }
     }
     (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>())
 }
@@ -553,6 +590,7 @@ pub(super) fn place_solids(model: &FastModel, g: usize, scratch: &mut FastScratc
     let Some(range) = model.groups[g].solids.clone() else {
         return;
     };
+    frame(scratch, g);
     let (rot, t) = &scratch.frames[g];
     for k in range {
         let placed = &mut scratch.solids[k];
@@ -612,8 +650,9 @@ pub(super) fn pair_contacts<const AVX: bool>(
     )
 }
 
-/// The frame and bounding-sphere centre of every link group in every lane; balls are placed
-/// later, for the groups that come near something ([`place_balls`]).
+/// The pose and bounding-sphere centre of every link group in every lane; frames, balls and
+/// solids are made later, for the groups that come near something ([`frame`],
+/// [`place_balls`], [`place_solids`]).
 #[inline(always)]
 pub(super) fn place<const AVX: bool>(
     model: &FastModel,
@@ -623,6 +662,8 @@ pub(super) fn place<const AVX: bool>(
     // the culling spheres' centres: their links' origins
     let groups = model.groups.len();
     scratch.solid_placed.fill(false);
+    scratch.placed.fill(false);
+    scratch.framed.fill(false);
     for (s, &frame) in model.origins.iter().enumerate() {
         let p = &poses[frame as usize];
         scratch.bounds[groups + s] = [F(p[4]), F(p[5]), F(p[6])];
@@ -634,11 +675,26 @@ pub(super) fn place<const AVX: bool>(
         return unsafe { avx::place(model, poses, scratch) };
     }
     for (g, group) in model.groups.iter().enumerate() {
-        let (rot, t) = link_frame(poses, group.frame);
-        scratch.bounds[g] = transform(&rot, &t, group.bound.center);
-        scratch.frames[g] = (rot, t);
-        scratch.placed[g] = false;
+        let p = &poses[group.frame];
+        scratch.bounds[g] = pose_point(p, group.bound.center);
+        let frame = &mut scratch.frames[g];
+        for k in 0..4 {
+            frame.0[k] = F(p[k]);
+        }
+        frame.1 = [F(p[4]), F(p[5]), F(p[6])];
     }
+}
+
+/// Group `g`'s frame in every lane (rotation rows, translation), its rotation made from the
+/// quaternion [`place`] left once per block.
+#[inline(always)]
+pub(super) fn frame(scratch: &mut FastScratch, g: usize) -> &([F; 9], [F; 3]) {
+    if !scratch.framed[g] {
+        let q = &scratch.frames[g].0;
+        scratch.frames[g].0 = rotation(q[0], q[1], q[2], q[3]);
+        scratch.framed[g] = true;
+    }
+    &scratch.frames[g]
 }
 
 /// The centres of group `g`'s balls in every lane, placed once per block.
@@ -647,6 +703,7 @@ pub(super) fn place_balls<const AVX: bool>(model: &FastModel, g: usize, scratch:
     if scratch.placed[g] {
         return;
     }
+    frame(scratch, g);
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: as in `F::any_within`
