@@ -357,7 +357,7 @@ pub(super) fn transform(rot: &[__m256; 9], t: &[__m256; 3], p: [f32; 3]) -> [__m
 }
 
 /// [`super::place`] written out: each link's bounding sphere's centre (rotated by its
-/// quaternion), and its pose kept for [`super::frame`].
+/// quaternion).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(super) fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut FastScratch) {
@@ -394,12 +394,6 @@ pub(super) fn place(model: &FastModel, poses: &[PoseLanes32], scratch: &mut Fast
             moved(t[1], c[1], u[1], cross(z, u[0], x, u[2])),
             moved(t[2], c[2], u[2], cross(x, u[1], y, u[0])),
         ]);
-        let frame = &mut scratch.frames[g];
-        frame.0[0] = store(w);
-        frame.0[1] = store(x);
-        frame.0[2] = store(y);
-        frame.0[3] = store(z);
-        frame.1 = store3(t);
     }
 }
 

@@ -20,6 +20,7 @@ use super::outcome::Contact;
 use super::solid::Solid;
 use super::walk::{FastScratch, place_solids};
 use super::{FAST_LANES, LaneMask};
+use trm_kinematics::PoseLanes32;
 
 /// Cells at most per point of the cloud (and at least this many in all): a grid finer than
 /// this over a sparse, wide cloud is coarsened so that its cells stay cheap to build.
@@ -446,8 +447,10 @@ fn envelope(f: &[f32], out: &mut Vec<f32>, v: &mut Vec<usize>, z: &mut Vec<f32>)
 /// `radius`), and those within their tolerance of it: per lane, the points within each solid's
 /// bounding sphere, measured to the solid itself (a box's point distance, a capsule's segment
 /// distance).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn solids_against_cloud(
     model: &FastModel,
+    poses: &[PoseLanes32],
     cloud: &CloudGrid,
     radius: f32,
     g: usize,
@@ -456,7 +459,7 @@ pub(super) fn solids_against_cloud(
     m: f32,
 ) -> Option<(LaneMask, LaneMask)> {
     let range = model.groups[g].solids.clone()?;
-    place_solids(model, g, scratch);
+    place_solids(model, poses, g, scratch);
     let mut contact = Contact::default();
     for k in range {
         let solid = model.solids[k];

@@ -119,8 +119,8 @@ fn avx_pair_contacts_are_the_portable_ones() {
         active.forward_block_unchecked(&qs, &mut block);
         place::<false>(&model, block.lanes(), &mut scratch);
         for gp in &model.group_pairs {
-            place_balls::<false>(&model, gp.a, &mut scratch);
-            place_balls::<false>(&model, gp.b, &mut scratch);
+            place_balls::<false>(&model, block.lanes(), gp.a, &mut scratch);
+            place_balls::<false>(&model, block.lanes(), gp.b, &mut scratch);
             let avx = pair_contacts::<true>(&model, gp, &scratch, &world);
             assert_eq!(avx, pair_contacts::<false>(&model, gp, &scratch, &world));
             contacts += usize::from(avx.0 != 0);
@@ -176,8 +176,8 @@ fn kdop_slabs_hold_the_hulls_and_clear_only_what_is_clear() {
         active.forward_block_unchecked(&qs, &mut block);
         place::<false>(&model, block.lanes(), &mut scratch);
         for gp in &model.group_pairs {
-            place_balls::<false>(&model, gp.a, &mut scratch);
-            place_balls::<false>(&model, gp.b, &mut scratch);
+            place_balls::<false>(&model, block.lanes(), gp.a, &mut scratch);
+            place_balls::<false>(&model, block.lanes(), gp.b, &mut scratch);
             let (_, near) = pair_contacts::<false>(&model, gp, &scratch, &world);
             let m = world.margin;
             let clear = kdop_clear::<false>(&model, gp.a, gp.b, &scratch, m);

@@ -25,8 +25,8 @@ pub struct FastScratch {
     /// Per link group: whether its solids are placed for the current block.
     pub(super) solid_placed: Vec<bool>,
     pub(super) bounds: Vec<[F; 3]>,
-    /// Per link group: its frame (rotation rows, translation) in every lane; until
-    /// [`frame`] makes the rotation (`framed`), the first four rows hold the quaternion.
+    /// Per link group: its frame (rotation rows, translation) in every lane, made by [`frame`]
+    /// when first needed in a block (`framed`).
     pub(super) frames: Vec<([F; 9], [F; 3])>,
     /// Per link group: whether its frame's rotation is made for the current block.
     pub(super) framed: Vec<bool>,
@@ -75,7 +75,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
 ) {
     place::<AVX>(model, poses, scratch);
     scratch.suspects.clear();
-    if O::STOPS_AT_FIRST && last_hit_again::<AVX, O>(model, live, world, scratch, verdict) {
+    if O::STOPS_AT_FIRST && last_hit_again::<AVX, O>(model, poses, live, world, scratch, verdict) {
         return;
     }
     let m = world.margin;
@@ -89,7 +89,8 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         for g in (0..model.groups.len()).rev() {
             for (&o, object) in world.original.iter().zip(&world.objects) {
                 let o = o as usize;
-                if object_link::<AVX, _>(model, o, object, g, live, world, scratch, verdict) {
+                if object_link::<AVX, _>(model, poses, o, object, g, live, world, scratch, verdict)
+                {
                     return;
                 }
             }
@@ -114,8 +115,9 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                     }
                     WorldStep::Link(g) => {
                         let g = g as usize;
-                        if object_link::<AVX, _>(model, o, object, g, mask, world, scratch, verdict)
-                        {
+                        if object_link::<AVX, _>(
+                            model, poses, o, object, g, mask, world, scratch, verdict,
+                        ) {
                             return;
                         }
                     }
@@ -129,11 +131,11 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
     // other hand), then each link pair's bounding spheres and spheres
     if !model.culls {
         for (k, gp) in model.group_pairs.iter().enumerate() {
-            if link_pair::<AVX>(model, gp, k, live, world, scratch, verdict) {
+            if link_pair::<AVX>(model, poses, gp, k, live, world, scratch, verdict) {
                 return;
             }
         }
-        clear_suspects::<AVX, _>(model, scratch, m, verdict);
+        clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
         return;
     }
     let steps = &model.steps;
@@ -159,7 +161,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                 if near != 0 {
                     let gp = &model.group_pairs[k as usize];
                     if near_link_pair::<AVX, _>(
-                        model, gp, k as usize, near, world, scratch, verdict,
+                        model, poses, gp, k as usize, near, world, scratch, verdict,
                     ) {
                         return;
                     }
@@ -168,7 +170,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         }
         i += 1;
     }
-    clear_suspects::<AVX, _>(model, scratch, m, verdict);
+    clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
 }
 
 /// Whether the pair the last stopped walk stopped at (when there is one, and its object is in
@@ -178,6 +180,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
 #[inline(always)]
 pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     live: LaneMask,
     world: &FastWorld,
     scratch: &mut FastScratch,
@@ -192,6 +195,7 @@ pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
             .is_some_and(|object_shape| {
                 object_link::<AVX, _>(
                     model,
+                    poses,
                     object as usize,
                     object_shape,
                     group as usize,
@@ -203,7 +207,7 @@ pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
             }),
         Some(Suspect::Pair(k)) => {
             let gp = &model.group_pairs[k as usize];
-            link_pair::<AVX>(model, gp, k as usize, live, world, scratch, verdict)
+            link_pair::<AVX>(model, poses, gp, k as usize, live, world, scratch, verdict)
         }
         None => false,
     };
@@ -220,6 +224,7 @@ pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
 #[inline(always)]
 pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     scratch: &mut FastScratch,
     m: f32,
     verdict: &mut O,
@@ -235,8 +240,8 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
             let gp = &model.group_pairs[k as usize];
             // the k-DOP screen reads both links' spheres: a link tested as one box has not had
             // them placed for this block
-            place_balls::<AVX>(model, gp.a, scratch);
-            place_balls::<AVX>(model, gp.b, scratch);
+            place_balls::<AVX>(model, poses, gp.a, scratch);
+            place_balls::<AVX>(model, poses, gp.b, scratch);
             *lanes &= !kdop_clear::<AVX>(model, gp.a, gp.b, scratch, m);
             if *lanes != 0 {
                 *lanes &= !kdop_clear::<AVX>(model, gp.b, gp.a, scratch, m);
@@ -256,6 +261,7 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn object_link<const AVX: bool, O: Outcome>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     o: usize,
     object: &Object,
     g: usize,
@@ -282,13 +288,24 @@ pub(super) fn object_link<const AVX: bool, O: Outcome>(
         }
     }
     let solids = match cloud {
-        Some((cloud, radius)) => solids_against_cloud(model, cloud, radius, g, near, scratch, m),
-        None => object_solids::<AVX>(model, object, g, scratch, m, !O::STOPS_AT_FIRST),
+        Some((cloud, radius)) => {
+            solids_against_cloud(model, poses, cloud, radius, g, near, scratch, m)
+        }
+        None => object_solids::<AVX>(model, poses, object, g, scratch, m, !O::STOPS_AT_FIRST),
     };
     let (hit, close) = if let Some(contacts) = solids {
         contacts
     } else {
-        object_balls::<AVX>(model, world, object, g, near, scratch, O::STOPS_AT_FIRST)
+        object_balls::<AVX>(
+            model,
+            poses,
+            world,
+            object,
+            g,
+            near,
+            scratch,
+            O::STOPS_AT_FIRST,
+        )
     };
     let suspect = Suspect::Object {
         object: o as u32,
@@ -314,6 +331,7 @@ compiled_per_isa! {
     /// `settle` false, the first solid that certainly collides in some lane ends the tests.
     object_solids => object_solids_in(
         model: &FastModel,
+        poses: &[PoseLanes32],
         object: &Object,
         g: usize,
         scratch: &mut FastScratch,
@@ -325,6 +343,7 @@ compiled_per_isa! {
 #[inline(always)]
 fn object_solids_in<const AVX: bool>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     object: &Object,
     g: usize,
     scratch: &mut FastScratch,
@@ -349,7 +368,7 @@ fn object_solids_in<const AVX: bool>(
         ),
         Object::Cylinder { .. } | Object::Bounded { .. } | Object::Cloud { .. } => return None,
     };
-    place_solids(model, g, scratch);
+    place_solids(model, poses, g, scratch);
     let mut contact = Contact::default();
     for k in range {
         let solid = model.solids[k];
@@ -388,8 +407,10 @@ fn object_solids_in<const AVX: bool>(
 /// spheres inside its bodies, when they enclose them), and those within the margin of contact
 /// (with `stop_at_hit`, possibly only some of them once one lane certainly collides).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn object_balls<const AVX: bool>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     world: &FastWorld,
     object: &Object,
     g: usize,
@@ -398,7 +419,7 @@ fn object_balls<const AVX: bool>(
     stop_at_hit: bool,
 ) -> (LaneMask, LaneMask) {
     let (m, group) = (world.margin, &model.groups[g]);
-    place_balls::<AVX>(model, g, scratch);
+    place_balls::<AVX>(model, poses, g, scratch);
     let mut contact = Contact::default();
     // a point cloud costs per sphere and lane: where a certain collision ends the walk, the
     // first one ends the link's spheres too (a sphere model's spheres are its bodies)
@@ -430,8 +451,10 @@ fn object_balls<const AVX: bool>(
 /// True when a lane certainly collides (then `verdict` says which); lanes left uncertain are
 /// added to `verdict` and the suspects.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn link_pair<const AVX: bool>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     gp: &GroupPair,
     k: usize,
     live: LaneMask,
@@ -446,13 +469,15 @@ pub(super) fn link_pair<const AVX: bool>(
         & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
             .within(reach * reach)
             .mask::<AVX>();
-    near != 0 && near_link_pair::<AVX, _>(model, gp, k, near, world, scratch, verdict)
+    near != 0 && near_link_pair::<AVX, _>(model, poses, gp, k, near, world, scratch, verdict)
 }
 
 /// [`link_pair`] in the lanes of `near`, where the links' bounding spheres come near.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     gp: &GroupPair,
     k: usize,
     near: LaneMask,
@@ -463,11 +488,11 @@ pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
     let m = world.margin;
     let (hit, close) = if !gp.solid_pairs.is_empty() {
         // the bodies themselves
-        solid_contacts::<AVX>(model, gp, scratch, m, !O::STOPS_AT_FIRST)
+        solid_contacts::<AVX>(model, poses, gp, scratch, m, !O::STOPS_AT_FIRST)
     } else if let Some((s, o)) = gp.solid {
         // the other link's spheres in the box link's frame, against the box itself
-        place_balls::<AVX>(model, o, scratch);
-        frame(scratch, s);
+        place_balls::<AVX>(model, poses, o, scratch);
+        frame(model, poses, scratch, s);
         let (box_, group, frame) = (&model.groups[s].solid, &model.groups[o], &scratch.frames[s]);
         let Some(box_) = box_ else { return false };
         let mut contact = Contact::default();
@@ -486,8 +511,8 @@ pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
         (inside.hit.mask::<AVX>(), close)
     } else {
         // each sphere of link a against link b's bounding sphere, then b's spheres
-        place_balls::<AVX>(model, gp.a, scratch);
-        place_balls::<AVX>(model, gp.b, scratch);
+        place_balls::<AVX>(model, poses, gp.a, scratch);
+        place_balls::<AVX>(model, poses, gp.b, scratch);
         let (mut hit, close) = pair_contacts::<AVX>(model, gp, scratch, world);
         if !model.exact {
             // enclosing spheres only say "maybe"; spheres inside the bodies say "certainly"
@@ -523,6 +548,7 @@ compiled_per_isa! {
     /// tests (for a walk that stops at the first collision).
     solid_contacts => solid_contacts_in(
         model: &FastModel,
+        poses: &[PoseLanes32],
         gp: &GroupPair,
         scratch: &mut FastScratch,
         m: f32,
@@ -533,13 +559,14 @@ compiled_per_isa! {
 #[inline(always)]
 fn solid_contacts_in<const AVX: bool>(
     model: &FastModel,
+    poses: &[PoseLanes32],
     gp: &GroupPair,
     scratch: &mut FastScratch,
     m: f32,
     settle: bool,
 ) -> (LaneMask, LaneMask) {
-    place_solids(model, gp.a, scratch);
-    place_solids(model, gp.b, scratch);
+    place_solids(model, poses, gp.a, scratch);
+    place_solids(model, poses, gp.b, scratch);
     let mut contact = Contact::default();
     let several = gp.solid_pairs.len() > 1;
     for pair in &gp.solid_pairs {
@@ -583,14 +610,19 @@ fn solid_contacts_in<const AVX: bool>(
 
 /// The solids of group `g` in every lane, placed once per block.
 #[inline(always)]
-pub(super) fn place_solids(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+pub(super) fn place_solids(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    g: usize,
+    scratch: &mut FastScratch,
+) {
     if scratch.solid_placed[g] {
         return;
     }
     let Some(range) = model.groups[g].solids.clone() else {
         return;
     };
-    frame(scratch, g);
+    frame(model, poses, scratch, g);
     let (rot, t) = &scratch.frames[g];
     for k in range {
         let placed = &mut scratch.solids[k];
@@ -650,7 +682,7 @@ pub(super) fn pair_contacts<const AVX: bool>(
     )
 }
 
-/// The pose and bounding-sphere centre of every link group in every lane; frames, balls and
+/// The bounding-sphere centre of every link group in every lane; frames, balls and
 /// solids are made later, for the groups that come near something ([`frame`],
 /// [`place_balls`], [`place_solids`]).
 #[inline(always)]
@@ -677,21 +709,22 @@ pub(super) fn place<const AVX: bool>(
     for (g, group) in model.groups.iter().enumerate() {
         let p = &poses[group.frame];
         scratch.bounds[g] = pose_point(p, group.bound.center);
-        let frame = &mut scratch.frames[g];
-        for k in 0..4 {
-            frame.0[k] = F(p[k]);
-        }
-        frame.1 = [F(p[4]), F(p[5]), F(p[6])];
     }
 }
 
-/// Group `g`'s frame in every lane (rotation rows, translation), its rotation made from the
-/// quaternion [`place`] left once per block.
+/// Group `g`'s frame in every lane (rotation rows, translation), made from its pose once per
+/// block.
 #[inline(always)]
-pub(super) fn frame(scratch: &mut FastScratch, g: usize) -> &([F; 9], [F; 3]) {
+pub(super) fn frame<'s>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    scratch: &'s mut FastScratch,
+    g: usize,
+) -> &'s ([F; 9], [F; 3]) {
     if !scratch.framed[g] {
-        let q = &scratch.frames[g].0;
-        scratch.frames[g].0 = rotation(q[0], q[1], q[2], q[3]);
+        let p = &poses[model.groups[g].frame];
+        let rot = rotation(F(p[0]), F(p[1]), F(p[2]), F(p[3]));
+        scratch.frames[g] = (rot, [F(p[4]), F(p[5]), F(p[6])]);
         scratch.framed[g] = true;
     }
     &scratch.frames[g]
@@ -699,11 +732,16 @@ pub(super) fn frame(scratch: &mut FastScratch, g: usize) -> &([F; 9], [F; 3]) {
 
 /// The centres of group `g`'s balls in every lane, placed once per block.
 #[inline(always)]
-pub(super) fn place_balls<const AVX: bool>(model: &FastModel, g: usize, scratch: &mut FastScratch) {
+pub(super) fn place_balls<const AVX: bool>(
+    model: &FastModel,
+    poses: &[PoseLanes32],
+    g: usize,
+    scratch: &mut FastScratch,
+) {
     if scratch.placed[g] {
         return;
     }
-    frame(scratch, g);
+    frame(model, poses, scratch, g);
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: as in `F::any_within`
