@@ -545,22 +545,15 @@ mod avx {
             // parent rotation ⊗ local rotation, the signs in fused (negated) multiply-adds
             let (add, sub) = (_mm256_fmadd_ps, _mm256_fnmadd_ps);
             let w_times = |v: __m256| _mm256_mul_ps(w, v);
-            store(
+            let product = [
                 sub(z, lk, sub(y, lj, sub(x, li, w_times(lw)))),
-                &mut child[0],
-            );
-            store(
                 sub(z, lj, add(y, lk, add(x, lw, w_times(li)))),
-                &mut child[1],
-            );
-            store(
                 add(z, li, add(y, lw, sub(x, lk, w_times(lj)))),
-                &mut child[2],
-            );
-            store(
                 add(z, lw, sub(y, li, add(x, lj, w_times(lk)))),
-                &mut child[3],
-            );
+            ];
+            for (k, v) in product.into_iter().enumerate() {
+                store(v, &mut child[k]);
+            }
         }
     }
 }

@@ -4,8 +4,8 @@ use super::avx;
 use super::cloud::solids_against_cloud;
 use super::kdop::kdop_clear;
 use super::lanes::{
-    F, Flags, PORTABLE, compiled_per_isa, distance2, inverse_transform, pose_point, rotation,
-    splat, transform,
+    F, PORTABLE, compiled_per_isa, distance2, inverse_transform, pose_point, rotation, splat,
+    transform,
 };
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
@@ -328,7 +328,8 @@ compiled_per_isa! {
     /// The lanes in which a world object certainly collides with link group `g`'s solids, and
     /// those within their tolerance of contact: `None` unless the link is solids
     /// ([`super::model::Group::solids`]) and the object a sphere, a capsule or a box. With
-    /// `settle` false, the first solid that certainly collides in some lane ends the tests.
+    /// `settle` false, a capsule–box pair that certainly collides in some lane is not refined
+    /// further (its undecided lanes stay close).
     object_solids => object_solids_in(
         model: &FastModel,
         poses: &[PoseLanes32],
@@ -396,9 +397,6 @@ fn object_solids_in<const AVX: bool>(
         };
         contact.hit = contact.hit | hit;
         contact.close = contact.close | close;
-        if !settle && contact.hit != Flags::default() {
-            break;
-        }
     }
     Some((contact.hit.mask::<AVX>(), contact.close.mask::<AVX>()))
 }
@@ -544,8 +542,9 @@ compiled_per_isa! {
     /// The lanes in which link pair `gp`'s solids ([`GroupPair::solid_pairs`]) certainly
     /// collide (placing them first), and those in which they come within their tolerance of
     /// contact (or NaN).
-    /// With `settle` false, the first pair that certainly collides in some lane ends the
-    /// tests (for a walk that stops at the first collision).
+    /// With `settle` false, a capsule–box pair that certainly collides in some lane is not
+    /// refined further (its undecided lanes stay close: for a walk that stops at the first
+    /// collision).
     solid_contacts => solid_contacts_in(
         model: &FastModel,
         poses: &[PoseLanes32],
@@ -601,9 +600,6 @@ fn solid_contacts_in<const AVX: bool>(
         };
         contact.hit = contact.hit | hit;
         contact.close = contact.close | close;
-        if !settle && several && contact.hit != Flags::default() {
-            break;
-        }
     }
     (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>())
 }
