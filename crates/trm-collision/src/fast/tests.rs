@@ -578,3 +578,89 @@ fn a_world_compiled_after_another_is_the_world_compiled_afresh() {
         &scan_grid(&rescanned, &changes[3].1)
     ));
 }
+
+/// Lanes outside `live` never decide the live ones: blocks whose dead lanes hold colliding
+/// configurations and whose live lanes hold random ones, among boxes, a sphere and a capsule,
+/// on a model of capsules and boxes (the iCub) and one of mesh hulls (the Panda). A live lane
+/// is reported colliding only where the exact model says so, and when no lane is reported
+/// colliding every live lane the exact model finds colliding is left uncertain, never clear.
+#[test]
+fn dead_lanes_never_decide_live_ones() {
+    let at = |x: f64, y: f64, z: f64| nalgebra::Isometry3::translation(x, y, z);
+    for (file, seed, reach) in [
+        ("icub_upper_body.ron", 21, 0.3),
+        ("panda-mbm/panda.ron", 22, 0.5),
+    ] {
+        let file = format!("{}/../../models/{file}", env!("CARGO_MANIFEST_DIR"));
+        let robot = trm_kinematics::RobotModel::load(&file).unwrap();
+        let collision = CollisionModel::new(&robot).unwrap();
+        let model = FastModel::new(&collision).unwrap();
+        let active = robot.all_active();
+        let mut world = World::new();
+        let plate = Shape::Box {
+            size: [0.3, 0.3, 0.02],
+        };
+        world.add("plate", plate, at(reach, 0.0, 0.2)).unwrap();
+        let post = Shape::Box {
+            size: [0.04, 0.04, 0.5],
+        };
+        world.add("post", post, at(0.0, reach, 0.3)).unwrap();
+        world
+            .add(
+                "ball",
+                Shape::Sphere { radius: 0.06 },
+                at(reach, -reach, 0.4),
+            )
+            .unwrap();
+        let rod = Shape::Capsule {
+            radius: 0.02,
+            length: 0.4,
+        };
+        world.add("rod", rod, at(-reach, 0.0, 0.3)).unwrap();
+        let (mut pose, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+        let mut colliding = |q: &[f64]| {
+            active.forward(q, &mut pose).unwrap();
+            collision.place(&pose, &mut placed);
+            collision.is_colliding(&placed, &world)
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let hits: Vec<Vec<f64>> = std::iter::repeat_with(|| active.random(&mut rng))
+            .filter(|q| colliding(q))
+            .take(64)
+            .collect();
+        let (mut block, mut scratch) = (robot.pose_block(), model.scratch());
+        let fast_world = model.world(&world);
+        let mut live_hits = 0;
+        for round in 0..1000 {
+            let live: LaneMask = (1 << (1 + round % (FAST_LANES - 1))) - 1;
+            let qs: Vec<Vec<f64>> = (0..FAST_LANES)
+                .map(|l| match live & (1 << l) {
+                    0 => hits[(round + l) % hits.len()].clone(),
+                    _ => active.random(&mut rng),
+                })
+                .collect();
+            active.forward_block_unchecked(&qs.concat(), &mut block);
+            let verdict = model.check(block.lanes(), live, &fast_world, &mut scratch);
+            let truth: LaneMask = (0..FAST_LANES)
+                .filter(|&l| live & (1 << l) != 0 && colliding(&qs[l]))
+                .fold(0, |m, l| m | (1 << l));
+            live_hits += truth.count_ones();
+            assert_eq!(
+                verdict.colliding & !truth,
+                0,
+                "{file}: a free lane reported colliding"
+            );
+            if verdict.colliding == 0 {
+                assert_eq!(
+                    truth & !verdict.uncertain,
+                    0,
+                    "{file}: a colliding live lane cleared"
+                );
+            }
+        }
+        assert!(
+            live_hits > 30,
+            "{file}: {live_hits} colliding live lanes: too few to test"
+        );
+    }
+}
