@@ -510,6 +510,14 @@ fn box_box_in<const AVX: bool>(
     let d = sub(&b[0], &a[0]);
     // the centre of b in a's frame, and the rotation from b's axes to a's
     let t = [dot(&d, &a[1]), dot(&d, &a[2]), dot(&d, &a[3])];
+    // first the sphere about b against a itself: most pairs a walk meets are apart by more
+    // than b's extent (a NaN axis of b reaches the distance through `nan_b`)
+    let reach = (hb[0] * hb[0] + hb[1] * hb[1] + hb[2] * hb[2]).sqrt() * (1.0 + 1e-6) + 1e-7 + tol;
+    let nan_b = (b[1][0] + b[2][1] + b[3][2]) * F::splat(0.0);
+    let out = beyond(&t, &[F::splat(ha[0]), F::splat(ha[1]), F::splat(ha[2])]);
+    if !(dot(&out, &out) + nan_b).any_within::<AVX>(reach * reach) {
+        return (Flags::default(), Flags::default());
+    }
     let r: [[F; 3]; 3] = [
         [dot(&a[1], &b[1]), dot(&a[1], &b[2]), dot(&a[1], &b[3])],
         [dot(&a[2], &b[1]), dot(&a[2], &b[2]), dot(&a[2], &b[3])],
