@@ -13,6 +13,15 @@ use nalgebra::{Point3, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// A shipped model (`models/…`): its robot, exact collision model and screen.
+fn shipped(file: &str) -> (trm_kinematics::RobotModel, CollisionModel, FastModel) {
+    let file = format!("{}/../../models/{file}", env!("CARGO_MANIFEST_DIR"));
+    let robot = trm_kinematics::RobotModel::load(&file).unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    let model = FastModel::new(&collision).unwrap();
+    (robot, collision, model)
+}
+
 /// The written-out AVX distances ([`avx`]) are the portable ones up to rounding, for every
 /// kind of object, points inside and outside (where the CPU has AVX2 and FMA).
 #[test]
@@ -101,12 +110,7 @@ fn avx_pair_contacts_are_the_portable_ones() {
     if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
         return;
     }
-    let file = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../models/panda-mbm/panda_spherized.ron"
-    );
-    let robot = trm_kinematics::RobotModel::load(file).unwrap();
-    let model = FastModel::new(&CollisionModel::new(&robot).unwrap()).unwrap();
+    let (robot, _, model) = shipped("panda-mbm/panda_spherized.ron");
     let active = robot.all_active();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let (mut block, mut scratch) = (robot.pose_block(), model.scratch());
@@ -136,13 +140,7 @@ fn avx_pair_contacts_are_the_portable_ones() {
 /// clears is clear of the hulls, as GJK finds; the AVX code clears the same lanes.
 #[test]
 fn kdop_slabs_hold_the_hulls_and_clear_only_what_is_clear() {
-    let file = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../models/panda-mbm/panda.ron"
-    );
-    let robot = trm_kinematics::RobotModel::load(file).unwrap();
-    let collision = CollisionModel::new(&robot).unwrap();
-    let model = FastModel::new(&collision).unwrap();
+    let (robot, collision, model) = shipped("panda-mbm/panda.ron");
     for group in &model.groups {
         let kdop = group.kdop.expect("every Panda link is a hull");
         for &b in &group.bodies {
@@ -471,12 +469,7 @@ fn solid_kernels_are_sound_at_contact() {
 /// objects, a renamed one, and a world rebuilt in another order.
 #[test]
 fn a_world_compiled_after_another_is_the_world_compiled_afresh() {
-    let file = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../models/panda-mbm/panda_spherized.ron"
-    );
-    let robot = trm_kinematics::RobotModel::load(file).unwrap();
-    let model = FastModel::new(&CollisionModel::new(&robot).unwrap()).unwrap();
+    let (_, _, model) = shipped("panda-mbm/panda_spherized.ron");
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let board = Shape::Box {
         size: [0.6, 0.8, 0.02],
@@ -591,10 +584,7 @@ fn dead_lanes_never_decide_live_ones() {
         ("icub_upper_body.ron", 21, 0.3),
         ("panda-mbm/panda.ron", 22, 0.5),
     ] {
-        let file = format!("{}/../../models/{file}", env!("CARGO_MANIFEST_DIR"));
-        let robot = trm_kinematics::RobotModel::load(&file).unwrap();
-        let collision = CollisionModel::new(&robot).unwrap();
-        let model = FastModel::new(&collision).unwrap();
+        let (robot, collision, model) = shipped(file);
         let active = robot.all_active();
         let mut world = World::new();
         let plate = Shape::Box {
