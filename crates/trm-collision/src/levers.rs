@@ -92,6 +92,16 @@ impl Levers {
         })
     }
 
+    /// The displacement of link `link`'s points per unit of joint `joint`'s value (tree joint
+    /// index), when the joint moves the link.
+    pub(crate) fn arm(&self, link: usize, joint: usize) -> Option<f64> {
+        let chain = self.chains.get(link)?;
+        chain
+            .iter()
+            .find(|&&(j, _, _)| j == joint)
+            .map(|&(_, _, per_unit)| per_unit)
+    }
+
     /// The number of active coordinates.
     pub fn num_coordinates(&self) -> usize {
         self.coordinates

@@ -33,9 +33,11 @@
 //! through spheres, is tested as that box: the other link's spheres are taken into its frame. A
 //! block whose lanes are left uncertain by two links of convex hulls gets a second, tighter
 //! screen before the exact checks: each link's spheres against the other's 18-sided bounding
-//! polytope (k-DOP). World objects of every shape are taken: spheres, capsules and boxes are
-//! checked in single precision, cylinders and convex hulls through their bounding spheres (a
-//! lane near one is uncertain). Point clouds sit in a counting-sorted uniform grid whose cells
+//! polytope (k-DOP), and a pair that one or two revolute joints alone move relative to each
+//! other (a forearm and the links beyond its wrist) is looked up in its clearance table: cells
+//! of those joints' angles proved free when compiling (`table.rs`). World objects of every
+//! shape are taken: spheres, capsules and boxes are checked in single precision, cylinders and
+//! convex hulls through their bounding spheres (a lane near one is uncertain). Point clouds sit in a counting-sorted uniform grid whose cells
 //! know their clearance (`cloud.rs`): a sphere, capsule or box is measured to the points within
 //! its reach, so points are decided in single precision as the primitives are; a triangle mesh
 //! is screened through samples at most 4 mm apart on its triangles (a lane within that of
@@ -55,6 +57,7 @@ mod lanes;
 mod model;
 mod outcome;
 mod solid;
+mod table;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
 mod walk;

@@ -3,6 +3,7 @@ use super::kdop::{KDOP, kdop_of};
 use super::lanes::{F, inverse_axes, norm, to_f32};
 use super::outcome::{Tally, Verdict};
 use super::solid::{SLOTS, Solid, SolidPair};
+use super::table::PairTable;
 use super::walk::{FastScratch, screen};
 use super::world::{FastWorld, Object};
 use crate::error::CollisionError;
@@ -75,6 +76,9 @@ pub(super) struct GroupPair {
     /// When both links are solids ([`Group::solids`]): their checked body pairs as solids,
     /// tested instead of the spheres.
     pub(super) solid_pairs: Vec<SolidPair>,
+    /// When one or two revolute joints alone move the two links relative to each other: the
+    /// pair's clearance table (an index into [`FastModel::tables`]), consulted first.
+    pub(super) table: Option<u32>,
 }
 
 /// One step of the self-collision walk, in the order of [`crate::cull`]'s steps.
@@ -131,6 +135,9 @@ pub struct FastModel {
     pub(super) group_pairs: Vec<GroupPair>,
     /// Ball pairs and the sums of their radii.
     pub(super) pairs: Vec<BallPair>,
+    /// Clearance tables of the link pairs that one or two revolute joints alone move
+    /// ([`GroupPair::table`]).
+    pub(super) tables: Vec<PairTable>,
     /// The self-collision walk through the culling spheres (when `culls`): culls and link
     /// pairs.
     pub(super) steps: Vec<CullStep>,
@@ -158,7 +165,14 @@ impl FastModel {
     pub fn new(model: &CollisionModel) -> Result<Self> {
         let exact = Self::is_sphere_model(model);
         let spheres = Spheres::of(model, exact)?;
-        let (pairs, group_pairs) = spheres.pairs(model);
+        let (pairs, mut group_pairs) = spheres.pairs(model);
+        // sphere models decide every lane in the screen; others leave lanes to exact checks,
+        // which tables spare
+        let tables = if exact {
+            Vec::new()
+        } else {
+            tables(model, &spheres.groups, &mut group_pairs)?
+        };
         let walks = Walks::of(model, &spheres, &group_pairs);
         let (reach, depth) = reach_and_depth(model, &spheres.balls);
         Ok(FastModel {
@@ -171,6 +185,7 @@ impl FastModel {
             bodies: spheres.ball_bodies,
             groups: spheres.groups,
             group_pairs,
+            tables,
             pairs,
             steps: walks.steps,
             world_steps: walks.world_steps,
@@ -460,10 +475,35 @@ impl Spheres {
                 bodies,
                 inner: inner_pairs,
                 solid,
+                table: None,
             });
         }
         (pairs, group_pairs)
     }
+}
+
+/// The clearance tables of the link pairs that allow one ([`PairTable::build`]), each pair
+/// given the index of its own.
+fn tables(
+    model: &CollisionModel,
+    groups: &[Group],
+    group_pairs: &mut [GroupPair],
+) -> Result<Vec<PairTable>> {
+    let levers = crate::levers::Levers::new(model, &model.robot().all_active())?;
+    let mut tables = Vec::new();
+    // pairs tested as solids leave few lanes to the exact checks: only pairs screened through
+    // enclosing spheres get a table
+    for gp in group_pairs
+        .iter_mut()
+        .filter(|gp| gp.solid_pairs.is_empty() && gp.solid.is_none())
+    {
+        let (a, b) = (groups[gp.a].frame, groups[gp.b].frame);
+        if let Some(table) = PairTable::build(model, &levers, a, b, &gp.bodies) {
+            gp.table = Some(tables.len() as u32);
+            tables.push(table);
+        }
+    }
+    Ok(tables)
 }
 
 /// The screen's walks through the exact model's culling spheres, while compiling.

@@ -238,6 +238,13 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
     for (suspect, lanes) in &mut suspects {
         if let Suspect::Pair(k) = *suspect {
             let gp = &model.group_pairs[k as usize];
+            // lanes in a free cell of the pair's clearance table are clear of it
+            if let Some(t) = gp.table {
+                *lanes &= !model.tables[t as usize].free_lanes(poses, *lanes);
+                if *lanes == 0 {
+                    continue;
+                }
+            }
             // the k-DOP screen reads both links' spheres: a link tested as one box has not had
             // them placed for this block
             place_balls::<AVX>(model, poses, gp.a, scratch);

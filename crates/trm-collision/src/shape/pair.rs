@@ -269,6 +269,22 @@ fn parry_intersects(
     query::intersection_test(i1, s1, i2, s2).unwrap_or(true)
 }
 
+/// The gap between two placed shapes known not to touch: GJK over the hulls' vertex walks when
+/// both have one (parry's polyhedra scan every vertex per support point), else
+/// [`signed_distance`].
+pub(crate) fn gap(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> f64 {
+    if let (Geometry::General { walk: Some(w1), .. }, Geometry::General { walk: Some(w2), .. }) =
+        (&c1.geometry, &c2.geometry)
+    {
+        return query::details::distance_support_map_support_map(
+            &p1.iso.inv_mul(&p2.iso),
+            &**w1,
+            &**w2,
+        );
+    }
+    signed_distance(c1, p1, c2, p2)
+}
+
 /// Signed distance between two placed shapes: the gap when apart, minus the penetration depth
 /// when they overlap.
 pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> f64 {

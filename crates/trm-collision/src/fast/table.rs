@@ -1,0 +1,435 @@
+//! Clearance tables: a link pair that one or two revolute joints alone move relative to each
+//! other (a forearm and the hand beyond its wrist) is looked up in a table over those joints'
+//! angles before its uncertain lanes go to the exact checks.
+//!
+//! Such pairs are near in almost every configuration, so for bodies screened through enclosing
+//! spheres they leave many lanes to the exact checks (on the Panda's mesh hulls, most of them).
+//! Their relative pose is a function of one or two angles, so it can be decided once, when
+//! compiling: the angles' ranges are cut into cells, and a cell is marked *free* when a
+//! certificate proves every configuration in it collision-free. The certificate is a bubble
+//! (Quinlan 1994): the exact (`f64`) distance `d` between the two links' checked bodies at one
+//! configuration, and the joints' lever arms ([`Levers`]): a change `Δθ` of the angles moves no
+//! point of the far link, seen from the near one, by more than `Σⱼ |Δθⱼ| λⱼ`, so every cell
+//! within that reach of distance `d` is free. A lane whose angles fall in a free cell is clear
+//! of the pair; every other lane is checked as before, so a table only spares work and never
+//! decides a collision. Pairs tested as solids (boxes, capsules) and sphere models get no
+//! table: their screen leaves few lanes to spare.
+//!
+//! The angles are read from the block's poses (the joint's parent and child link), not from
+//! the inputs, so that a table serves every active set and coupling: with `A` the parent's
+//! orientation times the joint origin's, the child's orientation is `A ⊗ (cos θ/2, sin θ/2 n)`.
+//! Cells are uniform in `u = tan((θ − θ̄)/4)` (`θ̄` the middle of the joint's range), which
+//! needs no arc tangent at run time and stretches cells by at most 2 against uniform angles.
+//! Each cell's angle interval is widened by [`ANGLE_PAD`] for the `f32` poses' rounding, a
+//! lane outside the table (or NaN) is undecided, and distances must exceed the bubble by
+//! [`SLACK`] (the exact distance's own tolerance).
+
+use super::lanes::F;
+use super::{FAST_LANES, LaneMask};
+use crate::levers::Levers;
+use crate::model::CollisionModel;
+use trm_kinematics::{JointKind, PoseLanes32};
+
+/// Radians added on each side of a cell's angle interval: the `f32` poses' rounding (a few
+/// 10⁻⁷ rad) many times over.
+const ANGLE_PAD: f64 = 1e-4;
+
+/// Metres by which a distance must exceed the bubble's reach: the exact distance's tolerance.
+const SLACK: f64 = 1e-5;
+
+/// The farthest a cell's configurations may move the far link's points, per joint (metres):
+/// cells are sized so that each joint's half-width times its lever arm is at most this, until
+/// [`MAX_CELLS`] stops them.
+const REACH_PER_JOINT: f64 = 1.5e-3;
+
+/// Most cells in one table (a bit each).
+const MAX_CELLS: usize = 1 << 17;
+
+/// A revolute joint of a tabled pair: how its angle is read from a block's poses and which cell
+/// it falls in.
+#[derive(Debug, Clone)]
+struct TableJoint {
+    /// Pose indices of the joint's parent and child links.
+    parent: u32,
+    child: u32,
+    /// The joint origin's rotation `w, x, y, z`.
+    origin: [f32; 4],
+    /// The joint's unit axis in its own frame.
+    axis: [f32; 3],
+    /// `cos`, `sin` of half the middle of the joint's range.
+    middle: [f32; 2],
+    /// The lowest `u` of the table and cells per unit of `u`.
+    u_low: f32,
+    per_u: f32,
+    cells: u32,
+}
+
+impl TableJoint {
+    /// The cell coordinate `(u − u_low) · per_u` of the joint's angle in every lane (the
+    /// cell is its integer part; outside `[0, cells)` or NaN, outside the table).
+    #[inline(always)]
+    fn coordinate(&self, poses: &[PoseLanes32]) -> F {
+        let (p, b) = (&poses[self.parent as usize], &poses[self.child as usize]);
+        let (pw, px, py, pz) = (F(p[0]), F(p[1]), F(p[2]), F(p[3]));
+        let (bw, bx, by, bz) = (F(b[0]), F(b[1]), F(b[2]), F(b[3]));
+        let [ow, ox, oy, oz] = self.origin.map(F::splat);
+        // A = parent ⊗ origin
+        let aw = pw * ow - px * ox - py * oy - pz * oz;
+        let ax = pw * ox + px * ow + py * oz - pz * oy;
+        let ay = pw * oy - px * oz + py * ow + pz * ox;
+        let az = pw * oz + px * oy - py * ox + pz * ow;
+        // conj(A) ⊗ child = (cos θ/2, sin θ/2 · axis)
+        let [nx, ny, nz] = self.axis.map(F::splat);
+        let c = aw * bw + ax * bx + ay * by + az * bz;
+        let (n_b, n_a) = (nx * bx + ny * by + nz * bz, nx * ax + ny * ay + nz * az);
+        let cross = nx * (ay * bz - az * by) + ny * (az * bx - ax * bz) + nz * (ax * by - ay * bx);
+        let s = aw * n_b - bw * n_a - cross;
+        // φ = θ/2 − θ̄/2, then u = tan(φ/2)
+        let (cm, sm) = (F::splat(self.middle[0]), F::splat(self.middle[1]));
+        let (sin_phi, cos_phi) = (s * cm - c * sm, c * cm + s * sm);
+        let u = sin_phi / (F::splat(1.0) + cos_phi);
+        (u - F::splat(self.u_low)) * F::splat(self.per_u)
+    }
+}
+
+/// The free cells of a link pair moved relative to each other by one or two revolute joints
+/// (made by [`PairTable::build`]).
+#[derive(Debug, Clone)]
+pub(super) struct PairTable {
+    /// Nearest the near link first; the cell index is row-major in this order.
+    joints: Vec<TableJoint>,
+    /// One bit per cell: set when every configuration in it is free.
+    free: Vec<u64>,
+}
+
+impl PairTable {
+    /// The lanes of `lanes` whose angles fall in a free cell: there the pair is clear.
+    #[inline(always)]
+    pub(super) fn free_lanes(&self, poses: &[PoseLanes32], lanes: LaneMask) -> LaneMask {
+        let mut index = [0u32; FAST_LANES];
+        let mut inside = lanes;
+        for joint in &self.joints {
+            let x = joint.coordinate(poses);
+            let cells = joint.cells as f32;
+            for l in 0..FAST_LANES {
+                let v = x.0[l];
+                // NaN fails both comparisons: outside
+                if !(v >= 0.0 && v < cells) {
+                    inside &= !(1 << l);
+                }
+                index[l] = index[l] * joint.cells + (v.max(0.0) as u32).min(joint.cells - 1);
+            }
+        }
+        let mut free = 0;
+        let mut bits = inside;
+        while bits != 0 {
+            let l = bits.trailing_zeros() as usize;
+            let i = index[l] as usize;
+            if self.free[i / 64] >> (i % 64) & 1 != 0 {
+                free |= 1 << l;
+            }
+            bits &= bits - 1;
+        }
+        free
+    }
+
+    /// The fraction of the table's cells that are free (for tests).
+    #[cfg(test)]
+    pub(super) fn free_fraction(&self) -> f64 {
+        let cells: usize = self.joints.iter().map(|j| j.cells as usize).product();
+        let free: u32 = self.free.iter().map(|w| w.count_ones()).sum();
+        f64::from(free) / cells as f64
+    }
+
+    /// The table of the pair of links `a` and `b` whose checked bodies are `bodies` (indices
+    /// into the model's bodies), when one link lies below the other and the joints between
+    /// them are one or two revolute joints with limits (spanning less than a turn) and no
+    /// `<mimic>`, besides fixed ones; `None` otherwise.
+    pub(super) fn build(
+        model: &CollisionModel,
+        levers: &Levers,
+        a: usize,
+        b: usize,
+        bodies: &[(u32, u32)],
+    ) -> Option<PairTable> {
+        let robot = model.robot();
+        let tree = robot.tree();
+        let (far, path) = chain(tree, a, b)
+            .map(|p| (b, p))
+            .or_else(|| chain(tree, b, a).map(|p| (a, p)))?;
+        let movable: Vec<usize> = path
+            .into_iter()
+            .filter(|&j| tree.joints[j].kind != JointKind::Fixed)
+            .collect();
+        if movable.is_empty() || movable.len() > 2 {
+            return None;
+        }
+        let mut axes = Vec::new();
+        for &j in &movable {
+            let joint = &tree.joints[j];
+            let (lo, hi) = (joint.limits.lower, joint.limits.upper);
+            let usable = joint.kind == JointKind::Revolute
+                && joint.mimic.is_none()
+                && lo.is_finite()
+                && hi.is_finite()
+                && hi > lo
+                && hi - lo < 2.0 * std::f64::consts::PI - 0.2;
+            if !usable {
+                return None;
+            }
+            let lever = levers.arm(far, j)?;
+            axes.push(Axis::new(j, lo, hi, lever));
+        }
+        // cells of width ≤ 4 du in angle: du = half the half-width the reach allows
+        let mut counts: Vec<usize> = axes
+            .iter()
+            .map(|x| {
+                let du = 0.5 * REACH_PER_JOINT / x.lever.max(1e-9);
+                ((x.u_high - x.u_low) / du).ceil().clamp(1.0, 4096.0) as usize
+            })
+            .collect();
+        let total: usize = counts.iter().product();
+        if total > MAX_CELLS {
+            let shrink = (MAX_CELLS as f64 / total as f64).powf(1.0 / counts.len() as f64);
+            for c in &mut counts {
+                *c = ((*c as f64 * shrink).floor() as usize).max(1);
+            }
+        }
+        for (x, &c) in axes.iter_mut().zip(&counts) {
+            x.cut(c);
+        }
+        let free = Flood::new(model, &axes, bodies)?.run();
+        let joints = axes
+            .iter()
+            .map(|x| {
+                let joint = &tree.joints[x.joint];
+                let o = joint.local_origin.rotation;
+                let middle = 0.25 * (x.low + x.high);
+                TableJoint {
+                    parent: joint.parent as u32,
+                    child: joint.child as u32,
+                    origin: [o.w, o.i, o.j, o.k].map(|v| v as f32),
+                    axis: [joint.axis.x, joint.axis.y, joint.axis.z].map(|v| v as f32),
+                    middle: [middle.cos() as f32, middle.sin() as f32],
+                    u_low: x.u_low as f32,
+                    per_u: (x.cells as f64 / (x.u_high - x.u_low)) as f32,
+                    cells: x.cells as u32,
+                }
+            })
+            .collect();
+        Some(PairTable { joints, free })
+    }
+}
+
+/// The joints from link `ancestor` down to link `link` (tree indices, nearest `ancestor`
+/// first), when `ancestor` is an ancestor of `link`.
+fn chain(tree: &trm_kinematics::Tree, ancestor: usize, link: usize) -> Option<Vec<usize>> {
+    let mut joints = Vec::new();
+    let mut at = link;
+    while at != ancestor {
+        let j = tree.links[at].parent_joint?;
+        joints.push(j);
+        at = tree.joints[j].parent;
+    }
+    joints.reverse();
+    Some(joints)
+}
+
+/// One joint of a table while building it: its range, lever arm and cells in `u`.
+#[derive(Debug, Clone)]
+struct Axis {
+    joint: usize,
+    low: f64,
+    high: f64,
+    lever: f64,
+    u_low: f64,
+    u_high: f64,
+    cells: usize,
+    /// Each cell's angle interval, widened by [`ANGLE_PAD`] (made by [`Axis::cut`]).
+    intervals: Vec<[f64; 2]>,
+}
+
+impl Axis {
+    fn new(joint: usize, low: f64, high: f64, lever: f64) -> Self {
+        let quarter = 0.25 * (high - low);
+        Axis {
+            joint,
+            low,
+            high,
+            lever,
+            u_low: (-0.5 * quarter).tan(),
+            u_high: (0.5 * quarter).tan(),
+            cells: 1,
+            intervals: Vec::new(),
+        }
+    }
+
+    /// Cuts the joint's range into `cells` cells.
+    fn cut(&mut self, cells: usize) {
+        self.cells = cells;
+        let du = (self.u_high - self.u_low) / cells as f64;
+        self.intervals = (0..cells)
+            .map(|k| {
+                let u = self.u_low + k as f64 * du;
+                [self.angle(u) - ANGLE_PAD, self.angle(u + du) + ANGLE_PAD]
+            })
+            .collect();
+    }
+
+    /// The angle at `u`: `θ̄ + 4 atan u`.
+    fn angle(&self, u: f64) -> f64 {
+        0.5 * (self.low + self.high) + 4.0 * u.atan()
+    }
+}
+
+/// The bubble flood that marks a table's free cells: each cell not yet free is measured at its
+/// middle, and every cell within the bubble of that distance is marked free.
+struct Flood<'a> {
+    model: &'a CollisionModel,
+    axes: &'a [Axis],
+    bodies: &'a [(u32, u32)],
+    joints: Vec<f64>,
+    pose: trm_kinematics::PoseBuffer,
+    placed: crate::placed::PlacedBodies,
+    free: Vec<u64>,
+}
+
+impl<'a> Flood<'a> {
+    fn new(model: &'a CollisionModel, axes: &'a [Axis], bodies: &'a [(u32, u32)]) -> Option<Self> {
+        let robot = model.robot();
+        let cells: usize = axes.iter().map(|x| x.cells).product();
+        let tree = robot.tree();
+        if bodies.is_empty()
+            || axes
+                .iter()
+                .any(|x| tree.joints[x.joint].coordinate.is_none())
+        {
+            return None;
+        }
+        Some(Flood {
+            model,
+            axes,
+            bodies,
+            joints: vec![0.0; robot.num_joints()],
+            pose: robot.pose_buffer(),
+            placed: model.placed_bodies(),
+            free: vec![0; cells.div_ceil(64)],
+        })
+    }
+
+    /// The cells' bits once every cell is free or measured.
+    fn run(mut self) -> Vec<u64> {
+        let dims: Vec<usize> = self.axes.iter().map(|x| x.cells).collect();
+        let cells: usize = dims.iter().product();
+        for i in 0..cells {
+            if self.is_free(i) {
+                continue;
+            }
+            let at = cell_of(i, &dims);
+            let middle: Vec<f64> = at
+                .iter()
+                .zip(self.axes)
+                .map(|(&k, x)| {
+                    let [lo, hi] = x.intervals[k];
+                    0.5 * (lo + hi)
+                })
+                .collect();
+            let Some(d) = self.distance(&middle) else {
+                continue;
+            };
+            self.mark(&middle, d - SLACK, &dims, &at);
+        }
+        self.free
+    }
+
+    fn is_free(&self, i: usize) -> bool {
+        self.free[i / 64] >> (i % 64) & 1 != 0
+    }
+
+    /// The exact distance between the pair's checked bodies with the joints at `angles`
+    /// (`None` if forward kinematics refuses them).
+    fn distance(&mut self, angles: &[f64]) -> Option<f64> {
+        let robot = self.model.robot();
+        for (x, &v) in self.axes.iter().zip(angles) {
+            self.joints[robot.tree().joints[x.joint].coordinate?] = v;
+        }
+        robot.forward_joints(&self.joints, &mut self.pose).ok()?;
+        let mut d = f64::INFINITY;
+        for &(a, b) in self.bodies {
+            let (a, b) = (a as usize, b as usize);
+            self.model.place_body(&self.pose, a, &mut self.placed);
+            self.model.place_body(&self.pose, b, &mut self.placed);
+            // touching bodies certify nothing: their depth is not needed
+            if self.model.bodies_touch(&self.placed, a, b) {
+                return Some(0.0);
+            }
+            d = d.min(self.model.bodies_gap(&self.placed, a, b));
+        }
+        d.is_finite().then_some(d)
+    }
+
+    /// Marks free every cell whose whole interval lies within reach `budget` of `middle`
+    /// (weighted by the lever arms), walking outwards from cell `at` along each joint.
+    fn mark(&mut self, middle: &[f64], budget: f64, dims: &[usize], at: &[usize]) {
+        if budget <= 0.0 {
+            return;
+        }
+        // per axis: the cells reachable and what each costs
+        let reach: Vec<Vec<(usize, f64)>> = self
+            .axes
+            .iter()
+            .zip(middle)
+            .zip(at)
+            .map(|((x, &m), &k)| {
+                let cost = |c: usize| {
+                    let [lo, hi] = x.intervals[c];
+                    x.lever * (m - lo).abs().max((hi - m).abs())
+                };
+                let mut cells = Vec::new();
+                for c in (0..=k).rev() {
+                    let v = cost(c);
+                    if v >= budget {
+                        break;
+                    }
+                    cells.push((c, v));
+                }
+                for c in k + 1..x.cells {
+                    let v = cost(c);
+                    if v >= budget {
+                        break;
+                    }
+                    cells.push((c, v));
+                }
+                cells
+            })
+            .collect();
+        match reach.as_slice() {
+            [only] => {
+                for &(c, _) in only {
+                    self.free[c / 64] |= 1 << (c % 64);
+                }
+            }
+            [first, second] => {
+                for &(c0, v0) in first {
+                    for &(c1, v1) in second {
+                        if v0 + v1 < budget {
+                            let i = c0 * dims[1] + c1;
+                            self.free[i / 64] |= 1 << (i % 64);
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Cell `i`'s coordinates (row-major over `dims`).
+fn cell_of(mut i: usize, dims: &[usize]) -> Vec<usize> {
+    let mut at = vec![0; dims.len()];
+    for (k, &d) in dims.iter().enumerate().rev() {
+        at[k] = i % d;
+        i /= d;
+    }
+    at
+}
