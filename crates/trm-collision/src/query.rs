@@ -343,11 +343,17 @@ impl CollisionModel {
         !bounds_apart(p, &o.placed) && intersects(c, p, &o.compiled, &o.placed)
     }
 
-    /// The gap between placed bodies `a` and `b`, which must not touch
-    /// ([`CollisionModel::bodies_touch`] false): their distance, faster for convex hulls.
-    pub(crate) fn bodies_gap(&self, placed: &PlacedBodies, a: usize, b: usize) -> f64 {
+    /// [`CollisionModel::body_distance`], faster for convex hulls, when whether the bodies
+    /// touch is known (`touching`, as [`CollisionModel::bodies_touch`] says).
+    pub(crate) fn body_distance_knowing(
+        &self,
+        placed: &PlacedBodies,
+        a: usize,
+        b: usize,
+        touching: bool,
+    ) -> f64 {
         let (c, p) = (self.compiled(), &placed.placed);
-        crate::shape::gap(&c[a], &p[a], &c[b], &p[b])
+        crate::shape::hull_signed_distance(&c[a], &p[a], &c[b], &p[b], touching)
     }
 
     /// Signed distance between bodies `a` and `b` (whether or not their pair is checked).

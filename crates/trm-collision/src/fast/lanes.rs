@@ -86,6 +86,16 @@ impl F {
         Flags(flags)
     }
 
+    /// The lanes outside `[low, high)`, or NaN.
+    #[inline(always)]
+    pub(super) fn outside(self, low: f32, high: f32) -> Flags {
+        let mut flags = [0; FAST_LANES];
+        for l in 0..FAST_LANES {
+            flags[l] = u32::from(!(self.0[l] >= low && self.0[l] < high));
+        }
+        Flags(flags)
+    }
+
     /// The lanes > `limit`.
     #[inline(always)]
     pub(super) fn above(self, limit: f32) -> Flags {

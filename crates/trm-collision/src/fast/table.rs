@@ -24,8 +24,8 @@
 //! lane outside the table (or NaN) is undecided, and distances must exceed the bubble by
 //! [`SLACK`] (the exact distance's own tolerance).
 
-use super::lanes::F;
-use super::{FAST_LANES, LaneMask};
+use super::LaneMask;
+use super::lanes::{F, Flags, PORTABLE};
 use crate::levers::Levers;
 use crate::model::CollisionModel;
 use trm_kinematics::{JointKind, PoseLanes32};
@@ -34,8 +34,13 @@ use trm_kinematics::{JointKind, PoseLanes32};
 /// 10⁻⁷ rad) many times over.
 const ANGLE_PAD: f64 = 1e-4;
 
-/// Metres by which a distance must exceed the bubble's reach: the exact distance's tolerance.
+/// Metres by which a gap must exceed the bubble's reach: the exact distance's tolerance.
 const SLACK: f64 = 1e-5;
+
+/// Metres by which a depth must exceed the bubble's reach. The depth of touching convex
+/// bodies is parry's EPA: the distance to a face of a polytope inside their Minkowski
+/// difference, so never more than the true depth; this covers its rounding many times over.
+const DEPTH_SLACK: f64 = 1e-4;
 
 /// The farthest a cell's configurations may move the far link's points, per joint (metres):
 /// cells are sized so that each joint's half-width times its lever arm is at most this, until
@@ -92,7 +97,7 @@ impl TableJoint {
     }
 }
 
-/// The free cells of a link pair moved relative to each other by one or two revolute joints
+/// The decided cells of a link pair moved relative to each other by one or two revolute joints
 /// (made by [`PairTable::build`]).
 #[derive(Debug, Clone)]
 pub(super) struct PairTable {
@@ -100,45 +105,44 @@ pub(super) struct PairTable {
     joints: Vec<TableJoint>,
     /// One bit per cell: set when every configuration in it is free.
     free: Vec<u64>,
+    /// One bit per cell: set when every configuration in it collides.
+    hit: Vec<u64>,
 }
 
 impl PairTable {
-    /// The lanes of `lanes` whose angles fall in a free cell: there the pair is clear.
+    /// The lanes of `lanes` whose angles fall in a free cell (there the pair is clear) and
+    /// those in a colliding cell (there it certainly collides).
     #[inline(always)]
-    pub(super) fn free_lanes(&self, poses: &[PoseLanes32], lanes: LaneMask) -> LaneMask {
-        let mut index = [0u32; FAST_LANES];
-        let mut inside = lanes;
+    pub(super) fn lookup(&self, poses: &[PoseLanes32], lanes: LaneMask) -> (LaneMask, LaneMask) {
+        let mut index = F::splat(0.0);
+        let mut outside = Flags::default();
         for joint in &self.joints {
             let x = joint.coordinate(poses);
             let cells = joint.cells as f32;
-            for l in 0..FAST_LANES {
-                let v = x.0[l];
-                // NaN fails both comparisons: outside
-                if !(v >= 0.0 && v < cells) {
-                    inside &= !(1 << l);
-                }
-                index[l] = index[l] * joint.cells + (v.max(0.0) as u32).min(joint.cells - 1);
-            }
+            outside = outside | x.outside(0.0, cells);
+            // exact: cell indices stay far below 2²⁴
+            index = index * F::splat(cells) + x.map(f32::floor);
         }
-        let mut free = 0;
+        let inside = lanes & !outside.mask::<PORTABLE>();
+        let (mut free, mut hit) = (0, 0);
         let mut bits = inside;
         while bits != 0 {
             let l = bits.trailing_zeros() as usize;
-            let i = index[l] as usize;
-            if self.free[i / 64] >> (i % 64) & 1 != 0 {
-                free |= 1 << l;
-            }
+            let i = index.0[l] as usize;
+            let (word, bit) = (i / 64, i % 64);
+            free |= ((self.free[word] >> bit) as u8 & 1) << l;
+            hit |= ((self.hit[word] >> bit) as u8 & 1) << l;
             bits &= bits - 1;
         }
-        free
+        (free, hit)
     }
 
-    /// The fraction of the table's cells that are free (for tests).
+    /// The fractions of the table's cells that are free and that collide (for tests).
     #[cfg(test)]
-    pub(super) fn free_fraction(&self) -> f64 {
+    pub(super) fn decided(&self) -> [f64; 2] {
         let cells: usize = self.joints.iter().map(|j| j.cells as usize).product();
-        let free: u32 = self.free.iter().map(|w| w.count_ones()).sum();
-        f64::from(free) / cells as f64
+        let count = |bits: &[u64]| bits.iter().map(|w| w.count_ones()).sum::<u32>();
+        [count(&self.free), count(&self.hit)].map(|n| f64::from(n) / cells as f64)
     }
 
     /// The table of the pair of links `a` and `b` whose checked bodies are `bodies` (indices
@@ -198,7 +202,7 @@ impl PairTable {
         for (x, &c) in axes.iter_mut().zip(&counts) {
             x.cut(c);
         }
-        let free = Flood::new(model, &axes, bodies)?.run();
+        let (free, hit) = Flood::new(model, &axes, bodies)?.run();
         let joints = axes
             .iter()
             .map(|x| {
@@ -217,7 +221,7 @@ impl PairTable {
                 }
             })
             .collect();
-        Some(PairTable { joints, free })
+        Some(PairTable { joints, free, hit })
     }
 }
 
@@ -282,8 +286,9 @@ impl Axis {
     }
 }
 
-/// The bubble flood that marks a table's free cells: each cell not yet free is measured at its
-/// middle, and every cell within the bubble of that distance is marked free.
+/// The bubble flood that marks a table's decided cells: each cell not yet decided is measured
+/// at its middle, and every cell within the bubble of that signed distance is marked free (a
+/// gap) or colliding (a depth).
 struct Flood<'a> {
     model: &'a CollisionModel,
     axes: &'a [Axis],
@@ -291,7 +296,9 @@ struct Flood<'a> {
     joints: Vec<f64>,
     pose: trm_kinematics::PoseBuffer,
     placed: crate::placed::PlacedBodies,
+    /// Cells proved free and proved colliding, one bit each.
     free: Vec<u64>,
+    hit: Vec<u64>,
 }
 
 impl<'a> Flood<'a> {
@@ -314,18 +321,33 @@ impl<'a> Flood<'a> {
             pose: robot.pose_buffer(),
             placed: model.placed_bodies(),
             free: vec![0; cells.div_ceil(64)],
+            hit: vec![0; cells.div_ceil(64)],
         })
     }
 
-    /// The cells' bits once every cell is free or measured.
-    fn run(mut self) -> Vec<u64> {
+    /// The cells' bits (free, colliding) once every cell is decided or measured: coarse to
+    /// fine (every 32nd cell along each joint first, then every 16th, …), so that the wide
+    /// bubbles far from contact are measured first and decide most cells.
+    fn run(mut self) -> (Vec<u64>, Vec<u64>) {
         let dims: Vec<usize> = self.axes.iter().map(|x| x.cells).collect();
-        let cells: usize = dims.iter().product();
-        for i in 0..cells {
-            if self.is_free(i) {
-                continue;
+        let (rows, columns) = (dims[0], dims.get(1).copied().unwrap_or(1));
+        for stride in [32, 16, 8, 4, 2, 1] {
+            for r in (0..rows).step_by(stride) {
+                for c in (0..columns).step_by(stride) {
+                    let at = [r, c];
+                    self.measure(r * columns + c, &at[..dims.len()], &dims);
+                }
             }
-            let at = cell_of(i, &dims);
+        }
+        (self.free, self.hit)
+    }
+
+    /// Measures cell `i` (at `at`) unless it is decided, and floods its bubble.
+    fn measure(&mut self, i: usize, at: &[usize], dims: &[usize]) {
+        {
+            if bit(&self.free, i) || bit(&self.hit, i) {
+                return;
+            }
             let middle: Vec<f64> = at
                 .iter()
                 .zip(self.axes)
@@ -335,19 +357,19 @@ impl<'a> Flood<'a> {
                 })
                 .collect();
             let Some(d) = self.distance(&middle) else {
-                continue;
+                return;
             };
-            self.mark(&middle, d - SLACK, &dims, &at);
+            if d > 0.0 {
+                self.mark(&middle, d - SLACK, dims, at, true);
+            } else {
+                self.mark(&middle, -d - DEPTH_SLACK, dims, at, false);
+            }
         }
-        self.free
     }
 
-    fn is_free(&self, i: usize) -> bool {
-        self.free[i / 64] >> (i % 64) & 1 != 0
-    }
-
-    /// The exact distance between the pair's checked bodies with the joints at `angles`
-    /// (`None` if forward kinematics refuses them).
+    /// The signed distance between the pair's checked bodies with the joints at `angles`: the
+    /// smallest gap, or minus the largest depth when some touch (`None` if forward kinematics
+    /// refuses the angles).
     fn distance(&mut self, angles: &[f64]) -> Option<f64> {
         let robot = self.model.robot();
         for (x, &v) in self.axes.iter().zip(angles) {
@@ -359,18 +381,25 @@ impl<'a> Flood<'a> {
             let (a, b) = (a as usize, b as usize);
             self.model.place_body(&self.pose, a, &mut self.placed);
             self.model.place_body(&self.pose, b, &mut self.placed);
-            // touching bodies certify nothing: their depth is not needed
-            if self.model.bodies_touch(&self.placed, a, b) {
-                return Some(0.0);
-            }
-            d = d.min(self.model.bodies_gap(&self.placed, a, b));
+            // touching bodies certify no gap: their depth, at most 0
+            let touching = self.model.bodies_touch(&self.placed, a, b);
+            let pair = self
+                .model
+                .body_distance_knowing(&self.placed, a, b, touching);
+            let pair = if touching {
+                pair.min(0.0)
+            } else {
+                pair.max(0.0)
+            };
+            d = d.min(pair);
         }
         d.is_finite().then_some(d)
     }
 
-    /// Marks free every cell whose whole interval lies within reach `budget` of `middle`
-    /// (weighted by the lever arms), walking outwards from cell `at` along each joint.
-    fn mark(&mut self, middle: &[f64], budget: f64, dims: &[usize], at: &[usize]) {
+    /// Marks free (`free`) or colliding every cell whose whole interval lies within reach
+    /// `budget` of `middle` (weighted by the lever arms), walking outwards from cell `at`
+    /// along each joint.
+    fn mark(&mut self, middle: &[f64], budget: f64, dims: &[usize], at: &[usize], free: bool) {
         if budget <= 0.0 {
             return;
         }
@@ -385,28 +414,18 @@ impl<'a> Flood<'a> {
                     let [lo, hi] = x.intervals[c];
                     x.lever * (m - lo).abs().max((hi - m).abs())
                 };
-                let mut cells = Vec::new();
-                for c in (0..=k).rev() {
-                    let v = cost(c);
-                    if v >= budget {
-                        break;
-                    }
-                    cells.push((c, v));
-                }
-                for c in k + 1..x.cells {
-                    let v = cost(c);
-                    if v >= budget {
-                        break;
-                    }
-                    cells.push((c, v));
-                }
+                let below = (0..=k).rev().map(|c| (c, cost(c)));
+                let above = (k + 1..x.cells).map(|c| (c, cost(c)));
+                let mut cells: Vec<(usize, f64)> = below.take_while(|&(_, v)| v < budget).collect();
+                cells.extend(above.take_while(|&(_, v)| v < budget));
                 cells
             })
             .collect();
+        let bits = if free { &mut self.free } else { &mut self.hit };
         match reach.as_slice() {
             [only] => {
                 for &(c, _) in only {
-                    self.free[c / 64] |= 1 << (c % 64);
+                    bits[c / 64] |= 1 << (c % 64);
                 }
             }
             [first, second] => {
@@ -414,7 +433,7 @@ impl<'a> Flood<'a> {
                     for &(c1, v1) in second {
                         if v0 + v1 < budget {
                             let i = c0 * dims[1] + c1;
-                            self.free[i / 64] |= 1 << (i % 64);
+                            bits[i / 64] |= 1 << (i % 64);
                         }
                     }
                 }
@@ -424,12 +443,7 @@ impl<'a> Flood<'a> {
     }
 }
 
-/// Cell `i`'s coordinates (row-major over `dims`).
-fn cell_of(mut i: usize, dims: &[usize]) -> Vec<usize> {
-    let mut at = vec![0; dims.len()];
-    for (k, &d) in dims.iter().enumerate().rev() {
-        at[k] = i % d;
-        i /= d;
-    }
-    at
+/// Bit `i` of `bits`.
+fn bit(bits: &[u64], i: usize) -> bool {
+    bits[i / 64] >> (i % 64) & 1 != 0
 }

@@ -238,13 +238,7 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
     for (suspect, lanes) in &mut suspects {
         if let Suspect::Pair(k) = *suspect {
             let gp = &model.group_pairs[k as usize];
-            // lanes in a free cell of the pair's clearance table are clear of it
-            if let Some(t) = gp.table {
-                *lanes &= !model.tables[t as usize].free_lanes(poses, *lanes);
-                if *lanes == 0 {
-                    continue;
-                }
-            }
+
             // the k-DOP screen reads both links' spheres: a link tested as one box has not had
             // them placed for this block
             place_balls::<AVX>(model, poses, gp.a, scratch);
@@ -491,6 +485,21 @@ pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
     verdict: &mut O,
 ) -> bool {
     let m = world.margin;
+    // the pair's clearance table decides the lanes in its free and colliding cells
+    let near = match gp.table {
+        Some(t) => {
+            let (free, hit) = model.tables[t as usize].lookup(poses, near);
+            if hit != 0 && verdict.add(hit, hit, 0).is_none() {
+                scratch.last_hit = Some(Suspect::Pair(k as u32));
+                return true;
+            }
+            near & !(free | hit)
+        }
+        None => near,
+    };
+    if near == 0 {
+        return false;
+    }
     let (hit, close) = if !gp.solid_pairs.is_empty() {
         // the bodies themselves
         solid_contacts::<AVX>(model, poses, gp, scratch, m, !O::STOPS_AT_FIRST)

@@ -21,7 +21,8 @@ mod spheres;
 
 pub(crate) use compiled::{Axial, Compiled, Geometry, LazyShape, Placed};
 pub(crate) use pair::{
-    Closest, bounds_apart, gap, intersects, proximity, signed_distance, sphere_apart,
+    Closest, bounds_apart, hull_signed_distance, intersects, proximity, signed_distance,
+    sphere_apart,
 };
 pub(crate) use segment_lanes::{PointLanes, segment_distance_squared_lanes};
 pub use spheres::{CONVEX_SPHERES, Sphere};

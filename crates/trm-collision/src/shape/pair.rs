@@ -269,18 +269,26 @@ fn parry_intersects(
     query::intersection_test(i1, s1, i2, s2).unwrap_or(true)
 }
 
-/// The gap between two placed shapes known not to touch: GJK over the hulls' vertex walks when
-/// both have one (parry's polyhedra scan every vertex per support point), else
-/// [`signed_distance`].
-pub(crate) fn gap(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Placed) -> f64 {
+/// [`signed_distance`] of two placed shapes, faster for convex hulls (GJK and EPA over the
+/// hulls' vertex walks: parry's polyhedra scan every vertex per support point); `touching`
+/// says whether they touch ([`intersects`]).
+pub(crate) fn hull_signed_distance(
+    c1: &Compiled,
+    p1: &Placed,
+    c2: &Compiled,
+    p2: &Placed,
+    touching: bool,
+) -> f64 {
     if let (Geometry::General { walk: Some(w1), .. }, Geometry::General { walk: Some(w2), .. }) =
         (&c1.geometry, &c2.geometry)
     {
-        return query::details::distance_support_map_support_map(
-            &p1.iso.inv_mul(&p2.iso),
-            &**w1,
-            &**w2,
-        );
+        let pos12 = p1.iso.inv_mul(&p2.iso);
+        return if touching {
+            query::details::contact_support_map_support_map(&pos12, &**w1, &**w2, 0.0)
+                .map_or(0.0, |c| c.dist.min(0.0))
+        } else {
+            query::details::distance_support_map_support_map(&pos12, &**w1, &**w2)
+        };
     }
     signed_distance(c1, p1, c2, p2)
 }
