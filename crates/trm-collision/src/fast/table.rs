@@ -92,6 +92,9 @@ impl TableJoint {
         // φ = θ/2 − θ̄/2, then u = tan(φ/2)
         let (cm, sm) = (F::splat(self.middle[0]), F::splat(self.middle[1]));
         let (sin_phi, cos_phi) = (s * cm - c * sm, c * cm + s * sm);
+        // q and −q are one rotation: the one with cos φ ≥ 0 (θ within π of θ̄)
+        let sign = cos_phi.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
+        let (sin_phi, cos_phi) = (sin_phi * sign, cos_phi * sign);
         let u = sin_phi / (F::splat(1.0) + cos_phi);
         (u - F::splat(self.u_low)) * F::splat(self.per_u)
     }
@@ -147,8 +150,8 @@ impl PairTable {
 
     /// The table of the pair of links `a` and `b` whose checked bodies are `bodies` (indices
     /// into the model's bodies), when one link lies below the other and the joints between
-    /// them are one or two revolute joints with limits (spanning less than a turn) and no
-    /// `<mimic>`, besides fixed ones; `None` otherwise.
+    /// them are one or two revolute or continuous joints without `<mimic>`, besides fixed ones;
+    /// `None` otherwise. A joint that turns a whole turn or more is tabled over every rotation.
     pub(super) fn build(
         model: &CollisionModel,
         levers: &Levers,
@@ -171,13 +174,13 @@ impl PairTable {
         let mut axes = Vec::new();
         for &j in &movable {
             let joint = &tree.joints[j];
+            let pi = std::f64::consts::PI;
             let (lo, hi) = (joint.limits.lower, joint.limits.upper);
-            let usable = joint.kind == JointKind::Revolute
+            // a joint that turns (nearly) a whole turn: the table covers every rotation
+            let (lo, hi) = if hi - lo < 2.0 * pi - 0.2 { (lo, hi) } else { (-pi, pi) };
+            let usable = matches!(joint.kind, JointKind::Revolute | JointKind::Continuous)
                 && joint.mimic.is_none()
-                && lo.is_finite()
-                && hi.is_finite()
-                && hi > lo
-                && hi - lo < 2.0 * std::f64::consts::PI - 0.2;
+                && hi > lo;
             if !usable {
                 return None;
             }
