@@ -33,9 +33,10 @@
 //! through spheres, is tested as that box: the other link's spheres are taken into its frame. A
 //! block whose lanes are left uncertain by two links of convex hulls gets a second, tighter
 //! screen before the exact checks: each link's spheres against the other's 18-sided bounding
-//! polytope (k-DOP), and a pair that one or two revolute joints alone move relative to each
-//! other (a forearm and the links beyond its wrist) is looked up in its clearance table: cells
-//! of those joints' angles proved free when compiling (`table.rs`). World objects of every
+//! polytope (k-DOP). Of such models, a pair that one or two revolute joints alone move
+//! relative to each other (a forearm and the links beyond its wrist) is first looked up in its
+//! clearance table: cells of those joints' angles proved free or colliding when compiling
+//! (`table.rs`). World objects of every
 //! shape are taken: spheres, capsules and boxes are checked in single precision, cylinders and
 //! convex hulls through their bounding spheres (a lane near one is uncertain). Point clouds sit in a counting-sorted uniform grid whose cells
 //! know their clearance (`cloud.rs`): a sphere, capsule or box is measured to the points within

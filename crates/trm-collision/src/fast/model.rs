@@ -489,16 +489,23 @@ fn tables(
     groups: &[Group],
     group_pairs: &mut [GroupPair],
 ) -> Result<Vec<PairTable>> {
+    use rayon::prelude::*;
     let levers = crate::levers::Levers::new(model, &model.robot().all_active())?;
-    let mut tables = Vec::new();
     // pairs tested as solids leave few lanes to the exact checks: only pairs screened through
-    // enclosing spheres get a table
-    for gp in group_pairs
-        .iter_mut()
-        .filter(|gp| gp.solid_pairs.is_empty() && gp.solid.is_none())
-    {
-        let (a, b) = (groups[gp.a].frame, groups[gp.b].frame);
-        if let Some(table) = PairTable::build(model, &levers, a, b, &gp.bodies) {
+    // enclosing spheres get a table (built in parallel: each is the same on any thread)
+    let built: Vec<Option<PairTable>> = group_pairs
+        .par_iter()
+        .map(|gp| {
+            let screened = gp.solid_pairs.is_empty() && gp.solid.is_none();
+            let (a, b) = (groups[gp.a].frame, groups[gp.b].frame);
+            screened
+                .then(|| PairTable::build(model, &levers, a, b, &gp.bodies))
+                .flatten()
+        })
+        .collect();
+    let mut tables = Vec::new();
+    for (gp, table) in group_pairs.iter_mut().zip(built) {
+        if let Some(table) = table {
             gp.table = Some(tables.len() as u32);
             tables.push(table);
         }

@@ -1,28 +1,32 @@
 //! Clearance tables: a link pair that one or two revolute joints alone move relative to each
 //! other (a forearm and the hand beyond its wrist) is looked up in a table over those joints'
-//! angles before its uncertain lanes go to the exact checks.
+//! angles before any of its spheres is tested.
 //!
-//! Such pairs are near in almost every configuration, so for bodies screened through enclosing
-//! spheres they leave many lanes to the exact checks (on the Panda's mesh hulls, most of them).
-//! Their relative pose is a function of one or two angles, so it can be decided once, when
-//! compiling: the angles' ranges are cut into cells, and a cell is marked *free* when a
-//! certificate proves every configuration in it collision-free. The certificate is a bubble
-//! (Quinlan 1994): the exact (`f64`) distance `d` between the two links' checked bodies at one
-//! configuration, and the joints' lever arms ([`Levers`]): a change `Δθ` of the angles moves no
-//! point of the far link, seen from the near one, by more than `Σⱼ |Δθⱼ| λⱼ`, so every cell
-//! within that reach of distance `d` is free. A lane whose angles fall in a free cell is clear
-//! of the pair; every other lane is checked as before, so a table only spares work and never
-//! decides a collision. Pairs tested as solids (boxes, capsules) and sphere models get no
-//! table: their screen leaves few lanes to spare.
+//! Such pairs are near in almost every configuration, so the screen tests them in almost every
+//! block and, for bodies screened through enclosing spheres, leaves many of their lanes to the
+//! exact checks (on the Panda's mesh hulls, most of them). Their relative pose is a function
+//! of one or two angles, so it can be decided once, when compiling: the angles' ranges are cut
+//! into cells, and a cell is marked *free* or *colliding* when a certificate proves every
+//! configuration in it so. The certificate is a bubble (Quinlan 1994): the exact (`f64`)
+//! signed distance `d` between the two links' checked bodies at one configuration, and the
+//! joints' lever arms ([`Levers`]): a change `Δθ` of the angles moves no point of the far link,
+//! seen from the near one, by more than `Σⱼ |Δθⱼ| λⱼ`, so every cell within that reach of a
+//! gap `d > 0` is free, and every cell within that reach of a depth `−d` collides (were the
+//! moved bodies apart, a translation no longer than the reach would part the measured ones,
+//! so their penetration depth could not exceed it). Cells are measured coarse to fine, each
+//! measurement deciding every cell its bubble holds. A lane whose angles fall in a decided
+//! cell is decided; every other lane is tested as before. Pairs tested as solids (boxes,
+//! capsules) and sphere models get no table: their screen decides almost every lane itself,
+//! and a table spares a block's tests only when all its lanes fall in decided cells.
 //!
 //! The angles are read from the block's poses (the joint's parent and child link), not from
 //! the inputs, so that a table serves every active set and coupling: with `A` the parent's
-//! orientation times the joint origin's, the child's orientation is `A ⊗ (cos θ/2, sin θ/2 n)`.
+//! orientation times the joint origin's, the child's orientation is `±A ⊗ (cos θ/2, sin θ/2 n)`.
 //! Cells are uniform in `u = tan((θ − θ̄)/4)` (`θ̄` the middle of the joint's range), which
 //! needs no arc tangent at run time and stretches cells by at most 2 against uniform angles.
 //! Each cell's angle interval is widened by [`ANGLE_PAD`] for the `f32` poses' rounding, a
-//! lane outside the table (or NaN) is undecided, and distances must exceed the bubble by
-//! [`SLACK`] (the exact distance's own tolerance).
+//! lane outside the table (or NaN) is undecided, and gaps and depths must exceed the bubble by
+//! [`SLACK`] and [`DEPTH_SLACK`] (the exact distance's own tolerance).
 
 use super::LaneMask;
 use super::lanes::{F, Flags, PORTABLE};
@@ -177,7 +181,11 @@ impl PairTable {
             let pi = std::f64::consts::PI;
             let (lo, hi) = (joint.limits.lower, joint.limits.upper);
             // a joint that turns (nearly) a whole turn: the table covers every rotation
-            let (lo, hi) = if hi - lo < 2.0 * pi - 0.2 { (lo, hi) } else { (-pi, pi) };
+            let (lo, hi) = if hi - lo < 2.0 * pi - 0.2 {
+                (lo, hi)
+            } else {
+                (-pi, pi)
+            };
             let usable = matches!(joint.kind, JointKind::Revolute | JointKind::Continuous)
                 && joint.mimic.is_none()
                 && hi > lo;
