@@ -238,7 +238,6 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
     for (suspect, lanes) in &mut suspects {
         if let Suspect::Pair(k) = *suspect {
             let gp = &model.group_pairs[k as usize];
-
             // the k-DOP screen reads both links' spheres: a link tested as one box has not had
             // them placed for this block
             place_balls::<AVX>(model, poses, gp.a, scratch);
