@@ -3,7 +3,7 @@ use super::kdop::{KDOP, kdop_of};
 use super::lanes::{F, inverse_axes, norm, to_f32};
 use super::outcome::{Tally, Verdict};
 use super::solid::{SLOTS, Solid, SolidPair};
-use super::table::PairTable;
+use super::table::{AngleReader, Angles, PairTable};
 use super::walk::{FastScratch, screen};
 use super::world::{FastWorld, Object};
 use crate::error::CollisionError;
@@ -138,6 +138,8 @@ pub struct FastModel {
     /// Clearance tables of the link pairs that one or two revolute joints alone move
     /// ([`GroupPair::table`]).
     pub(super) tables: Vec<PairTable>,
+    /// The tabled joints' angle readers ([`PairTable::lookup`]), one per joint.
+    pub(super) readers: Vec<AngleReader>,
     /// The self-collision walk through the culling spheres (when `culls`): culls and link
     /// pairs.
     pub(super) steps: Vec<CullStep>,
@@ -168,8 +170,8 @@ impl FastModel {
         let (pairs, mut group_pairs) = spheres.pairs(model);
         // sphere models decide every lane in the screen; others leave lanes to exact checks,
         // which tables spare
-        let tables = if exact {
-            Vec::new()
+        let (tables, readers) = if exact {
+            (Vec::new(), Vec::new())
         } else {
             tables(model, &spheres.groups, &mut group_pairs)?
         };
@@ -186,6 +188,7 @@ impl FastModel {
             groups: spheres.groups,
             group_pairs,
             tables,
+            readers,
             pairs,
             steps: walks.steps,
             world_steps: walks.world_steps,
@@ -243,6 +246,7 @@ impl FastModel {
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
             framed: vec![false; self.groups.len()],
+            angles: Angles::new(self.readers.len()),
             suspects: Vec::with_capacity(self.group_pairs.len() + self.groups.len()),
             last_hit: None,
         }
@@ -483,12 +487,12 @@ impl Spheres {
 }
 
 /// The clearance tables of the link pairs that allow one ([`PairTable::build`]), each pair
-/// given the index of its own.
+/// given the index of its own, and the readers of their joints' angles.
 fn tables(
     model: &CollisionModel,
     groups: &[Group],
     group_pairs: &mut [GroupPair],
-) -> Result<Vec<PairTable>> {
+) -> Result<(Vec<PairTable>, Vec<AngleReader>)> {
     use rayon::prelude::*;
     let levers = crate::levers::Levers::new(model, &model.robot().all_active())?;
     // pairs tested as solids leave few lanes to the exact checks: only pairs screened through
@@ -503,14 +507,29 @@ fn tables(
                 .flatten()
         })
         .collect();
-    let mut tables = Vec::new();
+    let tree = model.robot().tree();
+    let (mut tables, mut readers) = (Vec::new(), Vec::<AngleReader>::new());
     for (gp, table) in group_pairs.iter_mut().zip(built) {
-        if let Some(table) = table {
-            gp.table = Some(tables.len() as u32);
-            tables.push(table);
+        let Some(mut table) = table else { continue };
+        let mut indices = Vec::new();
+        for j in table.joints() {
+            let at = readers.iter().position(|r| r.joint() == j);
+            let Some(at) = at.or_else(|| {
+                readers.push(AngleReader::new(tree, j)?);
+                Some(readers.len() - 1)
+            }) else {
+                break;
+            };
+            indices.push(at as u32);
         }
+        if indices.len() != table.joints().count() {
+            continue;
+        }
+        table.attach(&indices);
+        gp.table = Some(tables.len() as u32);
+        tables.push(table);
     }
-    Ok(tables)
+    Ok((tables, readers))
 }
 
 /// The screen's walks through the exact model's culling spheres, while compiling.

@@ -54,30 +54,50 @@ const REACH_PER_JOINT: f64 = 1.5e-3;
 /// Most cells in one table (a bit each).
 const MAX_CELLS: usize = 1 << 17;
 
-/// A revolute joint of a tabled pair: how its angle is read from a block's poses and which cell
-/// it falls in.
+/// How a tabled joint's angle is read from a block's poses: one per joint, shared by every
+/// table over it ([`FastModel`](super::FastModel) keeps them; a block reads each at most once).
 #[derive(Debug, Clone)]
-struct TableJoint {
-    /// Pose indices of the joint's parent and child links.
+pub(super) struct AngleReader {
+    /// The joint (tree index), and the pose indices of its parent and child links.
+    joint: u32,
     parent: u32,
     child: u32,
     /// The joint origin's rotation `w, x, y, z`.
     origin: [f32; 4],
     /// The joint's unit axis in its own frame.
     axis: [f32; 3],
-    /// `cos`, `sin` of half the middle of the joint's range.
+    /// `cos`, `sin` of half the middle of the joint's tabled range.
     middle: [f32; 2],
-    /// The lowest `u` of the table and cells per unit of `u`.
+    /// The lowest `u` of the tabled range.
     u_low: f32,
-    per_u: f32,
-    cells: u32,
 }
 
-impl TableJoint {
-    /// The cell coordinate `(u − u_low) · per_u` of the joint's angle in every lane (the
-    /// cell is its integer part; outside `[0, cells)` or NaN, outside the table).
+impl AngleReader {
+    /// The reader of tree joint `j`, tabled over `range(j)`.
+    pub(super) fn new(tree: &trm_kinematics::Tree, j: usize) -> Option<Self> {
+        let joint = &tree.joints[j];
+        let axis = Axis::new(j, range(joint)?, 0.0);
+        let o = joint.local_origin.rotation;
+        let middle = 0.25 * (axis.low + axis.high);
+        Some(AngleReader {
+            joint: j as u32,
+            parent: joint.parent as u32,
+            child: joint.child as u32,
+            origin: [o.w, o.i, o.j, o.k].map(|v| v as f32),
+            axis: [joint.axis.x, joint.axis.y, joint.axis.z].map(|v| v as f32),
+            middle: [middle.cos() as f32, middle.sin() as f32],
+            u_low: axis.u_low as f32,
+        })
+    }
+
+    /// The joint it reads (tree index).
+    pub(super) fn joint(&self) -> usize {
+        self.joint as usize
+    }
+
+    /// `u − u_low` of the joint's angle in every lane (NaN in, NaN out).
     #[inline(always)]
-    fn coordinate(&self, poses: &[PoseLanes32]) -> F {
+    fn read(&self, poses: &[PoseLanes32]) -> F {
         let (p, b) = (&poses[self.parent as usize], &poses[self.child as usize]);
         let (pw, px, py, pz) = (F(p[0]), F(p[1]), F(p[2]), F(p[3]));
         let (bw, bx, by, bz) = (F(b[0]), F(b[1]), F(b[2]), F(b[3]));
@@ -99,9 +119,42 @@ impl TableJoint {
         // q and −q are one rotation: the one with cos φ ≥ 0 (θ within π of θ̄)
         let sign = cos_phi.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
         let (sin_phi, cos_phi) = (sin_phi * sign, cos_phi * sign);
-        let u = sin_phi / (F::splat(1.0) + cos_phi);
-        (u - F::splat(self.u_low)) * F::splat(self.per_u)
+        sin_phi / (F::splat(1.0) + cos_phi) - F::splat(self.u_low)
     }
+}
+
+/// The joints' readings of a block, made when first needed: [`FastScratch`](super::FastScratch)
+/// keeps one, cleared per block.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Angles {
+    /// Per reader: `u − u_low` in every lane, valid when `read`.
+    values: Vec<F>,
+    read: Vec<bool>,
+}
+
+impl Angles {
+    /// Room for `readers` readings, none made.
+    pub(super) fn new(readers: usize) -> Self {
+        Angles {
+            values: vec![F::default(); readers],
+            read: vec![false; readers],
+        }
+    }
+
+    /// Forgets the readings (a new block).
+    #[inline(always)]
+    pub(super) fn clear(&mut self) {
+        self.read.fill(false);
+    }
+}
+
+/// One joint of a table: its reader (an index into the model's readers) and its cells.
+#[derive(Debug, Clone)]
+struct TableAxis {
+    reader: u32,
+    /// Cells per unit of `u`.
+    per_u: f32,
+    cells: u32,
 }
 
 /// The decided cells of a link pair moved relative to each other by one or two revolute joints
@@ -109,7 +162,7 @@ impl TableJoint {
 #[derive(Debug, Clone)]
 pub(super) struct PairTable {
     /// Nearest the near link first; the cell index is row-major in this order.
-    joints: Vec<TableJoint>,
+    axes: Vec<TableAxis>,
     /// One bit per cell: set when every configuration in it is free.
     free: Vec<u64>,
     /// One bit per cell: set when every configuration in it collides.
@@ -118,14 +171,26 @@ pub(super) struct PairTable {
 
 impl PairTable {
     /// The lanes of `lanes` whose angles fall in a free cell (there the pair is clear) and
-    /// those in a colliding cell (there it certainly collides).
+    /// those in a colliding cell (there it certainly collides): the angles read by `readers`
+    /// from `poses`, or taken from `angles` when this block read them already.
     #[inline(always)]
-    pub(super) fn lookup(&self, poses: &[PoseLanes32], lanes: LaneMask) -> (LaneMask, LaneMask) {
+    pub(super) fn lookup(
+        &self,
+        readers: &[AngleReader],
+        angles: &mut Angles,
+        poses: &[PoseLanes32],
+        lanes: LaneMask,
+    ) -> (LaneMask, LaneMask) {
         let mut index = F::splat(0.0);
         let mut outside = Flags::default();
-        for joint in &self.joints {
-            let x = joint.coordinate(poses);
-            let cells = joint.cells as f32;
+        for axis in &self.axes {
+            let r = axis.reader as usize;
+            if !angles.read[r] {
+                angles.values[r] = readers[r].read(poses);
+                angles.read[r] = true;
+            }
+            let x = angles.values[r] * F::splat(axis.per_u);
+            let cells = axis.cells as f32;
             outside = outside | x.outside(0.0, cells);
             // exact: cell indices stay far below 2²⁴
             index = index * F::splat(cells) + x.map(f32::floor);
@@ -144,10 +209,24 @@ impl PairTable {
         (free, hit)
     }
 
+    /// The tree joints of the table's axes (until [`PairTable::attach`]), nearest the near
+    /// link first.
+    pub(super) fn joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.axes.iter().map(|a| a.reader as usize)
+    }
+
+    /// Points the table's axes at the model's readers (`readers`: their indices, in the order
+    /// of [`PairTable::joints`]).
+    pub(super) fn attach(&mut self, readers: &[u32]) {
+        for (a, &r) in self.axes.iter_mut().zip(readers) {
+            a.reader = r;
+        }
+    }
+
     /// The fractions of the table's cells that are free and that collide (for tests).
     #[cfg(test)]
     pub(super) fn decided(&self) -> [f64; 2] {
-        let cells: usize = self.joints.iter().map(|j| j.cells as usize).product();
+        let cells: usize = self.axes.iter().map(|a| a.cells as usize).product();
         let count = |bits: &[u64]| bits.iter().map(|w| w.count_ones()).sum::<u32>();
         [count(&self.free), count(&self.hit)].map(|n| f64::from(n) / cells as f64)
     }
@@ -177,23 +256,8 @@ impl PairTable {
         }
         let mut axes = Vec::new();
         for &j in &movable {
-            let joint = &tree.joints[j];
-            let pi = std::f64::consts::PI;
-            let (lo, hi) = (joint.limits.lower, joint.limits.upper);
-            // a joint that turns (nearly) a whole turn: the table covers every rotation
-            let (lo, hi) = if hi - lo < 2.0 * pi - 0.2 {
-                (lo, hi)
-            } else {
-                (-pi, pi)
-            };
-            let usable = matches!(joint.kind, JointKind::Revolute | JointKind::Continuous)
-                && joint.mimic.is_none()
-                && hi > lo;
-            if !usable {
-                return None;
-            }
             let lever = levers.arm(far, j)?;
-            axes.push(Axis::new(j, lo, hi, lever));
+            axes.push(Axis::new(j, range(&tree.joints[j])?, lever));
         }
         // cells of width ≤ 4 du in angle: du = half the half-width the reach allows
         let mut counts: Vec<usize> = axes
@@ -214,25 +278,16 @@ impl PairTable {
             x.cut(c);
         }
         let (free, hit) = Flood::new(model, &axes, bodies)?.run();
-        let joints = axes
+        // until attached, each axis's reader is its tree joint
+        let axes = axes
             .iter()
-            .map(|x| {
-                let joint = &tree.joints[x.joint];
-                let o = joint.local_origin.rotation;
-                let middle = 0.25 * (x.low + x.high);
-                TableJoint {
-                    parent: joint.parent as u32,
-                    child: joint.child as u32,
-                    origin: [o.w, o.i, o.j, o.k].map(|v| v as f32),
-                    axis: [joint.axis.x, joint.axis.y, joint.axis.z].map(|v| v as f32),
-                    middle: [middle.cos() as f32, middle.sin() as f32],
-                    u_low: x.u_low as f32,
-                    per_u: (x.cells as f64 / (x.u_high - x.u_low)) as f32,
-                    cells: x.cells as u32,
-                }
+            .map(|x| TableAxis {
+                reader: x.joint as u32,
+                per_u: (x.cells as f64 / (x.u_high - x.u_low)) as f32,
+                cells: x.cells as u32,
             })
             .collect();
-        Some(PairTable { joints, free, hit })
+        Some(PairTable { axes, free, hit })
     }
 }
 
@@ -250,6 +305,23 @@ fn chain(tree: &trm_kinematics::Tree, ancestor: usize, link: usize) -> Option<Ve
     Some(joints)
 }
 
+/// The range a joint is tabled over: its limits, or a whole turn about 0 for a joint that turns
+/// (nearly) a whole turn or more; `None` unless it is a revolute or continuous joint without
+/// `<mimic>`.
+fn range(joint: &trm_kinematics::Joint) -> Option<(f64, f64)> {
+    let pi = std::f64::consts::PI;
+    let (lo, hi) = (joint.limits.lower, joint.limits.upper);
+    let (lo, hi) = if hi - lo < 2.0 * pi - 0.2 {
+        (lo, hi)
+    } else {
+        (-pi, pi)
+    };
+    let usable = matches!(joint.kind, JointKind::Revolute | JointKind::Continuous)
+        && joint.mimic.is_none()
+        && hi > lo;
+    usable.then_some((lo, hi))
+}
+
 /// One joint of a table while building it: its range, lever arm and cells in `u`.
 #[derive(Debug, Clone)]
 struct Axis {
@@ -265,7 +337,7 @@ struct Axis {
 }
 
 impl Axis {
-    fn new(joint: usize, low: f64, high: f64, lever: f64) -> Self {
+    fn new(joint: usize, (low, high): (f64, f64), lever: f64) -> Self {
         let quarter = 0.25 * (high - low);
         Axis {
             joint,

@@ -692,7 +692,13 @@ fn clearance_tables_decide_only_what_the_exact_model_says() {
             active.forward_block_unchecked(&qs.concat(), &mut block);
             for gp in &model.group_pairs {
                 let Some(t) = gp.table else { continue };
-                let (free, hit) = model.tables[t as usize].lookup(block.lanes(), ALL_LANES);
+                let mut angles = super::table::Angles::new(model.readers.len());
+                let (free, hit) = model.tables[t as usize].lookup(
+                    &model.readers,
+                    &mut angles,
+                    block.lanes(),
+                    ALL_LANES,
+                );
                 assert_eq!(free & hit, 0);
                 looked += FAST_LANES;
                 decided += (free | hit).count_ones() as usize;

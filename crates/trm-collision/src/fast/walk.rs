@@ -10,6 +10,7 @@ use super::lanes::{
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
 use super::solid::{Placed, Solid, box_box, rotate, round_box, round_round};
+use super::table::Angles;
 use super::world::{FastWorld, Object};
 use crate::batch::Nest;
 use trm_kinematics::PoseLanes32;
@@ -30,6 +31,8 @@ pub struct FastScratch {
     pub(super) frames: Vec<([F; 9], [F; 3])>,
     /// Per link group: whether its frame's rotation is made for the current block.
     pub(super) framed: Vec<bool>,
+    /// The tabled joints' angles read for the current block.
+    pub(super) angles: Angles,
     /// Per link group: whether its balls are placed for the current block.
     pub(super) placed: Vec<bool>,
     /// What left lanes uncertain in the last check, and in which lanes.
@@ -487,7 +490,8 @@ pub(super) fn near_link_pair<const AVX: bool, O: Outcome>(
     // the pair's clearance table decides the lanes in its free and colliding cells
     let near = match gp.table {
         Some(t) => {
-            let (free, hit) = model.tables[t as usize].lookup(poses, near);
+            let table = &model.tables[t as usize];
+            let (free, hit) = table.lookup(&model.readers, &mut scratch.angles, poses, near);
             if hit != 0 && verdict.add(hit, hit, 0).is_none() {
                 scratch.last_hit = Some(Suspect::Pair(k as u32));
                 return true;
@@ -707,6 +711,7 @@ pub(super) fn place<const AVX: bool>(
     scratch.solid_placed.fill(false);
     scratch.placed.fill(false);
     scratch.framed.fill(false);
+    scratch.angles.clear();
     for (s, &frame) in model.origins.iter().enumerate() {
         let p = &poses[frame as usize];
         scratch.bounds[groups + s] = [F(p[4]), F(p[5]), F(p[6])];
