@@ -497,7 +497,7 @@ fn tables(
     let levers = crate::levers::Levers::new(model, &model.robot().all_active())?;
     // pairs tested as solids leave few lanes to the exact checks: only pairs screened through
     // enclosing spheres get a table (built in parallel: each is the same on any thread)
-    let built: Vec<Option<PairTable>> = group_pairs
+    let built: Vec<_> = group_pairs
         .par_iter()
         .map(|gp| {
             let screened = gp.solid_pairs.is_empty() && gp.solid.is_none();
@@ -507,24 +507,24 @@ fn tables(
                 .flatten()
         })
         .collect();
-    let tree = model.robot().tree();
+    // one reader per joint, shared by every table over it
     let (mut tables, mut readers) = (Vec::new(), Vec::<AngleReader>::new());
-    for (gp, table) in group_pairs.iter_mut().zip(built) {
-        let Some(mut table) = table else { continue };
-        let mut indices = Vec::new();
-        for j in table.joints() {
-            let at = readers.iter().position(|r| r.joint() == j);
-            let Some(at) = at.or_else(|| {
-                readers.push(AngleReader::new(tree, j)?);
-                Some(readers.len() - 1)
-            }) else {
-                break;
-            };
-            indices.push(at as u32);
-        }
-        if indices.len() != table.joints().count() {
+    for (gp, built) in group_pairs.iter_mut().zip(built) {
+        let Some((mut table, own)) = built else {
             continue;
-        }
+        };
+        let indices: Vec<u32> = own
+            .into_iter()
+            .map(
+                |r| match readers.iter().position(|x| x.joint() == r.joint()) {
+                    Some(at) => at as u32,
+                    None => {
+                        readers.push(r);
+                        readers.len() as u32 - 1
+                    }
+                },
+            )
+            .collect();
         table.attach(&indices);
         gp.table = Some(tables.len() as u32);
         tables.push(table);

@@ -73,21 +73,20 @@ pub(super) struct AngleReader {
 }
 
 impl AngleReader {
-    /// The reader of tree joint `j`, tabled over `range(j)`.
-    pub(super) fn new(tree: &trm_kinematics::Tree, j: usize) -> Option<Self> {
-        let joint = &tree.joints[j];
-        let axis = Axis::new(j, range(joint)?, 0.0);
+    /// The reader of the joint of `axis` (its range checked by [`range`]).
+    fn new(tree: &trm_kinematics::Tree, axis: &Axis) -> Self {
+        let joint = &tree.joints[axis.joint];
         let o = joint.local_origin.rotation;
         let middle = 0.25 * (axis.low + axis.high);
-        Some(AngleReader {
-            joint: j as u32,
+        AngleReader {
+            joint: axis.joint as u32,
             parent: joint.parent as u32,
             child: joint.child as u32,
             origin: [o.w, o.i, o.j, o.k].map(|v| v as f32),
             axis: [joint.axis.x, joint.axis.y, joint.axis.z].map(|v| v as f32),
             middle: [middle.cos() as f32, middle.sin() as f32],
             u_low: axis.u_low as f32,
-        })
+        }
     }
 
     /// The joint it reads (tree index).
@@ -209,14 +208,8 @@ impl PairTable {
         (free, hit)
     }
 
-    /// The tree joints of the table's axes (until [`PairTable::attach`]), nearest the near
-    /// link first.
-    pub(super) fn joints(&self) -> impl Iterator<Item = usize> + '_ {
-        self.axes.iter().map(|a| a.reader as usize)
-    }
-
     /// Points the table's axes at the model's readers (`readers`: their indices, in the order
-    /// of [`PairTable::joints`]).
+    /// of the readers [`PairTable::build`] gave).
     pub(super) fn attach(&mut self, readers: &[u32]) {
         for (a, &r) in self.axes.iter_mut().zip(readers) {
             a.reader = r;
@@ -235,13 +228,15 @@ impl PairTable {
     /// into the model's bodies), when one link lies below the other and the joints between
     /// them are one or two revolute or continuous joints without `<mimic>`, besides fixed ones;
     /// `None` otherwise. A joint that turns a whole turn or more is tabled over every rotation.
+    /// With the table, the readers of its joints' angles, nearest the near link first (to be
+    /// shared with other tables and [attached](PairTable::attach)).
     pub(super) fn build(
         model: &CollisionModel,
         levers: &Levers,
         a: usize,
         b: usize,
         bodies: &[(u32, u32)],
-    ) -> Option<PairTable> {
+    ) -> Option<(PairTable, Vec<AngleReader>)> {
         let robot = model.robot();
         let tree = robot.tree();
         let (far, path) = chain(tree, a, b)
@@ -278,16 +273,16 @@ impl PairTable {
             x.cut(c);
         }
         let (free, hit) = Flood::new(model, &axes, bodies)?.run();
-        // until attached, each axis's reader is its tree joint
+        let readers = axes.iter().map(|x| AngleReader::new(tree, x)).collect();
         let axes = axes
             .iter()
             .map(|x| TableAxis {
-                reader: x.joint as u32,
+                reader: 0, // until attached
                 per_u: (x.cells as f64 / (x.u_high - x.u_low)) as f32,
                 cells: x.cells as u32,
             })
             .collect();
-        Some(PairTable { axes, free, hit })
+        Some((PairTable { axes, free, hit }, readers))
     }
 }
 
