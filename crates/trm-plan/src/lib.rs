@@ -27,7 +27,8 @@ mod trajectory;
 pub use error::PlanError;
 pub use planner::{
     Connection, EXPERIENCE_FORMAT, EXPERIENCE_VERSION, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK,
-    HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS, Source,
+    GRAPH_TURNS, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS, ROUND_GROWTH,
+    Source,
 };
 pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{

@@ -7,8 +7,7 @@ use std::sync::OnceLock;
 
 use trm_collision::{Shape, World};
 use trm_kinematics::nalgebra::Isometry3;
-use trm_plan::rrt::{RrtOptions, path_length};
-use trm_plan::{ExactGoal, Goal, HEAD_START_SAMPLES, PlanError, PlanOptions, Planner, Source};
+use trm_plan::{ExactGoal, Goal, PlanError, PlanOptions, Planner};
 use trm_roadmap::{BuildOptions, Builder, Roadmap, connect};
 use trm_tasks::Problem;
 
@@ -353,126 +352,6 @@ fn an_attached_map_is_checked_in_the_planners_world_not_trusted() {
     other.active[0] = "l_elbow".into();
     let e = planner.add_map(&other).unwrap_err().to_string();
     assert!(e.contains("l_elbow") && e.contains("map 2"), "{e}");
-}
-
-/// The iCub's right arm (3 motors) beside a pole, a start (home) and a goal behind the pole.
-fn arm_beside_a_pole() -> (trm_tasks::Objective, Vec<f64>, Vec<f64>) {
-    let robot = trm_models::icub_upper_body();
-    let home = robot.posture("home").unwrap().to_vec();
-    let arm = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"];
-    let active = robot.active_set(&arm, &home).unwrap();
-    let mut world = World::new();
-    let pole = Shape::Box {
-        size: [0.04, 0.04, 2.0],
-    };
-    world
-        .add("pole", pole, Isometry3::translation(-0.25, 0.3, 0.0))
-        .unwrap();
-    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
-    let objective = trm_tasks::Objective::new(active, collision, world);
-    let start = objective.active().from_motors(&home);
-    let goal = vec![start[0] - 1.2, start[1] + 0.6, start[2] + 0.5];
-    (objective, start, goal)
-}
-
-#[test]
-fn experience_is_saved_and_loaded_whole_or_refused_whole() {
-    let (objective, start, goal) = arm_beside_a_pole();
-    let options = RrtOptions::default();
-    let mut kept = Planner::new(&objective, &[]).unwrap();
-    let first = kept.connect(&start, &goal, &options).unwrap();
-    kept.add_path(&first.path).unwrap();
-    let dir = std::env::temp_dir().join(format!("trm-experience-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("arm.experience.json");
-    kept.save_experience(&file).unwrap();
-    let mut fresh = Planner::new(&objective, &[]).unwrap();
-    assert_eq!(fresh.load_experience(&file).unwrap(), 1);
-    assert_eq!(fresh.kept_paths(), kept.kept_paths());
-    let again = fresh.connect(&start, &goal, &options).unwrap();
-    assert_eq!(again.source, Source::Retrieved);
-    assert_eq!(again.path, first.path);
-    // refused whole: other motors, a short waypoint, a cut file, another kind of file
-    let text = std::fs::read_to_string(&file).unwrap();
-    let bad = |name: &str, text: &str| {
-        let path = dir.join(name);
-        std::fs::write(&path, text).unwrap();
-        let mut planner = Planner::new(&objective, &[]).unwrap();
-        let e = planner.load_experience(&path).unwrap_err().to_string();
-        assert_eq!(planner.num_nodes(), 0, "{name}: {e}");
-        assert!(e.contains(name), "{e}");
-        e
-    };
-    let e = bad("motors.json", &text.replace("r_elbow", "l_elbow"));
-    assert!(
-        e.contains("l_elbow") && e.contains("the planner moves"),
-        "{e}"
-    );
-    let short = text.replacen("[[[", "[[[1.0],[", 1);
-    assert!(bad("short.json", &short).contains("1 values, not 3"));
-    assert!(bad("cut.json", &text[..text.len() / 2]).contains("truncated"));
-    let other = text.replace("trm-experience", "trm-map");
-    assert!(bad("other.json", &other).contains("not a trm-experience file"));
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
-#[test]
-fn a_graph_attached_to_connect_can_only_help() {
-    let (objective, start, goal) = arm_beside_a_pole();
-    // short steps: RRT-Connect needs more samples than its head start
-    let short = RrtOptions {
-        range: 0.1,
-        resolution: 0.05,
-        ..Default::default()
-    };
-    let mut plain = Planner::new(&objective, &[]).unwrap();
-    let mut kept = Planner::new(&objective, &[]).unwrap();
-    let first = kept.connect(&start, &goal, &short).unwrap();
-    assert_eq!(first.source, Source::Sampled);
-    kept.add_path(&first.path).unwrap();
-    let (mut sampled, mut through_graph) = (0, 0);
-    // queries near the kept one (farther than a retrieval's reach), with and without it, with
-    // short steps and with the default ones (RRT-Connect answers most in its head start)
-    let default = RrtOptions::default();
-    for k in 0..24 {
-        let options = if k < 12 { &short } else { &default };
-        let angle = k as f64 * 0.5;
-        let (c, s) = (0.15 * angle.cos(), 0.15 * angle.sin());
-        let a = vec![start[0] + c, start[1] + s, start[2] - c];
-        let b = vec![goal[0] - s, goal[1] + c, goal[2] + s];
-        if !plain.is_free(&a) || !plain.is_free(&b) {
-            continue;
-        }
-        let without = plain.connect(&a, &b, options).unwrap();
-        let with = kept.connect(&a, &b, options).unwrap();
-        match with.source {
-            // RRT-Connect drew the same samples, with or without the graph
-            Source::Sampled | Source::Straight => {
-                sampled += 1;
-                assert_eq!(with.path, without.path, "query {k}");
-                assert_eq!(with.iterations, without.iterations, "query {k}");
-            }
-            Source::Graph | Source::Retrieved => {
-                through_graph += 1;
-                // only after RRT-Connect's head start: not a query it answers that fast
-                assert!(
-                    without.iterations > HEAD_START_SAMPLES,
-                    "query {k}: {} samples",
-                    without.iterations
-                );
-                assert_eq!(with.iterations, HEAD_START_SAMPLES, "query {k}");
-                assert_eq!(with.path.first(), Some(&a));
-                assert_eq!(with.path.last(), Some(&b));
-                for w in with.path.windows(2) {
-                    assert!(plain.segment_free(&w[0], &w[1], options.resolution / 4.0));
-                }
-            }
-        }
-    }
-    assert!(
-        sampled > 0 && through_graph > 0,
-        "{sampled} answered by RRT-Connect, {through_graph} through the graph"
-    );
 }
 
 #[test]
@@ -921,36 +800,4 @@ fn repeated_queries_retrieve_the_kept_path_while_it_is_free() {
         }
         Err(e) => assert!(matches!(e, PlanError::Unreachable { .. }), "{e}"),
     }
-}
-
-/// Corner cutting (`RrtOptions::smoothing`) never lengthens a path, shortens the detours
-/// RRT-Connect takes round the pole, and keeps every path free at half the resolution.
-#[test]
-fn corner_cutting_shortens_paths_and_keeps_them_free() {
-    let (objective, start, goal) = arm_beside_a_pole();
-    let mut planner = Planner::new(&objective, &[]).unwrap();
-    let (mut shorter, mut total) = (0, 0);
-    for seed in 0..12 {
-        let plain = RrtOptions {
-            seed,
-            smoothing: 0,
-            ..Default::default()
-        };
-        let smoothed = RrtOptions {
-            smoothing: trm_plan::rrt::SMOOTHING_ROUNDS,
-            ..plain.clone()
-        };
-        let a = planner.connect(&start, &goal, &plain).unwrap();
-        let b = planner.connect(&start, &goal, &smoothed).unwrap();
-        let (la, lb) = (path_length(&a.path), path_length(&b.path));
-        assert!(lb <= la + 1e-9, "seed {seed}: {lb} > {la}");
-        shorter += usize::from(lb < la - 1e-6);
-        total += 1;
-        assert_eq!(b.path.first(), Some(&start));
-        assert_eq!(b.path.last(), Some(&goal));
-        for w in b.path.windows(2) {
-            assert!(planner.segment_free(&w[0], &w[1], smoothed.resolution / 2.0));
-        }
-    }
-    assert!(shorter * 2 >= total, "{shorter} of {total} paths shortened");
 }

@@ -7,11 +7,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::Planner;
+use super::search::LazySearch;
 use trm_collision::Certifier;
 
 use crate::PlanError;
 use crate::pose_goal::PoseGoal;
-use crate::query::{Goal, PlanOptions};
+use crate::query::{Goal, PlanOptions, Planned};
 use crate::rrt::{EdgeCheck, GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
 
 /// Where the path of a [`Planner::connect`] query came from.
@@ -64,13 +65,17 @@ impl Planner {
     /// - without maps or kept paths, by RRT-Connect ([`crate::rrt::rrt_connect`]: the straight
     ///   segment first, the path shortcut and checked again at half the resolution);
     /// - with them, so that they can only help: a kept path repeating the query is retrieved
-    ///   (when it is still free); else RRT-Connect first, for [`HEAD_START_SAMPLES`] samples
-    ///   (the queries it answers that fast get the path and checks they get without a graph);
-    ///   then the graph ([`Planner::plan`] to a configuration goal: lazy A* for as many
-    ///   searches as [`Planner::graph_searches`] allows), its path shortcut greedily and
-    ///   checked at half the resolution as RRT-Connect's paths are; where the graph does not
-    ///   join the two in that effort, RRT-Connect goes on with the same trees within the rest
-    ///   of the budget.
+    ///   (when it is still free); else RRT-Connect and the graph take turns. RRT-Connect
+    ///   first, for [`HEAD_START_SAMPLES`] samples (the queries it answers that fast get the
+    ///   path and checks they get without a graph); then the graph's lazy A* for
+    ///   [`Planner::graph_turn_searches`] searches; then RRT-Connect again with the
+    ///   same trees, up to [`ROUND_GROWTH`] times its samples so far, and the graph as many
+    ///   searches more, and so on until the graph has had its searches or has no path left;
+    ///   then
+    ///   RRT-Connect alone within the rest of the budget. The graph's path is shortcut
+    ///   greedily and checked at half the resolution as RRT-Connect's paths are. The graph's
+    ///   share of a query's effort shrinks as the query lasts: a map blocked in the scene
+    ///   costs a query a search or two, a map that joins the two answers a hard query early.
     ///
     /// Nothing is kept: a caller keeping experience adds the path ([`Planner::add_path`]) when
     /// [`Connection::source`] is [`Source::Sampled`].
@@ -108,7 +113,7 @@ impl Planner {
         }
         // a query repeating a kept path: that path, when it is still free
         if !self.kept.is_empty()
-            && let Some(found) = self.through_graph(start, goal, options, 0)?
+            && let Some(found) = self.retrieved(start, goal, options)?
         {
             return Ok(Connection {
                 checks: self.checker.checks - before,
@@ -120,18 +125,43 @@ impl Planner {
             Ok(growth) => growth,
             Err(e) => return Err(self.name_collisions(e, start, goal)),
         };
-        let head = options.max_iterations.min(HEAD_START_SAMPLES);
-        if !growth.grow(&mut self.checker, &self.bounds, options, head, began)
-            && let Some(found) = self.through_graph(start, goal, options, self.graph_searches())?
-        {
-            return Ok(Connection {
-                checks: self.checker.checks - before,
-                iterations: growth.iterations(),
-                seconds: began.elapsed().as_secs_f64(),
-                ..found
-            });
+        // RRT-Connect and the graph take turns: RRT-Connect's samples grow fourfold a round;
+        // after a round, the graph gets a turn (a quarter of its searches) when its work so far
+        // would stay within its share of RRT-Connect's checks, and the rest of its searches
+        // when RRT-Connect's budget is spent
+        let (most, step, mut lazy) = (self.graph_searches(), self.graph_turn_searches(), None);
+        // a turn's work in graph elements visited: the graph built, then its searches
+        let turn_work = (self.graph_elements() * (step + 1)) as f64;
+        let (mut samples, mut searches, mut work) = (HEAD_START_SAMPLES, step, 0.0);
+        loop {
+            let round = options.max_iterations.min(samples);
+            if growth.grow(&mut self.checker, &self.bounds, options, round, began) {
+                break;
+            }
+            let spent = growth.iterations() < samples;
+            let checks = (self.checker.checks - before) as f64;
+            if spent {
+                searches = most;
+            } else if work + turn_work > GRAPH_SHARE * ELEMENTS_PER_CHECK * checks {
+                samples = samples.saturating_mul(ROUND_GROWTH);
+                continue;
+            }
+            work += turn_work;
+            if let Some(found) = self.through_graph(start, goal, options, &mut lazy, searches)? {
+                return Ok(Connection {
+                    checks: self.checker.checks - before,
+                    iterations: growth.iterations(),
+                    seconds: began.elapsed().as_secs_f64(),
+                    ..found
+                });
+            }
+            if spent || searches >= most || lazy.as_ref().is_none_or(LazySearch::exhausted) {
+                break;
+            }
+            samples = samples.saturating_mul(ROUND_GROWTH);
+            searches = (searches + step).min(most);
         }
-        // the trees met within the head start, or the graph did not answer: RRT-Connect goes on
+        // the trees met, or the graph did not answer: RRT-Connect goes on
         match growth.finish(&mut self.checker, &self.bounds, options, began) {
             Ok(found) => Ok(self.sampled(found, began, before)),
             Err(e) => Err(self.name_collisions(e, start, goal)),
@@ -201,50 +231,79 @@ impl Planner {
         })
     }
 
-    /// The graph's path from `start` to `goal` ([`Planner::connect`]'s second try), shortcut and
-    /// checked at half the resolution; `None` where the graph does not join them within
-    /// `searches` A* searches (0: only a kept path repeating the query) or its path grazes an
-    /// obstacle.
+    /// A kept path repeating the query from `start` to `goal` ([`Planner::connect`]'s first
+    /// try), shortcut and checked at half the resolution; `None` where none repeats it or it is
+    /// blocked.
+    fn retrieved(
+        &mut self,
+        start: &[f64],
+        goal: &[f64],
+        options: &RrtOptions,
+    ) -> Result<Option<Connection>, PlanError> {
+        let d = self.active.len();
+        let well_formed = |q: &[f64]| q.len() == d && q.iter().all(|v| v.is_finite());
+        if !well_formed(start) || !well_formed(goal) {
+            // RRT-Connect names what is wrong
+            return Ok(None);
+        }
+        // looked up without the query's own checks of its start (the kept path's joining edges
+        // check it; RRT-Connect does otherwise)
+        self.time_paths = false;
+        let planned = self.retrieve(start, goal, &graph_options(options, 0), Instant::now());
+        self.time_paths = true;
+        match planned {
+            Ok(Some(planned)) => Ok(self.graph_connection(planned, options)),
+            Ok(None) | Err(PlanError::Unreachable { .. }) => Ok(None),
+            Err(e) => Err(self.name_collisions(e, start, goal)),
+        }
+    }
+
+    /// The graph's path from `start` to `goal` ([`Planner::connect`]'s turns between
+    /// RRT-Connect's rounds: `lazy`'s search, made on the first turn, given up to `searches` A*
+    /// searches in all), shortcut and checked at half the resolution; `None` where the graph
+    /// does not join them within those searches or its path grazes an obstacle.
     fn through_graph(
         &mut self,
         start: &[f64],
         goal: &[f64],
         options: &RrtOptions,
+        lazy: &mut Option<LazySearch>,
         searches: usize,
     ) -> Result<Option<Connection>, PlanError> {
-        let plan_options = PlanOptions {
-            resolution: options.resolution,
-            shortcuts: 0,
-            seed: options.seed,
-            exact_goal: false,
-            sampling: None,
-            max_searches: Some(searches),
-            ..Default::default()
+        let plan_options = graph_options(options, searches);
+        let began = Instant::now();
+        let lazy = match lazy {
+            Some(lazy) => lazy,
+            None => {
+                let to = Goal::Configuration(goal.to_vec());
+                let made = self
+                    .check_query(start, &to, &plan_options)
+                    .and_then(|()| self.lazy_search(start, &to, &plan_options));
+                match made {
+                    // RRT-Connect checked the straight segment before the graph's first turn
+                    Ok(mut made) => {
+                        made.straight_blocked();
+                        lazy.insert(made)
+                    }
+                    Err(PlanError::Unreachable { .. }) => return Ok(None),
+                    Err(e) => return Err(self.name_collisions(e, start, goal)),
+                }
+            }
         };
         // the waypoints only: their trajectory would be thrown away
         self.time_paths = false;
-        let d = self.active.len();
-        let well_formed = |q: &[f64]| q.len() == d && q.iter().all(|v| v.is_finite());
-        let planned = if searches == 0 && well_formed(start) && well_formed(goal) {
-            // only a kept path repeating the query: looked up without the query's own checks
-            // of its start (the kept path's joining edges check it; RRT-Connect does otherwise)
-            match self.retrieve(start, goal, &plan_options, Instant::now()) {
-                Ok(Some(planned)) => Ok(planned),
-                Ok(None) => {
-                    self.time_paths = true;
-                    return Ok(None);
-                }
-                Err(e) => Err(e),
-            }
-        } else {
-            self.plan(start, &Goal::Configuration(goal.to_vec()), &plan_options)
-        };
+        let planned = self.search_lazily(lazy, &plan_options, Some(searches), began);
         self.time_paths = true;
-        let planned = match planned {
-            Ok(planned) => planned,
-            Err(PlanError::Unreachable { .. }) => return Ok(None),
-            Err(e) => return Err(self.name_collisions(e, start, goal)),
-        };
+        match planned {
+            Ok(planned) => Ok(self.graph_connection(planned, options)),
+            Err(PlanError::Unreachable { .. }) => Ok(None),
+            Err(e) => Err(self.name_collisions(e, start, goal)),
+        }
+    }
+
+    /// The connection a path `planned` through the graph makes: shortcut greedily and checked
+    /// at half the resolution as RRT-Connect's paths are; `None` where it grazes an obstacle.
+    fn graph_connection(&mut self, planned: Planned, options: &RrtOptions) -> Option<Connection> {
         let mut path = planned.waypoints;
         let simplifying = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
@@ -268,14 +327,14 @@ impl Planner {
             (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
                 && checker.edge_midpoints_free(&w[0], &w[1], r)
         });
-        Ok(free.then_some(Connection {
+        free.then_some(Connection {
             path,
             source,
             checks: 0,
             iterations: 0,
             seconds: 0.0,
             simplify_seconds: simplifying.elapsed().as_secs_f64(),
-        }))
+        })
     }
 
     /// RRT-Connect from `start` to `goal` with the planner's checker, the query's checks
@@ -377,6 +436,42 @@ pub const GOAL_ATTEMPTS: usize = 500;
 /// answers within them are answered as without a graph.
 pub const HEAD_START_SAMPLES: usize = 64;
 
+/// How many times more samples RRT-Connect draws in each of [`Planner::connect`]'s rounds
+/// than in all rounds before, while the graph's turns stay the same size: the longer a query
+/// has run, the smaller the graph's share of its effort.
+pub const ROUND_GROWTH: usize = 4;
+
+/// The most [`Planner::connect`]'s turns through the graph may visit, in graph elements, for
+/// every element's worth of RRT-Connect's collision checks so far (see
+/// [`ELEMENTS_PER_CHECK`]): a graph whose searches cost more than this share of a query's
+/// sampling waits for a later round.
+pub const GRAPH_SHARE: f64 = 0.25;
+
+/// Graph elements (nodes and edges) a lazy A* search visits in the time of one collision
+/// check of a configuration, roughly: measured on the Panda's 302-point reach map (1 734
+/// elements, 12 µs a search) against its sphere model's checks (about 60 ns each, planner
+/// overhead included). A robot whose checks cost more gives the graph a larger share.
+pub const ELEMENTS_PER_CHECK: f64 = 8.0;
+
+/// Into how many turns [`Planner::connect`] splits the graph's work
+/// ([`GRAPH_SEARCH_WORK`]) between RRT-Connect's rounds.
+pub const GRAPH_TURNS: usize = 4;
+
+/// [`Planner::plan`]'s options for [`Planner::connect`]'s turns through the graph: `options`'
+/// resolution and seed, no shortcutting (the turn shortcuts as RRT-Connect does), at most
+/// `searches` searches.
+fn graph_options(options: &RrtOptions, searches: usize) -> PlanOptions {
+    PlanOptions {
+        resolution: options.resolution,
+        shortcuts: 0,
+        seed: options.seed,
+        exact_goal: false,
+        sampling: None,
+        max_searches: Some(searches),
+        ..Default::default()
+    }
+}
+
 /// Nodes and edges [`Planner::connect`]'s lazy searches through the graph may visit in all
 /// (each search visits the whole graph at worst): on a map of 300 nodes and 1 400 edges, 4
 /// searches; on a few kept paths, [`MAX_GRAPH_SEARCHES`].
@@ -391,8 +486,20 @@ impl Planner {
     /// [`GRAPH_SEARCH_WORK`] over the graph's nodes and edges, at least 2 and at most
     /// [`MAX_GRAPH_SEARCHES`].
     pub fn graph_searches(&self) -> usize {
-        (GRAPH_SEARCH_WORK / (self.nodes.len() + self.edges.len()).max(1))
-            .clamp(2, MAX_GRAPH_SEARCHES)
+        (GRAPH_SEARCH_WORK / self.graph_elements()).clamp(2, MAX_GRAPH_SEARCHES)
+    }
+
+    /// The searches each of [`Planner::connect`]'s turns through the graph adds:
+    /// [`GRAPH_SEARCH_WORK`] / [`GRAPH_TURNS`] over the graph's nodes and edges, at least 1,
+    /// at most [`Planner::graph_searches`] (a small graph, as a few kept paths make, gets all
+    /// its searches in its first turn).
+    pub fn graph_turn_searches(&self) -> usize {
+        (GRAPH_SEARCH_WORK / GRAPH_TURNS / self.graph_elements()).clamp(1, self.graph_searches())
+    }
+
+    /// The graph's nodes and edges (at least 1).
+    fn graph_elements(&self) -> usize {
+        (self.nodes.len() + self.edges.len()).max(1)
     }
 }
 

@@ -20,7 +20,8 @@ mod held;
 mod search;
 mod timed;
 pub use connect::{
-    Connection, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Source,
+    Connection, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK, GRAPH_TURNS, HEAD_START_SAMPLES,
+    MAX_GRAPH_SEARCHES, ROUND_GROWTH, Source,
 };
 pub use experience::{EXPERIENCE_FORMAT, EXPERIENCE_VERSION};
 
@@ -448,7 +449,6 @@ impl Planner {
     ) -> Result<Planned, PlanError> {
         let began = Instant::now();
         self.check_query(start, goal, options)?;
-        let n = self.nodes.len();
         // a kept path repeating the query first: before the start and goal are joined to the
         // graph, which a query answered so (or allowed no search) does not need
         if let Goal::Configuration(q) = goal {
@@ -463,76 +463,8 @@ impl Planner {
                 });
             }
         }
-        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
-        let (extra, goal_q) = self.query_edges(start, goal, options)?;
-        let goal_t = match goal {
-            Goal::Configuration(q) => self.task_of(q),
-            Goal::TaskPoint { t, .. } => t.clone(),
-            Goal::TaskRegion { min, max } => {
-                min.iter().zip(max).map(|(a, b)| (a + b) / 2.0).collect()
-            }
-        };
-        let target = Target { goal, n };
-        if goal_q.is_none() && !(0..n).any(|i| target.holds(i, &self.nodes)) {
-            let closest = self.closest_to(0..n, &goal_t);
-            return Err(self.unreachable(
-                "no map node lies within the goal's tolerance or region",
-                closest,
-                &goal_t,
-            ));
-        }
-        let mut stats = PlanStats::default();
-        let mut extra_state = vec![State::Unknown; extra.len()];
-        // built for the first search: the graph and A*'s heuristic (a map node's distance to a
-        // configuration goal)
-        let mut graph = None;
-        loop {
-            if options.max_searches.is_some_and(|m| stats.searches >= m) {
-                return Err(PlanError::Unreachable {
-                    reason: format!(
-                        "the search through the maps found no free path in {} searches",
-                        stats.searches
-                    ),
-                    closest_node: None,
-                    closest_distance: f64::INFINITY,
-                });
-            }
-            stats.searches += 1;
-            let (graph, estimate) = graph.get_or_insert_with(|| {
-                let estimate: Vec<f64> = match &goal_q {
-                    Some(q) => self.nodes.iter().map(|(p, _)| distance(p, q)).collect(),
-                    None => Vec::new(),
-                };
-                (self.query_graph(&extra), estimate)
-            });
-            let path = match self.search(graph, &extra, &extra_state, &target, estimate) {
-                Ok(path) => path,
-                Err(reachable) => {
-                    let closest = self.closest_to(reachable.into_iter(), &goal_t);
-                    return Err(self.unreachable(
-                        "no collision-free path through the maps in the current world",
-                        closest,
-                        &goal_t,
-                    ));
-                }
-            };
-            let config = |i: usize, this: &Self| -> Vec<f64> {
-                if i < n {
-                    this.nodes[i].0.clone()
-                } else if i == n {
-                    start.to_vec()
-                } else {
-                    goal_q.clone().unwrap_or_default()
-                }
-            };
-            if !self.path_valid(&path, &extra, &mut extra_state, &mut stats, options, config) {
-                continue;
-            }
-            let node_ids: Vec<usize> = path.iter().map(|&(v, _)| v).filter(|&i| i < n).collect();
-            let waypoints: Vec<Vec<f64>> = path.iter().map(|&(v, _)| config(v, self)).collect();
-            stats.path_nodes = node_ids.len();
-            return self.finish(waypoints, node_ids, goal, options, stats, began);
-        }
+        let mut lazy = self.lazy_search(start, goal, options)?;
+        self.search_lazily(&mut lazy, options, options.max_searches, began)
     }
 
     /// Checks a query's options, start and goal: an error says what is wrong.

@@ -1,12 +1,174 @@
 //! The lazy search's graph and its A*: the map and kept nodes with a query's start and goal,
-//! searched over what is not known blocked.
+//! searched over what is not known blocked, a search at a time.
+
+use std::time::Instant;
 
 use petgraph::graph::{EdgeReference, NodeIndex, UnGraph};
 use petgraph::visit::{EdgeFiltered, EdgeRef, IntoEdges};
 
 use super::{Edge, Planner, State, Target};
+use crate::PlanError;
+use crate::query::{Goal, PlanOptions, PlanStats, Planned};
+
+/// One query's lazy search through the graph, resumable: the query's own edges (the start's
+/// and goal's joins to the graph) with what their checks found, and the A* graph, outlive a
+/// call of [`Planner::search_lazily`], so that [`Planner::connect`] can give the search more
+/// searches later without checking anything twice (the graph's own nodes and edges keep their
+/// states in the planner).
+pub(super) struct LazySearch {
+    start: Vec<f64>,
+    goal: Goal,
+    /// The goal's configuration (node n + 1), for a configuration goal.
+    goal_q: Option<Vec<f64>>,
+    /// The goal's task point (a configuration goal's, through the task function).
+    goal_t: Vec<f64>,
+    extra: Vec<Edge>,
+    extra_state: Vec<State>,
+    /// Built for the first search: the graph and A*'s heuristic (a map node's distance to a
+    /// configuration goal).
+    graph: Option<(UnGraph<(), usize>, Vec<f64>)>,
+    stats: PlanStats,
+    /// No path is left through what is not known blocked: more searches cannot help.
+    exhausted: bool,
+}
+
+impl LazySearch {
+    /// Whether more searches cannot help (no path is left through the graph).
+    pub(super) fn exhausted(&self) -> bool {
+        self.exhausted
+    }
+
+    /// Records that the straight segment from the start to a configuration goal is blocked
+    /// (checked at the search's resolution by the caller), so that no search checks it again.
+    pub(super) fn straight_blocked(&mut self) {
+        if self.goal_q.is_some()
+            && let Some(last) = self.extra_state.last_mut()
+        {
+            *last = State::Invalid;
+        }
+    }
+}
 
 impl Planner {
+    /// A lazy search from `start` to `goal` through the graph, before its first search: the two
+    /// joined to their nearest nodes (and to each other, for a configuration goal); an error
+    /// when a configuration goal collides or no node meets a task-space goal.
+    pub(super) fn lazy_search(
+        &mut self,
+        start: &[f64],
+        goal: &Goal,
+        options: &PlanOptions,
+    ) -> Result<LazySearch, PlanError> {
+        let n = self.nodes.len();
+        // graph: map nodes, then the start (n) and, for a configuration goal, the goal (n + 1)
+        let (extra, goal_q) = self.query_edges(start, goal, options)?;
+        let goal_t = match goal {
+            Goal::Configuration(q) => self.task_of(q),
+            Goal::TaskPoint { t, .. } => t.clone(),
+            Goal::TaskRegion { min, max } => {
+                min.iter().zip(max).map(|(a, b)| (a + b) / 2.0).collect()
+            }
+        };
+        let target = Target { goal, n };
+        if goal_q.is_none() && !(0..n).any(|i| target.holds(i, &self.nodes)) {
+            let closest = self.closest_to(0..n, &goal_t);
+            return Err(self.unreachable(
+                "no map node lies within the goal's tolerance or region",
+                closest,
+                &goal_t,
+            ));
+        }
+        Ok(LazySearch {
+            start: start.to_vec(),
+            goal: goal.clone(),
+            goal_q,
+            goal_t,
+            extra_state: vec![State::Unknown; extra.len()],
+            extra,
+            graph: None,
+            stats: PlanStats::default(),
+            exhausted: false,
+        })
+    }
+
+    /// Runs `lazy`'s searches until one finds a path whose nodes and edges are free (that path
+    /// shortcut, finished and timed as `options` ask, [`Planner::finish`]), no path is left, or
+    /// `max_searches` searches in all (counted over every call) have run.
+    pub(super) fn search_lazily(
+        &mut self,
+        lazy: &mut LazySearch,
+        options: &PlanOptions,
+        max_searches: Option<usize>,
+        began: Instant,
+    ) -> Result<Planned, PlanError> {
+        let n = self.nodes.len();
+        loop {
+            if max_searches.is_some_and(|m| lazy.stats.searches >= m) {
+                return Err(PlanError::Unreachable {
+                    reason: format!(
+                        "the search through the maps found no free path in {} searches",
+                        lazy.stats.searches
+                    ),
+                    closest_node: None,
+                    closest_distance: f64::INFINITY,
+                });
+            }
+            lazy.stats.searches += 1;
+            let LazySearch {
+                start,
+                goal,
+                goal_q,
+                goal_t,
+                extra,
+                extra_state,
+                graph,
+                stats,
+                exhausted,
+            } = lazy;
+            let (graph, estimate) = graph.get_or_insert_with(|| {
+                let estimate: Vec<f64> = match goal_q {
+                    Some(q) => self
+                        .nodes
+                        .iter()
+                        .map(|(p, _)| super::distance(p, q))
+                        .collect(),
+                    None => Vec::new(),
+                };
+                (self.query_graph(extra), estimate)
+            });
+            let target = Target { goal, n };
+            let path = match self.search(graph, extra, extra_state, &target, estimate) {
+                Ok(path) => path,
+                Err(reachable) => {
+                    *exhausted = true;
+                    let closest = self.closest_to(reachable.into_iter(), goal_t);
+                    return Err(self.unreachable(
+                        "no collision-free path through the maps in the current world",
+                        closest,
+                        goal_t,
+                    ));
+                }
+            };
+            let config = |i: usize, this: &Self| -> Vec<f64> {
+                if i < n {
+                    this.nodes[i].0.clone()
+                } else if i == n {
+                    start.clone()
+                } else {
+                    goal_q.clone().unwrap_or_default()
+                }
+            };
+            if !self.path_valid(&path, extra, extra_state, stats, options, config) {
+                continue;
+            }
+            let node_ids: Vec<usize> = path.iter().map(|&(v, _)| v).filter(|&i| i < n).collect();
+            let waypoints: Vec<Vec<f64>> = path.iter().map(|&(v, _)| config(v, self)).collect();
+            stats.path_nodes = node_ids.len();
+            let stats = stats.clone();
+            return self.finish(waypoints, node_ids, goal, options, stats, began);
+        }
+    }
+
     /// The graph a query searches: the map and kept nodes, the start (node n) and goal
     /// (node n + 1), and every edge (the graph's, then `extra`), weighted by its index.
     pub(super) fn query_graph(&self, extra: &[Edge]) -> UnGraph<(), usize> {
