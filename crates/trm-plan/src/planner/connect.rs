@@ -130,7 +130,8 @@ impl Planner {
         // would stay within its share of RRT-Connect's checks, and the rest of its searches
         // when RRT-Connect's budget is spent
         let (most, step, mut lazy) = (self.graph_searches(), self.graph_turn_searches(), None);
-        // a turn's work in graph elements visited: the graph built, then its searches
+        // a turn's work in graph elements visited: its searches, plus a graph's worth for its
+        // set-up (the query's graph built on the first turn, A*'s filters on every one)
         let turn_work = (self.graph_elements() * (step + 1)) as f64;
         let (mut samples, mut searches, mut work) = (HEAD_START_SAMPLES, step, 0.0);
         loop {
