@@ -34,6 +34,10 @@ fn experience_is_saved_and_loaded_whole_or_refused_whole() {
     let options = RrtOptions::default();
     let mut kept = Planner::new(&objective, &[]).unwrap();
     let first = kept.connect(&start, &goal, &options).unwrap();
+    // a path without waypoints is refused, and keeps nothing a later query would trip on
+    let e = kept.add_path(&[]).unwrap_err().to_string();
+    assert!(e.contains("no waypoints"), "{e}");
+    assert!(kept.kept_paths().is_empty());
     kept.add_path(&first.path).unwrap();
     let dir = std::env::temp_dir().join(format!("trm-experience-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

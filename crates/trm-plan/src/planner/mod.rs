@@ -90,6 +90,9 @@ pub struct Planner {
     certifier: Option<trm_collision::Certifier>,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
+    /// The kept paths' first and last waypoints, twice the active motors' values per path, in
+    /// [`Planner::kept`]'s order: what a retrieval's scan reads, in one sweep.
+    kept_ends: Vec<f64>,
     /// [`Planner::rrt_options`], worked out on first use (the robot's bodies and active motors
     /// do not change; an allowed-collision matrix does not move a body).
     rrt: std::sync::OnceLock<RrtOptions>,
@@ -120,6 +123,7 @@ impl Planner {
             edge_state: Vec::new(),
             scratch: objective.scratch(),
             kept: Vec::new(),
+            kept_ends: Vec::new(),
             rrt: std::sync::OnceLock::new(),
             maps: 0,
         };
@@ -309,9 +313,16 @@ impl Planner {
     /// is joined to its 3 nearest older nodes by edges checked when a search first wants them.
     /// Later queries, in this world or another (after [`Planner::set_world`]), search through
     /// it; a query that repeats the path's ends tries the path itself first
-    /// ([`Planner::plan`]). Returns the number of nodes added.
+    /// ([`Planner::plan`]). Returns the number of nodes added; an error for a path without
+    /// waypoints or a waypoint that is not one finite value per active motor.
     pub fn add_path(&mut self, path: &[Vec<f64>]) -> Result<usize, PlanError> {
         let d = self.active.len();
+        if path.is_empty() {
+            return Err(PlanError::InvalidOptions {
+                what: "experience path".into(),
+                problem: "the path has no waypoints".into(),
+            });
+        }
         if let Some(bad) = path
             .iter()
             .find(|q| q.len() != d || q.iter().any(|v| !v.is_finite()))
@@ -348,6 +359,9 @@ impl Planner {
             edges.push(self.edges.len());
             self.edges.push((w[0], w[1], l));
             self.edge_state.push(State::Valid);
+        }
+        for end in [ids[0], ids[ids.len() - 1]] {
+            self.kept_ends.extend_from_slice(&self.nodes[end].0);
         }
         self.kept.push((ids, edges));
         Ok(self.nodes.len() - old)
@@ -642,15 +656,9 @@ impl Planner {
         began: Instant,
     ) -> Result<Option<Planned>, PlanError> {
         let near = RETRIEVE_STEPS * options.resolution;
-        let ends = |k: usize, this: &Self| {
-            let (ids, _) = &this.kept[k];
-            let (first, last) = (&this.nodes[ids[0]].0, &this.nodes[ids[ids.len() - 1]].0);
-            let forward = distance(start, first).max(distance(goal, last));
-            let backward = distance(start, last).max(distance(goal, first));
-            (forward.min(backward), backward < forward)
-        };
+        let d = self.active.len();
         // a cheap test first: most kept paths end far away in their first coordinates (the
-        // bound is a hair wider than `near`, so that `ends` alone decides)
+        // bound is a hair wider than `near`, so that the distances alone decide)
         let wide = near * near * (1.0 + 1e-9) + f64::MIN_POSITIVE;
         let close = |a: &[f64], b: &[f64]| {
             let mut sum = 0.0;
@@ -659,17 +667,24 @@ impl Planner {
                 sum <= wide
             })
         };
-        let candidate = |k: usize, this: &Self| {
-            let (ids, _) = &this.kept[k];
-            let (first, last) = (&this.nodes[ids[0]].0, &this.nodes[ids[ids.len() - 1]].0);
-            close(start, first) && close(goal, last) || close(start, last) && close(goal, first)
-        };
-        let Some((k, reversed)) = (0..self.kept.len())
-            .filter(|&k| candidate(k, self))
-            .map(|k| (k, ends(k, self)))
-            .filter(|(_, (d, _))| *d <= near)
-            .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
-            .map(|(k, (_, reversed))| (k, reversed))
+        let Some((k, reversed)) = self
+            .kept_ends
+            .chunks_exact(2 * d)
+            .enumerate()
+            .filter_map(|(k, ends)| {
+                let (first, last) = ends.split_at(d);
+                let forward = close(start, first) && close(goal, last);
+                let backward = close(start, last) && close(goal, first);
+                if !forward && !backward {
+                    return None;
+                }
+                let forward = distance(start, first).max(distance(goal, last));
+                let backward = distance(start, last).max(distance(goal, first));
+                let (d, reversed) = (forward.min(backward), backward < forward);
+                (d <= near).then_some((k, d, reversed))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(k, _, reversed)| (k, reversed))
         else {
             return Ok(None);
         };
