@@ -514,6 +514,24 @@ impl Tree {
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)
     }
+
+    /// The link `link` is rigidly attached to: its nearest ancestor (itself included) whose
+    /// parent joint is movable, or the root, and `link`'s pose in that link's frame, the same
+    /// in every configuration (the fixed joints' origins between them). Panics for an index
+    /// past the links.
+    pub fn rigid_ancestor(&self, link: usize) -> (usize, Isometry3<f64>) {
+        let mut at = link;
+        let mut offset = Isometry3::identity();
+        while at > 0 {
+            let joint = &self.joints[at - 1];
+            if joint.kind != JointKind::Fixed {
+                break;
+            }
+            offset = joint.local_origin * offset;
+            at = joint.parent;
+        }
+        (at, offset)
+    }
 }
 
 /// `link`'s visuals, each material named without a colour given the robot-level one's.

@@ -253,6 +253,48 @@ fn all_motors_active_shares_one_angle_among_coupled_phalanges() {
     );
 }
 
+/// A link's rigid ancestor and offset ([`trm_kinematics::Tree::rigid_ancestor`]) give its pose
+/// in every configuration: the Panda's hand and fingers (fixed joints, VAMP's sphere model) hang
+/// from `panda_link7` through `panda_link8`; a moving link is its own.
+#[test]
+fn a_link_rides_its_rigid_ancestor_at_a_fixed_offset() {
+    let model = RobotModel::load(models().join("panda-mbm/panda_spherized.ron")).unwrap();
+    let tree = model.tree();
+    let link = |name: &str| tree.link_index(name).unwrap();
+    let (hand, seven) = (link("panda_hand"), link("panda_link7"));
+    assert_eq!(tree.rigid_ancestor(hand).0, seven);
+    let (ancestor, offset) = tree.rigid_ancestor(seven);
+    assert_eq!(ancestor, seven);
+    assert!(offset.translation.vector.norm() == 0.0 && offset.rotation.angle() == 0.0);
+    assert_eq!(tree.rigid_ancestor(0).0, 0);
+    let mut buffer = model.pose_buffer();
+    let active = model.all_active();
+    let (lower, upper) = active.bounds();
+    let mut moved = 0;
+    for k in 0..20 {
+        // spread over the limits, a different fraction per motor
+        let q: Vec<f64> = (lower.iter().zip(&upper).enumerate())
+            .map(|(m, (l, u))| l + (u - l) * ((k * 7 + m * 3) % 20) as f64 / 19.0)
+            .collect();
+        model
+            .forward_motors(&active.to_motors(&q), &mut buffer)
+            .unwrap();
+        for l in 0..tree.links.len() {
+            let (a, offset) = tree.rigid_ancestor(l);
+            moved += usize::from(a != l);
+            let expected = buffer.poses()[a] * offset;
+            let got = buffer.poses()[l];
+            assert!(
+                (got.translation.vector - expected.translation.vector).norm() < 1e-12
+                    && got.rotation.angle_to(&expected.rotation) < 1e-12,
+                "{}",
+                tree.links[l].name
+            );
+        }
+    }
+    assert!(moved > 0);
+}
+
 #[test]
 fn named_frames_are_their_link_pose_times_the_offset() {
     let model = icub();

@@ -21,7 +21,10 @@ use trm_kinematics::PoseBuffer;
 pub struct FastChecker {
     pub(super) fast: Arc<FastModel>,
     pub(super) collision: CollisionModel,
+    /// The active set, its kinematics computing the bodies' links (the exact `f64` checks).
     pub(super) active: ActiveSet,
+    /// The active set, its kinematics computing the poses the screen reads (blocks in `f32`).
+    pub(super) screen: ActiveSet,
     /// `FAST_LANES × dim` inputs (unused lanes repeat the first configuration).
     pub(super) inputs: Vec<f64>,
     pub(super) block: PoseBlock,
@@ -43,8 +46,14 @@ impl FastChecker {
         // spheres' centres), not of frames and links without geometry
         let links = (collision.bodies().iter().map(|b| b.link))
             .chain(fast.origins.iter().map(|&o| o as usize));
+        // the screen's kinematics: the poses its balls are placed from (a sphere model's
+        // fixed links are placed from the links they are attached to)
+        let frames =
+            (fast.groups.iter().map(|g| g.frame)).chain(fast.origins.iter().map(|&o| o as usize));
+        let screen = active.pruned_to(frames);
         let active = active.pruned_to(links);
         Ok(FastChecker {
+            screen,
             scratch: fast.scratch(),
             inputs: vec![0.0; FAST_LANES * active.len()],
             block: robot.pose_block(),
@@ -287,7 +296,7 @@ impl FastChecker {
             }
             &self.inputs
         };
-        self.active.forward_block_unchecked(inputs, &mut self.block);
+        self.screen.forward_block_unchecked(inputs, &mut self.block);
         if n == FAST_LANES {
             ALL_LANES
         } else {

@@ -10,8 +10,8 @@ use crate::error::CollisionError;
 use crate::error::Result;
 use crate::model::CollisionModel;
 use crate::shape::Shape;
-use nalgebra::Point3;
 use nalgebra::Vector3;
+use nalgebra::{Isometry3, Point3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use trm_kinematics::JointKind;
@@ -27,7 +27,9 @@ pub(super) struct Ball {
 /// A link's spheres and the sphere bounding them (in the link frame).
 #[derive(Debug, Clone)]
 pub(super) struct Group {
-    /// Index of the link pose in the pose batches.
+    /// Index of the pose in the pose batches its balls are placed from: the link's, or in a
+    /// sphere model the link's it is rigidly attached to ([`trm_kinematics::Tree::rigid_ancestor`];
+    /// its balls' centres are then in that link's frame).
     pub(super) frame: usize,
     pub(super) bound: Ball,
     /// The link's spheres: indices into [`FastModel::balls`].
@@ -327,14 +329,23 @@ impl Spheres {
         let mut balls_of_body = vec![0..0; bodies.len()];
         let (mut solids, mut solid_of_body) = (Vec::new(), vec![None; bodies.len()]);
         for (&link, members) in &by_link {
+            // a sphere model's balls are placed from the link their link is rigidly attached
+            // to (fixed joints between them), whose pose the screen's kinematics computes
+            // anyway: the fixed links' poses are not computed
+            let (frame, offset) = if exact {
+                model.robot().tree().rigid_ancestor(link)
+            } else {
+                (link, Isometry3::identity())
+            };
             let (start, inner_start) = (balls.len(), inner.len());
             let mut spheres: Vec<(Point3<f64>, f64)> = Vec::new();
             for &i in members {
                 let first = balls.len();
                 for s in model.enclosing_spheres(i) {
-                    spheres.push((s.center, s.radius));
+                    let center = offset * s.center;
+                    spheres.push((center, s.radius));
                     balls.push(Ball {
-                        center: to_f32(s.center.coords),
+                        center: to_f32(center.coords),
                         radius: s.radius as f32,
                     });
                     ball_bodies.push(i);
@@ -383,7 +394,7 @@ impl Spheres {
                 first..solids.len()
             });
             groups.push(Group {
-                frame: link,
+                frame,
                 bound: bounding_ball(&spheres),
                 balls: start..balls.len(),
                 inner: inner_start..inner.len(),
