@@ -24,12 +24,13 @@ pub(super) struct Ball {
     pub(super) radius: f32,
 }
 
-/// A link's spheres and the sphere bounding them (in the link frame).
+/// A link's spheres and the sphere bounding them (in the frame they are placed from,
+/// [`Group::frame`]).
 #[derive(Debug, Clone)]
 pub(super) struct Group {
     /// Index of the pose in the pose batches its balls are placed from: the link's, or in a
-    /// sphere model the link's it is rigidly attached to ([`trm_kinematics::Tree::rigid_ancestor`];
-    /// its balls' centres are then in that link's frame).
+    /// sphere model the pose of the link it is rigidly attached to
+    /// ([`trm_kinematics::Tree::rigid_ancestor`]; its balls' centres are then in that frame).
     pub(super) frame: usize,
     pub(super) bound: Ball,
     /// The link's spheres: indices into [`FastModel::balls`].
