@@ -102,6 +102,13 @@ impl Levers {
             .map(|&(_, _, per_unit)| per_unit)
     }
 
+    /// Link `link`'s chain to the root, from the link up: each movable joint's tree index and
+    /// joint-value index with the displacement of the link's points per unit of that joint's
+    /// value (empty for a link without bodies).
+    pub(crate) fn chain(&self, link: usize) -> &[(usize, usize, f64)] {
+        &self.chains[link]
+    }
+
     /// The number of active coordinates.
     pub fn num_coordinates(&self) -> usize {
         self.coordinates
@@ -184,12 +191,12 @@ impl Levers {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use trm_kinematics::RobotModel;
 
     /// A planar arm of two 1 m links (revolute about z), a 0.1 m sphere at each link's end.
-    fn arm() -> CollisionModel {
+    pub(crate) fn arm() -> CollisionModel {
         let urdf = r#"<robot name="arm">
           <link name="base"/>
           <link name="a"><collision><origin xyz="1 0 0"/><geometry><sphere radius="0.1"/></geometry></collision></link>

@@ -242,21 +242,7 @@ pub fn certify_path_loaded(
 ) -> Result<Verdict, MbmError> {
     let active = problem.request.active_set(robot, &neutral(robot))?;
     let mut certifier = trm_collision::Certifier::new(&problem.collision, &active)?;
-    let t = std::time::Instant::now();
     let certificate = certifier.path(&problem.world, path)?;
-    if std::env::var("TRM_CERT_DEBUG").is_ok() {
-        eprintln!(
-            "CERTSTAT {} {} {} {} {} {:.1}",
-            path.len(),
-            problem.collision.num_checked_body_pairs(),
-            problem.collision.bodies().len(),
-            problem.world.objects().len(),
-            certifier.configurations,
-            t.elapsed().as_secs_f64() * 1e6
-        );
-        eprintln!("CERTD {}", certifier.distances);
-    }
-
     Ok(match certificate.failure {
         None => Verdict::Proved,
         Some((_, trm_collision::Certificate::Collides { .. })) => Verdict::Collides,
