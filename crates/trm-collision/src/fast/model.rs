@@ -147,12 +147,19 @@ pub struct FastModel {
     /// pairs.
     pub(super) steps: Vec<CullStep>,
     /// Each world object's walk through the culling spheres (when `culls`): culls and links.
+    /// Without `culls`, when a frame holds [`FRAME_CULL_GROUPS`] groups: the groups, the last
+    /// in the tree first, those of such a frame behind a cull by the sphere enclosing them
+    /// ([`FastModel::frame_balls`]), each step against every object. Empty: the groups one
+    /// by one, the last in the tree first, each against every object.
     pub(super) world_steps: Vec<WorldStep>,
-    /// Whether the walks take `steps` and `world_steps` ([`CULLED_LINK_PAIRS`]); else the
-    /// link pairs and links in order.
+    /// Whether the self walk takes `steps` ([`CULLED_LINK_PAIRS`]); else the link pairs in
+    /// order.
     pub(super) culls: bool,
     /// Pose index of each culling sphere's link (after the groups in [`FastScratch::bounds`]).
     pub(super) origins: Vec<u32>,
+    /// Spheres enclosing the groups that share a frame (its pose index and the centre in
+    /// it), after the culling spheres in [`FastScratch::bounds`].
+    pub(super) frame_balls: Vec<(u32, [f32; 3])>,
     /// Largest distance of any point of the robot from the world origin, in any configuration
     /// (a bound from the joint offsets).
     pub(super) reach: f64,
@@ -197,6 +204,7 @@ impl FastModel {
             world_steps: walks.world_steps,
             culls: walks.culls,
             origins: walks.origins,
+            frame_balls: walks.frame_balls,
             reach,
         })
     }
@@ -245,7 +253,10 @@ impl FastModel {
             inner: vec![[F::default(); 3]; self.inner.len()],
             solids: vec![[[F::default(); 3]; SLOTS]; self.solids.len()],
             solid_placed: vec![false; self.groups.len()],
-            bounds: vec![[F::default(); 3]; self.groups.len() + self.origins.len()],
+            bounds: vec![
+                [F::default(); 3];
+                self.groups.len() + self.origins.len() + self.frame_balls.len()
+            ],
             frames: vec![([F::default(); 9], [F::default(); 3]); self.groups.len()],
             placed: vec![false; self.groups.len()],
             framed: vec![false; self.groups.len()],
@@ -550,6 +561,7 @@ struct Walks {
     world_steps: Vec<WorldStep>,
     culls: bool,
     origins: Vec<u32>,
+    frame_balls: Vec<(u32, [f32; 3])>,
 }
 
 impl Walks {
@@ -604,10 +616,10 @@ impl Walks {
                 .collect()
         };
         // a block of one link's bodies: its group
-        let world_steps = if !culls {
-            Vec::new()
+        let (world_steps, frame_balls) = if !culls {
+            frame_culls(groups)
         } else {
-            culling
+            let steps = culling
                 .world_steps
                 .iter()
                 .map(|step| match *step {
@@ -623,7 +635,8 @@ impl Walks {
                         WorldStep::Link(group_of_body[start as usize] as u32)
                     }
                 })
-                .collect()
+                .collect();
+            (steps, Vec::new())
         };
         let origins = if culls {
             culling.origin_links.clone()
@@ -635,8 +648,57 @@ impl Walks {
             world_steps,
             culls,
             origins,
+            frame_balls,
         }
     }
+}
+
+/// Link groups a frame must hold for the world walk of a model without culls to test them
+/// behind one sphere enclosing them all (a gripper's links fixed to the wrist, placed from
+/// its frame): an object far from that sphere skips them all.
+pub(super) const FRAME_CULL_GROUPS: usize = 6;
+
+/// The world walk of a model without culls (see [`FastModel::world_steps`]): the groups the
+/// last in the tree first, those of a frame holding [`FRAME_CULL_GROUPS`] or more behind a
+/// cull by the sphere enclosing them; and those spheres. None when no frame holds so many.
+fn frame_culls(groups: &[Group]) -> (Vec<WorldStep>, Vec<(u32, [f32; 3])>) {
+    let mut members: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for g in (0..groups.len()).rev() {
+        members.entry(groups[g].frame).or_default().push(g);
+    }
+    if members.values().all(|m| m.len() < FRAME_CULL_GROUPS) {
+        return (Vec::new(), Vec::new());
+    }
+    let (mut steps, mut balls, mut done) = (Vec::new(), Vec::new(), vec![false; groups.len()]);
+    for g in (0..groups.len()).rev() {
+        if done[g] {
+            continue;
+        }
+        let frame = &members[&groups[g].frame];
+        if frame.len() < FRAME_CULL_GROUPS {
+            steps.push(WorldStep::Link(g as u32));
+            continue;
+        }
+        let bounds: Vec<(Point3<f64>, f64)> = frame
+            .iter()
+            .map(|&k| {
+                let b = &groups[k].bound;
+                (Point3::from(b.center.map(f64::from)), f64::from(b.radius))
+            })
+            .collect();
+        let ball = bounding_ball(&bounds);
+        steps.push(WorldStep::Cull {
+            ball: (groups.len() + balls.len()) as u32,
+            radius: ball.radius,
+            end: (steps.len() + 1 + frame.len()) as u32,
+        });
+        balls.push((groups[g].frame as u32, ball.center));
+        for &k in frame {
+            steps.push(WorldStep::Link(k as u32));
+            done[k] = true;
+        }
+    }
+    (steps, balls)
 }
 
 /// The largest distance of any point of the robot from the world origin in any configuration

@@ -733,3 +733,89 @@ fn clearance_tables_decide_only_what_the_exact_model_says() {
         }
     }
 }
+
+/// A frame holding [`FRAME_CULL_GROUPS`] groups or more (a gripper's fingers fixed to the
+/// wrist) is walked behind the sphere enclosing them: the screen still answers as the exact
+/// model does, configuration by configuration and block by block, among every primitive.
+#[test]
+fn groups_behind_their_frames_sphere_answer_as_the_exact_model_does() {
+    let (mut links, mut joints) = (String::new(), String::new());
+    for k in 0..FRAME_CULL_GROUPS {
+        let a = k as f64 * std::f64::consts::TAU / FRAME_CULL_GROUPS as f64;
+        let (x, y) = (0.06 * a.cos(), 0.06 * a.sin());
+        links += &format!(
+            r#"<link name="g{k}"><collision><origin xyz="{x} {y} 0.08"/><geometry><sphere radius="0.02"/></geometry></collision></link>"#
+        );
+        joints += &format!(
+            r#"<joint name="f{k}" type="fixed"><parent link="wrist"/><child link="g{k}"/></joint>"#
+        );
+    }
+    let limit = r#"<limit lower="-2.5" upper="2.5" effort="1" velocity="1"/>"#;
+    let urdf = format!(
+        r#"<robot name="gripper_arm">
+          <link name="base"/>
+          <link name="upper"><collision><origin xyz="0 0 0.2"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+          <link name="fore"><collision><origin xyz="0 0 0.2"/><geometry><sphere radius="0.04"/></geometry></collision></link>
+          <link name="wrist"><collision><geometry><sphere radius="0.03"/></geometry></collision></link>
+          {links}
+          <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>{limit}</joint>
+          <joint name="j2" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0 0 0.4"/><axis xyz="0 1 0"/>{limit}</joint>
+          <joint name="j3" type="revolute"><parent link="fore"/><child link="wrist"/><origin xyz="0 0 0.4"/><axis xyz="0 1 0"/>{limit}</joint>
+          {joints}
+        </robot>"#
+    );
+    let robot = trm_kinematics::RobotModel::from_urdf_str(&urdf, "<gripper arm>").unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    let active = robot.all_active();
+    let mut checker = FastChecker::new(&collision, active.clone()).unwrap();
+    assert_eq!(
+        checker.model().frame_balls.len(),
+        1,
+        "the wrist's fingers share a cull"
+    );
+    let at = |x: f64, y: f64, z: f64| nalgebra::Isometry3::translation(x, y, z);
+    let mut world = World::new();
+    let plate = Shape::Box {
+        size: [0.5, 0.5, 0.02],
+    };
+    world.add("plate", plate, at(0.4, 0.0, 0.45)).unwrap();
+    let ball = Shape::Sphere { radius: 0.12 };
+    world.add("ball", ball, at(-0.25, 0.25, 0.75)).unwrap();
+    let rod = Shape::Capsule {
+        radius: 0.02,
+        length: 0.4,
+    };
+    world.add("rod", rod, at(0.0, -0.4, 0.5)).unwrap();
+    let can = Shape::Cylinder {
+        radius: 0.05,
+        length: 0.2,
+    };
+    world.add("can", can, at(-0.3, -0.2, 0.4)).unwrap();
+    let fast_world = checker.model().world(&world);
+    let (mut pose, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let qs: Vec<Vec<f64>> = (0..4000).map(|_| active.random(&mut rng)).collect();
+    let mut truth = Vec::with_capacity(qs.len());
+    for q in &qs {
+        active.forward(q, &mut pose).unwrap();
+        collision.place(&pose, &mut placed);
+        truth.push(!collision.is_colliding(&placed, &world));
+    }
+    let free = truth.iter().filter(|&&f| f).count();
+    assert!(
+        free > 400 && free < 3600,
+        "{free} of 4000: a test of both answers"
+    );
+    for (q, &expected) in qs.iter().zip(&truth) {
+        assert_eq!(
+            checker.all_free(q, &world, &fast_world).unwrap(),
+            expected,
+            "{q:?}"
+        );
+    }
+    for (block, expected) in qs.chunks(FAST_LANES).zip(truth.chunks(FAST_LANES)) {
+        let expected = expected.iter().all(|&f| f);
+        let found = checker.all_free_unchecked(&block.concat(), &world, &fast_world);
+        assert_eq!(found, expected, "{block:?}");
+    }
+}

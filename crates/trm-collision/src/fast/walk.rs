@@ -88,7 +88,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
     // theirs), each link's bounding sphere against each object, then its spheres. A model of
     // many links: each object against the culling spheres of the kinematic tree's subtrees
     // first
-    if !model.culls {
+    if model.world_steps.is_empty() {
         for g in (0..model.groups.len()).rev() {
             for (&o, object) in world.original.iter().zip(&world.objects) {
                 let o = o as usize;
@@ -97,6 +97,42 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                     return;
                 }
             }
+        }
+    } else if !model.culls {
+        // the same order, a frame's groups behind the sphere enclosing them
+        let steps = &model.world_steps;
+        let mut i = 0;
+        while i < steps.len() {
+            let (links, ball) = match steps[i] {
+                WorldStep::Cull { ball, radius, end } => {
+                    (i + 1..end as usize, Some((ball, radius)))
+                }
+                WorldStep::Link(_) => (i..i + 1, None),
+            };
+            for (&o, object) in world.original.iter().zip(&world.objects) {
+                let o = o as usize;
+                let near = match ball {
+                    Some((ball, radius)) => {
+                        live & object.near::<AVX>(&scratch.bounds[ball as usize], radius + m)
+                    }
+                    None => live,
+                };
+                if near == 0 {
+                    continue;
+                }
+                for step in &steps[links.clone()] {
+                    let WorldStep::Link(g) = *step else {
+                        continue;
+                    };
+                    let g = g as usize;
+                    if object_link::<AVX, _>(
+                        model, poses, o, object, g, near, world, scratch, verdict,
+                    ) {
+                        return;
+                    }
+                }
+            }
+            i = links.end;
         }
     } else {
         for (&o, object) in world.original.iter().zip(&world.objects) {
@@ -715,6 +751,11 @@ pub(super) fn place<const AVX: bool>(
     for (s, &frame) in model.origins.iter().enumerate() {
         let p = &poses[frame as usize];
         scratch.bounds[groups + s] = [F(p[4]), F(p[5]), F(p[6])];
+    }
+    // the spheres enclosing the groups of a frame
+    let after = groups + model.origins.len();
+    for (k, &(frame, center)) in model.frame_balls.iter().enumerate() {
+        scratch.bounds[after + k] = pose_point(&poses[frame as usize], center);
     }
     #[cfg(target_arch = "x86_64")]
     if AVX {
