@@ -21,6 +21,7 @@
 #include <vamp/planning/simplify.hh>
 #include <vamp/planning/validate.hh>
 #include <vamp/random/halton.hh>
+#include <vamp/robots/baxter.hh>
 #include <vamp/robots/fetch.hh>
 #include <vamp/robots/panda.hh>
 #include <vamp/robots/ur5.hh>
@@ -345,9 +346,13 @@ auto main() -> int
     {
         dispatch<vamp::robots::UR5>(std::cin, 1.5F);
     }
+    else if (robot == "baxter")
+    {
+        dispatch<vamp::robots::Baxter>(std::cin, 0.5F);
+    }
     else
     {
-        fail("VAMP has no robot `" + robot + "` here (panda, fetch, ur5)");
+        fail("VAMP has no robot `" + robot + "` here (panda, fetch, ur5, baxter)");
     }
     return 0;
 }

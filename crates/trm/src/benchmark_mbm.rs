@@ -100,12 +100,12 @@ pub struct Args {
     experience: bool,
     /// Also run VAMP's RRT-Connect + simplifier on the same problems and print its table and a
     /// side-by-side one after trm's: the program benches/peers/vamp/build.sh builds
-    /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5),
-    /// or --vamp-robot's.
+    /// (target/peers/vamp-mbm). The robot is VAMP's of the URDF's name (panda, fetch, ur5,
+    /// baxter), or --vamp-robot's.
     #[arg(long, conflicts_with = "families")]
     vamp: Option<PathBuf>,
-    /// With --vamp: VAMP's robot to run (panda, fetch, ur5), where the URDF names it otherwise
-    /// (default: the URDF's robot name).
+    /// With --vamp: VAMP's robot to run (panda, fetch, ur5, baxter), where the URDF names it
+    /// otherwise (default: the URDF's robot name).
     #[arg(long, value_name = "NAME", requires = "vamp")]
     vamp_robot: Option<String>,
     /// Also solve the set with this map attached to each problem's planner (repeatable; built
@@ -470,7 +470,6 @@ fn run_vamp(
     let problems: Vec<trm_mbm::Problem> =
         bench.problems.iter().map(|p| p.problem.clone()).collect();
     let problems = &problems[..];
-    use std::io::Write as _;
     let vamp_robot = args.vamp_robot.as_deref().unwrap_or(robot.name());
     // with --cloud, the very points trm planned among
     let clouds: Vec<trm_collision::World> =
@@ -483,16 +482,23 @@ fn run_vamp(
         problems.len(),
         set.root().display()
     );
-    let mut child = std::process::Command::new(binary)
-        .stdin(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .map_err(|e| anyhow::anyhow!("--vamp: starting {}: {e}\n  {VAMP_FIX}", binary.display()))?;
-    let mut stdin = child.stdin.take().expect("stdin is piped");
-    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let output = child.wait_with_output()?;
-    let _ = writer.join();
+    // the problems through a file, not a pipe: a harness that stops reading early (a robot it
+    // does not have) must not end this process by SIGPIPE before its message is read
+    let staged = std::env::temp_dir().join(format!("trm-vamp-input-{}.txt", std::process::id()));
+    std::fs::write(&staged, &input)
+        .map_err(|e| anyhow::anyhow!("--vamp: writing {}: {e}", staged.display()))?;
+    let stdin = std::fs::File::open(&staged)
+        .map_err(|e| anyhow::anyhow!("--vamp: reading {}: {e}", staged.display()));
+    let output = stdin.and_then(|stdin| {
+        std::process::Command::new(binary)
+            .stdin(stdin)
+            .output()
+            .map_err(|e| {
+                anyhow::anyhow!("--vamp: starting {}: {e}\n  {VAMP_FIX}", binary.display())
+            })
+    });
+    let _ = std::fs::remove_file(&staged);
+    let output = output?;
     anyhow::ensure!(
         output.status.success(),
         "--vamp: {} failed ({}): {}",

@@ -300,7 +300,24 @@ pub fn cases(dir: &Path) -> Vec<Case> {
     )
     .unwrap();
     std::fs::set_permissions(&fake, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
-    for program in ["no/such/program", "map.json", "fake_vamp.sh"] {
+    // a harness that stops without reading its input (VAMP's, for a robot it does not have)
+    let refusing = dir.join("refusing_vamp.sh");
+    std::fs::write(
+        &refusing,
+        "#!/bin/sh\necho 'vamp-mbm: VAMP has no robot `x` here' >&2\nexit 2\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(
+        &refusing,
+        std::os::unix::fs::PermissionsExt::from_mode(0o755),
+    )
+    .unwrap();
+    for program in [
+        "no/such/program",
+        "map.json",
+        "fake_vamp.sh",
+        "refusing_vamp.sh",
+    ] {
         let mut args = bench(&mbm);
         args.extend(["--per-family", "1", "--vamp", program].map(String::from));
         cases.push(Case {
