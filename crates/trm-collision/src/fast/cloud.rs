@@ -4,9 +4,13 @@
 //! place), cells in x-fastest order, so that every run of cells along x is one contiguous run of
 //! points. A sphere's query visits only the rows of cells its ball crosses, and in each row only
 //! the cells under the ball's chord: the points it scans lie within about one cell of the ball.
-//! Building costs two passes over the points and one over the cells, nothing per point per
-//! cell — the difference from CAPT (Ramsey et al., RSS 2024), which stores, for every leaf of a
-//! k-d tree, every point its queries could reach, and from voxel distance fields.
+//! Most queries end before that, at their cell's clearance: near the points, the distance from
+//! the cell to the box about each nearby cell's points (a few cells about every occupied one,
+//! written row by row); farther, a distance transform of the occupied cells, truncated where
+//! no link's bounding sphere reaches. Building costs a sort of the points, a window of cells
+//! per occupied cell and a few passes over the cells — the difference from CAPT (Ramsey et
+//! al., RSS 2024), which stores, for every leaf of a k-d tree, every point its queries could
+//! reach.
 //!
 //! **Exact, as the other objects**: the scan finds the nearest point among all those within the
 //! query's range (its reach plus the margin, padded by a few units of rounding), so the
@@ -36,8 +40,8 @@ pub(super) struct CloudGrid {
     dims: [usize; 3],
     /// Per cell (x fastest), the index of its first point; one more entry at the end.
     starts: Vec<u32>,
-    /// Per cell: no point of the cloud lies nearer than this to any place in the cell, m (from
-    /// the cells' Euclidean distance transform): most queries end at this one look-up.
+    /// Per cell: no point of the cloud lies nearer than this to any place in the cell, m
+    /// ([`near_clearances`]): most queries end at this one look-up.
     clear: Vec<f32>,
     /// The points' coordinates, cell by cell.
     xyz: [Vec<f32>; 3],
@@ -62,8 +66,10 @@ const MESH_SAMPLES: usize = 1 << 21;
 
 impl CloudGrid {
     /// The points in a grid of cells about `cell` wide (coarser when the cloud is sparse and
-    /// wide; see [`CELLS_PER_POINT`]). `points` must be finite and not empty.
-    pub(super) fn new(points: &[[f32; 3]], cell: f32) -> CloudGrid {
+    /// wide; see [`CELLS_PER_POINT`]), each cell's clearance exact up to about `near` (see
+    /// [`near_clearances`]) and bounded up to about `far` ([`far_clearances`]). `points` must
+    /// be finite and not empty.
+    pub(super) fn new(points: &[[f32; 3]], cell: f32, near: f32, far: f32) -> CloudGrid {
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
         for p in points {
@@ -111,7 +117,12 @@ impl CloudGrid {
                 xyz[k][at] = p[k];
             }
         }
-        let clear = clearances(&starts, dims, cell);
+        // far from the points, the cells' distance transform; near them, exact
+        let far_cells = ((far / cell).ceil() as usize + 2).clamp(1, FAR_CELLS);
+        let far = far_clearances(&starts, dims, cell, far_cells);
+        let cells_near = ((near / cell).ceil() as usize).clamp(1, NEAR_CELLS);
+        let clear = near_clearances(&starts, &xyz, lo, dims, cell, cells_near, far);
+
         let largest = (0..3)
             .map(|k| lo[k].abs().max(hi[k].abs()))
             .fold(cell, f32::max);
@@ -135,8 +146,9 @@ impl CloudGrid {
     /// pieces' corners kept. Every point of a piece lies within its longest side of each of its
     /// corners, so every point of the mesh lies within the spacing of a sample (the grid's
     /// `gap`), and the samples lie on the mesh: the nearest sample's distance `d` bounds the
-    /// mesh's to `[d − gap, d]`. `None` past [`MESH_SAMPLES`] samples.
-    pub(super) fn of_mesh(corners: &[[[f64; 3]; 3]], cell: f32) -> Option<CloudGrid> {
+    /// mesh's to `[d − gap, d]`. Clearances bounded up to `far` as by [`CloudGrid::new`].
+    /// `None` past [`MESH_SAMPLES`] samples.
+    pub(super) fn of_mesh(corners: &[[[f64; 3]; 3]], cell: f32, far: f32) -> Option<CloudGrid> {
         let spacing = f64::from(MESH_SPACING);
         let mut points: Vec<[f32; 3]> = Vec::new();
         for [a, b, c] in corners {
@@ -157,7 +169,7 @@ impl CloudGrid {
                 }
             }
         }
-        let mut grid = CloudGrid::new(&points, cell);
+        let mut grid = CloudGrid::new(&points, cell, 2.0 * cell, far);
         // the samples' rounding to f32 is within the slack; the spacing bounds the rest
         grid.gap = MESH_SPACING + grid.slack;
         Some(grid)
@@ -174,13 +186,10 @@ impl CloudGrid {
     /// place in the box is at least as near every point as `p`).
     #[inline(always)]
     pub(super) fn clearance(&self, p: [f32; 3]) -> f32 {
+        // truncation is the floor of what is not negative
         let i: [usize; 3] = std::array::from_fn(|k| {
-            let v = ((p[k] - self.origin[k]) * self.inv_cell).floor();
-            if v >= 0.0 {
-                (v as usize).min(self.dims[k] - 1)
-            } else {
-                0
-            }
+            let v = (p[k] - self.origin[k]) * self.inv_cell;
+            (v.max(0.0) as usize).min(self.dims[k] - 1)
         });
         self.clear[i[0] + self.dims[0] * (i[1] + self.dims[1] * i[2])]
     }
@@ -204,13 +213,13 @@ impl CloudGrid {
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.
     #[inline(always)]
     fn cells(&self, k: usize, a: f32, b: f32) -> Option<(usize, usize)> {
-        let lo = ((a - self.origin[k]) * self.inv_cell).floor();
-        let hi = ((b - self.origin[k]) * self.inv_cell).floor();
-        let last = (self.dims[k] - 1) as f32;
-        if !(hi >= 0.0 && lo <= last) {
+        let lo = (a - self.origin[k]) * self.inv_cell;
+        let hi = (b - self.origin[k]) * self.inv_cell;
+        if !(hi >= 0.0 && lo < self.dims[k] as f32) {
             return None;
         }
-        Some((lo.max(0.0) as usize, hi.min(last) as usize))
+        // truncation is the floor of what is not negative
+        Some((lo.max(0.0) as usize, (hi as usize).min(self.dims[k] - 1)))
     }
 
     /// The squared distance from `p` to the slab of cells `i` along axis `k` (0 inside).
@@ -340,17 +349,18 @@ impl CloudGrid {
 }
 
 /// Per cell of a grid of `dims` cells of side `cell` whose points start at `starts`: a
-/// distance from any place in the cell within which no point lies, m. The squared Euclidean
-/// distance transform of the occupied cells over cell indices (Felzenszwalb and Huttenlocher,
-/// 2012: the lower envelope of parabolas, one axis after the other), `d` cells to the nearest
-/// occupied one; two places in cells `d` apart are at least `(d − √3)` cells apart.
-fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
-    let n = dims[0] * dims[1] * dims[2];
-    let far = 1e20_f32;
-    // along x, where cells are either occupied or not: the squared distance to the nearest
-    // occupied cell of the row, by one sweep each way
-    let mut d2 = vec![far; n];
-    for (r, row) in d2.chunks_mut(dims[0]).enumerate() {
+/// distance from any place in the cell within which no point lies, up to about `t` cells, m.
+/// The squared Euclidean distance transform of the cells holding points over cell indices, one
+/// axis after the other (exact sweeps along x; along y and z the least of `f[j + s] + s²` over
+/// `|s| ≤ t`, whole rows of x at once), each pass capped at `(t + 1)²`: a nearer cell beyond
+/// the window would lie more than `t` cells away along that axis alone, so the capped value
+/// never exceeds the true one. Two places in cells `d` apart are at least `(d − √3)` cells
+/// apart.
+fn far_clearances(starts: &[u32], dims: [usize; 3], cell: f32, t: usize) -> Vec<f32> {
+    let cap = ((t + 1) * (t + 1)) as f32;
+    let mut d2 = vec![cap; dims[0] * dims[1] * dims[2]];
+    // along x, where cells are either occupied or not: one sweep each way
+    for (r, row) in d2.chunks_exact_mut(dims[0]).enumerate() {
         let occupied = |x: usize| starts[r * dims[0] + x + 1] > starts[r * dims[0] + x];
         let mut last: Option<usize> = None;
         for x in 0..dims[0] {
@@ -358,7 +368,7 @@ fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
                 last = Some(x);
             }
             if let Some(l) = last {
-                row[x] = ((x - l) * (x - l)) as f32;
+                row[x] = row[x].min(((x - l) * (x - l)) as f32);
             }
         }
         let mut last: Option<usize> = None;
@@ -371,74 +381,141 @@ fn clearances(starts: &[u32], dims: [usize; 3], cell: f32) -> Vec<f32> {
             }
         }
     }
-    let stride = [1, dims[0], dims[0] * dims[1]];
-    let (mut f, mut out) = (Vec::new(), Vec::new());
-    let (mut v, mut z) = (Vec::new(), Vec::new());
-    // then along y and z: the lower envelope of parabolas; a line holding no finite value
-    // stays as it is
-    for axis in 1..3 {
-        let len = dims[axis];
-        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
-        for i in 0..dims[a] {
-            for j in 0..dims[b] {
-                let base = i * stride[a] + j * stride[b];
-                f.clear();
-                f.extend((0..len).map(|k| d2[base + k * stride[axis]]));
-                if f.iter().all(|&x| x >= far) {
-                    continue;
-                }
-                envelope(&f, &mut out, &mut v, &mut z);
-                for (k, value) in out.iter().enumerate() {
-                    d2[base + k * stride[axis]] = *value;
-                }
-            }
-        }
+    // along y within each slab of z, then along z: lines of whole rows, whole slabs
+    let mut out = vec![0.0; d2.len()];
+    let slab = dims[0] * dims[1];
+    for (from, to) in d2.chunks_exact(slab).zip(out.chunks_exact_mut(slab)) {
+        min_plus(from, to, dims[0], dims[1], t, cap);
     }
+    min_plus(&out, &mut d2, slab, dims[2], t, cap);
     d2.iter()
         .map(|&d| ((d.sqrt() - 3f32.sqrt()) * cell).max(0.0) * (1.0 - 1e-6))
         .collect()
 }
 
-/// The 1-D squared distance transform of `f` (`out[q] = min_p f[p] + (q − p)²`).
-fn envelope(f: &[f32], out: &mut Vec<f32>, v: &mut Vec<usize>, z: &mut Vec<f32>) {
-    let n = f.len();
-    out.clear();
-    v.clear();
-    z.clear();
-    // parabolas of the lower envelope, and where each takes over
-    for q in 0..n {
-        if f[q] >= 1e20 {
-            continue;
-        }
-        loop {
-            let Some(&p) = v.last() else {
-                v.push(q);
-                z.push(f32::NEG_INFINITY);
-                break;
-            };
-            let s = ((f[q] + (q * q) as f32) - (f[p] + (p * p) as f32)) / (2.0 * (q - p) as f32);
-            if s <= *z.last().expect("one per parabola") {
-                v.pop();
-                z.pop();
-            } else {
-                v.push(q);
-                z.push(s);
-                break;
+/// `to[j] = min(cap, min over |s| ≤ t of from[j + s] + s²)` for the `n` lines of `width`
+/// values each of `from` (line `j` at `j * width`), a whole line at a time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn min_plus(from: &[f32], to: &mut [f32], width: usize, n: usize, t: usize, cap: f32) {
+    for (j, out) in to.chunks_exact_mut(width).enumerate().take(n) {
+        out.fill(cap);
+        for k in j.saturating_sub(t)..(j + t + 1).min(n) {
+            let s2 = ((k as isize - j as isize).pow(2)) as f32;
+            for (o, f) in out.iter_mut().zip(&from[k * width..(k + 1) * width]) {
+                let v = f + s2;
+                *o = if v < *o { v } else { *o };
             }
         }
     }
-    if v.is_empty() {
-        out.extend(std::iter::repeat_n(1e20, n));
-        return;
-    }
-    let mut k = 0;
-    for q in 0..n {
-        while k + 1 < v.len() && z[k + 1] < q as f32 {
-            k += 1;
+}
+
+/// Most cells of [`far_clearances`]'s window along each axis.
+const FAR_CELLS: usize = 16;
+
+/// Most cells about a point whose clearances [`near_clearances`] makes exact, along each axis.
+const NEAR_CELLS: usize = 4;
+
+/// Per cell of a grid of `dims` cells of side `cell` from `lo` holding the points `xyz` (from
+/// `starts` per cell): the distance from the cell to the nearest box about a cell's points
+/// where that is below `k` cells (a point farther away along some axis than `k` cells is at
+/// least `k` cells from the cell; a box about one point is the point), else `k` cells; the
+/// larger of that and the cell's `far` clearance, m. Near the points, where queries land, this
+/// is what decides whether a query scans: a distance transform of the cells that hold points
+/// loses up to √3 cells.
+fn near_clearances(
+    starts: &[u32],
+    xyz: &[Vec<f32>; 3],
+    lo: [f32; 3],
+    dims: [usize; 3],
+    cell: f32,
+    k: usize,
+    far: Vec<f32>,
+) -> Vec<f32> {
+    // rows padded by NEAR_CELLS cells each side: every point's window is NEAR_WINDOW wide
+    let row_len = dims[0] + 2 * NEAR_CELLS;
+    let mut near2 = vec![(k as f32 * cell).powi(2); row_len * dims[1] * dims[2]];
+    splat(&mut near2, starts, xyz, lo, dims, cell, k);
+    let mut clear = far;
+    for (row, near2) in clear
+        .chunks_exact_mut(dims[0])
+        .zip(near2.chunks_exact(row_len))
+    {
+        for (c, d2) in row.iter_mut().zip(&near2[NEAR_CELLS..]) {
+            let near = d2.sqrt() * (1.0 - 1e-6);
+            *c = if near > *c { near } else { *c };
         }
-        let p = v[k];
-        let d = q as f32 - p as f32;
-        out.push(d * d + f[p]);
+    }
+    clear
+}
+
+/// Cells in the window [`splat`] updates about a point along x.
+const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
+
+/// Lowers `near2` (rows padded by [`NEAR_CELLS`] each side) to the squared distance from each
+/// cell within `k` cells of a cell holding points (`starts`, `xyz`) to the box about that
+/// cell's points: exact for a cell holding one point, never more than the nearest point's.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn splat(
+    near2: &mut [f32],
+    starts: &[u32],
+    xyz: &[Vec<f32>; 3],
+    lo: [f32; 3],
+    dims: [usize; 3],
+    cell: f32,
+    k: usize,
+) {
+    let cap2 = (k as f32 * cell).powi(2);
+    let row_len = dims[0] + 2 * NEAR_CELLS;
+    // the distance from [v0, v1] to the slab of cells `i` along `axis`
+    let gap = |axis: usize, i: isize, [v0, v1]: [f32; 2]| {
+        let a = lo[axis] + i as f32 * cell;
+        (a - v1).max(v0 - (a + cell)).max(0.0)
+    };
+    let span = |axis: usize, i: usize| (i.saturating_sub(k), (i + k).min(dims[axis] - 1));
+    for (c, run) in starts.windows(2).enumerate() {
+        let (from, to) = (run[0] as usize, run[1] as usize);
+        if from == to {
+            continue;
+        }
+        let bounds: [[f32; 2]; 3] = std::array::from_fn(|axis| {
+            let v = &xyz[axis][from..to];
+            [
+                v.iter().fold(f32::INFINITY, |a, &b| a.min(b)),
+                v.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b)),
+            ]
+        });
+        let (hx, hy, hz) = (c % dims[0], c / dims[0] % dims[1], c / (dims[0] * dims[1]));
+        let dx2: [f32; NEAR_WINDOW] = std::array::from_fn(|i| {
+            let offset = i as isize - NEAR_CELLS as isize;
+            if offset.unsigned_abs() > k {
+                f32::INFINITY
+            } else {
+                gap(0, hx as isize + offset, bounds[0]).powi(2)
+            }
+        });
+        let (y0, y1) = span(1, hy);
+        let (z0, z1) = span(2, hz);
+        let dy2: [f32; NEAR_WINDOW] =
+            std::array::from_fn(|i| gap(1, (y0 + i) as isize, bounds[1]).powi(2));
+        for kz in z0..=z1 {
+            let dz2 = gap(2, kz as isize, bounds[2]).powi(2);
+            for (ky, dy2) in (y0..=y1).zip(dy2) {
+                let dyz2 = dy2 + dz2;
+                if dyz2 >= cap2 {
+                    continue;
+                }
+                let at = row_len * (ky + dims[1] * kz) + hx;
+                let window: &mut [f32; NEAR_WINDOW] = (&mut near2[at..at + NEAR_WINDOW])
+                    .try_into()
+                    .expect("a window");
+                for (d2, dx2) in window.iter_mut().zip(dx2) {
+                    let d = dx2 + dyz2;
+                    *d2 = if d < *d2 { d } else { *d2 };
+                }
+            }
+        }
     }
 }
 
@@ -541,7 +618,9 @@ mod tests {
             let points: Vec<[f32; 3]> = (0..n)
                 .map(|_| std::array::from_fn(|k| rng.random_range(-0.5..=0.5) * spread[k] + 0.3))
                 .collect();
-            let grid = CloudGrid::new(&points, rng.random_range(0.005..0.2));
+            let cell = rng.random_range(0.005..0.2);
+            let (near, far) = (rng.random_range(0.0..4.0), rng.random_range(0.0..20.0));
+            let grid = CloudGrid::new(&points, cell, near * cell, far * cell);
             assert_eq!(grid.len(), n);
             for _ in 0..200 {
                 let p: [f32; 3] =
@@ -565,5 +644,49 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Near the points a cell's clearance is the distance from the cell to the points about
+    /// it (less than a cell short of a query's own distance, on average), and far from them it
+    /// still grows up to `far`: a transform of occupied cells alone is short by √3 cells.
+    #[test]
+    fn clearances_are_tight_near_the_points_and_reach_far() {
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        // a board of points 2 cm apart, as a thinned camera cloud gives it, and a small cell
+        let points: Vec<[f32; 3]> = (0..40)
+            .flat_map(|i| (0..30).map(move |j| [0.02 * i as f32, 0.02 * j as f32, 0.5]))
+            .chain([[0.4, 0.3, 0.0], [0.4, 0.3, 1.0]])
+            .collect();
+        let (cell, near, far) = (0.02, 0.08, 0.3);
+        let grid = CloudGrid::new(&points, cell, near, far);
+        // the grid's own cell: coarser than asked where the cells would be too many
+        let (cell, diagonal) = (grid.cell, 3f32.sqrt() * grid.cell);
+        let (mut short, mut count) = (0.0, 0);
+        for _ in 0..4000 {
+            let p: [f32; 3] = [
+                rng.random_range(0.0..0.8),
+                rng.random_range(0.0..0.6),
+                rng.random_range(0.0..1.0),
+            ];
+            let nearest = points
+                .iter()
+                .map(|q| (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f32>())
+                .fold(f32::INFINITY, f32::min)
+                .sqrt();
+            let clearance = grid.clearance(p);
+            assert!(clearance <= nearest, "{p:?}: {clearance} > {nearest}");
+            if nearest < near {
+                short += nearest - clearance;
+                count += 1;
+            } else if nearest < far - 2.0 * diagonal {
+                let lost = nearest - clearance;
+                assert!(lost <= 2.0 * diagonal, "{p:?}: {clearance} for {nearest}");
+            }
+        }
+        let short = short / count as f32;
+        assert!(
+            count > 500 && short < 0.75 * cell,
+            "{count} near: {short} short on average"
+        );
     }
 }

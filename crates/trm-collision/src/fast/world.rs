@@ -1,7 +1,7 @@
 use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
-use super::cloud::CloudGrid;
+use super::cloud::{CloudGrid, MESH_SPACING};
 use super::lanes::{
     F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, norm,
     segment_distance2, splat, to_f32,
@@ -149,6 +149,10 @@ impl FastModel {
         let cloud_cell = (self.balls.iter().chain(&self.inner))
             .map(|b| b.radius)
             .fold(0.0, f32::max);
+        // and their clearances bounded as far as the largest link's bounding sphere reaches
+        let far = (self.groups.iter())
+            .map(|g| g.bound.radius)
+            .fold(cloud_cell, f32::max);
         let mut clouds = Vec::new();
         let objects: Vec<Object> = world
             .objects()
@@ -214,7 +218,9 @@ impl FastModel {
                             .iter()
                             .map(|p| to_f32((pose * Point3::from(*p)).coords))
                             .collect();
-                        let grid = CloudGrid::new(&points, 0.25 * (cloud_cell + *radius as f32));
+                        let reach = cloud_cell + *radius as f32;
+                        let grid =
+                            CloudGrid::new(&points, 0.25 * reach, reach, far + *radius as f32);
                         let object = Object::Cloud {
                             index: clouds.len() as u32,
                             center: grid.center,
@@ -231,7 +237,7 @@ impl FastModel {
                         let corners: Vec<[[f64; 3]; 3]> = (triangles.iter())
                             .map(|t| t.map(|v| (pose * Point3::from(vertices[v as usize])).into()))
                             .collect();
-                        CloudGrid::of_mesh(&corners, 0.5 * cloud_cell)
+                        CloudGrid::of_mesh(&corners, 0.5 * cloud_cell, far + MESH_SPACING)
                     } =>
                     {
                         let object = Object::Cloud {
