@@ -416,13 +416,19 @@ const FAR_CELLS: usize = 16;
 /// Most cells about a point whose clearances [`near_clearances`] makes exact, along each axis.
 const NEAR_CELLS: usize = 4;
 
+/// Cells in the window [`near_clearances`] updates about an occupied cell along x.
+const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
+
 /// Per cell of a grid of `dims` cells of side `cell` from `lo` holding the points `xyz` (from
 /// `starts` per cell): the distance from the cell to the nearest box about a cell's points
 /// where that is below `k` cells (a point farther away along some axis than `k` cells is at
 /// least `k` cells from the cell; a box about one point is the point), else `k` cells; the
 /// larger of that and the cell's `far` clearance, m. Near the points, where queries land, this
 /// is what decides whether a query scans: a distance transform of the cells that hold points
-/// loses up to √3 cells.
+/// loses up to √3 cells. Each occupied cell lowers the cells of a window about it, a row of
+/// the window at a time.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
 fn near_clearances(
     starts: &[u32],
     xyz: &[Vec<f32>; 3],
@@ -432,42 +438,10 @@ fn near_clearances(
     k: usize,
     far: Vec<f32>,
 ) -> Vec<f32> {
-    // rows padded by NEAR_CELLS cells each side: every point's window is NEAR_WINDOW wide
-    let row_len = dims[0] + 2 * NEAR_CELLS;
-    let mut near2 = vec![(k as f32 * cell).powi(2); row_len * dims[1] * dims[2]];
-    splat(&mut near2, starts, xyz, lo, dims, cell, k);
-    let mut clear = far;
-    for (row, near2) in clear
-        .chunks_exact_mut(dims[0])
-        .zip(near2.chunks_exact(row_len))
-    {
-        for (c, d2) in row.iter_mut().zip(&near2[NEAR_CELLS..]) {
-            let near = d2.sqrt() * (1.0 - 1e-6);
-            *c = if near > *c { near } else { *c };
-        }
-    }
-    clear
-}
-
-/// Cells in the window [`splat`] updates about a point along x.
-const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
-
-/// Lowers `near2` (rows padded by [`NEAR_CELLS`] each side) to the squared distance from each
-/// cell within `k` cells of a cell holding points (`starts`, `xyz`) to the box about that
-/// cell's points: exact for a cell holding one point, never more than the nearest point's.
-#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
-#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
-fn splat(
-    near2: &mut [f32],
-    starts: &[u32],
-    xyz: &[Vec<f32>; 3],
-    lo: [f32; 3],
-    dims: [usize; 3],
-    cell: f32,
-    k: usize,
-) {
     let cap2 = (k as f32 * cell).powi(2);
+    // squared, in rows padded by NEAR_CELLS cells each side: every window is NEAR_WINDOW wide
     let row_len = dims[0] + 2 * NEAR_CELLS;
+    let mut near2 = vec![cap2; row_len * dims[1] * dims[2]];
     // the distance from [v0, v1] to the slab of cells `i` along `axis`
     let gap = |axis: usize, i: isize, [v0, v1]: [f32; 2]| {
         let a = lo[axis] + i as f32 * cell;
@@ -517,6 +491,17 @@ fn splat(
             }
         }
     }
+    let mut clear = far;
+    for (row, near2) in clear
+        .chunks_exact_mut(dims[0])
+        .zip(near2.chunks_exact(row_len))
+    {
+        for (c, d2) in row.iter_mut().zip(&near2[NEAR_CELLS..]) {
+            let near = d2.sqrt() * (1.0 - 1e-6);
+            *c = if near > *c { near } else { *c };
+        }
+    }
+    clear
 }
 
 /// The lanes of `near` in which link group `g`'s solids (boxes, capsules, spheres: the link
