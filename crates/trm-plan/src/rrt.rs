@@ -176,6 +176,10 @@ fn radical_inverse(mut i: u64, base: u64) -> f64 {
     value
 }
 
+/// Searches run again at a finer resolution (each halving it) at most, where a path grazes an
+/// obstacle between its checked points.
+const REFINEMENTS: u32 = 2;
+
 /// Draws per counted sample at most: samples outside every dynamic domain are drawn again
 /// without a collision check and not counted in [`RrtOptions::max_iterations`], up to this
 /// many times its value in all.
@@ -530,7 +534,9 @@ fn extend(
 /// of edges a random shortcut cut, at all their points); where an
 /// edge grazes an obstacle between the points first checked, the search runs again at that
 /// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
-/// it was checked. [`RrtPath::refinements`] counts the reruns.
+/// it was checked. [`RrtPath::refinements`] counts the reruns. Where even the finest search's
+/// shortcut path grazes (random shortcuts and corner cuts make edges no search visited), its
+/// own path through the greedy pass alone is returned if it passes the same check.
 pub fn rrt_connect(
     objective: &Objective,
     world: &World,
@@ -723,7 +729,7 @@ impl Growth {
         let (start, goal) = (self.start.clone(), self.goal.clone());
         let (mut iterations, mut simplify) = (0, 0.0);
         let mut growth = Some(self);
-        for refinement in 0..3 {
+        for refinement in 0..=REFINEMENTS {
             let resolution = options.resolution / f64::from(1u32 << refinement);
             let attempt = RrtOptions {
                 resolution,
@@ -735,20 +741,29 @@ impl Growth {
             };
             g.grow(checker, bounds, &attempt, attempt.max_iterations, began);
             let simplifying = Instant::now();
-            let (mut found, edges) = g.shortcut(checker, &attempt, began)?;
-            // the edges checked at `resolution` (by the search: the edges it kept, or by the
-            // shortcut) need only their midpoints to be checked at half that; a piece of an
-            // edge a random shortcut cut needs its own points too
-            let free = found.path.windows(2).zip(&edges).all(|(w, e)| {
-                (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
-                    && checker.edge_midpoints_free(&w[0], &w[1], resolution)
-                    // a refined search's points are not those of the asked resolution: those
-                    // too, so that the path is free at every point a check at
-                    // `options.resolution / 2` visits
-                    && (refinement == 0
-                        || checker.edge_free(&w[0], &w[1], options.resolution)
-                            && checker.edge_midpoints_free(&w[0], &w[1], options.resolution))
-            });
+            let (mut found, edges, raw) = g.shortcut(checker, &attempt, began)?;
+            let mut free = recheck(checker, &found.path, &edges, resolution, options.resolution);
+            if !free
+                && refinement == REFINEMENTS
+                && (attempt.shortcuts > 0 || attempt.smoothing > 0)
+            {
+                // random shortcuts and corner cuts make edges no search visited, which may
+                // graze an obstacle at every resolution: at the finest, the search's own path
+                // through the greedy pass only, rather than no path
+                let greedy_only = RrtOptions {
+                    shortcuts: 0,
+                    smoothing: 0,
+                    ..attempt.clone()
+                };
+                let mut plain = raw;
+                // no random shortcut: the generator is not drawn from
+                let mut unused = ChaCha8Rng::seed_from_u64(0);
+                let edges = shortcut(&mut plain, &greedy_only, checker, &mut unused);
+                if recheck(checker, &plain, &edges, resolution, options.resolution) {
+                    found.path = plain;
+                    free = true;
+                }
+            }
             iterations += found.iterations;
             simplify += simplifying.elapsed().as_secs_f64();
             if free {
@@ -763,21 +778,21 @@ impl Growth {
         Err(PlanError::Unreachable {
             reason: format!(
                 "every path RRT-Connect found grazed an obstacle between its checked points, down to a resolution of {} rad",
-                options.resolution / 4.0
+                options.resolution / f64::from(1u32 << REFINEMENTS)
             ),
             closest_node: None,
             closest_distance: f64::INFINITY,
         })
     }
 
-    /// The trees' path shortcut ([`shortcut`]), with how each edge was checked; an error when
-    /// the trees have not met.
+    /// The trees' path shortcut ([`shortcut`]), with how each edge was checked, and the path
+    /// as the trees gave it; an error when the trees have not met.
     fn shortcut(
         mut self,
         checker: &mut WorldChecker,
         options: &RrtOptions,
         began: Instant,
-    ) -> Result<(RrtPath, Vec<EdgeCheck>), PlanError> {
+    ) -> Result<Shortcut, PlanError> {
         self.result.nodes = self.a.len() + self.b.len();
         let Some(mut path) = self.raw.take() else {
             return Err(PlanError::Unreachable {
@@ -792,12 +807,37 @@ impl Growth {
             });
         };
         self.result.raw_waypoints = path.len();
+        let raw = path.clone();
         let edges = shortcut(&mut path, options, checker, &mut self.rng);
         self.result.path = path;
         self.result.checks = checker.checks - self.before;
         self.result.seconds = began.elapsed().as_secs_f64();
-        Ok((self.result, edges))
+        Ok((self.result, edges, raw))
     }
+}
+
+/// A path shortcut, how each of its edges was checked, and the path before the shortcut.
+type Shortcut = (RrtPath, Vec<EdgeCheck>, Vec<Vec<f64>>);
+
+/// Whether `path`, whose edges were checked at `resolution` as `edges` says, is free at half
+/// that: the edges checked at `resolution` (by the search: the edges it kept, or by the
+/// shortcut) need only their midpoints; a piece of an edge a random shortcut cut needs its own
+/// points too. A refined search's points are not those of the `asked` resolution: those too,
+/// so that the path is free at every point a check at `asked / 2` visits.
+fn recheck(
+    checker: &mut WorldChecker,
+    path: &[Vec<f64>],
+    edges: &[EdgeCheck],
+    resolution: f64,
+    asked: f64,
+) -> bool {
+    path.windows(2).zip(edges).all(|(w, e)| {
+        (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
+            && checker.edge_midpoints_free(&w[0], &w[1], resolution)
+            && (resolution == asked
+                || checker.edge_free(&w[0], &w[1], asked)
+                    && checker.edge_midpoints_free(&w[0], &w[1], asked))
+    })
 }
 
 /// How the reason of the error of a query whose goal collides begins.
