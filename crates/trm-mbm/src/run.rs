@@ -58,6 +58,10 @@ pub struct BenchmarkOptions {
     pub maps: Vec<Roadmap>,
     /// The obstacles trm plans among, and its paths are verified in.
     pub obstacles: crate::Obstacles,
+    /// Check the link pairs the robot's own allowed-collision matrix checks, ignoring each
+    /// scene's (as VAMP does: its checks know no scene matrix), so that both planners face
+    /// the same pairs.
+    pub ignore_scene_matrices: bool,
 }
 
 /// What a set run came to: the plain run, and each pass with experience kept.
@@ -90,6 +94,12 @@ pub fn benchmark(
     mut progress: impl FnMut(&str, usize, usize, &Problem),
 ) -> Result<Benchmark, MbmError> {
     let mut loaded = LoadedProblem::load_all(collision, problems)?;
+    if options.ignore_scene_matrices {
+        for p in &mut loaded {
+            p.collision = p.own.clone();
+            p.notes.clear();
+        }
+    }
     match options.obstacles {
         crate::Obstacles::AsGiven => {}
         crate::Obstacles::AsVamp => {

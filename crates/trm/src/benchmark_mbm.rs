@@ -66,6 +66,11 @@ pub struct Args {
     /// obstacles (trm_mbm::vamp_world)
     #[arg(long)]
     vamp_obstacles: bool,
+    /// Check the link pairs the model's own allowed-collision matrix checks, ignoring each
+    /// scene's, as VAMP does (a scene's matrix written for a robot's meshes may check pairs
+    /// that its sphere model's spheres overlap at the problems' starts and goals)
+    #[arg(long)]
+    ignore_scene_matrices: bool,
     /// Plan among the scenes as a depth camera would see them, as VAMP's evaluate_mbm.py
     /// --pointcloud does: SAMPLES points on every object's surface (VAMP's: 10000), thinned to
     /// 2 cm, points of 2.5 mm (trm_mbm::cloud_world); with --vamp, VAMP plans among the same
@@ -235,7 +240,7 @@ pub fn run(args: &Args) -> Result<()> {
 /// The report's first line: the set, the model and the planner's settings.
 fn header(args: &Args, options: &RrtOptions) -> String {
     format!(
-        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{})\n\n",
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{}{})\n\n",
         args.dir.display(),
         args.model.display(),
         options.smoothing,
@@ -259,6 +264,11 @@ fn header(args: &Args, options: &RrtOptions) -> String {
                 trm_mbm::CLOUD_POINT_RADIUS
             ),
             (false, None) => String::new(),
+        },
+        if args.ignore_scene_matrices {
+            "; the scenes' allowed-collision matrices ignored (the model's own only, as VAMP)"
+        } else {
+            ""
         }
     )
 }
@@ -324,6 +334,7 @@ fn run_benchmark(
             (false, Some(per_object)) => trm_mbm::Obstacles::Cloud { per_object },
             (false, None) => trm_mbm::Obstacles::AsGiven,
         },
+        ignore_scene_matrices: args.ignore_scene_matrices,
     };
     let mut bar: Option<(String, crate::progress::Progress)> = None;
     let bench = match trm_mbm::benchmark(
