@@ -345,6 +345,11 @@ pub fn cases(dir: &Path) -> Vec<Case> {
             vec!["--task-space", "panda_hand", "--orientation-tolerance", "0"],
             "--orientation-tolerance",
         ),
+        // a switch given a value
+        (
+            vec!["--ignore-scene-matrices=yes"],
+            "--ignore-scene-matrices",
+        ),
     ] {
         let mut args = bench(&mbm);
         args.extend(extra.iter().map(|s| s.to_string()));
