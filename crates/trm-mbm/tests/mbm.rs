@@ -731,8 +731,8 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
             if let (Some(x), Some(y)) = (tree.link_index(&m.names[i]), tree.link_index(&m.names[j]))
             {
                 let geometric = collision.acm().reason(x, y).is_some_and(|r| {
-                    use trm_kinematics::DisableReason::{Adjacent, Always, Default};
-                    matches!(r, Adjacent | Always | Default)
+                    use trm_kinematics::DisableReason::{Adjacent, Always, Default, Never};
+                    matches!(r, Adjacent | Always | Default | Never)
                 });
                 if x != y {
                     assert_eq!(
@@ -974,33 +974,48 @@ fn randomly_shortcut_paths_never_turn_a_solved_problem_unsolved() {
 }
 
 /// A scene's matrix written for the Fetch's meshes checks a pair its SRDF disables as never
-/// colliding, which VAMP's spheres overlap at bookshelf_small 32's goal: invalid as MoveIt
-/// applies the matrix, valid and solved with the scenes' matrices ignored (the model's own
-/// only, as VAMP checks).
+/// colliding, which VAMP's spheres overlap at bookshelf_small 32's goal: the pair stays
+/// disabled (a note names it) and the problem is solved. Were the pair disabled by hand, the
+/// scene's matrix would check it and the goal collide; with the scenes' matrices ignored (the
+/// model's own only, as VAMP checks) it is solved again.
 #[test]
-fn ignoring_the_scenes_matrices_checks_the_models_own_pairs_only() {
+fn a_pair_never_colliding_stays_disabled_and_scene_matrices_can_be_ignored() {
     let (set, robot, collision) = committed_set("fetch");
     let problems: Vec<_> = (set.problems.iter())
         .filter(|p| p.family == "bookshelf_small_fetch" && p.index == 32)
         .cloned()
         .collect();
     assert_eq!(problems.len(), 1);
-    let run = |ignore_scene_matrices| {
+    let run = |collision: &CollisionModel, ignore_scene_matrices| {
         let options = trm_mbm::BenchmarkOptions {
             // the benchmark's budget
             rrt: RrtOptions {
                 max_iterations: 1_000_000,
-                ..trm_mbm::rrt_options_for(&robot, &collision, &problems).unwrap()
+                ..trm_mbm::rrt_options_for(&robot, collision, &problems).unwrap()
             },
             ignore_scene_matrices,
             ..Default::default()
         };
-        let bench = trm_mbm::benchmark(&robot, &collision, &problems, &options, |_, _, _, _| {});
+        let bench = trm_mbm::benchmark(&robot, collision, &problems, &options, |_, _, _, _| {});
         bench.unwrap().runs.remove(0).outcome
     };
-    let applied = run(false);
-    assert!(!applied.valid, "{}", applied.note);
-    assert!(applied.note.contains("a scene's"), "{}", applied.note);
-    let ignored = run(true);
+    let applied = run(&collision, false);
+    assert!(applied.valid && applied.solved, "{}", applied.note);
+    let kept = "1 pairs it checks stay disabled, as this model disables them for a fact of \
+                geometry: `shoulder_lift_link`–`torso_lift_link` (never)";
+    assert!(applied.note.contains(kept), "{}", applied.note);
+    let tree = robot.tree();
+    let (a, b) = (
+        tree.link_index("torso_lift_link").unwrap(),
+        tree.link_index("shoulder_lift_link").unwrap(),
+    );
+    let mut by_hand = collision.acm().clone();
+    by_hand.enable(a, b);
+    by_hand.disable(a, b, trm_kinematics::DisableReason::User);
+    let by_hand = collision.with_acm(by_hand).unwrap();
+    let checked = run(&by_hand, false);
+    assert!(!checked.valid, "{}", checked.note);
+    assert!(checked.note.contains("a scene's"), "{}", checked.note);
+    let ignored = run(&by_hand, true);
     assert!(ignored.valid && ignored.solved, "{}", ignored.note);
 }

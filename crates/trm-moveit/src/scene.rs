@@ -70,10 +70,11 @@ impl AllowedCollisions {
     }
 }
 
-/// Whether the model disables a pair with this reason for a fact of its own geometry.
+/// Whether the model disables a pair with this reason for a fact of geometry (adjacent links,
+/// colliding at the default posture, in almost every sample or in none), rather than by hand.
 fn geometric(reason: trm_kinematics::DisableReason) -> bool {
-    use trm_kinematics::DisableReason::{Adjacent, Always, Default};
-    matches!(reason, Adjacent | Always | Default)
+    use trm_kinematics::DisableReason::{Adjacent, Always, Default, Never};
+    matches!(reason, Adjacent | Always | Default | Never)
 }
 
 impl AllowedCollisions {
@@ -97,10 +98,11 @@ impl AllowedCollisions {
     /// The rule, for a matrix written for other geometry than the model's (a scene made for a
     /// robot's meshes, applied to its sphere model): a pair the scene allows is not checked; a
     /// pair it checks is checked, except where the model's own matrix disables it for a fact
-    /// of the model's own geometry — adjacent links, links colliding at the default posture
-    /// or in (almost) every sample — which the scene's author could not know; those stay
-    /// disabled and a note counts them. Pairs the model disables by hand or as never
-    /// colliding are checked as the scene asks.
+    /// of geometry — adjacent links, links colliding at the default posture or in (almost)
+    /// every sample, or in none (MoveIt's "never": the links cannot meet within the joint
+    /// limits, so a coarser model's bodies overlapping there is the model's error, not a
+    /// collision); those stay disabled and a note counts them. Pairs the model disables by
+    /// hand are checked as the scene asks.
     pub fn over(
         &self,
         collision: &trm_collision::CollisionModel,
@@ -146,7 +148,7 @@ impl AllowedCollisions {
         if !kept.is_empty() {
             let shown = kept.len().min(3);
             notes.push(format!(
-                "allowed_collision_matrix: {} pairs it checks stay disabled, as this model's own geometry disables them: {}{}",
+                "allowed_collision_matrix: {} pairs it checks stay disabled, as this model disables them for a fact of geometry: {}{}",
                 kept.len(),
                 kept[..shown].join(", "),
                 if kept.len() > shown { ", …" } else { "" }
