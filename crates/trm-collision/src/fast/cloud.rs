@@ -266,15 +266,16 @@ impl CloudGrid {
         for k in k0..=k1 {
             let dz2 = self.gap2(2, k, p[2]);
             for j in j0..=j1 {
+                let row = self.dims[0] * (j + self.dims[1] * k);
                 let left = range2 - dz2 - self.gap2(1, j, p[1]);
-                if left < 0.0 {
+                // rows the ball misses, and rows without points
+                if left < 0.0 || self.starts[row] == self.starts[row + self.dims[0]] {
                     continue;
                 }
                 let chord = left.sqrt() + self.slack;
                 let Some((i0, i1)) = self.cells(0, p[0] - chord, p[0] + chord) else {
                     continue;
                 };
-                let row = self.dims[0] * (j + self.dims[1] * k);
                 let (from, to) = (
                     self.starts[row + i0] as usize,
                     self.starts[row + i1 + 1] as usize,
