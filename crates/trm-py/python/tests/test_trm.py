@@ -390,6 +390,28 @@ def test_the_python_door_benchmark_runs(capsys, monkeypatch, tmp_path):
     assert len(csv.read_text().splitlines()) == 15
 
 
+def test_the_python_cloud_door_benchmark_runs(capsys, monkeypatch, tmp_path):
+    import runpy
+    import sys
+
+    # every fixture problem with a cloud as `benchmark-mbm --cloud` writes it: a board of
+    # points under the robot's base
+    grid = np.stack(np.meshgrid(np.linspace(-0.5, 0.5, 11), np.linspace(-0.5, 0.5, 11)), -1)
+    points = np.concatenate([grid.reshape(-1, 2), np.full((121, 1), -0.3)], axis=1)
+    lines = ["trm-mbm-problems 1", "robot panda"]
+    for family in sorted(p for p in MBM.iterdir() if p.is_dir()):
+        for request in sorted(family.glob("request*.yaml")):
+            lines += [f"problem {family.name} {int(request.stem[len('request'):])}",
+                      "objects 1", f"cloud {len(points)} 0.0025"]
+            lines += [" ".join(repr(v) for v in p) for p in points.tolist()]
+    peer = tmp_path / "peer-problems.txt"
+    peer.write_text("\n".join(lines) + "\n")
+    monkeypatch.setattr(sys, "argv", ["mbm_cloud.py", str(MBM), str(peer), "--model", PANDA])
+    runpy.run_path(str(ROOT / "benches" / "python" / "mbm_cloud.py"), run_name="__main__")
+    out = capsys.readouterr().out
+    assert "| all | 14/14 | 14/14 |" in out, out
+
+
 def test_a_held_object_moves_with_the_hand_and_is_checked(robot):
     joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"]
     planner = trm.Planner(robot, joints=joints)
