@@ -89,12 +89,15 @@ pub struct PlanningSpec {
     /// Largest gap between checked points of an edge, rad.
     #[serde(default)]
     pub resolution: Option<f64>,
+    /// First radius of RRT-Connect's dynamic domains, rad.
+    #[serde(default)]
+    pub domain_radius: Option<f64>,
 }
 
 impl PlanningSpec {
     /// Whether no setting is given.
     pub fn is_empty(&self) -> bool {
-        self.range.is_none() && self.resolution.is_none()
+        self.range.is_none() && self.resolution.is_none() && self.domain_radius.is_none()
     }
 }
 

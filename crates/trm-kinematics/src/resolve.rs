@@ -522,7 +522,11 @@ pub(crate) fn resolve_planning(
     ctx: &DescCtx,
 ) -> Result<crate::PlanningSpec> {
     let p = desc.planning;
-    for (what, value) in [("range", p.range), ("resolution", p.resolution)] {
+    for (what, value) in [
+        ("range", p.range),
+        ("resolution", p.resolution),
+        ("domain_radius", p.domain_radius),
+    ] {
         if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
             return Err(ctx.invalid(
                 format!("planning.{what}"),

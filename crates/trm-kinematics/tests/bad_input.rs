@@ -256,6 +256,10 @@ fn other_description_mistakes_are_errors() {
             "(urdf: \"x\",\n planning: (resolution: Some(0.0)))",
             "planning.resolution",
         ),
+        (
+            "(urdf: \"x\",\n planning: (domain_radius: Some(-2.0)))",
+            "planning.domain_radius",
+        ),
         ("(urdf: \"x\", planning: (step: Some(1.0)))", "step"),
         (
             "(urdf: \"x\", motion_limits: {\"j3\": (acceleration: Some(1.0))})",

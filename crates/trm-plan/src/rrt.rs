@@ -43,10 +43,13 @@ pub struct RrtOptions {
     pub smoothing: usize,
     /// Dynamic domain (Jaillet, Yershova, LaValle and Siméon, IROS 2005), as VAMP grows its
     /// trees: a node whose extension hit an obstacle takes samples only within a radius of it
-    /// (first [`DOMAIN_RADIUS`], shrinking by [`DOMAIN_ALPHA`] at each failure down to
+    /// (first `domain_radius`, shrinking by [`DOMAIN_ALPHA`] at each failure down to
     /// [`DOMAIN_MIN_RADIUS`], growing at each success); farther samples are drawn again
     /// without a collision check.
     pub dynamic_domain: bool,
+    /// A dynamic domain's first radius, rad ([`DOMAIN_RADIUS`] by default, VAMP's; sized by the
+    /// motor count in [`RrtOptions::sized`]).
+    pub domain_radius: f64,
     /// Grow the smaller tree (the trees swap roles only while their sizes are within a factor
     /// of 2), as VAMP does; otherwise they alternate.
     pub balance: bool,
@@ -185,7 +188,8 @@ const REFINEMENTS: u32 = 2;
 /// many times its value in all.
 pub const MAX_DRAWS_PER_SAMPLE: usize = 100;
 
-/// First radius of a node's dynamic domain after a failed extension, rad (VAMP's default).
+/// First radius of a node's dynamic domain after a failed extension, rad (VAMP's default, for
+/// a robot of [`STEP_MOTORS`] motors; [`RrtOptions::sized`] scales it).
 pub const DOMAIN_RADIUS: f64 = 4.0;
 /// Relative change of a domain radius per failed (−) or successful (+) extension.
 pub const DOMAIN_ALPHA: f64 = 1e-4;
@@ -237,6 +241,7 @@ impl Default for RrtOptions {
             shortcuts: 0,
             smoothing: SMOOTHING_ROUNDS,
             dynamic_domain: true,
+            domain_radius: DOMAIN_RADIUS,
             balance: true,
             sampler: Sampler::default(),
             certified: false,
@@ -275,26 +280,31 @@ impl RrtOptions {
         Ok(RrtOptions {
             range: own.range.unwrap_or(sized.range),
             resolution: own.resolution.unwrap_or(sized.resolution),
+            domain_radius: own.domain_radius.unwrap_or(sized.domain_radius),
             ..sized
         })
     }
 
-    /// The default settings with the step and the resolution sized by the robot instead of by
-    /// hand, from the largest displacement of any body point per radian of the `n` active
-    /// coordinates (`levers`, a bound for every configuration): `range` = [`STEP_TRAVEL`] /
-    /// reach · √([`STEP_MOTORS`] / n) and `resolution` = [`CHECK_TRAVEL`] / reach. A robot
-    /// twice the Panda's size steps half as far and checks twice as densely; a dual-arm robot
-    /// is sized by its longer arm and steps shorter for moving both. The defaults when no
-    /// coordinate moves a body.
+    /// The default settings with the step, the resolution and the dynamic domains sized by the
+    /// robot instead of by hand, from the largest displacement of any body point per radian of
+    /// the `n` active coordinates (`levers`, a bound for every configuration): `range` =
+    /// [`STEP_TRAVEL`] / reach · √([`STEP_MOTORS`] / n), `resolution` = [`CHECK_TRAVEL`] /
+    /// reach and `domain_radius` = [`DOMAIN_RADIUS`] · √(n / [`STEP_MOTORS`]). A robot twice the
+    /// Panda's size steps half as far and checks twice as densely; a dual-arm robot is sized by
+    /// its longer arm and steps shorter for moving both; distances between configurations grow
+    /// as √n, and so do the domains (with VAMP's 4 rad on a 14-motor robot, most draws fall
+    /// outside every domain and are drawn again). The defaults when no coordinate moves a body.
     pub fn sized(levers: &trm_collision::Levers) -> RrtOptions {
         let defaults = RrtOptions::default();
         let (reach, motors) = (levers.max_reach(), levers.num_coordinates());
         if !(reach.is_finite() && reach > 0.0) || motors == 0 {
             return defaults;
         }
+        let motors = motors as f64;
         RrtOptions {
-            range: STEP_TRAVEL / reach * (STEP_MOTORS / motors as f64).sqrt(),
+            range: STEP_TRAVEL / reach * (STEP_MOTORS / motors).sqrt(),
             resolution: CHECK_TRAVEL / reach,
+            domain_radius: DOMAIN_RADIUS * (motors / STEP_MOTORS).sqrt(),
             ..defaults
         }
     }
@@ -318,6 +328,12 @@ impl RrtOptions {
                     "{} is not a finite step of at least 1e-6 rad",
                     self.resolution
                 ),
+            ));
+        }
+        if !(self.domain_radius.is_finite() && self.domain_radius > 0.0) {
+            return Err(bad(
+                "domain_radius",
+                format!("{} is not a positive finite radius", self.domain_radius),
             ));
         }
         if let Some(s) = self.max_seconds {
@@ -508,7 +524,7 @@ fn extend(
         if domain {
             let r = &mut tree.radii[near];
             *r = if r.is_infinite() {
-                DOMAIN_RADIUS
+                options.domain_radius
             } else {
                 (*r * (1.0 - DOMAIN_ALPHA)).max(DOMAIN_MIN_RADIUS)
             };

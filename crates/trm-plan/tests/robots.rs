@@ -87,9 +87,10 @@ fn the_talos_humanoid_builds_a_map_and_plans_through_it() {
     builds_a_map_and_plans_through_it("talos_reach.ron", 9, 80, 40, "arm_right_7_joint");
 }
 
-/// RRT-Connect's settings sized by the robot: VAMP's hand-tuned 1 rad and 1/32 rad on its
-/// Panda; the iCub upper body (shorter levers, 41 motors) checks less densely and steps shorter;
-/// a robot's own description overrides them.
+/// RRT-Connect's settings sized by the robot: VAMP's hand-tuned 1 rad and 1/32 rad and its
+/// 4 rad dynamic domains on its Panda; the iCub upper body (shorter levers, 41 motors) checks
+/// less densely, steps shorter and samples wider domains; a robot's own description overrides
+/// them.
 #[test]
 fn planner_settings_are_sized_by_the_robot() {
     use trm_collision::CollisionModel;
@@ -106,6 +107,8 @@ fn planner_settings_are_sized_by_the_robot() {
     let options = sized(&panda, &["panda_arm"]);
     assert!((options.range - 1.0).abs() < 0.02, "{options:?}");
     assert!((1.0 / options.resolution - 32.0).abs() < 0.7, "{options:?}");
+    // VAMP's dynamic domains on the 7-motor arm, wider as distances grow with the motors
+    assert_eq!(options.domain_radius, 4.0);
 
     let icub = trm_models::icub_upper_body();
     let all: Vec<&str> = icub.motors().iter().map(|m| m.name.as_str()).collect();
@@ -115,6 +118,11 @@ fn planner_settings_are_sized_by_the_robot() {
         "{icub_options:?}"
     );
     assert!(icub_options.range < options.range, "{icub_options:?}");
+    let wide = 4.0 * (all.len() as f64 / 7.0).sqrt();
+    assert!(
+        (icub_options.domain_radius - wide).abs() < 1e-12,
+        "{icub_options:?}"
+    );
 
     // the description's own settings win, each on its own
     let mut description = trm_kinematics::ModelDescription::default();
@@ -123,4 +131,7 @@ fn planner_settings_are_sized_by_the_robot() {
     let own_options = sized(&own, &["panda_joint1", "panda_joint2"]);
     assert_eq!(own_options.range, 0.5);
     assert!(own_options.resolution > 0.0 && own_options.resolution != 0.5);
+    description.planning.domain_radius = Some(2.5);
+    let own = panda.with_description(&description, None).unwrap();
+    assert_eq!(sized(&own, &["panda_joint1"]).domain_radius, 2.5);
 }

@@ -161,7 +161,7 @@ pub fn run(args: &Args) -> Result<()> {
             SamplerArg::Halton => trm_plan::rrt::Sampler::Halton,
             SamplerArg::Uniform => trm_plan::rrt::Sampler::Uniform,
         },
-        ..Default::default()
+        ..sized
     };
     let bench = run_benchmark(args, &robot, &collision, &problems, &options)?;
     let mut md = header(args, &options);
@@ -240,7 +240,7 @@ pub fn run(args: &Args) -> Result<()> {
 /// The report's first line: the set, the model and the planner's settings.
 fn header(args: &Args, options: &RrtOptions) -> String {
     format!(
-        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, {} samples at most{}{}{})\n\n",
+        "MotionBenchMaker set {} with {} (RRT-Connect + shortcutting and {} corner-cutting rounds, seed {}, range {:.3} rad, resolution 1/{:.1} rad{}, dynamic domains of {:.2} rad, {} samples at most{}{}{})\n\n",
         args.dir.display(),
         args.model.display(),
         options.smoothing,
@@ -252,6 +252,7 @@ fn header(args: &Args, options: &RrtOptions) -> String {
         } else {
             ""
         },
+        options.domain_radius,
         args.max_iterations,
         args.max_seconds
             .map_or(String::new(), |s| format!(", {s} s at most")),
