@@ -27,7 +27,7 @@ import trm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from mbm_planner import quantile  # noqa: E402
-from mbm_set import problems, unpacked  # noqa: E402
+from mbm_set import by_family, problems, unpacked  # noqa: E402
 
 
 def clouds(path):
@@ -108,10 +108,7 @@ def main():
           "| median length (rad) | benchmark solved | benchmark median ms | same length |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     med = lambda v: quantile(v, 0.5)  # noqa: E731
-    for family in sorted({r["family"] for r in rows}) + ["all"]:
-        sel = [r for r in rows if family in ("all", r["family"])]
-        valid = [r for r in sel if r["valid"]]
-        solved = [r for r in valid if r["solved"]]
+    for family, sel, valid, solved in by_family(rows):
         ms = [1e3 * r["seconds"] for r in solved]
         call = [1e3 * r["call"] for r in solved]
         build = [1e3 * r["build"] for r in sel]

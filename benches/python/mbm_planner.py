@@ -22,7 +22,7 @@ from pathlib import Path
 import trm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from mbm_set import problems, unpacked  # noqa: E402
+from mbm_set import by_family, problems, unpacked  # noqa: E402
 
 
 def quantile(values, q):
@@ -85,11 +85,7 @@ def main():
     print(f"trm.Planner({Path(args.model).name}) made in {made * 1e3:.2f} ms")
     print("| family | valid | solved | median ms | p95 ms | median call ms | median call + scene ms | median length (rad) |")
     print("|---|---|---|---|---|---|---|---|")
-    families = sorted({r["family"] for r in rows})
-    for family in families + ["all"]:
-        sel = [r for r in rows if family in ("all", r["family"])]
-        valid = [r for r in sel if r["valid"]]
-        solved = [r for r in valid if r["solved"]]
+    for family, sel, valid, solved in by_family(rows):
         ms = [1e3 * r["seconds"] for r in solved]
         call = [1e3 * r["call"] for r in solved]
         scene = [1e3 * r["with_scene"] for r in solved]

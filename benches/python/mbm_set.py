@@ -34,3 +34,12 @@ def problems(root):
             scene = family / f"scene{number}.yaml"
             if scene.is_file():
                 yield family.name, int(number), scene, request
+
+
+def by_family(rows):
+    """(family, its rows, the valid ones, the solved ones) for each family in order, then for
+    `all` (rows are dicts with `family`, `valid` and `solved`)."""
+    for family in sorted({r["family"] for r in rows}) + ["all"]:
+        sel = [r for r in rows if family in ("all", r["family"])]
+        valid = [r for r in sel if r["valid"]]
+        yield family, sel, valid, [r for r in valid if r["solved"]]
