@@ -526,7 +526,8 @@ fn extend(
             *r = if r.is_infinite() {
                 options.domain_radius
             } else {
-                (*r * (1.0 - DOMAIN_ALPHA)).max(DOMAIN_MIN_RADIUS)
+                // never below the first radius, were that set below the floor
+                (*r * (1.0 - DOMAIN_ALPHA)).max(DOMAIN_MIN_RADIUS.min(options.domain_radius))
             };
         }
         return Extend::Trapped;
@@ -901,6 +902,52 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn settings_out_of_range_are_refused_by_name() {
+        let cases: [(&str, RrtOptions); 5] = [
+            (
+                "range",
+                RrtOptions {
+                    range: 0.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "resolution",
+                RrtOptions {
+                    resolution: f64::NAN,
+                    ..Default::default()
+                },
+            ),
+            (
+                "domain_radius",
+                RrtOptions {
+                    domain_radius: -1.0,
+                    ..Default::default()
+                },
+            ),
+            (
+                "max_seconds",
+                RrtOptions {
+                    max_seconds: Some(0.0),
+                    ..Default::default()
+                },
+            ),
+            (
+                "max_iterations",
+                RrtOptions {
+                    max_iterations: 0,
+                    ..Default::default()
+                },
+            ),
+        ];
+        for (what, options) in cases {
+            let e = options.check().unwrap_err().to_string();
+            assert!(e.contains(what), "{what}: {e}");
+        }
+        assert!(RrtOptions::default().check().is_ok());
     }
 
     #[test]
