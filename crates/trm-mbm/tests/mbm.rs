@@ -720,7 +720,7 @@ fn the_scenes_allowed_collision_matrix_is_applied_to_link_pairs() {
     assert_eq!(notes.len(), 2);
     assert!(notes[0].contains("`table`"), "{notes:?}");
     assert!(
-        notes[1].contains("1 pairs it checks stay disabled")
+        notes[1].contains("1 pair it checks stays disabled")
             && notes[1].contains("`panda_link1`–`panda_link2` (adjacent)"),
         "{notes:?}"
     );
@@ -1001,7 +1001,7 @@ fn a_pair_never_colliding_stays_disabled_and_scene_matrices_can_be_ignored() {
     };
     let applied = run(&collision, false);
     assert!(applied.valid && applied.solved, "{}", applied.note);
-    let kept = "1 pairs it checks stay disabled, as this model disables them for a fact of \
+    let kept = "1 pair it checks stays disabled, as this model disables it for a fact of \
                 geometry: `shoulder_lift_link`–`torso_lift_link` (never)";
     assert!(applied.note.contains(kept), "{}", applied.note);
     let tree = robot.tree();

@@ -148,8 +148,10 @@ impl AllowedCollisions {
         if !kept.is_empty() {
             let shown = kept.len().min(3);
             notes.push(format!(
-                "allowed_collision_matrix: {} pairs it checks stay disabled, as this model disables them for a fact of geometry: {}{}",
-                kept.len(),
+                "allowed_collision_matrix: {} it checks {} disabled, as this model disables {} for a fact of geometry: {}{}",
+                if kept.len() == 1 { "1 pair".to_string() } else { format!("{} pairs", kept.len()) },
+                if kept.len() == 1 { "stays" } else { "stay" },
+                if kept.len() == 1 { "it" } else { "them" },
                 kept[..shown].join(", "),
                 if kept.len() > shown { ", …" } else { "" }
             ));
