@@ -36,7 +36,7 @@ pub struct RrtOptions {
     /// time, and their corner-cutting edges graze obstacles between checked points).
     pub shortcuts: usize,
     /// Rounds of corner cutting after the shortcuts ([`shortcut`]): each interior waypoint
-    /// `v` between `a` and `b` moved to `(a + 2v + b) / 4` where the corner's two new edges
+    /// `v` between `a` and `b` moved to `(a + 6v + b) / 8` where the corner's two new edges
     /// (from the midpoints of `a v` and `v b`) are free, then the greedy pass again, until a
     /// round changes nothing — VAMP's B-spline step and shortcut, alternated as its simplifier
     /// does ([`SMOOTHING_ROUNDS`] by default; 0: the greedy pass only).
@@ -761,6 +761,12 @@ impl Growth {
             let (mut found, edges, raw) = g.shortcut(checker, &attempt, began)?;
             let mut free = recheck(checker, &found.path, &edges, resolution, options.resolution);
             if !free
+                && let Some(again) = simplified_finer(checker, &raw, &attempt, options.resolution)
+            {
+                found.path = again;
+                free = true;
+            }
+            if !free
                 && refinement == REFINEMENTS
                 && (attempt.shortcuts > 0 || attempt.smoothing > 0)
             {
@@ -836,12 +842,33 @@ impl Growth {
 /// A path shortcut, how each of its edges was checked, and the path before the shortcut.
 type Shortcut = (RrtPath, Vec<EdgeCheck>, Vec<Vec<f64>>);
 
+/// `raw`, a path whose edges are free at `options.resolution`, simplified again ([`shortcut`])
+/// with the simplifier's new edges checked at half that resolution, where it passes
+/// [`recheck`] (`asked`: the resolution first asked for): where the first simplification's new
+/// edges grazed an obstacle between their points, the search's own edges are most often free
+/// at half the resolution. `None` where its path still grazes.
+pub(crate) fn simplified_finer(
+    checker: &mut WorldChecker,
+    raw: &[Vec<f64>],
+    options: &RrtOptions,
+    asked: f64,
+) -> Option<Vec<Vec<f64>>> {
+    let finer = RrtOptions {
+        resolution: options.resolution / 2.0,
+        ..options.clone()
+    };
+    let mut path = raw.to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let edges = shortcut(&mut path, &finer, checker, &mut rng);
+    recheck(checker, &path, &edges, options.resolution, asked).then_some(path)
+}
+
 /// Whether `path`, whose edges were checked at `resolution` as `edges` says, is free at half
 /// that: the edges checked at `resolution` (by the search: the edges it kept, or by the
 /// shortcut) need only their midpoints; a piece of an edge a random shortcut cut needs its own
 /// points too. A refined search's points are not those of the `asked` resolution: those too,
 /// so that the path is free at every point a check at `asked / 2` visits.
-fn recheck(
+pub(crate) fn recheck(
     checker: &mut WorldChecker,
     path: &[Vec<f64>],
     edges: &[EdgeCheck],

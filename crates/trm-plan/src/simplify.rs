@@ -39,7 +39,8 @@ pub fn shortcut(
     rng: &mut impl RngExt,
 ) -> Vec<EdgeCheck> {
     let mut edges = vec![EdgeCheck::Given; path.len().saturating_sub(1)];
-    greedy(path, &mut edges, options.resolution, checker);
+    let mut seen = Verdicts::default();
+    greedy(path, &mut edges, options.resolution, checker, &mut seen);
     for _ in 0..options.shortcuts {
         if path.len() < 3 {
             break;
@@ -92,29 +93,33 @@ pub fn shortcut(
         if !cut_corners(path, &mut edges, options.resolution, checker) {
             break;
         }
-        greedy(path, &mut edges, options.resolution, checker);
+        greedy(path, &mut edges, options.resolution, checker, &mut seen);
     }
     edges
 }
 
 /// From each kept waypoint of `path`, the farthest later one it sees: the waypoints between
 /// are dropped, and `edges` (one per edge) says how each edge of the result was checked.
+/// `seen` holds the verdicts of earlier passes (an edge between the same two points is not
+/// checked again: corner cutting moves a few waypoints, and the next pass asks again about
+/// most of the long edges the last one found blocked).
 fn greedy(
     path: &mut Vec<Vec<f64>>,
     edges: &mut Vec<EdgeCheck>,
     resolution: f64,
     checker: &mut WorldChecker,
+    seen: &mut Verdicts,
 ) {
     let mut kept = vec![path[0].clone()];
     let mut kept_edges = Vec::with_capacity(edges.len());
     let mut i = 0;
     while i + 1 < path.len() {
         let mut j = path.len() - 1;
-        while j > i + 1 && !checker.edge_free(&path[i], &path[j], resolution) {
+        while j > i + 1 && !seen.edge_free(&path[i], &path[j], resolution, checker) {
             j -= 1;
         }
         kept.push(path[j].clone());
-        // j > i + 1: that edge was just found free; else the edge i → i + 1, as it was
+        // j > i + 1: that edge was found free; else the edge i → i + 1, as it was
         kept_edges.push(if j > i + 1 {
             EdgeCheck::Checked
         } else {
@@ -126,57 +131,154 @@ fn greedy(
     *edges = kept_edges;
 }
 
-/// One round of corner cutting (see [`RrtOptions::smoothing`]): each interior waypoint `v`
-/// (between `a` and `b`) that would move by at least [`SMOOTHING_MIN_CHANGE`] is replaced by
-/// `m₁ → v' → m₂`, `m₁` and `m₂` the midpoints of `a v` and `v b` and `v'` the midpoint of
-/// `m₁ m₂`, where the three points and the two edges through `v'` are free. Whether any
-/// waypoint moved.
+/// The verdicts of [`WorldChecker::edge_free`] on the edges [`greedy`] asked about, by their
+/// ends' exact values.
+#[derive(Default)]
+struct Verdicts(std::collections::HashMap<Vec<u64>, bool>);
+
+impl Verdicts {
+    /// Whether a → b is free at `resolution`, checked only if not asked before.
+    fn edge_free(
+        &mut self,
+        a: &[f64],
+        b: &[f64],
+        resolution: f64,
+        checker: &mut WorldChecker,
+    ) -> bool {
+        let key: Vec<u64> = a.iter().chain(b).map(|v| v.to_bits()).collect();
+        *self
+            .0
+            .entry(key)
+            .or_insert_with(|| checker.edge_free(a, b, resolution))
+    }
+}
+
+/// One round of corner cutting, VAMP's B-spline step (see [`RrtOptions::smoothing`]): each
+/// interior waypoint `v` between `a` and `b`, with `m₁` and `m₂` the midpoints of `a v` and
+/// `v b`, is moved to `v' = (m₁ + 2v + m₂) / 4` where that moves it by at least
+/// [`SMOOTHING_MIN_CHANGE`] and `m₁`, `v'`, `m₂` and the edges `m₁ v'` and `v' m₂` are free;
+/// the path then runs through `m₁` and `m₂` around each moved waypoint (a midpoint between
+/// two moved waypoints once). Each move depends only on the waypoints given, so the moves are
+/// independent. Whether any waypoint moved.
 fn cut_corners(
     path: &mut Vec<Vec<f64>>,
     edges: &mut Vec<EdgeCheck>,
     resolution: f64,
     checker: &mut WorldChecker,
 ) -> bool {
-    let d = path[0].len();
-    let (mut changed, mut i) = (false, 1);
+    let (d, n) = (path[0].len(), path.len());
+    let mid = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect()
+    };
+    // the moved waypoints (None: left where it was)
+    let mut moved: Vec<Option<Vec<f64>>> = vec![None; n];
     let mut points = vec![0.0; 3 * d];
-    while i + 1 < path.len() {
+    for i in 1..n.saturating_sub(1) {
         let (a, v, b) = (&path[i - 1], &path[i], &path[i + 1]);
         let (m1, rest) = points.split_at_mut(d);
         let (cut, m2) = rest.split_at_mut(d);
         for k in 0..d {
             m1[k] = 0.5 * (a[k] + v[k]);
             m2[k] = 0.5 * (v[k] + b[k]);
-            cut[k] = 0.5 * (m1[k] + m2[k]);
+            cut[k] = 0.25 * (m1[k] + 2.0 * v[k] + m2[k]);
         }
-        if distance(cut, v) < SMOOTHING_MIN_CHANGE
-            || !checker.all_free(&points)
-            || !checker.edge_free(&points[..d], &points[d..2 * d], resolution)
-            || !checker.edge_free(&points[d..2 * d], &points[2 * d..], resolution)
+        if distance(cut, v) >= SMOOTHING_MIN_CHANGE
+            && checker.all_free(&points)
+            && checker.edge_free(&points[..d], &points[d..2 * d], resolution)
+            && checker.edge_free(&points[d..2 * d], &points[2 * d..], resolution)
         {
-            i += 1;
-            continue;
+            moved[i] = Some(points[d..2 * d].to_vec());
         }
-        // a → m₁ and m₂ → b are pieces of the edges they cut
-        let new = points.chunks(d).map(<[f64]>::to_vec);
-        path.splice(i..=i, new);
-        edges.splice(
-            i - 1..=i,
-            [
-                EdgeCheck::Piece,
-                EdgeCheck::Checked,
-                EdgeCheck::Checked,
-                EdgeCheck::Piece,
-            ],
-        );
-        changed = true;
-        // the next corner is the old b, now after m₂
-        i += 3;
     }
-    changed
+    if moved.iter().all(Option::is_none) {
+        return false;
+    }
+    let is_moved: Vec<bool> = moved.iter().map(Option::is_some).collect();
+    let (mut out, mut out_edges) = (vec![path[0].clone()], Vec::with_capacity(2 * n));
+    for i in 1..n {
+        let (left, right) = (is_moved[i - 1], is_moved[i]);
+        if left || right {
+            // the edge's midpoint joins the moved ends; an unmoved end's side is a piece of
+            // the edge as it was
+            out.push(mid(&path[i - 1], &path[i]));
+            let side = |m: bool| {
+                if m {
+                    EdgeCheck::Checked
+                } else {
+                    EdgeCheck::Piece
+                }
+            };
+            out_edges.extend([side(left), side(right)]);
+        } else {
+            out_edges.push(edges[i - 1]);
+        }
+        out.push(moved[i].take().unwrap_or_else(|| path[i].clone()));
+    }
+    *path = out;
+    *edges = out_edges;
+    true
 }
 
 /// Length of a path, rad.
 pub fn path_length(path: &[Vec<f64>]) -> f64 {
     path.windows(2).map(|w| distance(&w[0], &w[1])).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trm_collision::{CollisionModel, World};
+
+    /// A checker of the iCub's right arm (three joints) in an empty world, and its home.
+    fn arm() -> (WorldChecker, Vec<f64>) {
+        let robot = trm_models::icub_upper_body();
+        let home = robot.posture("home").unwrap().to_vec();
+        let joints = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"];
+        let active = robot.active_set(&joints, &home).unwrap();
+        let start = active.from_motors(&home);
+        let collision = CollisionModel::new(&robot).unwrap();
+        (
+            WorldChecker::new(&collision, &active, World::new()).unwrap(),
+            start,
+        )
+    }
+
+    /// A corner moves as VAMP's B-spline step moves it, to `(a + 6v + b) / 8`, the path
+    /// running through the midpoints of its two edges (their outer halves pieces of the edges
+    /// given); a corner that would move by less than the least change stays.
+    #[test]
+    fn a_corner_moves_an_eighth_of_the_way_and_a_flat_one_stays() {
+        let (mut checker, s) = arm();
+        let at = |x: f64, y: f64| vec![s[0] + x, s[1] + y, s[2]];
+        let mut path = vec![at(0.0, 0.0), at(0.6, 0.0), at(0.6, 0.6)];
+        assert!(checker.all_free(&path.concat()));
+        let mut edges = vec![EdgeCheck::Given; 2];
+        assert!(cut_corners(&mut path, &mut edges, 0.05, &mut checker));
+        let expected = [
+            at(0.0, 0.0),
+            at(0.3, 0.0),
+            at(0.525, 0.075),
+            at(0.6, 0.3),
+            at(0.6, 0.6),
+        ];
+        assert_eq!(path.len(), expected.len());
+        for (p, e) in path.iter().zip(&expected) {
+            assert!(distance(p, e) < 1e-12, "{p:?} against {e:?}");
+        }
+        use EdgeCheck::{Checked, Piece};
+        assert_eq!(edges, [Piece, Checked, Checked, Piece]);
+        // two corners that both move share the midpoint between them
+        let mut zigzag = vec![at(0.0, 0.0), at(0.6, 0.0), at(0.6, 0.6), at(1.2, 0.6)];
+        let mut edges = vec![EdgeCheck::Given; 3];
+        assert!(cut_corners(&mut zigzag, &mut edges, 0.05, &mut checker));
+        assert_eq!(zigzag.len(), 7);
+        assert!(distance(&zigzag[3], &at(0.6, 0.3)) < 1e-12);
+        assert_eq!(edges, [Piece, Checked, Checked, Checked, Checked, Piece]);
+        // |a − 2v + b| / 8 = |(−0.6, 0.3)| / 8 ≈ 0.084 < 0.1
+        let mut flat = vec![at(0.0, 0.0), at(0.6, 0.0), at(0.6, 0.3)];
+        let mut edges = vec![EdgeCheck::Given; 2];
+        assert!(!cut_corners(&mut flat, &mut edges, 0.05, &mut checker));
+        assert_eq!(flat, [at(0.0, 0.0), at(0.6, 0.0), at(0.6, 0.3)]);
+        assert_eq!(edges, [EdgeCheck::Given; 2]);
+    }
 }

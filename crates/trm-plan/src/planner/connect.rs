@@ -13,7 +13,9 @@ use trm_collision::Certifier;
 use crate::PlanError;
 use crate::pose_goal::PoseGoal;
 use crate::query::{Goal, PlanOptions, Planned};
-use crate::rrt::{EdgeCheck, GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
+use crate::rrt::{
+    GOAL_COLLIDES, Growth, RrtOptions, RrtPath, recheck, rrt_connect_in, shortcut, simplified_finer,
+};
 
 /// Where the path of a [`Planner::connect`] query came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -308,12 +310,17 @@ impl Planner {
         let mut path = planned.waypoints;
         let simplifying = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        let retrieved = planned.stats.retrieved;
+        // a kept path repeating the query was simplified when it was planned: the greedy pass
+        // only
         let greedy = RrtOptions {
             shortcuts: 0,
+            smoothing: if retrieved { 0 } else { options.smoothing },
             ..options.clone()
         };
+        let raw = path.clone();
         let edges = shortcut(&mut path, &greedy, &mut self.checker, &mut rng);
-        let source = if planned.stats.retrieved {
+        let source = if retrieved {
             Source::Retrieved
         } else if planned.nodes.is_empty() {
             Source::Straight
@@ -323,11 +330,11 @@ impl Planner {
         // at half the resolution: the edges the shortcut found free and the graph's own
         // (checked at the same points, `WorldChecker::segment_free`) need only their midpoints
         let r = options.resolution;
-        let checker = &mut self.checker;
-        let free = path.windows(2).zip(&edges).all(|(w, e)| {
-            (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], r))
-                && checker.edge_midpoints_free(&w[0], &w[1], r)
-        });
+        let mut free = recheck(&mut self.checker, &path, &edges, r, r);
+        if !free && let Some(again) = simplified_finer(&mut self.checker, &raw, &greedy, r) {
+            path = again;
+            free = true;
+        }
         free.then_some(Connection {
             path,
             source,
