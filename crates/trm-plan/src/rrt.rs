@@ -548,12 +548,13 @@ fn extend(
 ///
 /// The shortcut path is checked again at half the resolution: the points halfway between those
 /// its edges were checked at ([`WorldChecker::edge_midpoints_free`], raked as every edge; the pieces
-/// of edges a random shortcut cut, at all their points); where an
-/// edge grazes an obstacle between the points first checked, the search runs again at that
-/// finer resolution (at most twice), so a returned path is free at `resolution / 2` wherever
-/// it was checked. [`RrtPath::refinements`] counts the reruns. Where even the finest search's
-/// shortcut path grazes (random shortcuts and corner cuts make edges no search visited), its
-/// own path through the greedy pass alone is returned if it passes the same check.
+/// of edges a random shortcut or a corner cut made, at all their points). Where the simplified
+/// path grazes an obstacle between the points first checked (random shortcuts and corner cuts
+/// make edges no search visited), the search's own path is simplified again with its new edges
+/// checked at half the resolution, else taken through the greedy pass alone, if either passes
+/// the same check; else the search runs again at that finer resolution (at most twice), so a
+/// returned path is free at `resolution / 2` wherever it was checked. [`RrtPath::refinements`]
+/// counts the reruns.
 pub fn rrt_connect(
     objective: &Objective,
     world: &World,
@@ -766,13 +767,11 @@ impl Growth {
                 found.path = again;
                 free = true;
             }
-            if !free
-                && refinement == REFINEMENTS
-                && (attempt.shortcuts > 0 || attempt.smoothing > 0)
-            {
+            if !free && (attempt.shortcuts > 0 || attempt.smoothing > 0) {
                 // random shortcuts and corner cuts make edges no search visited, which may
-                // graze an obstacle at every resolution: at the finest, the search's own path
-                // through the greedy pass only, rather than no path
+                // graze an obstacle at every resolution (a finer search's paths are checked at
+                // the first resolution's points too): the search's own path through the
+                // greedy pass only, rather than a new search
                 let greedy_only = RrtOptions {
                     shortcuts: 0,
                     smoothing: 0,
