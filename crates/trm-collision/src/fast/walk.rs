@@ -90,7 +90,13 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
     // first
     if model.world_steps.is_empty() {
         for g in (0..model.groups.len()).rev() {
-            for (&o, object) in world.original.iter().zip(&world.objects) {
+            let within = farthest(&scratch.bounds[g]) + model.groups[g].bound.radius + m;
+            for (k, (&o, object)) in world.original.iter().zip(&world.objects).enumerate() {
+                if world.from_origin[k] > within {
+                    // the link's bounding sphere lies nearer the origin than this object and
+                    // every later one
+                    break;
+                }
                 let o = o as usize;
                 if object_link::<AVX, _>(model, poses, o, object, g, live, world, scratch, verdict)
                 {
@@ -109,7 +115,17 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                 }
                 WorldStep::Link(_) => (i..i + 1, None),
             };
-            for (&o, object) in world.original.iter().zip(&world.objects) {
+            let within = match (ball, steps[i]) {
+                (Some((ball, radius)), _) => farthest(&scratch.bounds[ball as usize]) + radius,
+                (None, WorldStep::Link(g)) => {
+                    farthest(&scratch.bounds[g as usize]) + model.groups[g as usize].bound.radius
+                }
+                (None, WorldStep::Cull { .. }) => f32::INFINITY,
+            } + m;
+            for (k, (&o, object)) in world.original.iter().zip(&world.objects).enumerate() {
+                if world.from_origin[k] > within {
+                    break;
+                }
                 let o = o as usize;
                 let near = match ball {
                     Some((ball, radius)) => {
@@ -210,6 +226,13 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         i += 1;
     }
     clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
+}
+
+/// The largest distance from the world's origin of the point in any lane of `c`.
+#[inline(always)]
+fn farthest(c: &[F; 3]) -> f32 {
+    let d2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    d2.0.iter().fold(0.0f32, |a, &b| a.max(b)).sqrt()
 }
 
 /// Whether the pair the last stopped walk stopped at (when there is one, and its object is in

@@ -3,8 +3,8 @@ use super::LaneMask;
 use super::avx;
 use super::cloud::{CloudGrid, MESH_SPACING};
 use super::lanes::{
-    F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, norm,
-    segment_distance2, splat, to_f32,
+    F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, segment_distance2,
+    splat, to_f32,
 };
 use super::model::FastModel;
 use super::outcome::Contact;
@@ -64,6 +64,9 @@ pub struct FastWorld {
     pub(super) objects: Vec<Object>,
     /// The world's index of each of `objects`.
     pub(super) original: Vec<u32>,
+    /// Per object of `objects` (ascending): a lower bound of its distance from the world's
+    /// origin ([`Object::origin_distance`]).
+    pub(super) from_origin: Vec<f32>,
     /// The index in `objects` of each of the world's objects.
     pub(super) compiled_of: Vec<u32>,
     pub(super) margin: f32,
@@ -259,16 +262,12 @@ impl FastModel {
                 }
             })
             .collect();
-        // nearest the robot's root first (as VAMP sorts its environment): a block that collides
-        // mostly collides there, and the walk stops at its first collision
+        // nearest the world's origin (the robot's root) first, as VAMP sorts its environment: a
+        // block that collides mostly collides there, the walk stops at its first collision, and
+        // a sphere nearer the origin than an object is also clear of every later one
+        let from_origin: Vec<f32> = objects.iter().map(Object::origin_distance).collect();
         let mut order: Vec<u32> = (0..objects.len() as u32).collect();
-        let reach_of = |o: &Object| {
-            let (center, radius) = o.bounding_sphere();
-            norm(center) - f64::from(radius)
-        };
-        order.sort_by(|&a, &b| {
-            reach_of(&objects[a as usize]).total_cmp(&reach_of(&objects[b as usize]))
-        });
+        order.sort_by(|&a, &b| from_origin[a as usize].total_cmp(&from_origin[b as usize]));
         let mut compiled_of = vec![0; order.len()];
         for (k, &o) in order.iter().enumerate() {
             compiled_of[o as usize] = k as u32;
@@ -281,6 +280,7 @@ impl FastModel {
         let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
         FastWorld {
             objects,
+            from_origin: order.iter().map(|&o| from_origin[o as usize]).collect(),
             original: order,
             compiled_of,
             margin,
@@ -295,29 +295,13 @@ impl FastModel {
 }
 
 impl Object {
-    /// Centre and radius of a sphere around the object.
-    pub(super) fn bounding_sphere(&self) -> ([f32; 3], f32) {
-        match *self {
-            Object::Round { a, b, radius } => {
-                let center = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
-                let half = std::array::from_fn(|k| 0.5 * (b[k] - a[k]));
-                (center, norm(half) as f32 + radius)
-            }
-            Object::Box { center, half, .. } => (center, norm(half) as f32),
-            Object::Cylinder {
-                center,
-                radius,
-                half,
-                ..
-            } => (center, radius.hypot(half)),
-            Object::Bounded { center, radius } => (center, radius),
-            Object::Cloud {
-                center,
-                half,
-                radius,
-                ..
-            } => (center, norm(half) as f32 + radius),
-        }
+    /// A lower bound of the distance from the world's origin to the object (0 where it holds
+    /// the origin): a sphere whose every point lies nearer the origin misses it. Measured in
+    /// `f64` from the object's single-precision geometry, less 1 µm per metre.
+    pub(super) fn origin_distance(&self) -> f32 {
+        let d2 = self.distance2(&splat([0.0; 3])).0[0];
+        let d = f64::from(d2).sqrt() - f64::from(self.reach(0.0));
+        (d - 1e-6 * (1.0 + d.abs())).max(0.0) as f32
     }
 
     /// The reach of a sphere of radius `r` from the object's own geometry: the sum of the radii
