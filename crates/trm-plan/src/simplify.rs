@@ -2,7 +2,8 @@
 //! shortcuts and corner cutting, with a record of how each edge of the result was checked.
 //! Re-exported from [`crate::rrt`].
 
-use rand::RngExt;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use trm_collision::WorldChecker;
 use trm_collision::edge::distance;
 
@@ -217,6 +218,48 @@ fn cut_corners(
     *path = out;
     *edges = out_edges;
     true
+}
+
+/// `raw`, a path whose edges are free at `options.resolution`, simplified again ([`shortcut`])
+/// with the simplifier's new edges checked at half that resolution, where it passes
+/// [`recheck`] (`asked`: the resolution first asked for): where the first simplification's new
+/// edges grazed an obstacle between their points, the search's own edges are most often free
+/// at half the resolution. `None` where its path still grazes.
+pub(crate) fn simplified_finer(
+    checker: &mut WorldChecker,
+    raw: &[Vec<f64>],
+    options: &RrtOptions,
+    asked: f64,
+) -> Option<Vec<Vec<f64>>> {
+    let finer = RrtOptions {
+        resolution: options.resolution / 2.0,
+        ..options.clone()
+    };
+    let mut path = raw.to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let edges = shortcut(&mut path, &finer, checker, &mut rng);
+    recheck(checker, &path, &edges, options.resolution, asked).then_some(path)
+}
+
+/// Whether `path`, whose edges were checked at `resolution` as `edges` says, is free at half
+/// that: the edges checked at `resolution` (by the search: the edges it kept, or by the
+/// shortcut) need only their midpoints; a piece of an edge a random shortcut cut needs its own
+/// points too. A refined search's points are not those of the `asked` resolution: those too,
+/// so that the path is free at every point a check at `asked / 2` visits.
+pub(crate) fn recheck(
+    checker: &mut WorldChecker,
+    path: &[Vec<f64>],
+    edges: &[EdgeCheck],
+    resolution: f64,
+    asked: f64,
+) -> bool {
+    path.windows(2).zip(edges).all(|(w, e)| {
+        (*e != EdgeCheck::Piece || checker.edge_free(&w[0], &w[1], resolution))
+            && checker.edge_midpoints_free(&w[0], &w[1], resolution)
+            && (resolution == asked
+                || checker.edge_free(&w[0], &w[1], asked)
+                    && checker.edge_midpoints_free(&w[0], &w[1], asked))
+    })
 }
 
 /// Length of a path, rad.

@@ -13,9 +13,8 @@ use trm_collision::Certifier;
 use crate::PlanError;
 use crate::pose_goal::PoseGoal;
 use crate::query::{Goal, PlanOptions, Planned};
-use crate::rrt::{
-    GOAL_COLLIDES, Growth, RrtOptions, RrtPath, recheck, rrt_connect_in, shortcut, simplified_finer,
-};
+use crate::rrt::{GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
+use crate::simplify::{recheck, simplified_finer};
 
 /// Where the path of a [`Planner::connect`] query came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
