@@ -19,6 +19,7 @@ mod planner;
 pub mod pose_goal;
 mod query;
 pub mod rrt;
+mod samples;
 pub mod scenario;
 mod simplify;
 pub mod timing;

@@ -7,12 +7,14 @@
 
 use std::time::Instant;
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use trm_collision::{World, WorldChecker};
 use trm_tasks::Objective;
 
 use crate::PlanError;
+pub use crate::samples::{BOX_DRAWS_BEFORE_DOMAINS, Sampler};
+use crate::samples::{DrawTally, Samples, domain_draw, weigh_domains};
 pub use crate::simplify::{
     EdgeCheck, SMOOTHING_MIN_CHANGE, SMOOTHING_ROUNDS, path_length, shortcut,
 };
@@ -46,7 +48,9 @@ pub struct RrtOptions {
     /// trees: a node whose extension hit an obstacle takes samples only within a radius of it
     /// (first `domain_radius`, shrinking by [`DOMAIN_ALPHA`] at each failure down to
     /// [`DOMAIN_MIN_RADIUS`], growing at each success); farther samples are drawn again
-    /// without a collision check.
+    /// without a collision check, from the domains themselves after
+    /// [`BOX_DRAWS_BEFORE_DOMAINS`] misses (the same distribution, at a cost that does not grow
+    /// as the domains shrink).
     pub dynamic_domain: bool,
     /// A dynamic domain's first radius, rad ([`DOMAIN_RADIUS`] by default, VAMP's; sized by the
     /// motor count in [`RrtOptions::sized`]).
@@ -62,122 +66,6 @@ pub struct RrtOptions {
     /// found, and replaces a segment it cannot prove by a search between its ends whose every
     /// accepted edge is proved.
     pub certified: bool,
-}
-
-/// The sequence of samples an RRT-Connect search draws, in the box of the joint limits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Sampler {
-    /// Independent uniform draws (ChaCha8, seeded; one 32-bit word per coordinate, 24 bits of
-    /// it used: steps of 2⁻²⁴ of the range).
-    #[default]
-    Uniform,
-    /// The Halton sequence (coordinate k: the radical inverse in the (k+1)-th prime base, 3, 5,
-    /// 7, …, as VAMP samples): low discrepancy, so that a few hundred samples already cover the
-    /// box evenly.
-    /// Shifted modulo 1 per coordinate by a seeded random offset (a Cranley–Patterson
-    /// rotation), so that seeds give different, equally even sequences. On MotionBenchMaker's
-    /// Panda set (seeds 0–2, both models) it changed the median by ≤ 3 % either way and the
-    /// 95th percentile by −37 % to +23 %: no gain measured, so uniform stays the default.
-    Halton,
-}
-
-impl std::str::FromStr for Sampler {
-    type Err = PlanError;
-
-    /// `uniform` or `halton`; anything else is an error naming the two.
-    fn from_str(name: &str) -> Result<Self, PlanError> {
-        match name {
-            "uniform" => Ok(Sampler::Uniform),
-            "halton" => Ok(Sampler::Halton),
-            _ => {
-                let close = trm_io::closest_names(name, ["uniform", "halton"]);
-                let hint = close
-                    .first()
-                    .map_or(String::new(), |c| format!(" (did you mean `{c}`?)"));
-                Err(PlanError::InvalidOptions {
-                    what: "sampler".into(),
-                    problem: format!("`{name}` is not `uniform` or `halton`{hint}"),
-                })
-            }
-        }
-    }
-}
-
-/// Samples of a [`Sampler`] in the box `lower..=upper`.
-struct Samples {
-    kind: Sampler,
-    rng: ChaCha8Rng,
-    /// Uniform: the random words of one sample.
-    words: Vec<u32>,
-    /// Halton: the index of the next point, the bases and the seeded shifts.
-    index: u64,
-    bases: Vec<u64>,
-    shifts: Vec<f64>,
-}
-
-impl Samples {
-    fn new(kind: Sampler, seed: u64, dim: usize) -> Self {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let shifts = match kind {
-            Sampler::Uniform => Vec::new(),
-            Sampler::Halton => (0..dim).map(|_| rng.random_range(0.0..1.0)).collect(),
-        };
-        Samples {
-            kind,
-            rng,
-            words: Vec::new(),
-            index: 0,
-            bases: primes(dim + 1).split_off(1),
-            shifts,
-        }
-    }
-
-    /// The next sample, into `out`.
-    fn next(&mut self, lower: &[f64], upper: &[f64], out: &mut [f64]) {
-        match self.kind {
-            Sampler::Uniform => {
-                // one 32-bit word per coordinate: 24 bits of it, a step of 2⁻²⁴ of the range
-                self.words.resize(out.len(), 0);
-                self.rng.fill(&mut self.words[..]);
-                for (k, (v, &w)) in out.iter_mut().zip(&self.words).enumerate() {
-                    let u = f64::from(w >> 8) * (1.0 / (1u32 << 24) as f64);
-                    *v = lower[k] + u * (upper[k] - lower[k]);
-                }
-            }
-            Sampler::Halton => {
-                self.index += 1;
-                for (k, v) in out.iter_mut().enumerate() {
-                    let u = (radical_inverse(self.index, self.bases[k]) + self.shifts[k]).fract();
-                    *v = lower[k] + u * (upper[k] - lower[k]);
-                }
-            }
-        }
-    }
-}
-
-/// The first `n` primes.
-fn primes(n: usize) -> Vec<u64> {
-    let mut out: Vec<u64> = Vec::with_capacity(n);
-    let mut k = 2;
-    while out.len() < n {
-        if out.iter().take_while(|&&p| p * p <= k).all(|&p| k % p != 0) {
-            out.push(k);
-        }
-        k += 1;
-    }
-    out
-}
-
-/// `i`'s digits in `base` mirrored about the point: 0.d₁d₂… for i = …d₂d₁.
-fn radical_inverse(mut i: u64, base: u64) -> f64 {
-    let (mut value, mut scale) = (0.0, 1.0);
-    let inverse = 1.0 / base as f64;
-    while i > 0 {
-        scale *= inverse;
-        value += (i % base) as f64 * scale;
-        i /= base;
-    }
-    value
 }
 
 /// Searches run again at a finer resolution (each halving it) at most, where a path grazes an
@@ -503,6 +391,18 @@ fn extend(
     domain: bool,
 ) -> Extend {
     let (near, d) = tree.nearest(target);
+    extend_from(tree, (near, d), target, options, checker, domain)
+}
+
+/// [`extend`] from `tree`'s node `near`, the nearest to `target` at distance `d`.
+fn extend_from(
+    tree: &mut Tree,
+    (near, d): (usize, f64),
+    target: &[f64],
+    options: &RrtOptions,
+    checker: &mut WorldChecker,
+    domain: bool,
+) -> Extend {
     if domain && d > tree.radii[near] {
         return Extend::Outside;
     }
@@ -604,6 +504,15 @@ pub(crate) struct Growth {
     samples: Samples,
     sample: Vec<f64>,
     draws: usize,
+    /// Draws from the dynamic domains ([`domain_draw`]), a stream of its own.
+    domain_rng: ChaCha8Rng,
+    /// Draws of the current sample so far that fell outside every domain.
+    rejected: usize,
+    /// [`weigh_domains`] of the growing tree for the current sample, once `weighed`.
+    domains: Vec<f64>,
+    weighed: bool,
+    /// Which way of drawing lands in a domain more often.
+    tally: DrawTally,
     result: RrtPath,
     /// The path the trees made, once they met (or the straight segment).
     raw: Option<Vec<Vec<f64>>>,
@@ -656,6 +565,15 @@ impl Growth {
             samples: Samples::new(options.sampler, options.seed, dim),
             sample: vec![0.0; dim],
             draws: 0,
+            domain_rng: {
+                let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+                rng.set_stream(1);
+                rng
+            },
+            rejected: 0,
+            domains: Vec::new(),
+            weighed: false,
+            tally: DrawTally::default(),
             result: RrtPath::default(),
             raw,
             before,
@@ -694,13 +612,48 @@ impl Growth {
             if self.draws > options.max_iterations.saturating_mul(MAX_DRAWS_PER_SAMPLE) {
                 break;
             }
-            self.samples.next(lower, upper, &mut self.sample);
-            let new = match extend(a, &self.sample, options, checker, options.dynamic_domain) {
+            // after a few draws outside every domain, drawn from the domains themselves where
+            // that lands in one more often
+            let missing = options.dynamic_domain && self.rejected >= BOX_DRAWS_BEFORE_DOMAINS;
+            if missing && !self.weighed {
+                weigh_domains(&a.radii, a.dim, &mut self.domains);
+                self.weighed = true;
+            }
+            let domain = missing && !self.domains.is_empty() && self.tally.from_domains();
+            let step = if domain {
+                let bounds = (lower.as_slice(), upper.as_slice());
+                let from = domain_draw(
+                    (&a.nodes, &a.radii),
+                    &self.domains,
+                    &mut self.domain_rng,
+                    bounds,
+                    &mut self.sample,
+                );
+                match from.map(|i| (i, a.nearest(&self.sample))) {
+                    Some((i, near)) if near.0 == i => {
+                        extend_from(a, near, &self.sample, options, checker, true)
+                    }
+                    // outside the box, or nearer another node
+                    _ => Extend::Outside,
+                }
+            } else {
+                self.samples.next(lower, upper, &mut self.sample);
+                extend(a, &self.sample, options, checker, options.dynamic_domain)
+            };
+            let outside = matches!(step, Extend::Outside);
+            if options.dynamic_domain {
+                self.tally.record(domain, !outside);
+            }
+            let new = match step {
                 // outside the dynamic domain: drawn again, not counted as a sample
-                Extend::Outside => continue,
+                Extend::Outside => {
+                    self.rejected += 1;
+                    continue;
+                }
                 Extend::Trapped => None,
                 Extend::Reached(i) | Extend::Advanced(i) => Some(i),
             };
+            (self.rejected, self.weighed) = (0, false);
             self.result.iterations += 1;
             if let Some(i) = new {
                 let target = a.node(i).to_vec();
@@ -848,6 +801,7 @@ pub(crate) const GOAL_COLLIDES: &str = "the goal configuration collides";
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::RngExt;
 
     #[test]
     fn the_blocked_scan_finds_the_first_nearest_node_as_a_plain_scan_does() {
@@ -933,45 +887,5 @@ mod tests {
             assert!(e.contains(what), "{what}: {e}");
         }
         assert!(RrtOptions::default().check().is_ok());
-    }
-
-    #[test]
-    fn samplers_are_named_and_a_wrong_name_says_the_two() {
-        assert_eq!("halton".parse::<Sampler>().unwrap(), Sampler::Halton);
-        assert_eq!("uniform".parse::<Sampler>().unwrap(), Sampler::Uniform);
-        let e = "halton2".parse::<Sampler>().unwrap_err().to_string();
-        assert!(
-            e.contains("did you mean `halton`") && e.contains("uniform"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn halton_points_are_radical_inverses_in_the_odd_prime_bases() {
-        assert_eq!(primes(6), vec![2, 3, 5, 7, 11, 13]);
-        assert_eq!(radical_inverse(1, 3), 1.0 / 3.0);
-        assert_eq!(radical_inverse(2, 3), 2.0 / 3.0);
-        assert!((radical_inverse(3, 3) - 1.0 / 9.0).abs() < 1e-15);
-        assert!((radical_inverse(5, 5) - 1.0 / 25.0).abs() < 1e-15);
-        // the first point of every coordinate: 1/base, shifted modulo 1, scaled into the box
-        let mut samples = Samples::new(Sampler::Halton, 4, 3);
-        let (lower, upper) = ([-1.0, 0.0, 2.0], [1.0, 0.5, 3.0]);
-        let mut q = [0.0; 3];
-        samples.next(&lower, &upper, &mut q);
-        for (k, base) in [3.0, 5.0, 7.0].into_iter().enumerate() {
-            let u = (1.0 / base + samples.shifts[k]).fract();
-            assert!((q[k] - (lower[k] + u * (upper[k] - lower[k]))).abs() < 1e-12);
-        }
-        // evenly spread: every eighth of each axis gets 1 000 of 8 000 points, ± 1 %
-        let mut counts = [[0usize; 8]; 3];
-        for _ in 0..8000 {
-            samples.next(&[0.0; 3], &[1.0; 3], &mut q);
-            for k in 0..3 {
-                counts[k][(q[k] * 8.0) as usize] += 1;
-            }
-        }
-        for row in counts {
-            assert!(row.iter().all(|&c| (990..=1010).contains(&c)), "{row:?}");
-        }
     }
 }
