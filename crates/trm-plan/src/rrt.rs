@@ -619,7 +619,7 @@ impl Growth {
                 weigh_domains(&a.radii, a.dim, &mut self.domains);
                 self.weighed = true;
             }
-            let domain = missing && !self.domains.is_empty() && self.tally.from_domains();
+            let domain = missing && !self.domains.is_empty() && self.tally.next_from_domains();
             let step = if domain {
                 let bounds = (lower.as_slice(), upper.as_slice());
                 let from = domain_draw(

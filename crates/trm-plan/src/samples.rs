@@ -146,7 +146,7 @@ pub(crate) struct DrawTally {
 impl DrawTally {
     /// Whether the next draw of a sample past [`BOX_DRAWS_BEFORE_DOMAINS`] misses comes from
     /// the domains.
-    pub(crate) fn from_domains(&mut self) -> bool {
+    pub(crate) fn next_from_domains(&mut self) -> bool {
         let rate = |[tries, hits]: [f64; 2]| (hits + 1.0) / (tries + 2.0);
         let better = rate(self.counts[1]) >= rate(self.counts[0]);
         self.draws += 1;

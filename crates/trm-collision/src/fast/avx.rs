@@ -2,7 +2,7 @@
 
 use super::kdop::KDOP;
 use super::lanes::{F, Flags};
-use super::model::{FastModel, GroupPair};
+use super::model::{Ball, FastModel, GroupPair};
 use super::outcome::Contact;
 use super::walk::FastScratch;
 use super::world::{FastWorld, Object};
@@ -184,6 +184,119 @@ pub(super) fn test(object: &Object, contact: &mut Contact, c: &[F; 3], r: f32, m
         ));
         contact.hit = contact.hit | hit;
     }
+}
+
+/// [`test`] for every sphere at `centres` (radii in `balls`) against `object`, not a point
+/// cloud: the lanes certainly colliding and those within the margin `m` of contact (or NaN).
+/// The object's kind is matched and its constants broadcast once, the flags kept in registers
+/// (the same arithmetic as [`distance2`], sphere by sphere).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+pub(super) fn balls_against(
+    object: &Object,
+    centres: &[[F; 3]],
+    balls: &[Ball],
+    m: f32,
+) -> (LaneMask, LaneMask) {
+    debug_assert!(!matches!(object, Object::Cloud { .. }));
+    let (mut hit, mut close) = (_mm256_setzero_ps(), _mm256_setzero_ps());
+    let bounded = matches!(object, Object::Bounded { .. });
+    let mut add = |d2: __m256, reach: f32| {
+        let outer = reach + m;
+        close = _mm256_or_ps(
+            close,
+            _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer)),
+        );
+        if !bounded {
+            let inner = (reach - m).max(0.0);
+            hit = _mm256_or_ps(
+                hit,
+                _mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inner * inner)),
+            );
+        }
+    };
+    let norm2 = |v: [__m256; 3]| {
+        _mm256_fmadd_ps(
+            v[2],
+            v[2],
+            _mm256_fmadd_ps(v[1], v[1], _mm256_mul_ps(v[0], v[0])),
+        )
+    };
+    let splat3 = |v: [f32; 3]| {
+        [
+            _mm256_set1_ps(v[0]),
+            _mm256_set1_ps(v[1]),
+            _mm256_set1_ps(v[2]),
+        ]
+    };
+    let spheres = centres.iter().zip(balls);
+    match *object {
+        Object::Round { a, b, radius } => {
+            let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+            let inv = _mm256_set1_ps(if len2 > 0.0 { 1.0 / len2 } else { 0.0 });
+            let (a, ab) = (splat3(a), splat3(ab));
+            for (c, ball) in spheres {
+                let p = [
+                    _mm256_sub_ps(load(&c[0]), a[0]),
+                    _mm256_sub_ps(load(&c[1]), a[1]),
+                    _mm256_sub_ps(load(&c[2]), a[2]),
+                ];
+                let along = _mm256_fmadd_ps(
+                    p[2],
+                    ab[2],
+                    _mm256_fmadd_ps(p[1], ab[1], _mm256_mul_ps(p[0], ab[0])),
+                );
+                let t = _mm256_mul_ps(along, inv);
+                let t = _mm256_max_ps(_mm256_min_ps(t, _mm256_set1_ps(1.0)), _mm256_setzero_ps());
+                let d2 = norm2([
+                    _mm256_fnmadd_ps(t, ab[0], p[0]),
+                    _mm256_fnmadd_ps(t, ab[1], p[1]),
+                    _mm256_fnmadd_ps(t, ab[2], p[2]),
+                ]);
+                add(d2, ball.radius + radius);
+            }
+        }
+        Object::Box { center, axes, half } => {
+            let (o, x, y, z) = (
+                splat3(center),
+                splat3(axes[0]),
+                splat3(axes[1]),
+                splat3(axes[2]),
+            );
+            for (c, ball) in spheres {
+                let p = [
+                    _mm256_sub_ps(load(&c[0]), o[0]),
+                    _mm256_sub_ps(load(&c[1]), o[1]),
+                    _mm256_sub_ps(load(&c[2]), o[2]),
+                ];
+                let along = |a: &[__m256; 3]| {
+                    _mm256_fmadd_ps(
+                        p[2],
+                        a[2],
+                        _mm256_fmadd_ps(p[1], a[1], _mm256_mul_ps(p[0], a[0])),
+                    )
+                };
+                let d2 = norm2([
+                    beyond(abs(along(&x)), half[0]),
+                    beyond(abs(along(&y)), half[1]),
+                    beyond(abs(along(&z)), half[2]),
+                ]);
+                add(d2, ball.radius);
+            }
+        }
+        _ => {
+            // cylinders and bounded objects: the per-sphere distance
+            let extra = object.reach(0.0);
+            for (c, ball) in spheres {
+                add(distance2(object, c), ball.radius + extra);
+            }
+        }
+    }
+    (
+        _mm256_movemask_ps(hit) as LaneMask,
+        _mm256_movemask_ps(close) as LaneMask,
+    )
 }
 
 /// The three coordinates of a point in every lane.

@@ -91,11 +91,15 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
     if model.world_steps.is_empty() {
         for g in (0..model.groups.len()).rev() {
             let within = farthest(&scratch.bounds[g]) + model.groups[g].bound.radius + m;
+            let reach = model.groups[g].bound.radius + m;
             for (k, (&o, object)) in world.original.iter().zip(&world.objects).enumerate() {
                 if world.from_origin[k] > within {
                     // the link's bounding sphere lies nearer the origin than this object and
                     // every later one
                     break;
+                }
+                if !enclosing_near::<AVX>(world, k, &scratch.bounds[g], reach, live) {
+                    continue;
                 }
                 let o = o as usize;
                 if object_link::<AVX, _>(model, poses, o, object, g, live, world, scratch, verdict)
@@ -115,16 +119,22 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                 }
                 WorldStep::Link(_) => (i..i + 1, None),
             };
-            let within = match (ball, steps[i]) {
-                (Some((ball, radius)), _) => farthest(&scratch.bounds[ball as usize]) + radius,
+            // the sphere enclosing the step's links: the cull's, or the link's bounding sphere
+            let (centre, reach) = match (ball, steps[i]) {
+                (Some((ball, radius)), _) => (ball as usize, radius + m),
                 (None, WorldStep::Link(g)) => {
-                    farthest(&scratch.bounds[g as usize]) + model.groups[g as usize].bound.radius
+                    (g as usize, model.groups[g as usize].bound.radius + m)
                 }
-                (None, WorldStep::Cull { .. }) => f32::INFINITY,
-            } + m;
+                // (a cull step has its ball)
+                (None, WorldStep::Cull { .. }) => (0, f32::INFINITY),
+            };
+            let within = farthest(&scratch.bounds[centre]) + reach;
             for (k, (&o, object)) in world.original.iter().zip(&world.objects).enumerate() {
                 if world.from_origin[k] > within {
                     break;
+                }
+                if !enclosing_near::<AVX>(world, k, &scratch.bounds[centre], reach, live) {
+                    continue;
                 }
                 let o = o as usize;
                 let near = match ball {
@@ -226,6 +236,24 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         i += 1;
     }
     clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
+}
+
+/// Whether a sphere at `c` of radius `reach` (in some lane of `live`) comes within object
+/// `k`'s enclosing sphere ([`FastWorld::enclosing`]): when not, it misses the object.
+#[inline(always)]
+fn enclosing_near<const AVX: bool>(
+    world: &FastWorld,
+    k: usize,
+    c: &[F; 3],
+    reach: f32,
+    live: LaneMask,
+) -> bool {
+    let (center, radius) = world.enclosing[k];
+    let limit = reach + radius;
+    live & distance2(c, &splat(center))
+        .within(limit * limit)
+        .mask::<AVX>()
+        != 0
 }
 
 /// The largest distance from the world's origin of the point in any lane of `c`.
@@ -480,6 +508,36 @@ fn object_balls<const AVX: bool>(
 ) -> (LaneMask, LaneMask) {
     let (m, group) = (world.margin, &model.groups[g]);
     place_balls::<AVX>(model, poses, g, scratch);
+    #[cfg(target_arch = "x86_64")]
+    if AVX && !matches!(object, Object::Cloud { .. }) {
+        let (balls, inner) = (group.balls.clone(), group.inner.clone());
+        // SAFETY: as in `F::any_within`
+        #[allow(unsafe_code)]
+        let (hit, close) = unsafe {
+            avx::balls_against(
+                object,
+                &scratch.balls[balls.clone()],
+                &model.balls[balls],
+                m,
+            )
+        };
+        if model.exact {
+            return (hit, close);
+        }
+        if near & close == 0 {
+            return (0, close);
+        }
+        #[allow(unsafe_code)]
+        let (inside, _) = unsafe {
+            avx::balls_against(
+                object,
+                &scratch.inner[inner.clone()],
+                &model.inner[inner],
+                m,
+            )
+        };
+        return (inside, close);
+    }
     let mut contact = Contact::default();
     // a point cloud costs per sphere and lane: where a certain collision ends the walk, the
     // first one ends the link's spheres too (a sphere model's spheres are its bodies)

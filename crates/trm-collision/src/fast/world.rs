@@ -67,6 +67,9 @@ pub struct FastWorld {
     /// Per object of `objects` (ascending): a lower bound of its distance from the world's
     /// origin ([`Object::origin_distance`]).
     pub(super) from_origin: Vec<f32>,
+    /// Per object of `objects`: a sphere enclosing it (centre, radius; [`Object::enclosing`]),
+    /// the first and cheapest test of a link against it.
+    pub(super) enclosing: Vec<([f32; 3], f32)>,
     /// The index in `objects` of each of the world's objects.
     pub(super) compiled_of: Vec<u32>,
     pub(super) margin: f32,
@@ -272,15 +275,19 @@ impl FastModel {
         for (k, &o) in order.iter().enumerate() {
             compiled_of[o as usize] = k as u32;
         }
-        let objects = order.iter().map(|&o| objects[o as usize]).collect();
+        let sorted = order.iter().map(|&o| objects[o as usize]).collect();
         let largest = self.reach.max(farthest);
         // placing and measuring, one more step where a sphere is taken into a box link's frame
         let solid = (self.groups.iter()).any(|g| g.solid.is_some() || g.kdop.is_some());
         let steps = self.depth + 2 + usize::from(solid);
         let margin = (MARGIN_PER_METRE_JOINT * (1.0 + largest) * steps as f64) as f32;
         FastWorld {
-            objects,
+            objects: sorted,
             from_origin: order.iter().map(|&o| from_origin[o as usize]).collect(),
+            enclosing: order
+                .iter()
+                .map(|&o| objects[o as usize].enclosing())
+                .collect(),
             original: order,
             compiled_of,
             margin,
@@ -302,6 +309,42 @@ impl Object {
         let d2 = self.distance2(&splat([0.0; 3])).0[0];
         let d = f64::from(d2).sqrt() - f64::from(self.reach(0.0));
         (d - 1e-6 * (1.0 + d.abs())).max(0.0) as f32
+    }
+
+    /// A sphere enclosing the object (its geometry widened by its radius): centre and radius,
+    /// the radius measured in `f64` and widened by 1 µm per metre, so that a point farther
+    /// from the centre than the radius is outside the object.
+    pub(super) fn enclosing(&self) -> ([f32; 3], f32) {
+        let norm = |v: [f32; 3]| v.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>().sqrt();
+        let (center, radius) = match *self {
+            Object::Round { a, b, radius } => {
+                let half = [
+                    (b[0] - a[0]) / 2.0,
+                    (b[1] - a[1]) / 2.0,
+                    (b[2] - a[2]) / 2.0,
+                ];
+                let c = [a[0] + half[0], a[1] + half[1], a[2] + half[2]];
+                // the centre's rounding: its distance to both ends, not half the length
+                let ends = norm([c[0] - a[0], c[1] - a[1], c[2] - a[2]]).max(norm([
+                    c[0] - b[0],
+                    c[1] - b[1],
+                    c[2] - b[2],
+                ]));
+                (c, ends + f64::from(radius))
+            }
+            Object::Box { center, half, .. } | Object::Cloud { center, half, .. } => {
+                (center, norm(half) + f64::from(self.reach(0.0)))
+            }
+            Object::Cylinder {
+                center,
+                radius,
+                half,
+                ..
+            } => (center, f64::from(radius).hypot(f64::from(half))),
+            Object::Bounded { center, radius } => (center, f64::from(radius)),
+        };
+        let far = radius + norm(center);
+        (center, (radius + 1e-6 * (1.0 + far)) as f32)
     }
 
     /// The reach of a sphere of radius `r` from the object's own geometry: the sum of the radii
