@@ -196,7 +196,19 @@ impl CloudGrid {
 
     /// The lanes of `lanes` whose sphere at `c` of radius `reach` may touch a point's centre
     /// (NaN lanes included).
-    pub(super) fn may_touch(&self, c: &[F; 3], reach: f32, lanes: LaneMask) -> LaneMask {
+    #[inline(always)]
+    pub(super) fn may_touch<const AVX: bool>(
+        &self,
+        c: &[F; 3],
+        reach: f32,
+        lanes: LaneMask,
+    ) -> LaneMask {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return lanes & unsafe { self.may_touch_avx(c, reach + self.slack) };
+        }
         let mut out = 0;
         for l in 0..FAST_LANES {
             if lanes & (1 << l) == 0 {
@@ -208,6 +220,53 @@ impl CloudGrid {
             }
         }
         out
+    }
+
+    /// [`CloudGrid::may_touch`] in every lane at once: the cells' indices in vector
+    /// instructions, their clearances gathered (the same arithmetic as
+    /// [`CloudGrid::clearance`]), the lanes within `reach` or not finite.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn may_touch_avx(&self, c: &[F; 3], reach: f32) -> LaneMask {
+        use std::arch::x86_64::{
+            _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_epi32, _mm256_and_ps, _mm256_andnot_ps,
+            _mm256_cmp_ps, _mm256_cvttps_epi32, _mm256_i32gather_ps, _mm256_load_ps, _mm256_max_ps,
+            _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_mullo_epi32,
+            _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
+        };
+        let index = |k: usize| {
+            // SAFETY: `F` is eight `f32` aligned to 32 bytes
+            #[allow(unsafe_code)]
+            let p = unsafe { _mm256_load_ps(c[k].0.as_ptr()) };
+            // |p| < ∞ (NaN fails too)
+            let magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0), p);
+            let ok = _mm256_cmp_ps::<_CMP_LT_OQ>(magnitude, _mm256_set1_ps(f32::INFINITY));
+            let v = _mm256_mul_ps(
+                _mm256_sub_ps(p, _mm256_set1_ps(self.origin[k])),
+                _mm256_set1_ps(self.inv_cell),
+            );
+            // NaN to 0 (the second operand), as `f32::max` does
+            let v = _mm256_max_ps(v, _mm256_setzero_ps());
+            let v = _mm256_min_ps(v, _mm256_set1_ps((self.dims[k] - 1) as f32));
+            (_mm256_cvttps_epi32(v), ok)
+        };
+        let ((i, a), (j, b), (k, d)) = (index(0), index(1), index(2));
+        let finite = _mm256_and_ps(a, _mm256_and_ps(b, d));
+        let (d0, d1) = (self.dims[0] as i32, self.dims[1] as i32);
+        let cell = _mm256_add_epi32(
+            i,
+            _mm256_mullo_epi32(
+                _mm256_set1_epi32(d0),
+                _mm256_add_epi32(j, _mm256_mullo_epi32(_mm256_set1_epi32(d1), k)),
+            ),
+        );
+        // SAFETY: every index lies in the grid (clamped to its cells), `clear` holds one
+        // value per cell
+        #[allow(unsafe_code)]
+        let clear = unsafe { _mm256_i32gather_ps::<4>(self.clear.as_ptr(), cell) };
+        let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(reach));
+        // (a mask's eight bits: one per lane)
+        (_mm256_movemask_ps(within) as LaneMask) | !(_mm256_movemask_ps(finite) as LaneMask)
     }
 
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.
@@ -674,5 +733,42 @@ mod tests {
             count > 500 && short < 0.75 * cell,
             "{count} near: {short} short on average"
         );
+    }
+
+    /// The vector instructions' lanes near a cloud (cells' indices, gathered clearances) are
+    /// the plain loop's, for points inside the grid, outside it on every side, on cell
+    /// borders and not finite.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn lanes_near_a_cloud_are_the_same_in_vector_instructions() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let points: Vec<[f32; 3]> = (0..2000)
+            .map(|_| std::array::from_fn(|_| rng.random_range(-0.3..0.3f32)))
+            .collect();
+        let grid = CloudGrid::new(&points, 0.02, 0.08, 0.3);
+        let (mut flagged, mut total) = (0, 0);
+        for round in 0..2000 {
+            let c: [F; 3] = std::array::from_fn(|_| {
+                F(std::array::from_fn(|l| match (round + l) % 23 {
+                    0 => f32::NAN,
+                    1 => f32::INFINITY,
+                    2 => -f32::INFINITY,
+                    // a cell's border
+                    3 => grid.origin[0] + grid.cell * rng.random_range(0..40) as f32,
+                    _ => rng.random_range(-1.0..1.0f32),
+                }))
+            });
+            let reach = rng.random_range(0.0..0.05f32);
+            let lanes: LaneMask = rng.random();
+            let plain = grid.may_touch::<false>(&c, reach, lanes);
+            assert_eq!(grid.may_touch::<true>(&c, reach, lanes), plain, "{c:?} {reach}");
+            flagged += plain.count_ones();
+            total += lanes.count_ones();
+        }
+        // both kinds of lanes were seen
+        assert!(flagged > total / 20 && flagged < total * 19 / 20, "{flagged} of {total}");
     }
 }

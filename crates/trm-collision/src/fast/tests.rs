@@ -947,10 +947,12 @@ fn enclosing_spheres_hold_their_objects() {
         let farthest = match o % 4 {
             0 => (p.abs() + Vector3::new(a, b, c)).norm(),
             1 => (p.x.hypot(p.y) + a).hypot(p.z.abs() + b),
-            2 => (p - Vector3::new(0.0, 0.0, b))
-                .norm()
-                .max((p + Vector3::new(0.0, 0.0, b)).norm())
-                + a,
+            2 => {
+                (p - Vector3::new(0.0, 0.0, b))
+                    .norm()
+                    .max((p + Vector3::new(0.0, 0.0, b)).norm())
+                    + a
+            }
             _ => p.norm() + a,
         };
         let radius = f64::from(radius);

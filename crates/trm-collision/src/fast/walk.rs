@@ -372,7 +372,7 @@ pub(super) fn object_link<const AVX: bool, O: Outcome>(
     if let Some((grid, radius)) = cloud {
         // the link's bounding sphere against the cells' clearances, past the cloud's box
         let reach = group.bound.radius + m + radius + grid.gap;
-        near = grid.may_touch(&scratch.bounds[g], reach, near);
+        near = grid.may_touch::<AVX>(&scratch.bounds[g], reach, near);
         if near == 0 {
             return false;
         }

@@ -126,6 +126,8 @@ impl FastWorld {
                 let outer = reach + grid.gap + m;
                 // a point certainly colliding settles the lane: the scan may stop there
                 let [inner2, _] = limits(reach, m);
+                // the lanes a cell's clearance does not settle, all at once
+                let near = grid.may_touch::<AVX>(c, outer, near);
                 let d2 = grid.distance2(c, outer, inner2, near, first);
                 contact.add_within(d2, [inner2, outer * outer]);
             }
