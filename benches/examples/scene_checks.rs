@@ -15,7 +15,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use trm_benches::{median, random_configurations};
+use trm_benches::{median, positive, random_configurations};
 use trm_collision::CollisionModel;
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_kinematics::RobotModel;
@@ -23,10 +23,7 @@ use trm_mbm::{LoadedProblem, ProblemSet};
 use trm_tasks::Objective;
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(2);
-    }
+    trm_benches::exit_on_error(run);
 }
 
 fn run() -> Result<(), String> {
@@ -34,12 +31,8 @@ fn run() -> Result<(), String> {
     if args.len() < 2 {
         return Err("usage: scene_checks PROBLEMS MODEL [PER_FAMILY] [ROUNDS]".into());
     }
-    let count = |text: &str, what: &str| match text.parse::<usize>() {
-        Ok(v) if v > 0 => Ok(v),
-        _ => Err(format!("{what}: `{text}` is not a positive whole number")),
-    };
-    let per_family = args.get(2).map_or(Ok(10), |r| count(r, "PER_FAMILY"))?;
-    let rounds = args.get(3).map_or(Ok(7), |r| count(r, "ROUNDS"))?;
+    let per_family = args.get(2).map_or(Ok(10), |r| positive(r, "PER_FAMILY"))?;
+    let rounds = args.get(3).map_or(Ok(7), |r| positive(r, "ROUNDS"))?;
     let robot = RobotModel::load(&args[1]).map_err(|e| e.to_string())?;
     let collision = CollisionModel::new(&robot).map_err(|e| e.to_string())?;
     let mut set = ProblemSet::open(Path::new(&args[0])).map_err(|e| e.to_string())?;

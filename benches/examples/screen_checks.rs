@@ -14,17 +14,14 @@
 
 use std::time::Instant;
 
-use trm_benches::{median, random_configurations};
+use trm_benches::{median, positive, random_configurations};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
 use trm_tasks::Objective;
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(2);
-    }
+    trm_benches::exit_on_error(run);
 }
 
 fn run() -> Result<(), String> {
@@ -32,12 +29,8 @@ fn run() -> Result<(), String> {
     if args.len() < 2 {
         return Err("usage: screen_checks MODEL COUNT [ROUNDS]".into());
     }
-    let count = |text: &str, what: &str| match text.parse::<usize>() {
-        Ok(v) if v > 0 => Ok(v),
-        _ => Err(format!("{what}: `{text}` is not a positive whole number")),
-    };
-    let n = count(&args[1], "COUNT")?;
-    let rounds = args.get(2).map_or(Ok(7), |r| count(r, "ROUNDS"))?;
+    let n = positive(&args[1], "COUNT")?;
+    let rounds = args.get(2).map_or(Ok(7), |r| positive(r, "ROUNDS"))?;
     let robot = RobotModel::load(&args[0]).map_err(|e| e.to_string())?;
     let collision = CollisionModel::new(&robot).map_err(|e| e.to_string())?;
     let world = World::new();

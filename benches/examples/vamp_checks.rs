@@ -20,7 +20,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use trm_benches::{median, random_configurations};
+use trm_benches::{median, positive, random_configurations};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, World};
 use trm_kinematics::{LANES, RobotModel};
@@ -48,10 +48,7 @@ fn objective(path: &str, joints: Option<&str>) -> Result<Objective, String> {
 type Exchanged = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<bool>);
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(2);
-    }
+    trm_benches::exit_on_error(run);
 }
 
 fn run() -> Result<(), String> {
@@ -64,12 +61,8 @@ fn run() -> Result<(), String> {
     }
     let joints = args.get(5).map(String::as_str);
     let (timed, exact) = (objective(&args[0], joints)?, objective(&args[1], joints)?);
-    let count = |text: &str, what: &str| match text.parse::<usize>() {
-        Ok(v) if v > 0 => Ok(v),
-        _ => Err(format!("{what}: `{text}` is not a positive whole number")),
-    };
-    let n = count(&args[3], "COUNT")?;
-    let rounds = args.get(4).map_or(Ok(7), |r| count(r, "ROUNDS"))?;
+    let n = positive(&args[3], "COUNT")?;
+    let rounds = args.get(4).map_or(Ok(7), |r| positive(r, "ROUNDS"))?;
     if timed.dim() != exact.dim() {
         return Err(format!(
             "{} moves {} motors, {} moves {}: give two models of one robot",

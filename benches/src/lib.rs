@@ -19,3 +19,19 @@ pub fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
 }
+
+/// A command-line count: `text` as a positive whole number, else an error naming `what`.
+pub fn positive(text: &str, what: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(v) if v > 0 => Ok(v),
+        _ => Err(format!("{what}: `{text}` is not a positive whole number")),
+    }
+}
+
+/// Runs an example's `run`, printing its error and exiting with status 2 when it fails.
+pub fn exit_on_error(run: impl FnOnce() -> Result<(), String>) {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(2);
+    }
+}

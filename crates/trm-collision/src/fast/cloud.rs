@@ -764,11 +764,18 @@ mod tests {
             let reach = rng.random_range(0.0..0.05f32);
             let lanes: LaneMask = rng.random();
             let plain = grid.may_touch::<false>(&c, reach, lanes);
-            assert_eq!(grid.may_touch::<true>(&c, reach, lanes), plain, "{c:?} {reach}");
+            assert_eq!(
+                grid.may_touch::<true>(&c, reach, lanes),
+                plain,
+                "{c:?} {reach}"
+            );
             flagged += plain.count_ones();
             total += lanes.count_ones();
         }
         // both kinds of lanes were seen
-        assert!(flagged > total / 20 && flagged < total * 19 / 20, "{flagged} of {total}");
+        assert!(
+            flagged > total / 20 && flagged < total * 19 / 20,
+            "{flagged} of {total}"
+        );
     }
 }

@@ -510,32 +510,24 @@ fn object_balls<const AVX: bool>(
     place_balls::<AVX>(model, poses, g, scratch);
     #[cfg(target_arch = "x86_64")]
     if AVX && !matches!(object, Object::Cloud { .. }) {
-        let (balls, inner) = (group.balls.clone(), group.inner.clone());
-        // SAFETY: as in `F::any_within`
-        #[allow(unsafe_code)]
-        let (hit, close) = unsafe {
-            avx::balls_against(
-                object,
-                &scratch.balls[balls.clone()],
-                &model.balls[balls],
-                m,
-            )
+        let against = |centres: &[[F; 3]], balls: &[super::model::Ball]| {
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            unsafe {
+                avx::balls_against(object, centres, balls, m)
+            }
         };
-        if model.exact {
-            return (hit, close);
+        let (hit, close) = against(
+            &scratch.balls[group.balls.clone()],
+            &model.balls[group.balls.clone()],
+        );
+        if model.exact || near & close == 0 {
+            // enclosing spheres only say "maybe": far from them, nothing is certain either
+            return (if model.exact { hit } else { 0 }, close);
         }
-        if near & close == 0 {
-            return (0, close);
-        }
-        #[allow(unsafe_code)]
-        let (inside, _) = unsafe {
-            avx::balls_against(
-                object,
-                &scratch.inner[inner.clone()],
-                &model.inner[inner],
-                m,
-            )
-        };
+        // a sphere inside a body says "certainly"
+        let inner = group.inner.clone();
+        let (inside, _) = against(&scratch.inner[inner.clone()], &model.inner[inner]);
         return (inside, close);
     }
     let mut contact = Contact::default();
