@@ -97,9 +97,18 @@ fn run() -> Result<(), String> {
         }
     }
     for (family, _, _, _, free, width) in &scenes {
-        times.get_mut(family).expect("timed").1 += free.len() / width * FAST_LANES;
+        if let Some(entry) = times.get_mut(family) {
+            entry.1 += free.len() / width * FAST_LANES;
+        }
     }
     let total: usize = times.values().map(|(_, n)| n).sum();
+    if total == 0 {
+        return Err(format!(
+            "{}: no block of free configurations in the scenes of {} problems (an empty set,              or scenes that fill the robot's reach)",
+            args[0],
+            scenes.len()
+        ));
+    }
     println!(
         "{} with {}: free configurations of {per_family} problems per family, blocks of \
          {FAST_LANES}, median of {rounds} rounds",
