@@ -16,6 +16,41 @@ fn table_world() -> World {
     .expect("valid world")
 }
 
+/// The table's objects as convex hulls (a box's eight corners) and its top as two triangles:
+/// the iCub's capsules against hulls and a triangle mesh.
+fn hull_world() -> World {
+    let table = table_world();
+    let mut world = World::new();
+    for object in table.objects() {
+        let trm_collision::Shape::Box { size } = object.shape() else {
+            unreachable!("the table world holds boxes")
+        };
+        let h = size.map(|s| 0.5 * s);
+        let corners = (0..8)
+            .map(|k| std::array::from_fn(|a| if k >> a & 1 == 1 { h[a] } else { -h[a] }))
+            .collect();
+        let pose = *object.pose();
+        let name = object.name();
+        world
+            .add(name, trm_collision::Shape::Convex { points: corners }, pose)
+            .expect("a hull of a box");
+        if name == "table" {
+            let top = |x: f64, y: f64| [x * h[0], y * h[1], h[2]];
+            let mesh = trm_collision::Shape::Mesh {
+                vertices: vec![
+                    top(-1.0, -1.0),
+                    top(1.0, -1.0),
+                    top(1.0, 1.0),
+                    top(-1.0, 1.0),
+                ],
+                triangles: vec![[0, 1, 2], [0, 2, 3]],
+            };
+            world.add("table_top", mesh, pose).expect("two triangles");
+        }
+    }
+    world
+}
+
 fn collision(c: &mut Criterion) {
     let robot = trm_models::icub_upper_body();
     let model = CollisionModel::new(&robot).expect("shipped model");
@@ -93,6 +128,16 @@ fn collision(c: &mut Criterion) {
             b.iter(|| {
                 model.place(black_box(cycle()), &mut placed);
                 black_box(model.count(&placed, &world).total())
+            })
+        },
+    );
+    let hulls = hull_world();
+    group.bench_function(
+        BenchmarkId::new("place_and_count_world", "random_table_hulls_and_mesh"),
+        |b| {
+            b.iter(|| {
+                model.place(black_box(cycle()), &mut placed);
+                black_box(model.count_world(&placed, &hulls))
             })
         },
     );

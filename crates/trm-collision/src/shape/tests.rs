@@ -385,3 +385,92 @@ fn shapes_touch_a_cloud_as_parry_says_without_its_tree() {
     };
     assert!(!shape.is_made(), "the tree was not needed");
 }
+
+/// A capsule or a sphere away from the origin against a triangle of a mesh, a convex hull and
+/// a cylinder, a few micrometres from touching on either side: touching exactly when
+/// penetrating, at the distance built (parry's GJK on the capsule itself, given as a segment
+/// away from its frame's origin, missed penetrations of a triangle of up to 13 µm). The gap is
+/// set by moving the other shape along the closest pair's direction, found by ternary search
+/// over the segment of parry's point projections onto the other shape.
+#[test]
+fn round_shapes_touch_flat_and_curved_shapes_within_a_micrometre_of_contact() {
+    use rand::RngExt;
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(13);
+    let mut wrong = Vec::new();
+    for k in 0..12_000 {
+        let mut point = |scale: f64| -> Point3<f64> {
+            Point3::from(Vector3::from_fn(|_, _| rng.random_range(-scale..scale)))
+        };
+        let (radius, length) = (0.038, if k % 4 == 0 { 0.0 } else { 0.166 });
+        let round = if length == 0.0 {
+            Shape::Sphere { radius }
+        } else {
+            Shape::Capsule { radius, length }
+        };
+        let pose = Isometry3::new(point(0.6).coords, point(3.0).coords);
+        let (a, b) = (
+            pose * Point3::new(0.0, 0.0, -0.5 * length),
+            pose * Point3::new(0.0, 0.0, 0.5 * length),
+        );
+        let other = match k / 8 % 3 {
+            0 => Shape::Mesh {
+                vertices: (0..3).map(|_| (0.15 * point(1.0)).into()).collect(),
+                triangles: vec![[0, 1, 2]],
+            },
+            1 => Shape::Convex {
+                points: (0..6).map(|_| (0.1 * point(1.0)).into()).collect(),
+            },
+            _ => Shape::Cylinder {
+                radius: 0.01 + 0.05 * point(1.0).x.abs(),
+                length: 0.02 + 0.2 * point(1.0).x.abs(),
+            },
+        };
+        let mut at = Isometry3::new(
+            pose.translation.vector + point(0.15).coords,
+            point(3.0).coords,
+        );
+        let (frame, parry) = other.to_parry().unwrap();
+        // the segment's closest point to the other shape and the other shape's to it
+        let closest = |at: &Isometry3<f64>| {
+            let foot = |t: f64| {
+                let on = a + t * (b - a);
+                (on, parry.project_point(&(at * frame), &on, true).point)
+            };
+            let gap = |t: f64| {
+                let (on, at) = foot(t);
+                (at - on).norm()
+            };
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..200 {
+                let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+                if gap(m1) < gap(m2) {
+                    hi = m2;
+                } else {
+                    lo = m1;
+                }
+            }
+            foot(0.5 * (lo + hi))
+        };
+        let (on, to) = closest(&at);
+        if (to - on).norm() < 1e-3 {
+            continue;
+        }
+        let gap = [-20e-6, -10e-6, -4e-6, -2e-6, 2e-6, 4e-6, 10e-6, 20e-6][k % 8];
+        let shift = radius + gap - (to - on).norm();
+        at.translation.vector += shift * (to - on).normalize();
+        let (c, p) = placed(&round, pose);
+        let (o, q) = placed(&other, at);
+        let touching = intersects(&c, &p, &o, &q);
+        let distance = signed_distance(&c, &p, &o, &q);
+        if touching != (gap < 0.0)
+            || touching != intersects(&o, &q, &c, &p)
+            || (gap > 0.0 && (distance - gap).abs() > 1e-7)
+        {
+            wrong.push((k, other.kind(), gap, touching, distance));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "(case, shape, gap, touching, distance): {wrong:?}"
+    );
+}
