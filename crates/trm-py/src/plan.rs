@@ -395,8 +395,11 @@ impl Planner {
     /// `graph`, `retrieved` or `sampled`), `checks` and `samples`. With `out` (a `.csv` path)
     /// the trajectory is also written as `trm plan --out` writes it (CSV, JSON, a ROS 2
     /// JointTrajectory `.ros.yaml`, a MoveIt MotionPlanResponse `.response.yaml`), the
-    /// files listed under `files`.
-    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, out = None))]
+    /// files listed under `files`. With `timed=False` (posture goals) the path is not timed
+    /// (no `times`, `positions`, `velocities`, `accelerations`, `motor_names`, `task_path`):
+    /// planning alone, as MoveIt's planners and VAMP return paths (timing a MotionBenchMaker
+    /// Panda path time-optimally costs about 1.5× its planning).
+    #[pyo3(signature = (to, start = None, *, tolerance = 0.03, posture = None, exact = true, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, timed = true, out = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan<'py>(
         &mut self,
@@ -413,9 +416,10 @@ impl Planner {
         range: Option<f64>,
         certified: bool,
         smoothing: usize,
+        timed: bool,
         out: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        check_out(out.as_deref())?;
+        check_out(out.as_deref(), timed)?;
         let dim = self.planner.active().len();
         let from = match (start, &self.start) {
             (Some(s), _) => configurations(s, dim, "start")?.0,
@@ -427,6 +431,11 @@ impl Planner {
         if !posture && self.task_dim == 0 {
             return Err(err(
                 "to: a task point needs a map planner (its task space); give a posture (posture=True)",
+            ));
+        }
+        if !posture && !timed {
+            return Err(err(
+                "timed=False: a task point's motion is timed as it is planned; give timed=True",
             ));
         }
         let d = PyDict::new(py);
@@ -447,8 +456,8 @@ impl Planner {
                 certified,
                 smoothing,
             };
-            let timing = self.timing.timing(None);
-            self.connect(py, &d, from, RequestGoal::Joints(target), &budget, &timing)?
+            let timing = timed.then(|| self.timing.timing(None));
+            self.connect(py, &d, from, RequestGoal::Joints(target), &budget, timing)?
         } else {
             let goal = trm_plan::Goal::TaskPoint {
                 t: target,
@@ -465,7 +474,7 @@ impl Planner {
                 .detach(|| planner.plan(&from, &goal, &options))
                 .map_err(err)?;
             (
-                planned.trajectory,
+                Some(planned.trajectory),
                 planned.waypoints,
                 planned.stats.length,
                 planned.stats.seconds,
@@ -481,9 +490,9 @@ impl Planner {
     /// task-space goal, met by IK for a collision-free configuration first; its
     /// `allowed_planning_time` as the budget unless `max_seconds`), in the current world; load
     /// its scene first (`load_scene`). Objects its start state holds are held from then on
-    /// (beside the scene's). Returns what `plan` returns; `out` as for `plan` (the response
-    /// names the request's group).
-    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, out = None))]
+    /// (beside the scene's). Returns what `plan` returns; `timed` and `out` as for `plan` (the
+    /// response names the request's group).
+    #[pyo3(signature = (request, *, seed = 0, max_seconds = None, max_samples = 1_000_000, resolution = None, range = None, certified = false, smoothing = trm_plan::rrt::SMOOTHING_ROUNDS, timed = true, out = None))]
     #[allow(clippy::too_many_arguments)]
     fn plan_request<'py>(
         &mut self,
@@ -496,9 +505,10 @@ impl Planner {
         range: Option<f64>,
         certified: bool,
         smoothing: usize,
+        timed: bool,
         out: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        check_out(out.as_deref())?;
+        check_out(out.as_deref(), timed)?;
         let read;
         let request = match request.cast::<MotionPlanRequest>() {
             Ok(r) => &r.get().request,
@@ -522,8 +532,8 @@ impl Planner {
             smoothing,
         };
         let d = PyDict::new(py);
-        let timing = self.timing.timing(Some(request));
-        let planned = self.connect(py, &d, start, goal, &budget, &timing)?;
+        let timing = timed.then(|| self.timing.timing(Some(request)));
+        let planned = self.connect(py, &d, start, goal, &budget, timing)?;
         self.write(&d, &planned, &request.group, out.as_deref())?;
         self.fill(py, d, planned)
     }
@@ -577,15 +587,20 @@ impl Planner {
 }
 
 /// Refuses an `out` the trajectory's JSON would overwrite, before planning.
-fn check_out(out: Option<&std::path::Path>) -> PyResult<()> {
+fn check_out(out: Option<&std::path::Path>, timed: bool) -> PyResult<()> {
+    if out.is_some() && !timed {
+        return Err(err(
+            "out: the files hold a timed trajectory; give timed=True (the default) to write them",
+        ));
+    }
     out.map_or(Ok(()), |o| {
         trm_moveit::check_trajectory_out("out", o).map_err(err)
     })
 }
 
-/// A path, timed: the trajectory, the waypoints (moved motors), its length (rad) and the
-/// planning time (s).
-type Timed = (trm_plan::Trajectory, Vec<Vec<f64>>, f64, f64);
+/// A path: its trajectory (unless asked for the waypoints alone), the waypoints (moved
+/// motors), its length (rad) and the planning time (s).
+type Timed = (Option<trm_plan::Trajectory>, Vec<Vec<f64>>, f64, f64);
 
 impl Planner {
     /// `from` joined to `goal` (a configuration or a task-space goal) by
@@ -599,7 +614,7 @@ impl Planner {
         from: Vec<f64>,
         goal: RequestGoal,
         budget: &Budget,
-        timing: &trm_plan::Timing,
+        timing: Option<trm_plan::Timing>,
     ) -> PyResult<Timed> {
         let rrt = self.planner.rrt_options_within(budget).map_err(err)?;
         let (experience, planner) = (self.experience, &mut self.planner);
@@ -609,7 +624,9 @@ impl Planner {
                 if experience && found.source == trm_plan::Source::Sampled {
                     planner.add_path(&found.path)?;
                 }
-                let trajectory = planner.trajectory(&found.path, timing)?;
+                let trajectory = timing
+                    .map(|timing| planner.trajectory(&found.path, &timing))
+                    .transpose()?;
                 Ok((found, trajectory))
             })
             .map_err(err)?;
@@ -629,8 +646,9 @@ impl Planner {
         group: &str,
         out: Option<&std::path::Path>,
     ) -> PyResult<()> {
-        let Some(out) = out else { return Ok(()) };
-        let (trajectory, _, _, seconds) = planned;
+        let (Some(out), (Some(trajectory), _, _, seconds)) = (out, planned) else {
+            return Ok(());
+        };
         let robot = self.planner.active().model();
         let files = trm_moveit::trajectory_files(trajectory, robot, Some((group, *seconds)), out)
             .map_err(err)?;
@@ -649,38 +667,33 @@ impl Planner {
         planned: Timed,
     ) -> PyResult<Bound<'py, PyDict>> {
         let dim = self.planner.active().len();
-        let (t, waypoints, length, seconds) = planned;
-        d.set_item(
-            "times",
-            shaped(py, None, &[t.times.len()], t.times.clone())?,
-        )?;
-        let motors = t.names.len();
-        let flat: Vec<f64> = t.positions.iter().flatten().copied().collect();
-        d.set_item(
-            "positions",
-            shaped(py, None, &[t.positions.len(), motors], flat)?,
-        )?;
-        for (key, rows) in [
-            ("velocities", &t.velocities),
-            ("accelerations", &t.accelerations),
-        ] {
-            if rows.len() == t.times.len() {
-                let flat: Vec<f64> = rows.iter().flatten().copied().collect();
-                d.set_item(key, shaped(py, None, &[rows.len(), motors], flat)?)?;
-            }
-        }
-        d.set_item("motor_names", t.names.clone())?;
+        let (trajectory, waypoints, length, seconds) = planned;
         let rows = waypoints.len();
         d.set_item(
             "waypoints",
             shaped(py, None, &[rows, dim], waypoints.concat())?,
         )?;
-        if self.task_dim > 0 {
-            let tasks: Vec<f64> = t.task_path.iter().flatten().copied().collect();
-            d.set_item(
-                "task_path",
-                shaped(py, None, &[t.task_path.len(), self.task_dim], tasks)?,
-            )?;
+        if let Some(t) = trajectory {
+            d.set_item("times", shaped(py, None, &[t.times.len()], t.times)?)?;
+            let motors = t.names.len();
+            for (key, rows) in [
+                ("positions", &t.positions),
+                ("velocities", &t.velocities),
+                ("accelerations", &t.accelerations),
+            ] {
+                if key == "positions" || rows.len() == t.positions.len() {
+                    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+                    d.set_item(key, shaped(py, None, &[rows.len(), motors], flat)?)?;
+                }
+            }
+            d.set_item("motor_names", t.names)?;
+            if self.task_dim > 0 {
+                let tasks: Vec<f64> = t.task_path.iter().flatten().copied().collect();
+                d.set_item(
+                    "task_path",
+                    shaped(py, None, &[t.task_path.len(), self.task_dim], tasks)?,
+                )?;
+            }
         }
         d.set_item("length", length)?;
         d.set_item("seconds", seconds)?;

@@ -342,7 +342,17 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does(tmp_pat
         assert not r["velocities"][-1].any() and not r["velocities"][0].any()
         assert r["times"][0] == 0.0 and np.all(np.diff(r["times"]) > 0)
         assert r["source"] in ("straight", "sampled")
+        # the path alone, untimed: the same waypoints, no trajectory
+        bare = planner.plan_request(read, timed=False)
+        np.testing.assert_array_equal(bare["waypoints"], r["waypoints"])
+        assert bare["length"] == r["length"] and bare["checks"] == r["checks"]
+        assert not {"times", "positions", "velocities", "motor_names"} & bare.keys()
+        alone = planner.plan(r["waypoints"][-1], r["waypoints"][0], timed=False)
+        assert "times" not in alone and alone["waypoints"].shape[1] == 7
     assert "7 motors" in repr(planner)
+    with pytest.raises(ValueError, match="timed=True"):
+        planner.plan_request(str(requests[0]), timed=False, out=tmp_path / "untimed.csv")
+    assert not (tmp_path / "untimed.csv").exists()
     # timing: MoveIt-like limits, scaled; stopping at every waypoint takes longer
     limits = ROOT / "benches" / "timing" / "panda_joint_limits.yaml"
     planner.set_timing(joint_limits=str(limits), sample_period=0.001)

@@ -196,6 +196,7 @@ class Planner:
         range: float | None = None,
         certified: bool = False,
         smoothing: int = 5,
+        timed: bool = True,
         out: str | os.PathLike | None = None,
     ) -> dict: ...
     def plan_request(
@@ -209,6 +210,7 @@ class Planner:
         range: float | None = None,
         certified: bool = False,
         smoothing: int = 5,
+        timed: bool = True,
         out: str | os.PathLike | None = None,
     ) -> dict: ...
 
