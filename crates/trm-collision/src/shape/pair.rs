@@ -237,7 +237,7 @@ fn round_axial(p1: &Placed, radius: f64, p2: &Placed, axial: &Axial) -> Option<b
 /// Whether a round shape placed at `round` (its segment swept by `radius`) touches a general
 /// shape placed at `general` that is no cloud: a cylinder (`axial`) through its capsules, then
 /// GJK on the round shape itself; anything flat-sided by its core's distance
-/// ([`core_distance`]).
+/// ([`core_within`]).
 fn round_touches(
     round: &Placed,
     radius: f64,
@@ -302,11 +302,11 @@ fn core_within(
 }
 
 /// The distance from the core of a round shape placed at `round` (its segment, or its centre)
-/// to a general shape placed at `general` (0 where they touch): GJK between a segment and a
-/// polytope or a triangle ends on their exact features, and converges to a relative precision
-/// of ~1e-7 against curved shapes a radius away, where GJK's intersection test of the swept
+/// to a flat-sided general shape placed at `general` (0 where they touch): GJK between a
+/// segment and a polytope or a triangle ends on their exact features, where GJK on the swept
 /// shape itself stalls micrometres from contact (parry 0.25 missed penetrations of a capsule
-/// into a triangle of up to 13 µm).
+/// into a triangle of up to 13 µm). Not for curved shapes: against a cylinder's side GJK's
+/// distance strays by micrometres too.
 fn core_distance(
     round: &Placed,
     shape: &SharedShape,
