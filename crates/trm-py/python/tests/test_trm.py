@@ -289,6 +289,8 @@ def test_a_map_builds_saves_loads_and_plans(tmp_path):
         planner.plan([goal[0], np.nan, goal[2]])
     with pytest.raises(trm.TrmError, match="the goal configuration has 3 values"):
         planner.plan([0.0, 0.0, 0.0], posture=True)
+    with pytest.raises(ValueError, match="a task point's motion is timed as it is planned"):
+        planner.plan(goal, timed=False)
     # the plan drawn over its map, as `trm plan --view` draws it
     page = trm.view(trm.Robot.icub(), str(tmp_path / "plan.html"),
                     frames=plan["positions"], times=plan["times"], roadmap=loaded)
