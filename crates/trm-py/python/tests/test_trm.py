@@ -354,6 +354,9 @@ def test_one_robot_planner_answers_moveit_requests_as_the_benchmark_does(tmp_pat
     assert "7 motors" in repr(planner)
     with pytest.raises(ValueError, match="timed=True"):
         planner.plan_request(str(requests[0]), timed=False, out=tmp_path / "untimed.csv")
+    for wrong in ["no", None, 1.5]:
+        with pytest.raises(TypeError, match="timed"):
+            planner.plan_request(str(requests[0]), timed=wrong)
     assert not (tmp_path / "untimed.csv").exists()
     # timing: MoveIt-like limits, scaled; stopping at every waypoint takes longer
     limits = ROOT / "benches" / "timing" / "panda_joint_limits.yaml"
