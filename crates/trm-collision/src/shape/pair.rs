@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use parry3d_f64::shape::{SegmentPointLocation, Shape as ParryShape, SharedShape, SupportMap};
 
-use super::compiled::{Axial, Compiled, Geometry, LazyShape, Placed, RoundShape};
+use super::compiled::{Axial, Compiled, Geometry, Placed, RoundShape};
 use super::hull::HullWalk;
 use super::segment_box::segment_box_distance_squared;
 
@@ -420,72 +420,16 @@ pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Pl
     {
         return segment_distance_squared(&p1.a, &p1.b, &p2.a, &p2.b).sqrt() - r1 - r2;
     }
-    let round_box = match (&c1.geometry, &c2.geometry) {
-        (
-            Geometry::Round { radius, .. },
-            Geometry::General {
-                half_extents: Some(h),
-                ..
-            },
-        ) => Some((round_box_distance_squared(p1, p2, h), *radius)),
-        (
-            Geometry::General {
-                half_extents: Some(h),
-                ..
-            },
-            Geometry::Round { radius, .. },
-        ) => Some((round_box_distance_squared(p2, p1, h), *radius)),
+    // a round shape against a general one, the round one first
+    let round_general = match (&c1.geometry, &c2.geometry) {
+        (Geometry::Round { radius, .. }, Geometry::General { .. }) => Some((p1, *radius, c2, p2)),
+        (Geometry::General { .. }, Geometry::Round { radius, .. }) => Some((p2, *radius, c1, p1)),
         _ => None,
     };
-    if let Some((squared, radius)) = round_box {
-        if squared > 0.0 {
-            return squared.sqrt() - radius;
-        }
-    }
-    // a round shape whose core stays out of a general one: the core's distance less the radius
-    // (flat-sided shapes only: GJK's distance to a cylinder's curved side strays micrometres)
-    let flat = |shape: &LazyShape, axial: &Option<Axial>| shape.grid.is_none() && axial.is_none();
-    let core = match (&c1.geometry, &c2.geometry) {
-        (
-            Geometry::Round { radius, .. },
-            Geometry::General {
-                shape, walk, axial, ..
-            },
-        ) if flat(shape, axial) => Some((core_distance(p1, shape, walk, p2), radius)),
-        (
-            Geometry::General {
-                shape, walk, axial, ..
-            },
-            Geometry::Round { radius, .. },
-        ) if flat(shape, axial) => Some((core_distance(p2, shape, walk, p1), radius)),
-        _ => None,
-    };
-    if let Some((distance, radius)) = core
-        && distance > 0.0
+    if let Some(distance) = round_general
+        .and_then(|(round, radius, general, at)| round_signed_distance(round, radius, general, at))
     {
-        return distance - radius;
-    }
-    // a round shape whose core stays out of a cylinder: the core's exact distance less the
-    // radius (the depth too, where the radius reaches in: as for the flat-sided shapes)
-    let cylinder = match (&c1.geometry, &c2.geometry) {
-        (
-            Geometry::Round { radius, .. },
-            Geometry::General {
-                axial: Some(axial), ..
-            },
-        ) => Some((core_cylinder_distance(p1, p2, axial), radius)),
-        (
-            Geometry::General {
-                axial: Some(axial), ..
-            },
-            Geometry::Round { radius, .. },
-        ) => Some((core_cylinder_distance(p2, p1, axial), radius)),
-        _ => None,
-    };
-    if let Some((distance, radius)) = cylinder
-        && distance > 0.0
-    {
-        return distance - radius;
+        return distance;
     }
     with_parry(c1, p1, c2, p2, |i1, s1, i2, s2| {
         // closest points, not `query::distance`: parry 0.25's cuboid–cuboid distance
@@ -500,6 +444,42 @@ pub(crate) fn signed_distance(c1: &Compiled, p1: &Placed, c2: &Compiled, p2: &Pl
             .flatten()
             .map_or(0.0, |c| c.dist.min(0.0))
     })
+}
+
+/// The signed distance between a round shape placed at `round` (its segment swept by
+/// `radius`) and a general shape `general` placed at `at`, where it needs no parry: a box by
+/// the segment's exact distance, a cylinder ([`core_cylinder_distance`]) or a flat-sided shape
+/// ([`core_distance`]; GJK's distance to a cylinder's curved side strays micrometres) by its
+/// core's, each while the core stays out (the distance less the radius is then the depth too,
+/// where the radius reaches in). `None` otherwise: a cloud, or the core inside.
+fn round_signed_distance(
+    round: &Placed,
+    radius: f64,
+    general: &Compiled,
+    at: &Placed,
+) -> Option<f64> {
+    let Geometry::General {
+        shape,
+        walk,
+        axial,
+        half_extents,
+        ..
+    } = &general.geometry
+    else {
+        return None;
+    };
+    if let Some(h) = half_extents {
+        let squared = round_box_distance_squared(round, at, h);
+        if squared > 0.0 {
+            return Some(squared.sqrt() - radius);
+        }
+    }
+    let core = match axial {
+        Some(axial) => core_cylinder_distance(round, at, axial),
+        None if shape.grid.is_none() => core_distance(round, shape, walk, at),
+        None => return None,
+    };
+    (core > 0.0).then_some(core - radius)
 }
 
 /// Calls `f` with both placed shapes in parry's form (round shapes get their parry twin).
