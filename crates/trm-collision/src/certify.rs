@@ -212,9 +212,11 @@ pub struct Certifier {
     values: [Vec<f64>; 2],
     /// Per term: how much its joint's value changes over the current motion.
     motion: Vec<f64>,
-    /// The current motion's configurations placed so far (reused).
+    /// Placed configurations (reused): those of the current motion's pieces still to prove,
+    /// and spares.
     snapshots: Vec<Snapshot>,
-    placed_count: usize,
+    /// Snapshots free for the next configuration placed.
+    free: Vec<usize>,
     q: Vec<f64>,
     /// Pieces to prove, and spare lists of open pairs and reaches.
     stack: Vec<Piece>,
@@ -314,7 +316,7 @@ impl Certifier {
             values: [vec![0.0; joints], vec![0.0; joints]],
             motion: Vec::new(),
             snapshots: Vec::new(),
-            placed_count: 0,
+            free: Vec::new(),
             q: vec![0.0; n],
             stack: Vec::new(),
             spare: Vec::new(),
@@ -378,7 +380,7 @@ impl Certifier {
         Ok(PathCertificate { failure: None })
     }
 
-    fn check_configuration(&self, q: &[f64]) -> Result<()> {
+    pub(crate) fn check_configuration(&self, q: &[f64]) -> Result<()> {
         if q.len() != self.active.len() {
             return Err(CollisionError::InvalidValue {
                 what: "a configuration to certify".into(),
@@ -455,7 +457,8 @@ impl Certifier {
         self.motion.clear();
         self.motion
             .extend(self.terms.iter().map(|t| (vb[t.value] - va[t.value]).abs()));
-        self.placed_count = 0;
+        self.free.clear();
+        self.free.extend((0..self.snapshots.len()).rev());
         (self.place(a), self.place(b))
     }
 
@@ -562,6 +565,8 @@ impl Certifier {
                 return certificate;
             }
             if piece.open.is_empty() {
+                // the pieces left of this one are proved: its start is no other piece's end
+                self.free.push(piece.s0);
                 self.recycle(piece);
                 continue;
             }
@@ -703,19 +708,23 @@ impl Certifier {
         0..len as u32
     }
 
-    /// Places the bodies at active configuration `q`: the index of its snapshot.
+    /// Places the bodies at active configuration `q` in a free snapshot: its index.
     fn place(&mut self, q: &[f64]) -> usize {
-        if self.placed_count == self.snapshots.len() {
-            self.snapshots.push(Snapshot {
-                links: self.collision.robot().pose_buffer(),
-                centers: vec![Point3::origin(); self.balls.len()],
-                placed: self.collision.placed_bodies(),
-                ready: vec![false; self.collision.bodies().len()],
-                arms: vec![0.0; self.terms.len()],
-                armed: vec![false; self.balls.len()],
-            });
-        }
-        let snapshot = &mut self.snapshots[self.placed_count];
+        let s = match self.free.pop() {
+            Some(s) => s,
+            None => {
+                self.snapshots.push(Snapshot {
+                    links: self.collision.robot().pose_buffer(),
+                    centers: vec![Point3::origin(); self.balls.len()],
+                    placed: self.collision.placed_bodies(),
+                    ready: vec![false; self.collision.bodies().len()],
+                    arms: vec![0.0; self.terms.len()],
+                    armed: vec![false; self.balls.len()],
+                });
+                self.snapshots.len() - 1
+            }
+        };
+        let snapshot = &mut self.snapshots[s];
         self.active.forward_unchecked(q, &mut snapshot.links);
         let poses = snapshot.links.poses();
         snapshot.ready.fill(false);
@@ -724,8 +733,7 @@ impl Certifier {
             *c = poses[ball.link] * ball.center;
         }
         self.configurations += 1;
-        self.placed_count += 1;
-        self.placed_count - 1
+        s
     }
 
     /// A lower bound on the distance of every pair of group `group` at snapshot `s`, from the

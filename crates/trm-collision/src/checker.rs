@@ -6,12 +6,13 @@ use std::sync::Arc;
 use trm_kinematics::{ActiveSet, LANES, PoseBatch, PoseBuffer};
 
 use crate::batch::PlacedBatch;
-use crate::certify::Certifier;
+use crate::certify::Certificate;
 use crate::edge::{edge_steps, rake, span_steps};
 use crate::error::Result;
 use crate::fast::{FAST_LANES, FastChecker, FastModel, FastWorld};
 use crate::model::CollisionModel;
 use crate::placed::PlacedBodies;
+use crate::prove::Prover;
 use crate::world::World;
 
 /// Collision checks of one robot's configurations and straight edges in one world, counted.
@@ -49,11 +50,16 @@ pub struct WorldChecker {
     engine: Engine,
     /// The points of the edge being checked.
     samples: Vec<f64>,
-    /// With it, an edge free at its points must also be proved free in continuous motion.
-    certifier: Option<Box<Certifier>>,
+    /// The robot and its active set (for the prover, made on first use).
+    collision: CollisionModel,
+    active: ActiveSet,
+    /// Proofs in continuous motion, once asked for.
+    prover: Option<Box<Prover>>,
+    /// Whether an edge free at its points must also be proved free in continuous motion.
+    proving: bool,
     /// Configurations checked so far (each point of an edge is one).
     pub checks: u64,
-    /// Edges proved free, or refused, by the certifier so far.
+    /// Edges proved free, or refused, in continuous motion so far.
     pub certified: u64,
 }
 
@@ -105,7 +111,10 @@ impl WorldChecker {
             world,
             engine,
             samples: Vec::new(),
-            certifier: None,
+            collision: collision.clone(),
+            active: active.clone(),
+            prover: None,
+            proving: false,
             checks: 0,
             certified: 0,
         })
@@ -131,21 +140,44 @@ impl WorldChecker {
             let (checker, fast_world) = &mut **screen;
             *fast_world = checker.model().world_after(&world, &self.world, fast_world);
         }
+        if let Some(prover) = &mut self.prover {
+            prover.set_world(world.clone());
+        }
         self.world = world;
     }
 
-    /// Certified edges ([`Certifier`], made for the same robot and active set): with one, every
-    /// edge check but [`WorldChecker::edge_midpoints_free`] also proves the edge free in
-    /// continuous motion once its points are free, and refuses an edge it cannot prove; `None`
-    /// checks edges at their points only.
-    /// Returns the certifier it had.
-    pub fn set_certifier(&mut self, certifier: Option<Certifier>) -> Option<Certifier> {
-        std::mem::replace(&mut self.certifier, certifier.map(Box::new)).map(|c| *c)
+    /// Certified edges: with `on`, every edge check but [`WorldChecker::edge_midpoints_free`]
+    /// also proves the edge free in continuous motion once its points are free
+    /// ([`WorldChecker::prove`]), and refuses an edge it cannot prove; otherwise edges are
+    /// checked at their points only. An error when the prover cannot be made.
+    pub fn set_proving(&mut self, on: bool) -> Result<()> {
+        if on {
+            self.prover()?;
+        }
+        self.proving = on;
+        Ok(())
     }
 
-    /// The certifier edges are proved with, if any.
-    pub fn certifier(&self) -> Option<&Certifier> {
-        self.certifier.as_deref()
+    /// Whether edges are proved free in continuous motion ([`WorldChecker::set_proving`]).
+    pub fn is_proving(&self) -> bool {
+        self.proving
+    }
+
+    /// What can be proved about the straight motion `a` → `b` in the world, in continuous
+    /// motion ([`Prover`]: the robot padded, checked on this checker's engine, and exact
+    /// distances near contact). An error for configurations the [`crate::Certifier`] refuses,
+    /// or when the prover cannot be made.
+    pub fn prove(&mut self, a: &[f64], b: &[f64]) -> Result<Certificate> {
+        self.prover()?.segment(a, b)
+    }
+
+    /// The prover, made on first use for this robot and world.
+    pub fn prover(&mut self) -> Result<&mut Prover> {
+        if self.prover.is_none() {
+            let prover = Prover::new(&self.collision, &self.active, self.world.clone())?;
+            self.prover = Some(Box::new(prover));
+        }
+        Ok(self.prover.as_deref_mut().expect("made above"))
     }
 
     /// Whether the single-precision screen checks this robot.
@@ -240,14 +272,15 @@ impl WorldChecker {
         self.rake(a, b, steps + 1, |s| s as f64 / steps as f64) && self.proved(a, b)
     }
 
-    /// Whether the certifier, if there is one, proves the edge a → b free.
+    /// Whether the edge a → b is proved free, when edges are proved
+    /// ([`WorldChecker::set_proving`]).
     fn proved(&mut self, a: &[f64], b: &[f64]) -> bool {
-        match &mut self.certifier {
-            Some(certifier) => {
+        match (&mut self.prover, self.proving) {
+            (Some(prover), true) => {
                 self.certified += 1;
-                certifier.segment_unchecked(&self.world, a, b).is_free()
+                prover.segment_unchecked(a, b).is_free()
             }
-            None => true,
+            _ => true,
         }
     }
 

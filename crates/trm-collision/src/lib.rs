@@ -67,6 +67,7 @@ pub mod mesh;
 mod model;
 mod placed;
 mod points;
+pub mod prove;
 mod query;
 mod shape;
 mod world;

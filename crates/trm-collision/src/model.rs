@@ -67,6 +67,16 @@ pub struct Body {
     pub local: Isometry3<f64>,
 }
 
+/// How a model was made from another ([`CollisionModel::padded`],
+/// [`CollisionModel::only_pairs`]).
+#[derive(Debug, PartialEq)]
+enum Derived {
+    /// Padded by a margin, without some link pairs.
+    Padded(f64, Vec<[usize; 2]>),
+    /// With only some link pairs.
+    Only(Vec<[usize; 2]>),
+}
+
 #[derive(Debug)]
 struct Inner {
     robot: RobotModel,
@@ -80,6 +90,9 @@ struct Inner {
     kept: Kept,
     /// The model compiled for single-precision checks ([`crate::fast::FastModel::of`]).
     fast: OnceLock<Arc<crate::fast::FastModel>>,
+    /// The models made from it so far ([`CollisionModel::padded`],
+    /// [`CollisionModel::only_pairs`]), by how they were made.
+    derived: std::sync::Mutex<Vec<(Derived, CollisionModel)>>,
 }
 
 /// What a model hands on to the models made from it ([`CollisionModel::with_acm`],
@@ -287,6 +300,7 @@ impl CollisionModel {
                 culling,
                 kept,
                 fast: OnceLock::new(),
+                derived: Default::default(),
             }),
         })
     }
@@ -496,6 +510,99 @@ impl CollisionModel {
             options: self.inner.kept.options.clone(),
         };
         let acm = self.inner.acm.clone();
+        Self::build(&self.inner.robot, bodies, acm, kept)
+    }
+
+    /// The same robot with every body grown by `margin` (m, finite and positive;
+    /// [`crate::Shape::grown`]) and the link pairs `unchecked` no longer checked, the same
+    /// matrix otherwise and the same held objects: wherever it is free of a world, each body of
+    /// this model keeps at least `margin` from every object it is checked against, and
+    /// 2·`margin` from every body it is still checked against. Its spheres are this model's
+    /// grown by what the bodies grow ([`crate::Shape::growth`]): nothing is fitted again. Made
+    /// once per margin and pairs, then shared.
+    pub fn padded(&self, margin: f64, unchecked: &[[usize; 2]]) -> Result<Self> {
+        if !(margin.is_finite() && margin > 0.0) {
+            return Err(CollisionError::InvalidValue {
+                what: "a padding".into(),
+                problem: format!("{margin} is not a positive distance (m)"),
+            });
+        }
+        let mut acm = self.inner.acm.clone();
+        for &[a, b] in unchecked {
+            acm.disable(a, b, trm_kinematics::DisableReason::User);
+        }
+        let key = Derived::Padded(margin, unchecked.to_vec());
+        self.derived(key, || self.pad(margin, acm))
+    }
+
+    /// The same model checking only the link pairs `pairs` of those it checks (and its held
+    /// objects, always checked). Made once per pairs, then shared.
+    pub(crate) fn only_pairs(&self, pairs: &[[usize; 2]]) -> Result<Self> {
+        let mut acm = self.inner.acm.clone();
+        for [a, b] in self.checked_link_pairs() {
+            if !pairs.contains(&[a, b]) && !pairs.contains(&[b, a]) {
+                acm.disable(a, b, trm_kinematics::DisableReason::User);
+            }
+        }
+        let key = Derived::Only(pairs.to_vec());
+        self.derived(key, || {
+            let bodies = self.inner.bodies.clone();
+            Self::build(&self.inner.robot, bodies, acm, self.inner.kept.clone())
+        })
+    }
+
+    /// The link pairs with checked body pairs, each once.
+    pub(crate) fn checked_link_pairs(&self) -> Vec<[usize; 2]> {
+        let bodies = &self.inner.bodies;
+        let mut out: Vec<[usize; 2]> = (self.inner.pairs.iter())
+            .map(|p| [bodies[p.a as usize].link, bodies[p.b as usize].link])
+            .collect();
+        out.dedup();
+        out
+    }
+
+    /// The model made as `key` says: the one made before, or `make`'s, kept.
+    fn derived(&self, key: Derived, make: impl FnOnce() -> Result<Self>) -> Result<Self> {
+        let mut made = self.inner.derived.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, model)) = made.iter().find(|(k, _)| *k == key) {
+            return Ok(model.clone());
+        }
+        let model = make()?;
+        made.push((key, model.clone()));
+        Ok(model)
+    }
+
+    /// This model's bodies grown by `margin`, checked as `acm` says.
+    fn pad(&self, margin: f64, acm: AllowedCollisionMatrix) -> Result<Self> {
+        let bodies: Vec<Body> = (self.bodies().iter())
+            .map(|b| Body {
+                shape: b.shape.grown(margin).expect("a link's bodies are convex"),
+                ..b.clone()
+            })
+            .collect();
+        let spheres = |sets: Vec<Vec<crate::Sphere>>, grown: bool| {
+            let cell = OnceLock::new();
+            let sets = sets.into_iter().zip(self.bodies()).map(|(mut set, b)| {
+                for s in set.iter_mut().filter(|_| grown) {
+                    s.radius += margin * b.shape.growth();
+                }
+                set
+            });
+            let _ = cell.set(sets.collect());
+            cell
+        };
+        let all = |of: fn(&Self, usize) -> &[crate::Sphere]| {
+            (0..bodies.len()).map(|b| of(self, b).to_vec()).collect()
+        };
+        let kept = Kept {
+            spheres: Arc::new(SphereSets {
+                // the grown bodies lie within this model's enclosing spheres grown as much, and
+                // hold its inscribed ones
+                enclosing: spheres(all(Self::enclosing_spheres), true),
+                inscribed: spheres(all(Self::inscribed_spheres), false),
+            }),
+            ..self.inner.kept.clone()
+        };
         Self::build(&self.inner.robot, bodies, acm, kept)
     }
 

@@ -5,6 +5,7 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use trm_collision::prove::Prover;
 use trm_collision::{
     Certificate, Certifier, CollisionModel, Contact, Levers, Shape, World, edge::distance,
 };
@@ -51,12 +52,14 @@ fn clutter(rng: &mut ChaCha8Rng, count: usize, reach: f64) -> World {
     world
 }
 
-/// Random motions among clutter: each certificate checked against a dense sampling of the
-/// motion with the exact model. Returns (free, colliding, unproved) counts.
-fn soundness(robot: &RobotModel, motions: usize, seed: u64) -> [usize; 3] {
+/// Random motions among clutter: each certificate (the [`Certifier`]'s, or with `fast` the
+/// [`Prover`]'s) checked against a dense sampling of the motion with the exact model. Returns
+/// (free, colliding, unproved) counts.
+fn soundness(robot: &RobotModel, motions: usize, seed: u64, fast: bool) -> [usize; 3] {
     let collision = CollisionModel::new(robot).unwrap();
     let active = robot.all_active();
     let mut certifier = Certifier::new(&collision, &active).unwrap();
+    let mut prover = Prover::new(&collision, &active, World::new()).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (lower, upper) = active.bounds();
     let (mut poses, mut placed) = (robot.pose_buffer(), collision.placed_bodies());
@@ -78,7 +81,12 @@ fn soundness(robot: &RobotModel, motions: usize, seed: u64) -> [usize; 3] {
             .map(|i| (a[i] + step[i]).clamp(lower[i], upper[i]))
             .collect();
         done += 1;
-        let certificate = certifier.segment(&world, &a, &b).unwrap();
+        let certificate = if fast {
+            prover.set_world(world.clone());
+            prover.segment(&a, &b).unwrap()
+        } else {
+            certifier.segment(&world, &a, &b).unwrap()
+        };
         let at = |u: f64| -> Vec<f64> { a.iter().zip(&b).map(|(x, y)| x + u * (y - x)).collect() };
         match certificate {
             Certificate::Free => {
@@ -113,15 +121,95 @@ fn soundness(robot: &RobotModel, motions: usize, seed: u64) -> [usize; 3] {
 
 #[test]
 fn proofs_hold_on_the_fitted_panda() {
-    let counts = soundness(&model("panda/panda.ron"), 40, 1);
-    // both verdicts occur: the test can fail either way
-    assert!(counts[0] >= 5 && counts[1] >= 5, "{counts:?}");
+    for fast in [false, true] {
+        let counts = soundness(&model("panda/panda.ron"), 40, 1, fast);
+        // both verdicts occur: the test can fail either way
+        assert!(counts[0] >= 5 && counts[1] >= 5, "{counts:?}");
+    }
 }
 
 #[test]
 fn proofs_hold_on_the_icub_upper_body() {
-    let counts = soundness(&model("icub_upper_body.ron"), 12, 2);
-    assert!(counts[0] >= 2 && counts[1] >= 2, "{counts:?}");
+    for fast in [false, true] {
+        let counts = soundness(&model("icub_upper_body.ron"), 12, 2, fast);
+        assert!(counts[0] >= 2 && counts[1] >= 2, "{counts:?}");
+    }
+}
+
+/// The fast proofs on VAMP's sphere Panda (the model the planner's benchmark proves paths
+/// of): sound, and both verdicts occur.
+#[test]
+fn fast_proofs_hold_on_the_sphere_panda() {
+    let counts = soundness(&model("panda-mbm/panda_spherized.ron"), 80, 3, true);
+    assert!(counts[0] >= 10 && counts[1] >= 5, "{counts:?}");
+}
+
+/// Wherever a padded model is free of a world, the model's every body keeps at least the
+/// margin from every object, and its answers on the screen are its exact model's (its spheres
+/// grown, not fitted again): on the iCub (capsules, boxes, spheres) and the fitted Panda.
+#[test]
+fn a_padded_model_free_keeps_the_margin() {
+    for (file, seed, objects) in [("icub_upper_body.ron", 4, 24), ("panda/panda.ron", 5, 10)] {
+        let robot = model(file);
+        let collision = CollisionModel::new(&robot).unwrap();
+        let active = robot.all_active();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let world = clutter(&mut rng, objects, 0.6);
+        let margin = 0.02;
+        let padded = collision.padded(margin, &[]).unwrap();
+        let mut screen = trm_collision::WorldChecker::new(&padded, &active, world.clone()).unwrap();
+        let (mut poses, mut placed, mut grown) = (
+            robot.pose_buffer(),
+            collision.placed_bodies(),
+            padded.placed_bodies(),
+        );
+        let (mut free, mut near) = (0, 0);
+        for _ in 0..400 {
+            let q = active.random(&mut rng);
+            active.forward(&q, &mut poses).unwrap();
+            collision.place(&poses, &mut placed);
+            padded.place(&poses, &mut grown);
+            let exact = !padded.any_world_collision(&grown, &world);
+            assert_eq!(screen.free(&q), exact && !padded.any_self_collision(&grown));
+            let closest = (0..collision.bodies().len())
+                .flat_map(|b| (0..world.len()).map(move |o| (b, o)))
+                .map(|(b, o)| collision.object_distance(&placed, b, &world, o))
+                .fold(f64::INFINITY, f64::min);
+            if exact {
+                free += 1;
+                assert!(closest >= margin - 1e-9, "{file}: {closest} < {margin}");
+            } else if closest > 0.0 {
+                near += 1;
+            }
+        }
+        // free configurations, and some within the margin that the padding catches
+        assert!(free >= 20 && near >= 5, "{file}: {free} free, {near} near");
+    }
+}
+
+/// The fast proof finds the collision between two samples a planner would check, and proves
+/// the same motion away from the post.
+#[test]
+fn a_fast_proof_finds_a_collision_between_samples() {
+    let (robot, collision) = arm();
+    let mut world = World::new();
+    let post = Shape::Cylinder {
+        radius: 0.005,
+        length: 1.0,
+    };
+    world
+        .add("post", post, Isometry3::translation(1.0, 0.0, 0.0))
+        .unwrap();
+    let mut prover = Prover::new(&collision, &robot.all_active(), world).unwrap();
+    assert!(matches!(
+        prover.segment(&[-0.1], &[0.1]).unwrap(),
+        Certificate::Collides {
+            pair: Contact::Object(0, 0),
+            ..
+        }
+    ));
+    assert!(prover.segment(&[0.2], &[1.5]).unwrap().is_free());
+    assert!(prover.segment(&[0.2], &[9.0]).is_err());
 }
 
 /// A planar arm of one 1 m link (revolute about z) with a 5 cm sphere at its end.

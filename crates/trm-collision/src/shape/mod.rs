@@ -134,6 +134,54 @@ impl Shape {
         }
     }
 
+    /// A shape holding every point within `margin` (m, ≥ 0) of this one: a sphere, capsule or
+    /// point cloud with its radius grown (exactly that), a box or cylinder with every side
+    /// moved out by `margin`, a hull of its points moved to the corners of a cube of half-side
+    /// `margin` (both at most √3·`margin` beyond); `None` for a triangle mesh, which has no
+    /// inside.
+    pub fn grown(&self, margin: f64) -> Option<Shape> {
+        let m = margin;
+        Some(match self {
+            Shape::Sphere { radius } => Shape::Sphere { radius: radius + m },
+            Shape::Capsule { radius, length } => Shape::Capsule {
+                radius: radius + m,
+                length: *length,
+            },
+            Shape::Box { size } => Shape::Box {
+                size: size.map(|s| s + 2.0 * m),
+            },
+            Shape::Cylinder { radius, length } => Shape::Cylinder {
+                radius: radius + m,
+                length: length + 2.0 * m,
+            },
+            Shape::Convex { points } => Shape::Convex {
+                points: points
+                    .iter()
+                    .flat_map(|p| {
+                        (0..8).map(move |k| {
+                            let corner = |axis: usize| if k >> axis & 1 == 1 { m } else { -m };
+                            [p[0] + corner(0), p[1] + corner(1), p[2] + corner(2)]
+                        })
+                    })
+                    .collect(),
+            },
+            Shape::Points { points, radius } => Shape::Points {
+                points: points.clone(),
+                radius: radius + m,
+            },
+            Shape::Mesh { .. } => return None,
+        })
+    }
+
+    /// How far beyond this shape [`Shape::grown`]`(margin)` may reach, per metre of margin: 1
+    /// for round shapes, √3 for the others.
+    pub fn growth(&self) -> f64 {
+        match self {
+            Shape::Sphere { .. } | Shape::Capsule { .. } | Shape::Points { .. } => 1.0,
+            _ => 3f64.sqrt(),
+        }
+    }
+
     /// Whether a robot's link may be made of it (every kind but [`Shape::Points`] and
     /// [`Shape::Mesh`], which only the world holds).
     pub fn is_convex(&self) -> bool {

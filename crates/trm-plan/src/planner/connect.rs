@@ -8,7 +8,6 @@ use rand_chacha::ChaCha8Rng;
 
 use super::Planner;
 use super::search::LazySearch;
-use trm_collision::Certifier;
 
 use crate::PlanError;
 use crate::pose_goal::PoseGoal;
@@ -378,30 +377,19 @@ impl Planner {
 }
 
 impl Planner {
-    /// Proves every segment of `path` free in continuous motion ([`RrtOptions::certified`]);
-    /// a segment that cannot be proved is replaced by RRT-Connect between its ends with every
-    /// accepted edge proved (its checker given the certifier). An error when no proved path
-    /// joins them within `options`' budget.
+    /// Proves every segment of `path` free in continuous motion ([`RrtOptions::certified`]:
+    /// [`trm_collision::WorldChecker::prove`]); a segment that cannot be proved is replaced by RRT-Connect
+    /// between its ends with every accepted edge proved. An error when no proved path joins
+    /// them within `options`' budget.
     fn prove(&mut self, path: &mut Vec<Vec<f64>>, options: &RrtOptions) -> Result<(), PlanError> {
-        let mut certifier = match self.certifier.take() {
-            Some(c) => c,
-            None => Certifier::new(self.objective.collision(), &self.active)?,
-        };
         let mut i = 0;
-        let result = loop {
-            if i + 1 >= path.len() {
-                break Ok(());
-            }
-            let world = self.checker.world();
-            if certifier
-                .segment_unchecked(world, &path[i], &path[i + 1])
-                .is_free()
-            {
+        while i + 1 < path.len() {
+            if self.checker.prove(&path[i], &path[i + 1])?.is_free() {
                 i += 1;
                 continue;
             }
             // the segment grazes or crosses an obstacle between its checked points
-            self.checker.set_certifier(Some(certifier));
+            self.checker.set_proving(true)?;
             let repaired = rrt_connect_in(
                 &mut self.checker,
                 &self.bounds,
@@ -409,10 +397,7 @@ impl Planner {
                 &path[i + 1],
                 options,
             );
-            certifier = self
-                .checker
-                .set_certifier(None)
-                .expect("the certifier was given to the checker");
+            self.checker.set_proving(false)?;
             match repaired {
                 Ok(found) => {
                     let n = found.path.len();
@@ -420,7 +405,7 @@ impl Planner {
                     i += n - 1;
                 }
                 Err(e) => {
-                    break Err(PlanError::Unreachable {
+                    return Err(PlanError::Unreachable {
                         reason: format!(
                             "segment {i} of the path found cannot be proved free in continuous motion, and no proved path replaces it: {e}"
                         ),
@@ -429,9 +414,8 @@ impl Planner {
                     });
                 }
             }
-        };
-        self.certifier = Some(certifier);
-        result
+        }
+        Ok(())
     }
 }
 

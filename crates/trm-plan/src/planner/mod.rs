@@ -85,9 +85,6 @@ pub struct Planner {
     scratch: trm_tasks::Scratch,
     /// Checks in the current world.
     checker: WorldChecker,
-    /// Proves paths free in continuous motion ([`RrtOptions::certified`]); made on first use
-    /// for the current collision model.
-    certifier: Option<trm_collision::Certifier>,
     /// The paths kept by [`Planner::add_path`]: their nodes and edges, in order.
     kept: Vec<(Vec<usize>, Vec<usize>)>,
     /// The kept paths' first and last waypoints, twice the active motors' values per path, in
@@ -111,7 +108,6 @@ impl Planner {
     pub fn new(objective: &Objective, maps: &[&Roadmap]) -> Result<Self, PlanError> {
         let mut planner = Planner {
             checker: objective.world_checker(objective.world())?,
-            certifier: None,
             time_paths: true,
             objective: objective.clone(),
             active: objective.active().clone(),
@@ -265,7 +261,6 @@ impl Planner {
         let checks = self.checker.checks;
         self.checker = self.objective.world_checker(&world)?;
         self.checker.checks = checks;
-        self.certifier = None;
         self.node_state.fill(State::Unknown);
         self.edge_state.fill(State::Unknown);
         Ok(true)
