@@ -380,39 +380,8 @@ impl Certifier {
         Ok(PathCertificate { failure: None })
     }
 
-    pub(crate) fn check_configuration(&self, q: &[f64]) -> Result<()> {
-        if q.len() != self.active.len() {
-            return Err(CollisionError::InvalidValue {
-                what: "a configuration to certify".into(),
-                problem: format!(
-                    "{} values for {} active coordinates",
-                    q.len(),
-                    self.active.len()
-                ),
-            });
-        }
-        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-            return Err(CollisionError::InvalidValue {
-                what: "a configuration to certify".into(),
-                problem: format!("value {i} is {}", q[i]),
-            });
-        }
-        // the lever arms of prismatic joints rest on their travel: a motion outside the limits
-        // is not what they bound
-        let motors = self.collision.robot().motors();
-        for (&m, &v) in self.active.motor_indices().iter().zip(q) {
-            let limits = &motors[m].limits;
-            if v < limits.lower - TRAVEL_SLACK || v > limits.upper + TRAVEL_SLACK {
-                return Err(CollisionError::InvalidValue {
-                    what: "a configuration to certify".into(),
-                    problem: format!(
-                        "{} = {v} is outside its limits [{}, {}]: clamp it into them",
-                        motors[m].name, limits.lower, limits.upper
-                    ),
-                });
-            }
-        }
-        Ok(())
+    fn check_configuration(&self, q: &[f64]) -> Result<()> {
+        check_configuration(&self.collision, &self.active, q)
     }
 
     /// [`Certifier::segment`] without checking the configurations.
@@ -838,6 +807,43 @@ impl Certifier {
             (a, Err(object)) => Contact::Object(a, object),
         }
     }
+}
+
+/// Whether `q` holds one finite value per coordinate of `active`, within the motors' limits of
+/// `collision`'s robot (up to [`TRAVEL_SLACK`]): an error that says what is wrong otherwise.
+pub(crate) fn check_configuration(
+    collision: &CollisionModel,
+    active: &ActiveSet,
+    q: &[f64],
+) -> Result<()> {
+    if q.len() != active.len() {
+        return Err(CollisionError::InvalidValue {
+            what: "a configuration to certify".into(),
+            problem: format!("{} values for {} active coordinates", q.len(), active.len()),
+        });
+    }
+    if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+        return Err(CollisionError::InvalidValue {
+            what: "a configuration to certify".into(),
+            problem: format!("value {i} is {}", q[i]),
+        });
+    }
+    // the lever arms of prismatic joints rest on their travel: a motion outside the limits
+    // is not what they bound
+    let motors = collision.robot().motors();
+    for (&m, &v) in active.motor_indices().iter().zip(q) {
+        let limits = &motors[m].limits;
+        if v < limits.lower - TRAVEL_SLACK || v > limits.upper + TRAVEL_SLACK {
+            return Err(CollisionError::InvalidValue {
+                what: "a configuration to certify".into(),
+                problem: format!(
+                    "{} = {v} is outside its limits [{}, {}]: clamp it into them",
+                    motors[m].name, limits.lower, limits.upper
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

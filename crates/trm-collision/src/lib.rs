@@ -49,7 +49,9 @@
 //! ([`edge`]) of one robot in one world, on the screen where the model compiles to it and
 //! through the exact model otherwise, and counts what it checked. [`Certifier`] proves straight
 //! motions free in continuous motion (lever-arm bounds on exact distances, [`certify`]), for
-//! verifying paths independently of the planner that made them.
+//! verifying paths independently of the planner that made them; [`prove::Prover`] proves them
+//! fast, for planners, on the screen with the robot padded ([`CollisionModel::padded`]), the
+//! certifier deciding only what comes within millimetres of contact.
 
 mod acm;
 mod attached;

@@ -2,40 +2,129 @@
 //! cost of a discrete check.
 //!
 //! A configuration where the robot grown by a margin `m` ([`CollisionModel::padded`]) is free
-//! keeps every checked pair at least `m` apart (two of its bodies `2m`). Between two such
-//! configurations no point moves farther than the lever-arm bound of the step ([`Levers`]), so
-//! when that bound is below `2m` the pair cannot close the gap anywhere between (it would have to
-//! come from `m` away at both ends): the step is proved. [`Prover`] checks a motion's
-//! configurations, that close together, with the fast checker ([`WorldChecker`]) of the robot
-//! padded by a coarse margin, then the stretches it could not prove with a finer one, and
-//! gives the [`Certifier`] (exact distances and bisection) only the stretches that come within
-//! the finest margin of contact.
+//! keeps every checked pair at least `m` apart from the world and `2m` from the robot's other
+//! bodies. Between two such configurations a body moves no farther than the lever-arm bound of
+//! the step ([`Levers`]), and two bodies close in on each other by at most their relative
+//! bound, so when those stay below `2m` and `4m` the pair cannot close the gap anywhere between
+//! (it would have to come from `m`, or `2m`, away at both ends): the step is proved. [`Prover`]
+//! checks a motion's configurations, that close together, with the fast checker
+//! ([`WorldChecker`]) of the robot padded by a coarse margin, then the stretches it could not
+//! prove with finer ones, and gives the [`Certifier`] (exact distances and bisection) only the
+//! stretches that come within the finest margin of contact.
+//!
+//! Link pairs that one or two coordinates alone move relative to each other (a wrist's links)
+//! may stay closer than any margin for good, yet barely move relative to each other: they are
+//! proved apart from the rest, in no world, at steps bounded by their relative motion alone.
 
 use trm_kinematics::ActiveSet;
 
-use crate::certify::{Certificate, Certifier};
+use crate::certify::{Certificate, Certifier, check_configuration};
 use crate::checker::WorldChecker;
 use crate::error::Result;
 use crate::levers::Levers;
 use crate::model::CollisionModel;
 use crate::world::World;
 
-/// The margins of [`Prover::new`], m, coarse to fine.
+/// The margins the robot is padded by against the world and its distant link pairs, m, coarse
+/// to fine.
 pub const MARGINS: [f64; 3] = [0.032, 0.008, 0.002];
 
-/// Link pairs that this many active coordinates or fewer move relative to each other (a
-/// wrist's links) are left to the certifier: they may stay closer than any margin for good,
-/// and, barely moving apart, are proved in a few steps.
+/// The margins for the link pairs [`NEAR_COORDINATES`] or fewer coordinates move relative to
+/// each other, m, coarse to fine.
+pub const NEAR_MARGINS: [f64; 2] = [0.004, 0.001];
+
+/// Link pairs that this many active coordinates or fewer move relative to each other are
+/// proved on their own ([module](self)).
 pub const NEAR_COORDINATES: usize = 2;
 
-/// A step's bound must stay this share below twice the margin (for rounding).
+/// A step's bound must stay this share below its limit (for rounding).
 const ROUNDING: f64 = 1e-9;
 
-/// One margin: the robot padded by it, checked in the prover's world.
+/// One margin: the pairs' model padded by it, and its checker in the family's world (made
+/// when a stretch first needs it; the coarsest at once).
 #[derive(Debug, Clone)]
 struct Level {
     margin: f64,
-    checker: WorldChecker,
+    padded: CollisionModel,
+    checker: Option<WorldChecker>,
+}
+
+/// Pairs proved together: the padded models that check them, how far they can close in, and
+/// the certifier of what the finest margin leaves.
+#[derive(Debug, Clone)]
+struct Family {
+    levels: Vec<Level>,
+    /// The model the certifier is made of, and the certifier once needed.
+    model: CollisionModel,
+    certifier: Option<Certifier>,
+    /// How far the pairs close in per unit of each active coordinate: one row per link for
+    /// the world and distant pairs (which close in by at most twice a link's motion), one per
+    /// link pair for near pairs (their relative motion). `limit` × margin bounds a step.
+    rows: Vec<Vec<f64>>,
+    limit: f64,
+    /// The current motion's bound, over the whole motion.
+    reach: f64,
+}
+
+impl Family {
+    /// A family checking the pairs of `model`, padded by `margins` as `padded` pads it, in
+    /// `world`.
+    fn new(
+        model: CollisionModel,
+        padded: impl Fn(f64) -> Result<CollisionModel>,
+        active: &ActiveSet,
+        margins: &[f64],
+        world: &World,
+        (rows, limit): (Vec<Vec<f64>>, f64),
+    ) -> Result<Self> {
+        let mut levels = (margins.iter())
+            .map(|&margin| {
+                let padded = padded(margin)?;
+                Ok(Level {
+                    margin,
+                    padded,
+                    checker: None,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if let Some(coarsest) = levels.first_mut() {
+            coarsest.checker = Some(WorldChecker::new(&coarsest.padded, active, world.clone())?);
+        }
+        Ok(Family {
+            levels,
+            model,
+            certifier: None,
+            rows,
+            limit,
+            reach: 0.0,
+        })
+    }
+
+    /// The farthest the pairs close in along `delta`.
+    fn reach_of(&self, delta: &[f64]) -> f64 {
+        (self.rows.iter())
+            .map(|row| row.iter().zip(delta).map(|(l, d)| l * d.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Buffers of the motion being proved.
+#[derive(Debug, Clone, Default)]
+struct Motion {
+    /// Its start and change.
+    start: Vec<f64>,
+    delta: Vec<f64>,
+    /// The configurations of a block, one after the other.
+    samples: Vec<f64>,
+    /// The ends of a stretch handed to a certifier.
+    ends: [Vec<f64>; 2],
+}
+
+impl Motion {
+    /// Writes the configuration at fraction `u` of the motion into `out`, after what it holds.
+    fn at(&self, u: f64, out: &mut Vec<f64>) {
+        out.extend(self.start.iter().zip(&self.delta).map(|(x, d)| x + u * d));
+    }
 }
 
 /// Proves straight motions of one robot free in one world, fast (see the [module](self)):
@@ -62,61 +151,62 @@ struct Level {
 /// ```
 #[derive(Debug, Clone)]
 pub struct Prover {
-    /// The certifier of the link pairs the padded robots do not check, in no world.
-    near: Certifier,
-    none: World,
-    /// The certifier of everything, for the stretches the padded robots cannot prove.
-    certifier: Certifier,
-    levers: Levers,
-    levels: Vec<Level>,
+    /// The world and the distant link pairs; then the near link pairs, in no world.
+    families: [Family; 2],
     world: World,
-    /// The configurations of a block, one after the other (reused).
-    samples: Vec<f64>,
-    /// The ends of a stretch handed to the certifier (reused).
-    ends: [Vec<f64>; 2],
-    /// The current motion's change, and the farthest a point moves over it.
-    delta: Vec<f64>,
-    reach: f64,
+    none: World,
+    collision: CollisionModel,
+    active: ActiveSet,
+    motion: Motion,
     /// Configurations checked on the padded robots so far.
     pub checks: u64,
-    /// Stretches handed to the certifier so far.
+    /// Stretches handed to a certifier so far.
     pub exact: u64,
 }
 
 impl Prover {
     /// A prover of `collision`'s robot moved by `active`'s coordinates in `world`, with
-    /// [`MARGINS`]; an error for an active set of another robot.
+    /// [`MARGINS`] and [`NEAR_MARGINS`]; an error for an active set of another robot.
     pub fn new(collision: &CollisionModel, active: &ActiveSet, world: World) -> Result<Self> {
         let levers = Levers::new(collision, active)?;
-        // the link pairs that at most NEAR_COORDINATES coordinates move relative to each other
-        let mut relative = vec![0.0; active.len()];
-        let near: Vec<[usize; 2]> = (collision.checked_link_pairs().into_iter())
-            .filter(|&[a, b]| {
-                levers.relative_into(a, b, &mut relative);
-                relative.iter().filter(|&&l| l > 0.0).count() <= NEAR_COORDINATES
-            })
-            .collect();
-        let levels = MARGINS
-            .iter()
-            .map(|&margin| {
-                let padded = collision.padded(margin, &near)?;
-                Ok(Level {
-                    margin,
-                    checker: WorldChecker::new(&padded, active, world.clone())?,
-                })
-            })
-            .collect::<Result<_>>()?;
+        let n = active.len();
+        let (mut near, mut near_rows) = (Vec::new(), Vec::new());
+        for [a, b] in collision.checked_link_pairs() {
+            let mut relative = vec![0.0; n];
+            levers.relative_into(a, b, &mut relative);
+            if relative.iter().filter(|&&l| l > 0.0).count() <= NEAR_COORDINATES {
+                near.push([a, b]);
+                near_rows.push(relative);
+            }
+        }
+        let far_rows = levers.links().iter().map(|(_, l)| l.clone()).collect();
+        let none = World::new();
+        // a link moves at most its row: the world's gap m and two bodies' 2m stay closed to a
+        // step below 2m; two near bodies' relative motion is their row, against their 4m
+        let far = Family::new(
+            collision.clone(),
+            |margin| collision.padded(margin, &near),
+            active,
+            &MARGINS,
+            &world,
+            (far_rows, 2.0),
+        )?;
+        let only_near = collision.only_pairs(&near)?;
+        let near = Family::new(
+            only_near.clone(),
+            |margin| only_near.padded(margin, &[]),
+            active,
+            &NEAR_MARGINS,
+            &none,
+            (near_rows, 4.0),
+        )?;
         Ok(Prover {
-            near: Certifier::new(&collision.only_pairs(&near)?, active)?,
-            none: World::new(),
-            certifier: Certifier::new(collision, active)?,
-            levers,
-            levels,
+            families: [far, near],
             world,
-            samples: Vec::new(),
-            ends: [Vec::new(), Vec::new()],
-            delta: Vec::new(),
-            reach: 0.0,
+            none,
+            collision: collision.clone(),
+            active: active.clone(),
+            motion: Motion::default(),
             checks: 0,
             exact: 0,
         })
@@ -129,52 +219,72 @@ impl Prover {
 
     /// Replaces the world (the padded robots' checks compile again only what changed).
     pub fn set_world(&mut self, world: World) {
-        for level in &mut self.levels {
-            level.checker.set_world(world.clone());
+        for level in &mut self.families[0].levels {
+            if let Some(checker) = &mut level.checker {
+                checker.set_world(world.clone());
+            }
         }
         self.world = world;
     }
 
-    /// The certifier it hands the stretches near contact to.
-    pub fn certifier(&self) -> &Certifier {
-        &self.certifier
-    }
-
     /// What can be proved about the straight motion `a` → `b` (active coordinates): free, or
-    /// the [`Certifier`]'s verdict on the stretch it could not prove (its fraction `at` of the
+    /// the [`Certifier`]'s verdict on a stretch it could not prove (its fraction `at` of the
     /// whole motion). An error as for [`Certifier::segment`].
     pub fn segment(&mut self, a: &[f64], b: &[f64]) -> Result<Certificate> {
-        self.certifier.check_configuration(a)?;
-        self.certifier.check_configuration(b)?;
+        check_configuration(&self.collision, &self.active, a)?;
+        check_configuration(&self.collision, &self.active, b)?;
         Ok(self.segment_unchecked(a, b))
     }
 
     /// [`Prover::segment`] without checking the configurations.
     pub fn segment_unchecked(&mut self, a: &[f64], b: &[f64]) -> Certificate {
-        self.delta.clear();
-        self.delta.extend(b.iter().zip(a).map(|(y, x)| y - x));
-        self.reach = self.levers.displacement(&self.delta);
-        match self.near.segment_unchecked(&self.none, a, b) {
-            Certificate::Free => self.cover(0, a, 0.0, 1.0),
-            not => not,
+        let motion = &mut self.motion;
+        motion.start.clear();
+        motion.start.extend_from_slice(a);
+        motion.delta.clear();
+        motion.delta.extend(b.iter().zip(a).map(|(y, x)| y - x));
+        // the near pairs first: they cost least, and a wrist that folds onto itself fails there
+        for f in [1, 0] {
+            let family = &mut self.families[f];
+            family.reach = family.reach_of(&self.motion.delta);
+            let verdict = self.cover(f, 0, 0.0, 1.0);
+            if !verdict.is_free() {
+                return verdict;
+            }
         }
+        Certificate::Free
     }
 
-    /// Proves the stretch `u0`..`u1` of the motion from `a` with level `level`'s margin, the
-    /// stretches it leaves with the next level, and the rest with the certifier.
-    fn cover(&mut self, level: usize, a: &[f64], u0: f64, u1: f64) -> Certificate {
-        let Some(Level { margin, .. }) = self.levels.get(level) else {
-            return self.exactly(a, u0, u1);
+    /// Proves family `f`'s pairs over the stretch `u0`..`u1` of the motion with its level
+    /// `level`'s margin, the stretches that leaves with the next level, and the rest with its
+    /// certifier.
+    fn cover(&mut self, f: usize, level: usize, u0: f64, u1: f64) -> Certificate {
+        let family = &self.families[f];
+        let Some(&Level { margin, .. }) = family.levels.get(level) else {
+            return self.exactly(f, u0, u1);
         };
-        // points close enough that a step's bound stays below twice the margin
-        let bound = self.reach * (u1 - u0);
-        let steps = (bound / (2.0 * margin * (1.0 - ROUNDING))).ceil().max(1.0) as usize;
+        // points close enough that a step's bound stays below the limit
+        let bound = family.reach * (u1 - u0);
+        let steps = (bound / (family.limit * margin * (1.0 - ROUNDING)))
+            .ceil()
+            .max(1.0) as usize;
         let at = |i: usize| match i == steps {
             true => u1,
             false => u0 + (u1 - u0) * i as f64 / steps as f64,
         };
-        let width = self.levels[level].checker.width();
-        let mut samples = std::mem::take(&mut self.samples);
+        let world = if f == 0 { &self.world } else { &self.none };
+        let Level {
+            padded, checker, ..
+        } = &mut self.families[f].levels[level];
+        let checker = match checker {
+            Some(checker) => checker,
+            none => none.insert(
+                WorldChecker::new(padded, &self.active, world.clone())
+                    .expect("the prover's robot moved by its active set"),
+            ),
+        };
+        let width = checker.width();
+        let mut samples = std::mem::take(&mut self.motion.samples);
         // the points of the stretch not yet proved: from .0 to .1
         let mut open: Option<(usize, usize)> = None;
         let mut first = 0;
@@ -183,44 +293,52 @@ impl Prover {
             let n = width.min(steps + 1 - first);
             samples.clear();
             for i in first..first + n {
-                let u = at(i);
-                samples.extend(a.iter().zip(&self.delta).map(|(x, d)| x + u * d));
+                self.motion.at(at(i), &mut samples);
             }
             self.checks += n as u64;
-            let free = self.levels[level].checker.all_free(&samples);
+            let checker = self.families[f].levels[level].checker.as_mut();
+            let free = checker.expect("made above").all_free(&samples);
             if !free {
                 // the steps into, within and out of the block
                 let (lo, hi) = (first.saturating_sub(1), (first + n).min(steps));
-                open = Some(match open {
-                    Some((start, _)) => (start, hi),
-                    None => (lo, hi),
-                });
+                open = Some((open.map_or(lo, |o| o.0), hi));
             }
             first += n;
             if let Some((lo, hi)) = open
                 && (free || first > steps)
             {
                 open = None;
-                verdict = self.cover(level + 1, a, at(lo), at(hi));
+                verdict = self.cover(f, level + 1, at(lo), at(hi));
                 if !verdict.is_free() {
                     break;
                 }
             }
         }
-        self.samples = samples;
+        self.motion.samples = samples;
         verdict
     }
 
-    /// The certifier's verdict on the stretch `u0`..`u1` of the motion from `a`.
-    fn exactly(&mut self, a: &[f64], u0: f64, u1: f64) -> Certificate {
+    /// Family `f`'s certifier's verdict on the stretch `u0`..`u1` of the motion.
+    fn exactly(&mut self, f: usize, u0: f64, u1: f64) -> Certificate {
         self.exact += 1;
-        let [start, end] = &mut self.ends;
-        for (out, u) in [(&mut *start, u0), (&mut *end, u1)] {
-            out.clear();
-            out.extend(a.iter().zip(&self.delta).map(|(x, d)| x + u * d));
+        let family = &mut self.families[f];
+        let certifier = match &mut family.certifier {
+            Some(c) => c,
+            none => none.insert(
+                Certifier::new(&family.model, &self.active)
+                    .expect("the prover's model moved by its active set"),
+            ),
+        };
+        let mut ends = std::mem::take(&mut self.motion.ends);
+        for (end, u) in ends.iter_mut().zip([u0, u1]) {
+            end.clear();
+            self.motion.at(u, end);
         }
+        let world = if f == 0 { &self.world } else { &self.none };
         let within = |at: f64| u0 + at * (u1 - u0);
-        match self.certifier.segment_unchecked(&self.world, start, end) {
+        let verdict = certifier.segment_unchecked(world, &ends[0], &ends[1]);
+        self.motion.ends = ends;
+        match verdict {
             Certificate::Free => Certificate::Free,
             Certificate::Collides { at, pair } => Certificate::Collides {
                 at: within(at),

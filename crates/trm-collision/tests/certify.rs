@@ -146,10 +146,16 @@ fn fast_proofs_hold_on_the_sphere_panda() {
 
 /// Wherever a padded model is free of a world, the model's every body keeps at least the
 /// margin from every object, and its answers on the screen are its exact model's (its spheres
-/// grown, not fitted again): on the iCub (capsules, boxes, spheres) and the fitted Panda.
+/// grown, not fitted again): on the iCub (capsules, boxes, spheres), the fitted Panda and the
+/// Panda's mesh hulls. A margin that is not a positive distance is refused.
 #[test]
 fn a_padded_model_free_keeps_the_margin() {
-    for (file, seed, objects) in [("icub_upper_body.ron", 4, 24), ("panda/panda.ron", 5, 10)] {
+    let files = [
+        ("icub_upper_body.ron", 4, 24),
+        ("panda/panda.ron", 5, 10),
+        ("panda-mbm/panda.ron", 6, 10),
+    ];
+    for (file, seed, objects) in files {
         let robot = model(file);
         let collision = CollisionModel::new(&robot).unwrap();
         let active = robot.all_active();
@@ -184,6 +190,10 @@ fn a_padded_model_free_keeps_the_margin() {
         }
         // free configurations, and some within the margin that the padding catches
         assert!(free >= 20 && near >= 5, "{file}: {free} free, {near} near");
+        for bad in [0.0, -0.01, f64::NAN] {
+            let e = collision.padded(bad, &[]).unwrap_err().to_string();
+            assert!(e.contains("positive distance"), "{e}");
+        }
     }
 }
 

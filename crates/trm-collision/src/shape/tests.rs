@@ -494,3 +494,66 @@ fn round_shapes_at_gaps(seed: u64, cases: usize, kinds: &[usize], gaps: &[f64]) 
         "(case, shape, gap, touching, distance): {wrong:?}"
     );
 }
+
+/// A grown shape holds every point within the margin of the shape (parry's distances, points
+/// just inside the margin around each kind), and [`Shape::growth`] bounds how far beyond it
+/// reaches (points just outside that are outside it).
+#[test]
+fn grown_shapes_hold_the_margin_and_no_more_than_their_growth() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let margin = 0.01;
+    let hull = (0..12)
+        .map(|_| [0; 3].map(|_| rng.random_range(-0.1..0.1)))
+        .collect();
+    let shapes = [
+        Shape::Sphere { radius: 0.05 },
+        Shape::Capsule {
+            radius: 0.03,
+            length: 0.2,
+        },
+        Shape::Box {
+            size: [0.1, 0.2, 0.05],
+        },
+        Shape::Cylinder {
+            radius: 0.04,
+            length: 0.15,
+        },
+        Shape::Convex { points: hull },
+    ];
+    assert!(
+        Shape::Mesh {
+            vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            triangles: vec![[0, 1, 2]],
+        }
+        .grown(margin)
+        .is_none()
+    );
+    for shape in shapes {
+        let grown = shape.grown(margin).unwrap();
+        let ((f0, s0), (f1, s1)) = (shape.to_parry().unwrap(), grown.to_parry().unwrap());
+        let (mut inside, mut beyond) = (0, 0);
+        for _ in 0..4000 {
+            // a point of the surface, moved up to 2.5 margins in a random direction
+            let far = Point3::from(Vector3::from([0; 3].map(|_| rng.random_range(-0.5..0.5))));
+            let on = s0.project_point(&f0, &far, true).point;
+            let dir = Vector3::from([0; 3].map(|_| rng.random_range(-1.0..1.0))).normalize();
+            let p = on + dir * rng.random_range(0.0..2.5 * margin);
+            let d = s0.distance_to_point(&f0, &p, true);
+            let in_grown = s1.contains_point(&f1, &p);
+            if d < margin - 1e-9 {
+                assert!(in_grown, "{}: a point {d} from it is outside", shape.kind());
+                inside += 1;
+            }
+            if d > margin * shape.growth() + 1e-9 {
+                assert!(!in_grown, "{}: a point {d} from it is inside", shape.kind());
+                beyond += 1;
+            }
+        }
+        assert!(
+            inside > 100 && beyond > 100,
+            "{}: {inside}, {beyond}",
+            shape.kind()
+        );
+    }
+}
