@@ -11,7 +11,8 @@ Run (the wheel installed: `python3 -m maturin build --release -m crates/trm-py/C
 and `pip install` the wheel it writes):
     python3 benches/python/mbm_planner.py SET_DIR --model models/panda-mbm/panda_spherized.ron
 where SET_DIR holds one folder per family (unpack benches/mbm/panda_problems.tar.bz2), or a
-.tar.bz2 of one. `--csv FILE` writes one row per problem.
+.tar.bz2 of one. `--csv FILE` writes one row per problem; `--certified` plans proved paths
+(`certified=True`, as `trm benchmark-mbm --certified`).
 """
 
 import argparse
@@ -43,6 +44,7 @@ def main():
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--max-samples", type=int, default=1_000_000)
     ap.add_argument("--csv", type=Path)
+    ap.add_argument("--certified", action="store_true")
     args = ap.parse_args()
 
     root = unpacked(args.set)
@@ -73,12 +75,13 @@ def main():
         try:
             # the path alone, as the benchmark plans it
             r = planner.plan_request(read, seed=args.seed, max_samples=args.max_samples,
-                                     timed=False)
+                                     certified=args.certified, timed=False)
             t2 = time.perf_counter()
             row.update(solved=True, seconds=r["seconds"], length=r["length"],
                        waypoints=len(r["waypoints"]), checks=r["checks"], note=r["source"])
             # and timed (time-optimal, sampled every 10 ms), as a robot would run it
-            planner.plan_request(read, seed=args.seed, max_samples=args.max_samples)
+            planner.plan_request(read, seed=args.seed, max_samples=args.max_samples,
+                                 certified=args.certified)
             row["timed"] = time.perf_counter() - t2
         except trm.TrmError as e:
             t2 = time.perf_counter()
