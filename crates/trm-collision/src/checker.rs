@@ -75,8 +75,6 @@ enum Engine {
 /// Buffers of the `f64` checks.
 #[derive(Debug, Clone)]
 struct Exact {
-    collision: CollisionModel,
-    active: ActiveSet,
     /// [`LANES`] configurations, one after the other.
     lanes: Vec<f64>,
     batch: PoseBatch,
@@ -98,9 +96,7 @@ impl WorldChecker {
                 Engine::Screen(Box::new((checker, fast_world)))
             }
             None => Engine::Exact(Box::new(Exact {
-                collision: collision.clone(),
                 lanes: vec![0.0; LANES * active.len()],
-                active: active.clone(),
                 batch: robot.pose_batch(),
                 placed_batch: collision.placed_batch(),
                 poses: robot.pose_buffer(),
@@ -206,7 +202,7 @@ impl WorldChecker {
     pub fn dim(&self) -> usize {
         match &self.engine {
             Engine::Screen(screen) => screen.0.dim(),
-            Engine::Exact(exact) => exact.active.len(),
+            Engine::Exact(_) => self.active.len(),
         }
     }
 
@@ -306,7 +302,7 @@ impl WorldChecker {
                 let (checker, fast_world) = &mut **screen;
                 checker.all_free_unchecked(qs, &self.world, fast_world)
             }
-            Engine::Exact(exact) => exact.all_free(qs, &self.world),
+            Engine::Exact(exact) => exact.all_free(&self.collision, &self.active, qs, &self.world),
         }
     }
 }
@@ -314,18 +310,23 @@ impl WorldChecker {
 impl Exact {
     /// Whether the 1 to [`LANES`] configurations of `qs` are free: one configuration placed
     /// alone (through the batched kinematics, as every `f64` evaluation), several in a batch.
-    fn all_free(&mut self, qs: &[f64], world: &World) -> bool {
-        let d = self.active.len();
+    fn all_free(
+        &mut self,
+        collision: &CollisionModel,
+        active: &ActiveSet,
+        qs: &[f64],
+        world: &World,
+    ) -> bool {
+        let d = active.len();
         let n = qs.len() / d;
         if n == 1 {
             for lane in 0..LANES {
                 self.lanes[lane * d..(lane + 1) * d].copy_from_slice(qs);
             }
-            self.active
-                .forward_batch_unchecked(&self.lanes, &mut self.batch);
+            active.forward_batch_unchecked(&self.lanes, &mut self.batch);
             self.batch.lane_into(0, &mut self.poses);
-            self.collision.place(&self.poses, &mut self.placed);
-            return !self.collision.is_colliding(&self.placed, world);
+            collision.place(&self.poses, &mut self.placed);
+            return !collision.is_colliding(&self.placed, world);
         }
         if qs.iter().any(|v| v.is_nan()) {
             return false;
@@ -335,11 +336,9 @@ impl Exact {
         for l in n..LANES {
             self.lanes.copy_within(0..d, l * d);
         }
-        self.active
-            .forward_batch_unchecked(&self.lanes, &mut self.batch);
-        self.collision
-            .place_batch(&self.batch, n, &mut self.placed_batch);
-        !self.collision.is_colliding_batch(&self.placed_batch, world)[..n]
+        active.forward_batch_unchecked(&self.lanes, &mut self.batch);
+        collision.place_batch(&self.batch, n, &mut self.placed_batch);
+        !collision.is_colliding_batch(&self.placed_batch, world)[..n]
             .iter()
             .any(|&hit| hit)
     }
