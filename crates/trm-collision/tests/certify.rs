@@ -219,7 +219,20 @@ fn a_fast_proof_finds_a_collision_between_samples() {
         }
     ));
     assert!(prover.segment(&[0.2], &[1.5]).unwrap().is_free());
-    assert!(prover.segment(&[0.2], &[9.0]).is_err());
+    // bad configurations are located errors: outside the limits, not a number, wrong length
+    for (a, b, says) in [
+        (vec![0.2], vec![9.0], "outside its limits"),
+        (vec![f64::NAN], vec![0.2], "value 0 is NaN"),
+        (vec![0.2], vec![f64::INFINITY], "value 0 is inf"),
+        (
+            vec![0.2, 0.1],
+            vec![0.2],
+            "2 values for 1 active coordinates",
+        ),
+    ] {
+        let e = prover.segment(&a, &b).unwrap_err().to_string();
+        assert!(e.contains(says), "{e}");
+    }
 }
 
 /// A planar arm of one 1 m link (revolute about z) with a 5 cm sphere at its end.
