@@ -88,20 +88,13 @@ impl WorldChecker {
     /// for an active set of another robot.
     pub fn new(collision: &CollisionModel, active: &ActiveSet, world: World) -> Result<Self> {
         collision.check_active(active)?;
-        let robot = collision.robot();
         let engine = match Self::screen_model(collision) {
             Some(_) => {
                 let checker = FastChecker::new(collision, active.clone())?;
                 let fast_world = checker.model().world(&world);
                 Engine::Screen(Box::new((checker, fast_world)))
             }
-            None => Engine::Exact(Box::new(Exact {
-                lanes: vec![0.0; LANES * active.len()],
-                batch: robot.pose_batch(),
-                placed_batch: collision.placed_batch(),
-                poses: robot.pose_buffer(),
-                placed: collision.placed_bodies(),
-            })),
+            None => Engine::Exact(Box::new(Exact::new(collision, active))),
         };
         Ok(WorldChecker {
             world,
@@ -295,6 +288,30 @@ impl WorldChecker {
         free
     }
 
+    /// Which of the 1 to [`WorldChecker::width`] configurations of `qs` are free: bit `l` for
+    /// configuration `l` (a value that is not finite collides). Checks every configuration to
+    /// the end, where [`WorldChecker::all_free`] stops at the first collision; not counted.
+    pub(crate) fn free_lanes(&mut self, qs: &[f64]) -> u8 {
+        let n = qs.len() / self.dim();
+        let all = u8::MAX >> (8 - n);
+        match &mut self.engine {
+            Engine::Screen(screen) => {
+                let (checker, fast_world) = &mut **screen;
+                let ([mut links, mut objects], mut free) = ([[0; FAST_LANES]; 2], 0);
+                checker.count_unchecked(qs, &self.world, fast_world, &mut links, &mut objects);
+                for l in 0..n {
+                    if links[l] + objects[l] == 0 {
+                        free |= 1 << l;
+                    }
+                }
+                free
+            }
+            Engine::Exact(exact) => {
+                all & !exact.colliding(&self.collision, &self.active, qs, &self.world)
+            }
+        }
+    }
+
     /// Whether every configuration of `qs` (1 to [`WorldChecker::width`] of them) is free.
     fn block_free(&mut self, qs: &[f64]) -> bool {
         match &mut self.engine {
@@ -308,8 +325,19 @@ impl WorldChecker {
 }
 
 impl Exact {
-    /// Whether the 1 to [`LANES`] configurations of `qs` are free: one configuration placed
-    /// alone (through the batched kinematics, as every `f64` evaluation), several in a batch.
+    /// Buffers for `collision`'s robot moved by `active`.
+    fn new(collision: &CollisionModel, active: &ActiveSet) -> Self {
+        let robot = collision.robot();
+        Exact {
+            lanes: vec![0.0; LANES * active.len()],
+            batch: robot.pose_batch(),
+            placed_batch: collision.placed_batch(),
+            poses: robot.pose_buffer(),
+            placed: collision.placed_bodies(),
+        }
+    }
+
+    /// Whether the 1 to [`LANES`] configurations of `qs` are free.
     fn all_free(
         &mut self,
         collision: &CollisionModel,
@@ -317,19 +345,39 @@ impl Exact {
         qs: &[f64],
         world: &World,
     ) -> bool {
+        let several = qs.len() > active.len();
+        !(several && qs.iter().any(|v| v.is_nan()))
+            && self.colliding(collision, active, qs, world) == 0
+    }
+
+    /// Which of the 1 to [`LANES`] configurations of `qs` collide, bit `l` for configuration
+    /// `l` (NaN collides): one configuration placed alone (through the batched kinematics, as
+    /// every `f64` evaluation), several in a batch.
+    fn colliding(
+        &mut self,
+        collision: &CollisionModel,
+        active: &ActiveSet,
+        qs: &[f64],
+        world: &World,
+    ) -> u8 {
         let d = active.len();
         let n = qs.len() / d;
         if n == 1 {
+            if qs.iter().any(|v| v.is_nan()) {
+                return 1;
+            }
             for lane in 0..LANES {
                 self.lanes[lane * d..(lane + 1) * d].copy_from_slice(qs);
             }
             active.forward_batch_unchecked(&self.lanes, &mut self.batch);
             self.batch.lane_into(0, &mut self.poses);
             collision.place(&self.poses, &mut self.placed);
-            return !collision.is_colliding(&self.placed, world);
+            return u8::from(collision.is_colliding(&self.placed, world));
         }
         if qs.iter().any(|v| v.is_nan()) {
-            return false;
+            return (qs.chunks_exact(d).enumerate())
+                .map(|(l, q)| self.colliding(collision, active, q, world) << l)
+                .fold(0, |mask, lane| mask | lane);
         }
         // a partial batch padded with its first configuration, whose answer is not used
         self.lanes[..qs.len()].copy_from_slice(qs);
@@ -338,9 +386,9 @@ impl Exact {
         }
         active.forward_batch_unchecked(&self.lanes, &mut self.batch);
         collision.place_batch(&self.batch, n, &mut self.placed_batch);
-        !collision.is_colliding_batch(&self.placed_batch, world)[..n]
-            .iter()
-            .any(|&hit| hit)
+        (collision.is_colliding_batch(&self.placed_batch, world)[..n].iter())
+            .enumerate()
+            .fold(0, |mask, (l, &hit)| mask | u8::from(hit) << l)
     }
 }
 
@@ -365,5 +413,61 @@ mod tests {
         assert!(checker.is_screened());
         let home = upper.posture("home").unwrap().to_vec();
         assert!(checker.free(&upper.all_active().from_motors(&home)));
+    }
+
+    /// Each engine's per-configuration verdicts of a block are its verdicts one at a time,
+    /// NaN colliding, whether the block's first configuration collides or not.
+    #[test]
+    fn free_lanes_are_the_verdicts_one_at_a_time() {
+        use rand::{RngExt, SeedableRng};
+        let robot = trm_models::icub_upper_body();
+        let home = robot.posture("home").unwrap().to_vec();
+        let names = [
+            "torso_yaw",
+            "r_shoulder_pitch",
+            "r_shoulder_roll",
+            "r_elbow",
+        ];
+        let active = robot.active_set(&names, &home).unwrap();
+        let collision = CollisionModel::new(&robot).unwrap();
+        let mut world = World::new();
+        let pose = trm_kinematics::nalgebra::Isometry3::translation(0.0, -0.3, 0.1);
+        world
+            .add("ball", crate::Shape::Sphere { radius: 0.12 }, pose)
+            .unwrap();
+        let limits: Vec<_> = (active.motor_indices().iter())
+            .map(|&i| robot.motors()[i].limits)
+            .collect();
+        let mut screened = WorldChecker::new(&collision, &active, world.clone()).unwrap();
+        let mut exact = WorldChecker::new(&collision, &active, world).unwrap();
+        exact.engine = Engine::Exact(Box::new(Exact::new(&collision, &active)));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let (mut free, mut colliding) = (0, 0);
+        for round in 0..200 {
+            for checker in [&mut screened, &mut exact] {
+                let n = 1 + round % checker.width();
+                let mut qs = Vec::new();
+                for _ in 0..n {
+                    qs.extend(limits.iter().map(|l| rng.random_range(l.lower..=l.upper)));
+                }
+                if round % 7 == 3 {
+                    qs[(n - 1) * names.len()] = f64::NAN;
+                }
+                let lanes = checker.free_lanes(&qs);
+                for (l, q) in qs.chunks(names.len()).enumerate() {
+                    let one = checker.free(q);
+                    assert_eq!(lanes & (1 << l) != 0, one, "round {round}, lane {l}");
+                    match one {
+                        true => free += 1,
+                        false => colliding += 1,
+                    }
+                }
+                assert_eq!(u16::from(lanes) >> n, 0, "no lane past the block");
+            }
+        }
+        assert!(
+            free > 100 && colliding > 100,
+            "{free} free, {colliding} colliding"
+        );
     }
 }

@@ -9,8 +9,13 @@
 //! (it would have to come from `m`, or `2m`, away at both ends): the step is proved. [`Prover`]
 //! checks a motion's configurations, that close together, with the fast checker
 //! ([`WorldChecker`]) of the robot padded by a coarse margin, then the stretches it could not
-//! prove with finer ones, and gives the [`Certifier`] (exact distances and bisection) only the
-//! stretches that come within the finest margin of contact.
+//! prove with finer ones (only the steps into and out of a configuration that the margin
+//! fails: the configurations of a block are judged one by one), and gives the [`Certifier`]
+//! (exact distances and bisection) only the stretches that come within the finest margin of
+//! contact. The margins shrink fourfold from level to level, down to a fraction of a
+//! millimetre: a path pulled tight along an obstacle by shortcutting runs a few tenths of a
+//! millimetre from it for centimetres, which padded checks prove for less than exact
+//! distances do.
 //!
 //! Link pairs that one or two coordinates alone move relative to each other (a wrist's links)
 //! may stay closer than any margin for good, yet barely move relative to each other: they are
@@ -27,7 +32,7 @@ use crate::world::World;
 
 /// The margins the robot is padded by against the world and its distant link pairs, m, coarse
 /// to fine.
-pub const MARGINS: [f64; 3] = [0.032, 0.008, 0.002];
+pub const MARGINS: [f64; 5] = [0.032, 0.008, 0.002, 0.0005, 0.000125];
 
 /// The margins for the link pairs [`NEAR_COORDINATES`] or fewer coordinates move relative to
 /// each other, m, coarse to fine.
@@ -47,6 +52,8 @@ struct Level {
     margin: f64,
     padded: CollisionModel,
     checker: Option<WorldChecker>,
+    /// The configurations of a block, one after the other.
+    samples: Vec<f64>,
 }
 
 /// Pairs proved together: the padded models that check them, how far they can close in, and
@@ -84,6 +91,7 @@ impl Family {
                     margin,
                     padded,
                     checker: None,
+                    samples: Vec::new(),
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -114,8 +122,6 @@ struct Motion {
     /// Its start and change.
     start: Vec<f64>,
     delta: Vec<f64>,
-    /// The configurations of a block, one after the other.
-    samples: Vec<f64>,
     /// The ends of a stretch handed to a certifier.
     ends: [Vec<f64>; 2],
 }
@@ -256,8 +262,8 @@ impl Prover {
     }
 
     /// Proves family `f`'s pairs over the stretch `u0`..`u1` of the motion with its level
-    /// `level`'s margin, the stretches that leaves with the next level, and the rest with its
-    /// certifier.
+    /// `level`'s margin, each run of steps that leaves (a step whose end fails the margin)
+    /// with the next level, and the rest with its certifier.
     fn cover(&mut self, f: usize, level: usize, u0: f64, u1: f64) -> Certificate {
         let family = &self.families[f];
         let Some(&Level { margin, .. }) = family.levels.get(level) else {
@@ -284,12 +290,12 @@ impl Prover {
             ),
         };
         let width = checker.width();
-        let mut samples = std::mem::take(&mut self.motion.samples);
-        // the points of the stretch not yet proved: from .0 to .1
-        let mut open: Option<(usize, usize)> = None;
-        let mut first = 0;
-        let mut verdict = Certificate::Free;
-        while first <= steps {
+        let mut samples = std::mem::take(&mut self.families[f].levels[level].samples);
+        // the first point of the run of steps not yet proved, and whether the point before
+        // the one at hand is free
+        let (mut open, mut last_free) = (None, true);
+        let (mut first, mut verdict) = (0, Certificate::Free);
+        'blocks: while first <= steps {
             let n = width.min(steps + 1 - first);
             samples.clear();
             for i in first..first + n {
@@ -297,24 +303,31 @@ impl Prover {
             }
             self.checks += n as u64;
             let checker = self.families[f].levels[level].checker.as_mut();
-            let free = checker.expect("made above").all_free(&samples);
-            if !free {
-                // the steps into, within and out of the block
-                let (lo, hi) = (first.saturating_sub(1), (first + n).min(steps));
-                open = Some((open.map_or(lo, |o| o.0), hi));
+            let free = checker.expect("made above").free_lanes(&samples);
+            for (i, l) in (first..first + n).zip(0..) {
+                let here = free & (1 << l) != 0;
+                // the step into point i: proved when both its ends are free
+                match (open, i > 0 && !(last_free && here)) {
+                    (None, true) => open = Some(i - 1),
+                    (Some(lo), false) if i > 0 => {
+                        open = None;
+                        verdict = self.cover(f, level + 1, at(lo), at(i - 1));
+                        if !verdict.is_free() {
+                            break 'blocks;
+                        }
+                    }
+                    _ => {}
+                }
+                last_free = here;
             }
             first += n;
-            if let Some((lo, hi)) = open
-                && (free || first > steps)
-            {
-                open = None;
-                verdict = self.cover(f, level + 1, at(lo), at(hi));
-                if !verdict.is_free() {
-                    break;
-                }
-            }
         }
-        self.motion.samples = samples;
+        if let Some(lo) = open
+            && verdict.is_free()
+        {
+            verdict = self.cover(f, level + 1, at(lo), at(steps));
+        }
+        self.families[f].levels[level].samples = samples;
         verdict
     }
 

@@ -13,7 +13,7 @@ use crate::experience::{Scope, solve_leave_one_out, solve_with_experience};
 use crate::loaded::LoadedProblem;
 use crate::problems::Problem;
 use crate::report::{markdown_table, side_by_side};
-use crate::solve::{Outcome, Verdict, certify_path_loaded, solve_with_maps};
+use crate::solve::{Outcome, Solver, Verdict, certify_path_loaded};
 
 /// One problem of a benchmark run and how it went.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -192,9 +192,10 @@ fn runs_of(
         .collect()
 }
 
-/// Solves each problem by RRT-Connect + shortcutting ([`crate::solve_loaded`]), re-checking
-/// solved paths when `options.verify`; with `options.task_space`, each joint goal is first
-/// turned into the task-space goal it implies. With `options.maps`, each problem is solved
+/// Solves each problem by RRT-Connect + shortcutting through kept planners ([`Solver`]: the
+/// outcomes [`crate::solve_loaded`] gives), re-checking solved paths when `options.verify`;
+/// with `options.task_space`, each joint goal is first turned into the task-space goal it
+/// implies. With `options.maps`, each problem is solved
 /// again right after with the maps attached ([`crate::solve_with_maps`]), so that a machine's
 /// changing load weighs on both runs alike. Returns the plain runs and those with the maps
 /// (empty without maps); `progress(done, problem)` after each problem.
@@ -206,6 +207,7 @@ pub fn run_set(
 ) -> Result<(Vec<Run>, Vec<Run>), MbmError> {
     let mut runs = Vec::with_capacity(problems.len());
     let mut with_maps = Vec::new();
+    let (mut plain, mut mapped) = (Solver::new(robot, &[]), Solver::new(robot, &options.maps));
     for (k, p) in problems.iter().enumerate() {
         let posed;
         let p = match &options.task_space {
@@ -215,8 +217,8 @@ pub fn run_set(
             }
             None => p,
         };
-        let run = |maps: &[Roadmap]| -> Result<Run, MbmError> {
-            let outcome = solve_with_maps(robot, p, &options.rrt, maps)?;
+        let run = |solver: &mut Solver| -> Result<Run, MbmError> {
+            let outcome = solver.solve(p, &options.rrt)?;
             Ok(Run {
                 family: p.problem.family.clone(),
                 index: p.problem.index,
@@ -224,9 +226,9 @@ pub fn run_set(
                 outcome,
             })
         };
-        runs.push(run(&[])?);
+        runs.push(run(&mut plain)?);
         if !options.maps.is_empty() {
-            with_maps.push(run(&options.maps)?);
+            with_maps.push(run(&mut mapped)?);
         }
         progress(k + 1, &p.problem);
     }

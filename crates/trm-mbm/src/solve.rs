@@ -76,17 +76,76 @@ pub fn solve_with_maps(
     options: &RrtOptions,
     maps: &[Roadmap],
 ) -> Result<Outcome, MbmError> {
-    options.check()?;
-    let (request, world) = (&problem.request, &problem.world);
-    let (objective, active, mut start) = problem_objective(robot, &problem.own, world, request)?;
-    let mut goal = request.goal.positions.clone();
-    // the planner every door uses: compiled here once, for the IK of a task-space goal, the
-    // validity checks and the search
-    let mut planner = Planner::new(&objective, &[])?;
-    planner.set_collision(&problem.collision)?;
-    for map in maps {
-        planner.add_map(map)?;
+    Solver::new(robot, maps).solve(problem, options)
+}
+
+/// Solves problems one after the other through kept planners, as a user keeps one planner
+/// per robot ([`Planner`]): one per planning group, `maps` attached once; each problem's
+/// matrix and scene are set on it ([`Planner::set_collision`], [`Planner::set_world`]: what
+/// changed compiled again) before its query is timed, as VAMP builds a problem's environment
+/// before its timing starts. The outcome of a problem does not depend on the ones before.
+#[derive(Debug)]
+pub struct Solver<'a> {
+    robot: &'a RobotModel,
+    maps: &'a [Roadmap],
+    /// The planners made so far, by the active motors they move.
+    planners: Vec<(Vec<usize>, Planner)>,
+}
+
+impl<'a> Solver<'a> {
+    /// A solver of `robot`'s problems with `maps` attached to its planners.
+    pub fn new(robot: &'a RobotModel, maps: &'a [Roadmap]) -> Self {
+        Solver {
+            robot,
+            maps,
+            planners: Vec::new(),
+        }
     }
+
+    /// Solves `problem` as [`solve_with_maps`] does, through the planner kept for its group.
+    pub fn solve(
+        &mut self,
+        problem: &LoadedProblem,
+        options: &RrtOptions,
+    ) -> Result<Outcome, MbmError> {
+        options.check()?;
+        let (request, world) = (&problem.request, &problem.world);
+        let (objective, active, start) =
+            problem_objective(self.robot, &problem.own, world, request)?;
+        let k = match self.planners.iter().position(|(a, _)| *a == active) {
+            Some(k) => k,
+            None => {
+                // compiled once per group, for the IK of a task-space goal, the validity
+                // checks and the search
+                let mut planner = Planner::new(&objective, &[])?;
+                for map in self.maps {
+                    planner.add_map(map)?;
+                }
+                self.planners.push((active.clone(), planner));
+                self.planners.len() - 1
+            }
+        };
+        let planner = &mut self.planners[k].1;
+        planner.set_collision(&problem.collision)?;
+        planner.set_world(world.clone());
+        let maps = !self.maps.is_empty();
+        solve_on(self.robot, planner, maps, problem, &active, start, options)
+    }
+}
+
+/// [`Solver::solve`] on `planner`, set for `problem`'s group, matrix and scene, with `maps`
+/// attached or not (`start`: the request's start, active motors).
+fn solve_on(
+    robot: &RobotModel,
+    planner: &mut Planner,
+    maps: bool,
+    problem: &LoadedProblem,
+    active: &[usize],
+    mut start: Vec<f64>,
+    options: &RrtOptions,
+) -> Result<Outcome, MbmError> {
+    let request = &problem.request;
+    let mut goal = request.goal.positions.clone();
     let mut outcome = Outcome {
         note: problem.notes.join("; "),
         build_seconds: problem.cloud.map_or(0.0, |c| c.build_seconds),
@@ -118,7 +177,7 @@ pub fn solve_with_maps(
             }
         }
     }
-    if let Some(why) = invalid(robot, &active, &mut start, &mut goal, &mut planner) {
+    if let Some(why) = invalid(robot, active, &mut start, &mut goal, planner) {
         outcome.note = why;
         return Ok(outcome);
     }
@@ -136,7 +195,7 @@ pub fn solve_with_maps(
             outcome.waypoints = found.path.len();
             outcome.checks = found.checks;
             outcome.path = found.path;
-            if !maps.is_empty() {
+            if maps {
                 // how the maps served, after the problem's own notes
                 let source = found.source.name();
                 outcome.note = match outcome.note.is_empty() {

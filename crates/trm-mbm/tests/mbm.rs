@@ -802,6 +802,45 @@ fn experience_runs_apply_each_scenes_allowed_collision_matrix() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A kept solver (one planner, each problem's scene set on it) answers every problem as a
+/// planner made for that problem alone does, in either order and in both modes: the
+/// benchmark's outcomes do not depend on the problems before.
+#[test]
+fn a_kept_planner_answers_as_a_fresh_one() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda-mbm/panda.ron");
+    let robot = trm_kinematics::RobotModel::load(&model).unwrap();
+    let collision = CollisionModel::new(&robot).unwrap();
+    let problems = find_problems(&fixtures()).unwrap();
+    let loaded = LoadedProblem::load_all(&collision, &problems).unwrap();
+    assert!(loaded.len() >= 3, "{} problems", loaded.len());
+    for certified in [false, true] {
+        let options = RrtOptions {
+            certified,
+            ..RrtOptions::default()
+        };
+        let fresh: Vec<_> = (loaded.iter())
+            .map(|p| trm_mbm::solve_loaded(&robot, p, &options).unwrap())
+            .collect();
+        for order in [false, true] {
+            let mut solver = trm_mbm::Solver::new(&robot, &[]);
+            let mut ks: Vec<usize> = (0..loaded.len()).collect();
+            if order {
+                ks.reverse();
+            }
+            for k in ks {
+                let kept = solver.solve(&loaded[k], &options).unwrap();
+                let (a, b) = (&kept, &fresh[k]);
+                assert!(a.solved, "problem {k}: {}", a.note);
+                assert_eq!(
+                    (a.solved, &a.path, a.checks, &a.note),
+                    (b.solved, &b.path, b.checks, &b.note),
+                    "problem {k}, certified {certified}"
+                );
+            }
+        }
+    }
+}
+
 /// Leave-one-out experience: each problem planned through the other problems' paths (of its
 /// family, or of the set) never retrieves its own, even when the paths given include it at its
 /// own index; a path given for itself alone is retrieved. Times split into planning and
