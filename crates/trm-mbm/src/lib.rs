@@ -33,6 +33,6 @@ pub use run::{
     Benchmark, BenchmarkOptions, Run, TaskSpaceGoals, benchmark, run_set, verdicts_line,
 };
 pub use solve::{
-    GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, Solver, Verdict, certify_path, certify_path_loaded, solve,
-    solve_loaded, solve_with_maps,
+    GOAL_ATTEMPTS, LIMIT_SLACK, Outcome, Solver, VERIFY_FLOOR, Verdict, certify_path,
+    certify_path_loaded, solve, solve_loaded, solve_with_maps,
 };

@@ -348,8 +348,8 @@ pub fn verdicts_line(verdicts: impl Iterator<Item = Verdict>, what: &str) -> Str
     }
     let [proved, collides, unproved] = counts;
     format!(
-        "\n{what} certified in continuous motion (f64, exact distances, lever-arm bounds; its own code path): {proved} of {} proved free, {collides} collide, {unproved} come within {} µm of contact (not proved).\n",
+        "\n{what} certified in continuous motion (f64, exact distances, lever-arm bounds; its own code path): {proved} of {} proved free, {collides} collide, {unproved} come within {} nm of contact (not proved).\n",
         proved + collides + unproved,
-        trm_collision::certify::DEFAULT_FLOOR * 1e6
+        crate::solve::VERIFY_FLOOR * 1e9
     )
 }

@@ -255,6 +255,13 @@ pub(crate) fn invalid(
     }
 }
 
+/// The floor of the independent check ([`certify_path`]), m: 1 nm, finer than the planner's
+/// own proofs' ([`trm_collision::certify::DEFAULT_FLOOR`], 1 µm), so that a motion the
+/// planner proved (bisected at other points) is proved again unless it passes within a
+/// nanometre of contact: a shortcut path pulled tight along a box can pass within a
+/// micrometre of it.
+pub const VERIFY_FLOOR: f64 = 1e-9;
+
 /// What certification proved about a path ([`certify_path`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -263,8 +270,7 @@ pub enum Verdict {
     Proved,
     /// A configuration along it collides.
     Collides,
-    /// Not proved: it comes within the certifier's floor of contact
-    /// ([`trm_collision::certify::DEFAULT_FLOOR`]).
+    /// Not proved: it comes within the check's floor of contact ([`VERIFY_FLOOR`]).
     Unproved,
 }
 
@@ -300,7 +306,8 @@ pub fn certify_path_loaded(
     path: &[Vec<f64>],
 ) -> Result<Verdict, MbmError> {
     let active = problem.request.active_set(robot, &neutral(robot))?;
-    let mut certifier = trm_collision::Certifier::new(&problem.collision, &active)?;
+    let mut certifier =
+        trm_collision::Certifier::new(&problem.collision, &active)?.with_floor(VERIFY_FLOOR)?;
     let certificate = certifier.path(&problem.world, path)?;
     Ok(match certificate.failure {
         None => Verdict::Proved,

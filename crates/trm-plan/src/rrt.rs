@@ -18,7 +18,7 @@ use crate::samples::{DrawTally, Samples, domain_draw, weigh_domains};
 pub use crate::simplify::{
     EdgeCheck, SMOOTHING_MIN_CHANGE, SMOOTHING_ROUNDS, path_length, shortcut,
 };
-use crate::simplify::{recheck, simplified_finer};
+use crate::simplify::{prove_path, recheck, simplified_finer};
 
 /// RRT-Connect settings.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,10 +61,11 @@ pub struct RrtOptions {
     /// Where samples come from.
     pub sampler: Sampler,
     /// Certified paths: the returned path is proved free in continuous motion
-    /// ([`trm_collision::Certifier`]: `f64`, exact distances, lever-arm bounds), not only free
-    /// at its checked points. [`crate::Planner::connect`] proves each segment of the path it
-    /// found, and replaces a segment it cannot prove by a search between its ends whose every
-    /// accepted edge is proved.
+    /// ([`WorldChecker::prove`]: the robot padded on the fast checker, then exact distances and
+    /// lever-arm bounds), not only free at its checked points. RRT-Connect proves each segment
+    /// of its simplified path in place of checking it again at half the resolution, and
+    /// replaces a segment it cannot prove by a search between its ends whose every accepted
+    /// edge is proved; [`crate::Planner::connect`] proves the paths its maps give as well.
     pub certified: bool,
 }
 
@@ -260,6 +261,8 @@ pub struct RrtPath {
     pub simplify_seconds: f64,
     /// Searches run again at a finer resolution because the path grazed an obstacle.
     pub refinements: u32,
+    /// Whether the path is proved free in continuous motion ([`RrtOptions::certified`]).
+    pub proved: bool,
 }
 
 /// Draws of a search between two reads of the clock for its time limit.
@@ -455,7 +458,8 @@ fn extend_from(
 /// checked at half the resolution, else taken through the greedy pass alone, if either passes
 /// the same check; else the search runs again at that finer resolution (at most twice), so a
 /// returned path is free at `resolution / 2` wherever it was checked. [`RrtPath::refinements`]
-/// counts the reruns.
+/// counts the reruns. With [`RrtOptions::certified`] the path is proved free in continuous
+/// motion instead (see there).
 pub fn rrt_connect(
     objective: &Objective,
     world: &World,
@@ -714,7 +718,19 @@ impl Growth {
             g.grow(checker, bounds, &attempt, attempt.max_iterations, began);
             let simplifying = Instant::now();
             let (mut found, edges, raw) = g.shortcut(checker, &attempt, began)?;
-            let mut free = recheck(checker, &found.path, &edges, resolution, options.resolution);
+            // a certified path is proved, which its points at half the resolution add nothing
+            // to; a search whose checker proves every edge it accepts has proved its path
+            found.proved = options.certified || checker.is_proving();
+            let mut free = match (checker.is_proving(), options.certified) {
+                (true, _) => true,
+                (false, true) => {
+                    prove_path(checker, bounds, &mut found.path, options)?;
+                    true
+                }
+                (false, false) => {
+                    recheck(checker, &found.path, &edges, resolution, options.resolution)
+                }
+            };
             if !free
                 && let Some(again) = simplified_finer(checker, &raw, &attempt, options.resolution)
             {

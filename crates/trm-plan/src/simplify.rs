@@ -7,7 +7,8 @@ use rand_chacha::ChaCha8Rng;
 use trm_collision::WorldChecker;
 use trm_collision::edge::distance;
 
-use crate::rrt::RrtOptions;
+use crate::PlanError;
+use crate::rrt::{RrtOptions, rrt_connect_in};
 
 /// [`RrtOptions::smoothing`]'s default: VAMP's simplifier's iterations.
 pub const SMOOTHING_ROUNDS: usize = 5;
@@ -260,6 +261,50 @@ pub(crate) fn recheck(
                 || checker.edge_free(&w[0], &w[1], asked)
                     && checker.edge_midpoints_free(&w[0], &w[1], asked))
     })
+}
+
+/// Proves every segment of `path` free in continuous motion ([`WorldChecker::prove`]), in
+/// `checker`'s world; a segment that cannot be proved is replaced by RRT-Connect between its
+/// ends within `bounds`, with every accepted edge proved ([`WorldChecker::set_proving`]). An
+/// error when no proved path joins them within `options`' budget.
+pub(crate) fn prove_path(
+    checker: &mut WorldChecker,
+    bounds: &(Vec<f64>, Vec<f64>),
+    path: &mut Vec<Vec<f64>>,
+    options: &RrtOptions,
+) -> Result<(), PlanError> {
+    let mut i = 0;
+    while i + 1 < path.len() {
+        if checker
+            .prover()?
+            .segment_unchecked(&path[i], &path[i + 1])
+            .is_free()
+        {
+            i += 1;
+            continue;
+        }
+        // the segment grazes or crosses an obstacle between its checked points
+        checker.set_proving(true)?;
+        let repaired = rrt_connect_in(checker, bounds, &path[i], &path[i + 1], options);
+        checker.set_proving(false)?;
+        match repaired {
+            Ok(found) => {
+                let n = found.path.len();
+                path.splice(i..i + 2, found.path);
+                i += n - 1;
+            }
+            Err(e) => {
+                return Err(PlanError::Unreachable {
+                    reason: format!(
+                        "segment {i} of the path found cannot be proved free in continuous motion, and no proved path replaces it: {e}"
+                    ),
+                    closest_node: None,
+                    closest_distance: f64::INFINITY,
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Length of a path, rad.

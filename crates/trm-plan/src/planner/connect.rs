@@ -13,7 +13,7 @@ use crate::PlanError;
 use crate::pose_goal::PoseGoal;
 use crate::query::{Goal, PlanOptions, Planned};
 use crate::rrt::{GOAL_COLLIDES, Growth, RrtOptions, RrtPath, rrt_connect_in, shortcut};
-use crate::simplify::{recheck, simplified_finer};
+use crate::simplify::{prove_path, recheck, simplified_finer};
 
 /// Where the path of a [`Planner::connect`] query came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -57,6 +57,8 @@ pub struct Connection {
     /// and checking the result again; proving it, with certified paths), s: the rest is
     /// planning.
     pub simplify_seconds: f64,
+    /// Whether the path is proved free in continuous motion ([`RrtOptions::certified`]).
+    pub proved: bool,
 }
 
 impl Planner {
@@ -89,9 +91,10 @@ impl Planner {
         let began = Instant::now();
         let before = self.checker.checks;
         let mut found = self.find(start, goal, options, began, before)?;
-        if options.certified {
+        if options.certified && !found.proved {
             let proving = Instant::now();
-            self.prove(&mut found.path, options)?;
+            prove_path(&mut self.checker, &self.bounds, &mut found.path, options)?;
+            found.proved = true;
             found.simplify_seconds += proving.elapsed().as_secs_f64();
             found.checks = self.checker.checks - before;
             found.seconds = began.elapsed().as_secs_f64();
@@ -340,6 +343,7 @@ impl Planner {
             iterations: 0,
             seconds: 0.0,
             simplify_seconds: simplifying.elapsed().as_secs_f64(),
+            proved: false,
         })
     }
 
@@ -372,51 +376,8 @@ impl Planner {
             iterations: found.iterations,
             seconds: began.elapsed().as_secs_f64(),
             simplify_seconds: found.simplify_seconds,
+            proved: found.proved,
         }
-    }
-}
-
-impl Planner {
-    /// Proves every segment of `path` free in continuous motion ([`RrtOptions::certified`]:
-    /// [`trm_collision::WorldChecker::prove`]); a segment that cannot be proved is replaced by RRT-Connect
-    /// between its ends with every accepted edge proved. An error when no proved path joins
-    /// them within `options`' budget.
-    fn prove(&mut self, path: &mut Vec<Vec<f64>>, options: &RrtOptions) -> Result<(), PlanError> {
-        let mut i = 0;
-        while i + 1 < path.len() {
-            let (a, b) = (&path[i], &path[i + 1]);
-            if self.checker.prover()?.segment_unchecked(a, b).is_free() {
-                i += 1;
-                continue;
-            }
-            // the segment grazes or crosses an obstacle between its checked points
-            self.checker.set_proving(true)?;
-            let repaired = rrt_connect_in(
-                &mut self.checker,
-                &self.bounds,
-                &path[i],
-                &path[i + 1],
-                options,
-            );
-            self.checker.set_proving(false)?;
-            match repaired {
-                Ok(found) => {
-                    let n = found.path.len();
-                    path.splice(i..i + 2, found.path);
-                    i += n - 1;
-                }
-                Err(e) => {
-                    return Err(PlanError::Unreachable {
-                        reason: format!(
-                            "segment {i} of the path found cannot be proved free in continuous motion, and no proved path replaces it: {e}"
-                        ),
-                        closest_node: None,
-                        closest_distance: f64::INFINITY,
-                    });
-                }
-            }
-        }
-        Ok(())
     }
 }
 
