@@ -55,10 +55,13 @@ pub enum Scope {
 
 /// Solves each of `problems` through the paths `paths[j]` found for the *other* problems
 /// (leave-one-out: a problem never sees its own path) of its family or of the whole set
-/// (`scope`), as a robot that has planned those before: a planner per problem holding those
-/// paths ([`Planner::add_path`], checked lazily in the problem's scene), RRT-Connect where they
-/// do not join start and goal; nothing is kept. `paths[k]` is empty for a problem without a
-/// path; `done(k)` after each problem. Notes as in [`solve_with_experience`].
+/// (`scope`), as a robot that has planned those before: a planner per set of moving motors
+/// (and the others' values), kept across the problems as [`crate::Solver`] keeps them, given
+/// each problem's matrix before its query and those paths in stack order (`leave_out`:
+/// checked lazily in the problem's scene, the graph not rebuilt per problem), RRT-Connect
+/// where they do not join start and goal; nothing is kept. `paths[k]` is empty for a problem
+/// without a path; `done(k)` after each problem, in their order within each group of
+/// problems sharing paths. Notes as in [`solve_with_experience`].
 pub fn solve_leave_one_out(
     robot: &RobotModel,
     problems: &[LoadedProblem],
@@ -88,27 +91,86 @@ pub fn solve_leave_one_out(
         )?;
         setups.push((active, objective.active().to_motors(&start)));
     }
-    let shares = |k: usize, j: usize| {
-        j != k
-            && !paths[j].is_empty()
-            && setups[j] == setups[k]
-            && (scope == Scope::Set || problems[j].problem.family == problems[k].problem.family)
-    };
-    let mut outcomes = Vec::with_capacity(problems.len());
+    // the problems that share their paths: the same setup, and the same family unless the
+    // scope is the set
+    let mut groups: Vec<Vec<usize>> = Vec::new();
     for k in 0..problems.len() {
-        let mut run = FamilyRun::new(robot, problems, vec![k])?;
-        run.kept = (0..problems.len())
-            .filter(|&j| shares(k, j))
-            .map(|j| paths[j].clone())
-            .collect();
-        let mut results = vec![Outcome::default(); problems.len()];
-        run.keep = false;
-        run.pass(options, &mut results, |_| {})?;
-        outcomes.push(std::mem::take(&mut results[k]));
-        done(k);
+        let together = |g: &&mut Vec<usize>| {
+            setups[g[0]] == setups[k]
+                && (scope == Scope::Set
+                    || problems[g[0]].problem.family == problems[k].problem.family)
+        };
+        match groups.iter_mut().find(together) {
+            Some(group) => group.push(k),
+            None => groups.push(vec![k]),
+        }
+    }
+    // one planner per setup, kept across the problems as the plain run keeps its planners
+    let mut planners: Vec<(&Setup, Planner)> = Vec::new();
+    let mut outcomes = vec![Outcome::default(); problems.len()];
+    for group in &groups {
+        let first = &problems[group[0]];
+        let (objective, _, _) = problem_objective(
+            robot,
+            &first.own,
+            &trm_collision::World::new(),
+            &first.request,
+        )?;
+        let setup = &setups[group[0]];
+        let at = match planners.iter().position(|(s, _)| *s == setup) {
+            Some(at) => at,
+            None => {
+                planners.push((setup, Planner::new(&objective, &[])?));
+                planners.len() - 1
+            }
+        };
+        let planner = &mut planners[at].1;
+        planner.forget_paths();
+        leave_out(planner, group, paths, &mut |planner, k| {
+            let mut run = FamilyRun::new(robot, problems, vec![k])?;
+            run.keep = false;
+            planner.set_collision(&problems[k].collision)?;
+            outcomes[k] = run.plan(planner, &objective, k, options)?;
+            done(k);
+            Ok(())
+        })?;
     }
     Ok(outcomes)
 }
+
+/// Asks `query` for each problem of `group` with the paths of every other one of them (not
+/// empty) kept by `planner` besides what it keeps already: the group halved, each half asked
+/// with the other half's paths kept ([`Planner::add_path`]) and then forgotten
+/// ([`Planner::forget_last_path`]), down to single problems. Every path is kept about log₂ of
+/// the group's size times, and the planner changes by a few paths between most queries, as a
+/// planner in use does, instead of being rebuilt for each.
+fn leave_out(
+    planner: &mut Planner,
+    group: &[usize],
+    paths: &[Vec<Vec<f64>>],
+    query: &mut dyn FnMut(&mut Planner, usize) -> Result<(), MbmError>,
+) -> Result<(), MbmError> {
+    if let [k] = group {
+        return query(planner, *k);
+    }
+    let (left, right) = group.split_at(group.len() / 2);
+    for (half, other) in [(left, right), (right, left)] {
+        let mut kept = 0;
+        for &j in other.iter().filter(|&&j| !paths[j].is_empty()) {
+            planner.add_path(&paths[j])?;
+            kept += 1;
+        }
+        leave_out(planner, half, paths, query)?;
+        for _ in 0..kept {
+            planner.forget_last_path();
+        }
+    }
+    Ok(())
+}
+
+/// The motors a problem moves and the values of the others (problems share paths only when
+/// theirs agree).
+type Setup = (Vec<usize>, Vec<f64>);
 
 /// One family's problems and the paths its planners keep, pass after pass.
 struct FamilyRun<'a> {
@@ -260,5 +322,56 @@ impl<'a> FamilyRun<'a> {
             });
         }
         Ok((start, request.goal.positions.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each problem of a group is asked with exactly the other problems' paths kept (those
+    /// not empty), and the planner ends as it began.
+    #[test]
+    fn each_problem_is_asked_with_every_other_path_and_never_its_own() {
+        let robot = trm_models::icub_upper_body();
+        let home = robot.posture("home").expect("shipped posture").to_vec();
+        let arm = ["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"];
+        let active = robot.active_set(&arm, &home).expect("shipped motors");
+        let collision = trm_collision::CollisionModel::new(&robot).expect("shipped model");
+        let objective = Objective::new(active, collision, trm_collision::World::new());
+        let mut planner = Planner::new(&objective, &[]).expect("valid objective");
+        let before = vec![vec![0.1, 0.2, 0.3], vec![0.2, 0.2, 0.3]];
+        planner.add_path(&before).expect("finite");
+        for n in [1, 2, 5, 11] {
+            // problem j's path: two waypoints of its own (none for every third problem)
+            let paths: Vec<Vec<Vec<f64>>> = (0..n)
+                .map(|j| match j % 3 {
+                    2 => Vec::new(),
+                    _ => vec![
+                        vec![0.01 * j as f64, -0.3, 0.5],
+                        vec![0.5, 0.01 * j as f64, 0.2],
+                    ],
+                })
+                .collect();
+            let group: Vec<usize> = (0..n).collect();
+            let mut asked = Vec::new();
+            leave_out(&mut planner, &group, &paths, &mut |planner, k| {
+                let mut kept = planner.kept_paths();
+                assert_eq!(kept.remove(0), before, "problem {k}");
+                let mut others: Vec<Vec<Vec<f64>>> = (0..n)
+                    .filter(|&j| j != k && !paths[j].is_empty())
+                    .map(|j| paths[j].clone())
+                    .collect();
+                let order = |a: &Vec<Vec<f64>>, b: &Vec<Vec<f64>>| a[0][0].total_cmp(&b[0][0]);
+                kept.sort_by(order);
+                others.sort_by(order);
+                assert_eq!(kept, others, "problem {k} of {n}");
+                asked.push(k);
+                Ok(())
+            })
+            .expect("no error");
+            assert_eq!(asked, group);
+            assert_eq!(planner.kept_paths(), vec![before.clone()]);
+        }
     }
 }

@@ -155,8 +155,10 @@ pub fn benchmark(
             (Scope::Family, "leave-one-out, family"),
             (Scope::Set, "leave-one-out, set"),
         ] {
+            let mut finished = 0;
             let outcomes = solve_leave_one_out(robot, &loaded, &paths, scope, &options.rrt, |k| {
-                progress(stage, k + 1, problems.len(), &problems[k])
+                finished += 1;
+                progress(stage, finished, problems.len(), &problems[k])
             })?;
             leave_one_out.push((scope, runs_of(robot, &loaded, outcomes, options)?));
         }

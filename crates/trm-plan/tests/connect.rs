@@ -226,3 +226,62 @@ fn corner_cutting_shortens_paths_and_keeps_them_free() {
     }
     assert!(shorter * 2 >= total, "{shorter} of {total} paths shortened");
 }
+
+/// Among many kept paths, a query repeating one's ends (either way round, each end moved up to
+/// the retrieval's reach) gets that path, and one whose end lies beyond the reach gets none.
+#[test]
+fn among_many_kept_paths_the_repeated_one_is_retrieved() {
+    let (objective, _, _) = arm_beside_a_pole();
+    let options = RrtOptions::default();
+    let near = trm_plan::RETRIEVE_STEPS * options.resolution;
+    let mut planner = Planner::new(&objective, &[]).unwrap();
+    let (lower, upper) = objective.active().bounds();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut random = |planner: &mut Planner| loop {
+        let q: Vec<f64> = (lower.iter().zip(&upper))
+            .map(|(l, u)| rng.random_range(*l + 0.1..*u - 0.1))
+            .collect();
+        if planner.is_free(&q) {
+            return q;
+        }
+    };
+    let mut paths = Vec::new();
+    while paths.len() < 150 {
+        let (a, b) = (random(&mut planner), random(&mut planner));
+        if planner.segment_free(&a, &b, options.resolution) {
+            planner.add_path(&[a.clone(), b.clone()]).unwrap();
+            paths.push((a, b));
+        }
+    }
+    // an end moved by `by` along the diagonal (its distance: `by`)
+    let moved = |q: &[f64], by: f64| -> Vec<f64> {
+        let step = by / (q.len() as f64).sqrt();
+        q.iter().map(|v| v + step).collect()
+    };
+    let mut retrieved = 0;
+    for (k, (a, b)) in paths.iter().enumerate().step_by(10) {
+        // both ends moved the same way: the keys differ by as much as they can
+        let (s, g) = (moved(a, 0.99 * near), moved(b, 0.99 * near));
+        let (s, g) = if k % 20 == 0 { (g, s) } else { (s, g) };
+        if !planner.is_free(&s) || !planner.is_free(&g) {
+            continue;
+        }
+        let found = planner.connect(&s, &g, &options).unwrap();
+        assert_eq!(found.source, Source::Retrieved, "path {k}");
+        assert_eq!(
+            (found.path.first(), found.path.last()),
+            (Some(&s), Some(&g))
+        );
+        retrieved += 1;
+        let far = moved(b, 1.5 * near);
+        if planner.is_free(&far) {
+            let found = planner.connect(a, &far, &options).unwrap();
+            assert_ne!(
+                found.source,
+                Source::Retrieved,
+                "path {k}, beyond the reach"
+            );
+        }
+    }
+    assert!(retrieved >= 10, "{retrieved} queries tried");
+}

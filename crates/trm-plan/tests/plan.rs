@@ -801,3 +801,68 @@ fn repeated_queries_retrieve_the_kept_path_while_it_is_free() {
         Err(e) => assert!(matches!(e, PlanError::Unreachable { .. }), "{e}"),
     }
 }
+
+/// Forgetting the kept paths leaves the maps as they were (nodes, edges, answers); paths kept
+/// afterwards are searched as by a planner made with the maps and given only them. A path whose
+/// waypoints are map nodes takes nothing of the map with it.
+#[test]
+fn forgotten_paths_leave_the_maps_as_they_were() {
+    let p = problem();
+    let map = map();
+    let options = PlanOptions {
+        shortcuts: 0,
+        exact_goal: false,
+        sampling: None,
+        ..Default::default()
+    };
+    let mut kept = Planner::new(&p.objective, &[map]).unwrap();
+    let (nodes, edges) = (kept.num_nodes(), kept.num_edges());
+    let goal = |k: usize| Goal::Configuration(map.points[k * map.points.len() / 5].q.clone());
+    let first = kept.plan(&p.start, &goal(2), &options).unwrap();
+    kept.add_path(&first.waypoints).unwrap();
+    kept.add_path(&[map.points[0].q.clone(), map.points[1].q.clone()])
+        .unwrap();
+    assert!(kept.num_nodes() > nodes && kept.num_edges() > edges + 1);
+    kept.forget_paths();
+    assert_eq!((kept.num_nodes(), kept.num_edges()), (nodes, edges));
+    assert!(kept.kept_paths().is_empty());
+    let second = Planner::new(&p.objective, &[map])
+        .unwrap()
+        .plan(&p.start, &goal(4), &options)
+        .unwrap();
+    let mut fresh = Planner::new(&p.objective, &[map]).unwrap();
+    for planner in [&mut kept, &mut fresh] {
+        planner.add_path(&second.waypoints).unwrap();
+    }
+    assert_eq!(kept.kept_paths(), fresh.kept_paths());
+    assert_eq!(kept.num_edges(), fresh.num_edges());
+    // the path kept last, forgotten: as though it had never been kept
+    let edges = kept.num_edges();
+    kept.add_path(&first.waypoints).unwrap();
+    assert!(kept.num_edges() > edges);
+    assert!(kept.forget_last_path());
+    assert_eq!(kept.kept_paths(), fresh.kept_paths());
+    assert_eq!(
+        (kept.num_nodes(), kept.num_edges()),
+        (fresh.num_nodes(), edges)
+    );
+    for k in 0..5 {
+        let (a, b) = (
+            kept.plan(&p.start, &goal(k), &options),
+            fresh.plan(&p.start, &goal(k), &options),
+        );
+        match (a, b) {
+            (Ok(a), Ok(b)) => {
+                assert_eq!(a.waypoints, b.waypoints, "goal {k}");
+                assert_eq!(a.stats.retrieved, b.stats.retrieved, "goal {k}");
+            }
+            (a, b) => assert_eq!(a.is_err(), b.is_err(), "goal {k}"),
+        }
+    }
+    // not past a map attached after it, nor with no path kept
+    kept.add_map(map).unwrap();
+    assert!(!kept.forget_last_path());
+    let mut bare = Planner::new(&p.objective, &[map]).unwrap();
+    assert!(!bare.forget_last_path());
+    assert_eq!(bare.num_nodes(), nodes);
+}

@@ -318,6 +318,12 @@ impl Planner {
             .collect()
     }
 
+    /// Forgets every kept path (the attached maps stay): later queries plan as a planner
+    /// given no experience does, the robot and the world not compiled again.
+    fn forget_paths(&mut self) {
+        self.planner.forget_paths();
+    }
+
     /// Writes the kept paths to `path` (a versioned JSON file: the moved motors' names and
     /// every path's waypoints), atomically.
     fn save_experience(&self, path: &str) -> PyResult<()> {

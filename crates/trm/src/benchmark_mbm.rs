@@ -118,7 +118,8 @@ pub struct Args {
     /// the search first wants them) and print that run beside the plain one.
     #[arg(long = "map", value_name = "FILE", conflicts_with = "task_space")]
     maps: Vec<PathBuf>,
-    /// Where results.csv, results.md and times.svg go.
+    /// Where results.csv, results.md and times.svg go (and results-maps.csv with --map,
+    /// results-leave-one-out-{family,set}.csv with --experience).
     #[arg(long, default_value = "target/benchmark-mbm")]
     pub out_dir: PathBuf,
 }
@@ -180,6 +181,13 @@ pub fn run(args: &Args) -> Result<()> {
             "results-maps.csv",
             trm_mbm::runs_csv(&bench.with_maps).into_bytes(),
         ));
+    }
+    for (scope, runs) in &bench.leave_one_out {
+        let name = match scope {
+            trm_mbm::Scope::Family => "results-leave-one-out-family.csv",
+            trm_mbm::Scope::Set => "results-leave-one-out-set.csv",
+        };
+        files.push((name, trm_mbm::runs_csv(runs).into_bytes()));
     }
     let outcomes: Vec<(&str, &Outcome)> = bench
         .runs

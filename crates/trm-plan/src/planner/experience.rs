@@ -32,6 +32,70 @@ impl Planner {
             .collect()
     }
 
+    /// Forgets every kept path ([`Planner::add_path`], [`Planner::load_experience`]): their
+    /// nodes, their edges and the edges joining them to the rest of the graph. The maps stay,
+    /// with what their checks found (a map attached after paths loses its joins to them), so
+    /// that a planner kept across queries can be given other experience without compiling
+    /// the robot or its world again; it then answers as a planner made with the same maps and
+    /// given the new paths.
+    pub fn forget_paths(&mut self) {
+        if self.kept.is_empty() {
+            return;
+        }
+        // the maps' nodes, renumbered; their own edges and joins
+        let keep_node = self.map_node.clone();
+        let mut renumbered = vec![usize::MAX; self.nodes.len()];
+        for (new, old) in (0..self.nodes.len()).filter(|&i| keep_node[i]).enumerate() {
+            renumbered[old] = new;
+        }
+        let mut keep_edge: Vec<bool> = (self.edges.iter())
+            .map(|&(a, b, _)| keep_node[a] && keep_node[b])
+            .collect();
+        for &e in self.kept.iter().flat_map(|(_, edges)| edges) {
+            keep_edge[e] = false;
+        }
+        retain_marked(&mut self.nodes, &keep_node);
+        retain_marked(&mut self.node_state, &keep_node);
+        retain_marked(&mut self.map_node, &keep_node);
+        retain_marked(&mut self.edges, &keep_edge);
+        retain_marked(&mut self.edge_state, &keep_edge);
+        for (a, b, _) in &mut self.edges {
+            (*a, *b) = (renumbered[*a], renumbered[*b]);
+        }
+        self.kept.clear();
+        self.kept_ends.clear();
+        self.kept_keys.clear();
+        self.kept_from.clear();
+    }
+
+    /// Forgets the path kept last ([`Planner::add_path`]) when no map was attached after it:
+    /// the graph goes back to what it was before that path was kept, in time proportional to
+    /// the path (not to the graph), so that a planner can be given experience and have it
+    /// taken back in stack order without a rebuild. Whether a path was forgotten (not when
+    /// none is kept, or a map came after it).
+    pub fn forget_last_path(&mut self) -> bool {
+        let Some(&(nodes, edges, maps)) = self.kept_from.last() else {
+            return false;
+        };
+        if maps != self.maps {
+            return false;
+        }
+        let k = self.kept.len() - 1;
+        self.kept_from.pop();
+        self.kept.pop();
+        let d = self.active.len();
+        self.kept_ends.truncate(2 * d * k);
+        let at = (self.kept_keys.iter().rposition(|&(_, path)| path == k))
+            .expect("every kept path has a key");
+        self.kept_keys.remove(at);
+        self.nodes.truncate(nodes);
+        self.node_state.truncate(nodes);
+        self.map_node.truncate(nodes);
+        self.edges.truncate(edges);
+        self.edge_state.truncate(edges);
+        true
+    }
+
     /// Writes the kept paths to `path` (a versioned JSON file, [`EXPERIENCE_FORMAT`]: the
     /// moving motors' names and every path's waypoints), atomically: a file that exists stays
     /// whole until the new one replaces it.
@@ -100,4 +164,13 @@ impl Planner {
         }
         Ok(file.paths.len())
     }
+}
+
+/// Keeps the items of `items` whose place in `keep` is true, in order.
+fn retain_marked<T>(items: &mut Vec<T>, keep: &[bool]) {
+    let mut at = 0;
+    items.retain(|_| {
+        at += 1;
+        keep[at - 1]
+    });
 }

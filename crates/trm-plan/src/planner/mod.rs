@@ -32,6 +32,12 @@ enum State {
     Invalid,
 }
 
+/// A kept path's or a query's key for [`Planner::retrieve`]'s look-up: the sum of the values of
+/// its two ends (the same either way round).
+fn ends_key(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().chain(b).sum()
+}
+
 /// How near, in steps of the planning resolution, both ends of a query must lie to a kept path's
 /// ends for [`Planner::plan`] to try that path before searching: a query that repeats one
 /// planned before.
@@ -80,6 +86,8 @@ pub struct Planner {
     own_acm: trm_collision::AllowedCollisionMatrix,
     nodes: Vec<(Vec<f64>, Vec<f64>)>,
     node_state: Vec<State>,
+    /// Per node: whether a map brought it (else a kept path did).
+    map_node: Vec<bool>,
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
     scratch: trm_tasks::Scratch,
@@ -90,6 +98,13 @@ pub struct Planner {
     /// The kept paths' first and last waypoints, twice the active motors' values per path, in
     /// [`Planner::kept`]'s order: what a retrieval's scan reads, in one sweep.
     kept_ends: Vec<f64>,
+    /// Each kept path's key ([`ends_key`]: the sum of its ends' values) and its index in
+    /// [`Planner::kept`], sorted by key: a retrieval reads only the paths whose keys lie near
+    /// the query's.
+    kept_keys: Vec<(f64, usize)>,
+    /// Per kept path: the graph's nodes, edges and maps before it was kept (what
+    /// [`Planner::forget_last_path`] goes back to).
+    kept_from: Vec<(usize, usize, usize)>,
     /// [`Planner::rrt_options`], worked out on first use (the robot's bodies and active motors
     /// do not change; an allowed-collision matrix does not move a body).
     rrt: std::sync::OnceLock<RrtOptions>,
@@ -115,11 +130,14 @@ impl Planner {
             own_acm: objective.collision().acm().clone(),
             node_state: Vec::new(),
             nodes: Vec::new(),
+            map_node: Vec::new(),
             edges: Vec::new(),
             edge_state: Vec::new(),
             scratch: objective.scratch(),
             kept: Vec::new(),
             kept_ends: Vec::new(),
+            kept_keys: Vec::new(),
+            kept_from: Vec::new(),
             rrt: std::sync::OnceLock::new(),
             maps: 0,
         };
@@ -186,6 +204,7 @@ impl Planner {
         self.nodes
             .extend(map.points.iter().map(|p| (p.q.clone(), p.t.clone())));
         self.node_state.resize(self.nodes.len(), state);
+        self.map_node.resize(self.nodes.len(), true);
         for &(a, b, l) in &map.edges {
             self.edges.push((base + a, base + b, l));
             self.edge_state.push(state);
@@ -328,6 +347,7 @@ impl Planner {
             });
         }
         let old = self.nodes.len();
+        self.kept_from.push((old, self.edges.len(), self.maps));
         let mut ids = Vec::with_capacity(path.len());
         for q in path {
             let same = (0..self.nodes.len()).find(|&i| distance(&self.nodes[i].0, q) <= 1e-9);
@@ -337,6 +357,7 @@ impl Planner {
                     let t = self.task_of(q);
                     self.nodes.push((q.clone(), t));
                     self.node_state.push(State::Valid);
+                    self.map_node.push(false);
                     let me = self.nodes.len() - 1;
                     for (l, j) in k_nearest(q, &self.nodes, 0..old, 3) {
                         self.edges.push((me, j, l));
@@ -358,6 +379,9 @@ impl Planner {
         for end in [ids[0], ids[ids.len() - 1]] {
             self.kept_ends.extend_from_slice(&self.nodes[end].0);
         }
+        let key = ends_key(&self.nodes[ids[0]].0, &self.nodes[ids[ids.len() - 1]].0);
+        let at = self.kept_keys.partition_point(|&(k, _)| k <= key);
+        self.kept_keys.insert(at, (key, self.kept.len()));
         self.kept.push((ids, edges));
         Ok(self.nodes.len() - old)
     }
@@ -652,7 +676,13 @@ impl Planner {
     ) -> Result<Option<Planned>, PlanError> {
         let near = RETRIEVE_STEPS * options.resolution;
         let d = self.active.len();
-        // a cheap test first: most kept paths end far away in their first coordinates (the
+        // only the paths whose keys lie near the query's: ends within `near` of the query's
+        // (either way round) move the sum of the 2d values by at most 2·√d·near (a hair
+        // more for rounding)
+        let key = ends_key(start, goal);
+        let reach = 2.0 * (d as f64).sqrt() * near * (1.0 + 1e-6) + 1e-9 * (1.0 + key.abs());
+        let from = self.kept_keys.partition_point(|&(k, _)| k < key - reach);
+        // a cheap test first: most candidates end far away in their first coordinates (the
         // bound is a hair wider than `near`, so that the distances alone decide)
         let wide = near * near * (1.0 + 1e-9) + f64::MIN_POSITIVE;
         let close = |a: &[f64], b: &[f64]| {
@@ -662,12 +692,11 @@ impl Planner {
                 sum <= wide
             })
         };
-        let Some((k, reversed)) = self
-            .kept_ends
-            .chunks_exact(2 * d)
-            .enumerate()
-            .filter_map(|(k, ends)| {
-                let (first, last) = ends.split_at(d);
+        let Some((k, reversed)) = self.kept_keys[from..]
+            .iter()
+            .take_while(|&&(k, _)| k <= key + reach)
+            .filter_map(|&(_, k)| {
+                let (first, last) = self.kept_ends[2 * d * k..2 * d * (k + 1)].split_at(d);
                 let forward = close(start, first) && close(goal, last);
                 let backward = close(start, last) && close(goal, first);
                 if !forward && !backward {
@@ -678,7 +707,8 @@ impl Planner {
                 let (d, reversed) = (forward.min(backward), backward < forward);
                 (d <= near).then_some((k, d, reversed))
             })
-            .min_by(|a, b| a.1.total_cmp(&b.1))
+            // the nearest, the first kept among equals
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
             .map(|(k, _, reversed)| (k, reversed))
         else {
             return Ok(None);

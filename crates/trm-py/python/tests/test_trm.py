@@ -473,6 +473,10 @@ def test_a_robot_planner_keeps_experience_across_worlds(robot, tmp_path):
         np.testing.assert_array_equal(a, b)
     if first["source"] == "sampled":
         assert other.plan(goal, start=start, seed=4)["source"] == "retrieved"
+    # forgotten: the next query searches afresh
+    other.forget_paths()
+    assert other.kept_paths() == [] and other.num_nodes == 0
+    assert other.plan(goal, start=start, seed=4)["source"] in ("sampled", "straight")
     with pytest.raises(trm.TrmError, match="the planner moves"):
         trm.Planner(robot, joints=joints[:2]).load_experience(str(tmp_path / "arm.experience.json"))
     # the pole removed: what was found free stays free (a world that adds or moves objects
