@@ -730,6 +730,16 @@ fn a_configuration_goal_the_maps_do_not_reach_is_finished_by_rrt_connect() {
     assert_eq!(found, 3, "too few goals the map alone cannot reach");
 }
 
+/// Options of a search through the graph alone: no shortcut, no sampling, no exact finish.
+fn graph_only() -> PlanOptions {
+    PlanOptions {
+        shortcuts: 0,
+        exact_goal: false,
+        sampling: None,
+        ..Default::default()
+    }
+}
+
 /// A query that repeats a kept path's ends is answered by that path, without a search, when it
 /// is free (checked in the current world), and by a search otherwise; a query elsewhere
 /// searches.
@@ -737,12 +747,7 @@ fn a_configuration_goal_the_maps_do_not_reach_is_finished_by_rrt_connect() {
 fn repeated_queries_retrieve_the_kept_path_while_it_is_free() {
     let p = problem();
     let map = map();
-    let options = PlanOptions {
-        shortcuts: 0,
-        exact_goal: false,
-        sampling: None,
-        ..Default::default()
-    };
+    let options = graph_only();
     let goal = map.points[map.points.len() / 2].q.clone();
     let found = Planner::new(&p.objective, &[map])
         .unwrap()
@@ -809,12 +814,7 @@ fn repeated_queries_retrieve_the_kept_path_while_it_is_free() {
 fn forgotten_paths_leave_the_maps_as_they_were() {
     let p = problem();
     let map = map();
-    let options = PlanOptions {
-        shortcuts: 0,
-        exact_goal: false,
-        sampling: None,
-        ..Default::default()
-    };
+    let options = graph_only();
     let mut kept = Planner::new(&p.objective, &[map]).unwrap();
     let (nodes, edges) = (kept.num_nodes(), kept.num_edges());
     let goal = |k: usize| Goal::Configuration(map.points[k * map.points.len() / 5].q.clone());
