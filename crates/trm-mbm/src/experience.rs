@@ -60,8 +60,9 @@ pub enum Scope {
 /// each problem's matrix before its query and those paths in stack order (`leave_out`:
 /// checked lazily in the problem's scene, the graph not rebuilt per problem), RRT-Connect
 /// where they do not join start and goal; nothing is kept. `paths[k]` is empty for a problem
-/// without a path; `done(k)` after each problem, in their order within each group of
-/// problems sharing paths. Notes as in [`solve_with_experience`].
+/// without a path; each problem is also solved afresh beside it ([`LeaveOneOut::fresh`]);
+/// `done(k)` after each problem, in their order within each group of problems sharing paths.
+/// Notes as in [`solve_with_experience`].
 pub fn solve_leave_one_out(
     robot: &RobotModel,
     problems: &[LoadedProblem],
@@ -69,7 +70,7 @@ pub fn solve_leave_one_out(
     scope: Scope,
     options: &RrtOptions,
     mut done: impl FnMut(usize),
-) -> Result<Vec<Outcome>, MbmError> {
+) -> Result<LeaveOneOut, MbmError> {
     options.check()?;
     if paths.len() != problems.len() {
         return Err(MbmError::Invalid {
@@ -108,6 +109,9 @@ pub fn solve_leave_one_out(
     // one planner per setup, kept across the problems as the plain run keeps its planners
     let mut planners: Vec<(&Setup, Planner)> = Vec::new();
     let mut outcomes = vec![Outcome::default(); problems.len()];
+    let mut fresh = vec![Outcome::default(); problems.len()];
+    let mut solver = crate::Solver::new(robot, &[]);
+    let mut asked = 0;
     for group in &groups {
         let first = &problems[group[0]];
         let (objective, _, _) = problem_objective(
@@ -130,12 +134,33 @@ pub fn solve_leave_one_out(
             let mut run = FamilyRun::new(robot, problems, vec![k])?;
             run.keep = false;
             planner.set_collision(&problems[k].collision)?;
+            // in turn first and second: the query second finds the problem's scene in the
+            // caches
+            if asked % 2 == 1 {
+                fresh[k] = solver.solve(&problems[k], options)?;
+            }
             outcomes[k] = run.plan(planner, &objective, k, options)?;
+            if asked % 2 == 0 {
+                fresh[k] = solver.solve(&problems[k], options)?;
+            }
+            asked += 1;
             done(k);
             Ok(())
         })?;
     }
-    Ok(outcomes)
+    Ok(LeaveOneOut { outcomes, fresh })
+}
+
+/// What [`solve_leave_one_out`] found: each problem through the other problems' paths, and
+/// the same problem solved afresh right before or after it, in turn ([`crate::Solver`], no
+/// paths), so that a machine's changing speed weighs on both alike, and so does the head
+/// start the second query of a problem gets from the first (its scene in the caches).
+#[derive(Debug, Clone)]
+pub struct LeaveOneOut {
+    /// Through the other problems' paths, one per problem.
+    pub outcomes: Vec<Outcome>,
+    /// Afresh, beside each of them.
+    pub fresh: Vec<Outcome>,
 }
 
 /// Asks `query` for each problem of `group` with the paths of every other one of them (not

@@ -21,7 +21,7 @@ mod run;
 mod solve;
 
 pub use error::{MbmError, Result};
-pub use experience::{Scope, solve_leave_one_out, solve_with_experience};
+pub use experience::{LeaveOneOut, Scope, solve_leave_one_out, solve_with_experience};
 pub use loaded::LoadedProblem;
 pub use peers::{
     CLOUD_POINT_RADIUS, CLOUD_SPACING, CloudBuild, Obstacles, cloud_world, parse_peer_results,

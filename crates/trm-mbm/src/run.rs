@@ -75,8 +75,9 @@ pub struct Benchmark {
     /// Each pass with experience, one run per problem.
     pub experience: Vec<Vec<Run>>,
     /// With experience: each problem planned through the plain run's paths of the other
-    /// problems of its family, then of the set ([`solve_leave_one_out`]), one run per problem.
-    pub leave_one_out: Vec<(Scope, Vec<Run>)>,
+    /// problems of its family, then of the set ([`solve_leave_one_out`]), one run per problem,
+    /// and beside it each problem solved afresh right after.
+    pub leave_one_out: Vec<(Scope, Vec<Run>, Vec<Run>)>,
     /// The run with [`BenchmarkOptions::maps`] attached, one per problem (empty without maps).
     pub with_maps: Vec<Run>,
     /// Whether solved paths were re-checked ([`BenchmarkOptions::verify`]).
@@ -160,7 +161,11 @@ pub fn benchmark(
                 finished += 1;
                 progress(stage, finished, problems.len(), &problems[k])
             })?;
-            leave_one_out.push((scope, runs_of(robot, &loaded, outcomes, options)?));
+            leave_one_out.push((
+                scope,
+                runs_of(robot, &loaded, outcomes.outcomes, options)?,
+                runs_of(robot, &loaded, outcomes.fresh, options)?,
+            ));
         }
     }
     Ok(Benchmark {
@@ -282,14 +287,14 @@ impl Benchmark {
                 md.push_str(&verified_line(runs, "Every path"));
             }
         }
-        for (scope, runs) in &self.leave_one_out {
+        for (scope, runs, fresh) in &self.leave_one_out {
             let through = runs
                 .iter()
                 .filter(|r| r.outcome.solved && r.outcome.note == "experience")
                 .count();
             let _ = write!(
                 md,
-                "\nLeave-one-out experience, {}: each problem planned through the plain run's paths of every other problem of {} (never its own), RRT-Connect where they do not reach; {through} answered through them. Beside the plain run (ratio = leave-one-out / fresh):\n\n{}",
+                "\nLeave-one-out experience, {}: each problem planned through the plain run's paths of every other problem of {} (never its own), RRT-Connect where they do not reach; {through} answered through them. Beside each problem solved afresh right after it (ratio = leave-one-out / fresh):\n\n{}",
                 match scope {
                     Scope::Family => "within the family",
                     Scope::Set => "across the set",
@@ -300,7 +305,7 @@ impl Benchmark {
                 },
                 side_by_side(
                     (&family_outcomes(runs), "leave-one-out"),
-                    (&family_outcomes(&self.runs), "fresh")
+                    (&family_outcomes(fresh), "fresh")
                 )
             );
             if self.verified {

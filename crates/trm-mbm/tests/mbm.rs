@@ -867,9 +867,15 @@ fn leave_one_out_experience_never_sees_the_problem_s_own_path() {
             trm_mbm::solve_leave_one_out(&robot, &loaded, &paths, scope, &options, |_| calls += 1)
                 .unwrap();
         assert_eq!(calls, problems.len());
-        for (p, o) in problems.iter().zip(&outcomes) {
+        for (k, (p, o)) in problems.iter().zip(&outcomes.outcomes).enumerate() {
             assert!(o.solved, "{scope:?} {} {}: {}", p.family, p.index, o.note);
             assert_ne!(o.note, "retrieved", "{scope:?} {} {}", p.family, p.index);
+            // beside it, the problem afresh: the plain run's answer
+            let fresh = &outcomes.fresh[k];
+            assert_eq!(
+                (&fresh.path, fresh.checks),
+                (&plain[k].path, plain[k].checks)
+            );
         }
     }
     // the control: a problem's own path, given under another problem's index, is retrieved
@@ -894,8 +900,9 @@ fn leave_one_out_experience_never_sees_the_problem_s_own_path() {
             |_| {},
         )
         .unwrap();
-        assert_eq!(outcomes[1].note, "retrieved", "{}", outcomes[1].note);
-        assert_ne!(outcomes[0].note, "retrieved");
+        let notes = &outcomes.outcomes;
+        assert_eq!(notes[1].note, "retrieved", "{}", notes[1].note);
+        assert_ne!(notes[0].note, "retrieved");
     }
     let e = trm_mbm::solve_leave_one_out(
         &robot,

@@ -119,7 +119,7 @@ pub struct Args {
     #[arg(long = "map", value_name = "FILE", conflicts_with = "task_space")]
     maps: Vec<PathBuf>,
     /// Where results.csv, results.md and times.svg go (and results-maps.csv with --map,
-    /// results-leave-one-out-{family,set}.csv with --experience).
+    /// results-leave-one-out-{family,set}[-fresh].csv with --experience).
     #[arg(long, default_value = "target/benchmark-mbm")]
     pub out_dir: PathBuf,
 }
@@ -182,12 +182,19 @@ pub fn run(args: &Args) -> Result<()> {
             trm_mbm::runs_csv(&bench.with_maps).into_bytes(),
         ));
     }
-    for (scope, runs) in &bench.leave_one_out {
-        let name = match scope {
-            trm_mbm::Scope::Family => "results-leave-one-out-family.csv",
-            trm_mbm::Scope::Set => "results-leave-one-out-set.csv",
+    for (scope, runs, fresh) in &bench.leave_one_out {
+        let [name, beside] = match scope {
+            trm_mbm::Scope::Family => [
+                "results-leave-one-out-family.csv",
+                "results-leave-one-out-family-fresh.csv",
+            ],
+            trm_mbm::Scope::Set => [
+                "results-leave-one-out-set.csv",
+                "results-leave-one-out-set-fresh.csv",
+            ],
         };
         files.push((name, trm_mbm::runs_csv(runs).into_bytes()));
+        files.push((beside, trm_mbm::runs_csv(fresh).into_bytes()));
     }
     let outcomes: Vec<(&str, &Outcome)> = bench
         .runs

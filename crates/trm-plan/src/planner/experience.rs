@@ -42,6 +42,7 @@ impl Planner {
         if self.kept.is_empty() {
             return;
         }
+        self.graph_changed();
         // the maps' nodes, renumbered; their own edges and joins
         let keep_node = self.map_node.clone();
         let mut renumbered = vec![usize::MAX; self.nodes.len()];
@@ -80,6 +81,7 @@ impl Planner {
         if maps != self.maps {
             return false;
         }
+        self.graph_changed();
         let k = self.kept.len() - 1;
         self.kept_from.pop();
         self.kept.pop();

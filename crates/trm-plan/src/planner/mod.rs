@@ -88,6 +88,10 @@ pub struct Planner {
     node_state: Vec<State>,
     /// Per node: whether a map brought it (else a kept path did).
     map_node: Vec<bool>,
+    /// The nodes (and two for a query's start and goal) and edges as the graph a query
+    /// searches, built on first use and dropped when nodes or edges change
+    /// ([`Planner::graph_changed`]).
+    query_base: Option<petgraph::graph::UnGraph<(), usize>>,
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
     scratch: trm_tasks::Scratch,
@@ -131,6 +135,7 @@ impl Planner {
             node_state: Vec::new(),
             nodes: Vec::new(),
             map_node: Vec::new(),
+            query_base: None,
             edges: Vec::new(),
             edge_state: Vec::new(),
             scratch: objective.scratch(),
@@ -170,6 +175,7 @@ impl Planner {
     /// search first wants them, and each node is joined to its 3 nearest nodes of the graph
     /// already there (maps and kept paths). Returns the number of nodes added.
     pub fn add_map(&mut self, map: &Roadmap) -> Result<usize, PlanError> {
+        self.graph_changed();
         let base = self.nodes.len();
         self.push_map(map, State::Unknown)?;
         for i in base..self.nodes.len() {
@@ -184,6 +190,7 @@ impl Planner {
     /// Adds the next map's nodes and own edges in `state` (an error when its active motors are
     /// not the planner's).
     fn push_map(&mut self, map: &Roadmap, state: State) -> Result<(), PlanError> {
+        self.graph_changed();
         if map
             .active
             .iter()
@@ -211,6 +218,11 @@ impl Planner {
         }
         self.maps += 1;
         Ok(())
+    }
+
+    /// Drops the query graph kept for the nodes and edges: they are about to change.
+    fn graph_changed(&mut self) {
+        self.query_base = None;
     }
 
     /// The current world.
@@ -346,6 +358,7 @@ impl Planner {
                 problem: format!("a waypoint has {} values, not {d} finite ones", bad.len()),
             });
         }
+        self.graph_changed();
         let old = self.nodes.len();
         self.kept_from.push((old, self.edges.len(), self.maps));
         let mut ids = Vec::with_capacity(path.len());

@@ -25,7 +25,7 @@ pub(super) struct LazySearch {
     extra: Vec<Edge>,
     extra_state: Vec<State>,
     /// Built for the first search: the graph and A*'s heuristic (a map node's distance to a
-    /// configuration goal).
+    /// configuration goal), each node's worked out when a search first reaches it.
     graph: Option<(UnGraph<(), usize>, Vec<f64>)>,
     stats: PlanStats,
     /// No path is left through what is not known blocked: more searches cannot help.
@@ -125,19 +125,14 @@ impl Planner {
                 stats,
                 exhausted,
             } = lazy;
-            let (graph, estimate) = graph.get_or_insert_with(|| {
-                let estimate: Vec<f64> = match goal_q {
-                    Some(q) => self
-                        .nodes
-                        .iter()
-                        .map(|(p, _)| super::distance(p, q))
-                        .collect(),
-                    None => Vec::new(),
-                };
-                (self.query_graph(extra), estimate)
-            });
+            // A*'s heuristic, worked out for the nodes a search reaches (NaN: not yet)
+            if graph.is_none() {
+                *graph = Some((self.query_graph(extra), vec![f64::NAN; n]));
+            }
+            let (graph, estimate) = graph.as_mut().expect("made above");
             let target = Target { goal, n };
-            let path = match self.search(graph, extra, extra_state, &target, estimate) {
+            let to = goal_q.as_deref();
+            let path = match self.search(graph, extra, extra_state, &target, to, estimate) {
                 Ok(path) => path,
                 Err(reachable) => {
                     *exhausted = true;
@@ -170,21 +165,38 @@ impl Planner {
     }
 
     /// The graph a query searches: the map and kept nodes, the start (node n) and goal
-    /// (node n + 1), and every edge (the graph's, then `extra`), weighted by its index.
-    pub(super) fn query_graph(&self, extra: &[Edge]) -> UnGraph<(), usize> {
-        let total = self.nodes.len() + 2;
-        let mut graph = UnGraph::<(), usize>::with_capacity(total, self.edges.len() + extra.len());
-        for _ in 0..total {
-            graph.add_node(());
-        }
-        for (k, &(a, b, _)) in self.edges.iter().chain(extra).enumerate() {
-            graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
+    /// (node n + 1), and every edge (the graph's, then `extra`), weighted by its index. The
+    /// part without `extra` is built once for the planner's graph and copied per query.
+    pub(super) fn query_graph(&mut self, extra: &[Edge]) -> UnGraph<(), usize> {
+        let (nodes, edges) = (self.nodes.len(), &self.edges);
+        let mut graph = self
+            .query_base
+            .get_or_insert_with(|| {
+                let mut graph = UnGraph::<(), usize>::with_capacity(nodes + 2, edges.len());
+                for _ in 0..nodes + 2 {
+                    graph.add_node(());
+                }
+                for (k, &(a, b, _)) in edges.iter().enumerate() {
+                    graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), k);
+                }
+                graph
+            })
+            .clone();
+        debug_assert_eq!(
+            (graph.node_count(), graph.edge_count()),
+            (nodes + 2, self.edges.len()),
+            "the query graph was kept past a change of the planner's graph"
+        );
+        graph.reserve_edges(extra.len());
+        for (k, &(a, b, _)) in extra.iter().enumerate() {
+            graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), self.edges.len() + k);
         }
         graph
     }
 
     /// A* on `graph` ([`Planner::query_graph`]) from the start (node n) to a goal node over the
-    /// nodes and edges not known invalid, `estimate[v]` the heuristic of map node v: the path's
+    /// nodes and edges not known invalid, `estimate[v]` the heuristic of map node v (its
+    /// distance to the configuration goal `goal_q`, worked out where NaN): the path's
     /// nodes, each with the edge that reaches it (`usize::MAX` for the first; edges past the
     /// map's are `extra`'s). Without a path, the map nodes reachable from the start.
     pub(super) fn search(
@@ -193,7 +205,8 @@ impl Planner {
         extra: &[Edge],
         extra_state: &[State],
         target: &Target,
-        estimate: &[f64],
+        goal_q: Option<&[f64]>,
+        estimate: &mut [f64],
     ) -> Result<Vec<(usize, usize)>, Vec<usize>> {
         let n = target.n;
         let node_ok = |i: usize| i >= n || self.node_state[i] != State::Invalid;
@@ -221,7 +234,15 @@ impl Planner {
             NodeIndex::new(n),
             |v| target.holds(v.index(), &self.nodes),
             |e| length(*e.weight()),
-            |v| estimate.get(v.index()).copied().unwrap_or(0.0),
+            |v| match (goal_q, estimate.get_mut(v.index())) {
+                (Some(q), Some(e)) => {
+                    if e.is_nan() {
+                        *e = super::distance(&self.nodes[v.index()].0, q);
+                    }
+                    *e
+                }
+                _ => 0.0,
+            },
         );
         let Some((_, path)) = found else {
             let reachable =
