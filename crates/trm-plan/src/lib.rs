@@ -27,9 +27,9 @@ mod trajectory;
 
 pub use error::PlanError;
 pub use planner::{
-    Connection, EXPERIENCE_FORMAT, EXPERIENCE_VERSION, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK,
-    GRAPH_TURNS, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner, RETRIEVE_STEPS, ROUND_GROWTH,
-    Source,
+    Connection, EXPERIENCE_FORMAT, EXPERIENCE_VERSION, GOAL_ATTEMPTS, GRAPH_MEMORY,
+    GRAPH_SEARCH_WORK, GRAPH_TURNS, HEAD_START_SAMPLES, MAX_GRAPH_SEARCHES, Planner,
+    RETRIEVE_STEPS, ROUND_GROWTH, Source,
 };
 pub use query::{EXACT_WEIGHT, ExactGoal, Goal, PlanOptions, PlanStats, Planned};
 pub use scenario::{

@@ -76,8 +76,10 @@ impl Planner {
     ///   then
     ///   RRT-Connect alone within the rest of the budget. The graph's path is shortcut
     ///   greedily and checked at half the resolution as RRT-Connect's paths are. The graph's
-    ///   share of a query's effort shrinks as the query lasts: a map blocked in the scene
-    ///   costs a query a search or two, a map that joins the two answers a hard query early.
+    ///   share of a query's effort shrinks as the query lasts, and as its turns in recent
+    ///   queries fail ([`Planner::graph_share`]): a map blocked in the scene costs a query a
+    ///   search or two, and less in the queries after; a map that joins the two answers a
+    ///   hard query early.
     ///
     /// Nothing is kept: a caller keeping experience adds the path ([`Planner::add_path`]) when
     /// [`Connection::source`] is [`Source::Sampled`].
@@ -146,12 +148,13 @@ impl Planner {
             let checks = (self.checker.checks - before) as f64;
             if spent {
                 searches = most;
-            } else if work + turn_work > GRAPH_SHARE * ELEMENTS_PER_CHECK * checks {
+            } else if work + turn_work > self.graph_share() * ELEMENTS_PER_CHECK * checks {
                 samples = samples.saturating_mul(ROUND_GROWTH);
                 continue;
             }
             work += turn_work;
             if let Some(found) = self.through_graph(start, goal, options, &mut lazy, searches)? {
+                self.graph_record.paid();
                 return Ok(Connection {
                     checks: self.checker.checks - before,
                     iterations: growth.iterations(),
@@ -166,6 +169,9 @@ impl Planner {
             searches = (searches + step).min(most);
         }
         // the trees met, or the graph did not answer: RRT-Connect goes on
+        if work > 0.0 {
+            self.graph_record.unpaid();
+        }
         match growth.finish(&mut self.checker, &self.bounds, options, began) {
             Ok(found) => Ok(self.sampled(found, began, before)),
             Err(e) => Err(self.name_collisions(e, start, goal)),
@@ -389,6 +395,44 @@ pub const GOAL_ATTEMPTS: usize = 500;
 /// answers within them are answered as without a graph.
 pub const HEAD_START_SAMPLES: usize = 64;
 
+/// Of the last queries in which [`Planner::connect`]'s graph took a turn, how many it answered:
+/// the graph's share of a query's effort follows it ([`Planner::graph_share`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct GraphRecord {
+    paid: f64,
+    unpaid: f64,
+}
+
+/// The queries [`GraphRecord`] remembers, about: past this, both counts are halved, so that a
+/// graph that starts answering (a world where it is free again) gets its share back within a
+/// few queries.
+pub const GRAPH_MEMORY: f64 = 16.0;
+
+impl GraphRecord {
+    fn paid(&mut self) {
+        self.paid += 1.0;
+        self.forget_old();
+    }
+
+    fn unpaid(&mut self) {
+        self.unpaid += 1.0;
+        self.forget_old();
+    }
+
+    fn forget_old(&mut self) {
+        if self.paid + self.unpaid > GRAPH_MEMORY {
+            self.paid /= 2.0;
+            self.unpaid /= 2.0;
+        }
+    }
+
+    /// The share of the turns that answered, counting one answered beforehand (1 with no
+    /// record).
+    fn rate(&self) -> f64 {
+        (self.paid + 1.0) / (self.paid + self.unpaid + 1.0)
+    }
+}
+
 /// How many times more samples RRT-Connect draws in each of [`Planner::connect`]'s rounds
 /// than in all rounds before, while the graph's turns stay the same size: the longer a query
 /// has run, the smaller the graph's share of its effort.
@@ -397,7 +441,8 @@ pub const ROUND_GROWTH: usize = 4;
 /// The most [`Planner::connect`]'s turns through the graph may visit, in graph elements, for
 /// every element's worth of RRT-Connect's collision checks so far (see
 /// [`ELEMENTS_PER_CHECK`]): a graph whose searches cost more than this share of a query's
-/// sampling waits for a later round.
+/// sampling waits for a later round. Scaled by how the graph's recent turns fared
+/// ([`Planner::graph_share`]).
 pub const GRAPH_SHARE: f64 = 0.25;
 
 /// Graph elements (nodes and edges) a lazy A* search visits in the time of one collision
@@ -448,6 +493,14 @@ impl Planner {
     /// its searches in its first turn).
     pub fn graph_turn_searches(&self) -> usize {
         (GRAPH_SEARCH_WORK / GRAPH_TURNS / self.graph_elements()).clamp(1, self.graph_searches())
+    }
+
+    /// The most of a query's effort [`Planner::connect`] gives the graph: [`GRAPH_SHARE`] times
+    /// the share of its recent turns that answered (one answered counted beforehand, the last
+    /// [`GRAPH_MEMORY`] queries or so): a graph that keeps failing (kept paths of other scenes,
+    /// a map blocked here) costs less and less, one that answers keeps its share.
+    pub fn graph_share(&self) -> f64 {
+        GRAPH_SHARE * self.graph_record.rate()
     }
 
     /// The graph's nodes and edges (at least 1).
@@ -578,3 +631,39 @@ impl Planner {
 
 /// Colliding pairs an error names (the deepest first); the rest are counted.
 const MAX_NAMED: usize = 5;
+
+#[cfg(test)]
+mod tests {
+    use super::{GRAPH_MEMORY, GraphRecord};
+
+    /// Turns that fail shrink the graph's share to about 1 / GRAPH_MEMORY and no further; a
+    /// turn that answers lifts it at once.
+    #[test]
+    fn the_graphs_share_follows_its_recent_turns() {
+        let mut record = GraphRecord::default();
+        assert_eq!(record.rate(), 1.0);
+        for _ in 0..3 {
+            record.unpaid();
+        }
+        assert_eq!(record.rate(), 0.25);
+        // past the memory the counts are halved: the share stays between about 1/GRAPH_MEMORY
+        // and twice that
+        for _ in 0..100 {
+            record.unpaid();
+            let rate = record.rate();
+            assert!(rate > 1.0 / (GRAPH_MEMORY + 2.0) && rate < 0.25, "{rate}");
+        }
+        assert!(record.rate() < 2.5 / GRAPH_MEMORY, "{}", record.rate());
+        let before = record.rate();
+        record.paid();
+        assert!(
+            record.rate() > 1.5 * before,
+            "{} after {before}",
+            record.rate()
+        );
+        for _ in 0..10 {
+            record.paid();
+        }
+        assert!(record.rate() > 0.5, "{}", record.rate());
+    }
+}

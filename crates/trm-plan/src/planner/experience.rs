@@ -43,6 +43,8 @@ impl Planner {
             return;
         }
         self.graph_changed();
+        // what the forgotten paths were worth says nothing of the next ones
+        self.graph_record = Default::default();
         // the maps' nodes, renumbered; their own edges and joins
         let keep_node = self.map_node.clone();
         let mut renumbered = vec![usize::MAX; self.nodes.len()];

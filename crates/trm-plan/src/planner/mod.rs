@@ -20,7 +20,7 @@ mod held;
 mod search;
 mod timed;
 pub use connect::{
-    Connection, GOAL_ATTEMPTS, GRAPH_SEARCH_WORK, GRAPH_TURNS, HEAD_START_SAMPLES,
+    Connection, GOAL_ATTEMPTS, GRAPH_MEMORY, GRAPH_SEARCH_WORK, GRAPH_TURNS, HEAD_START_SAMPLES,
     MAX_GRAPH_SEARCHES, ROUND_GROWTH, Source,
 };
 pub use experience::{EXPERIENCE_FORMAT, EXPERIENCE_VERSION};
@@ -92,6 +92,8 @@ pub struct Planner {
     /// searches, built on first use and dropped when nodes or edges change
     /// ([`Planner::graph_changed`]).
     query_base: Option<petgraph::graph::UnGraph<(), usize>>,
+    /// How [`Planner::connect`]'s recent turns through the graph fared.
+    graph_record: connect::GraphRecord,
     edges: Vec<(usize, usize, f64)>,
     edge_state: Vec<State>,
     scratch: trm_tasks::Scratch,
@@ -136,6 +138,7 @@ impl Planner {
             nodes: Vec::new(),
             map_node: Vec::new(),
             query_base: None,
+            graph_record: Default::default(),
             edges: Vec::new(),
             edge_state: Vec::new(),
             scratch: objective.scratch(),
