@@ -76,7 +76,7 @@ pub struct Benchmark {
     pub experience: Vec<Vec<Run>>,
     /// With experience: each problem planned through the plain run's paths of the other
     /// problems of its family, then of the set ([`solve_leave_one_out`]), one run per problem,
-    /// and beside it each problem solved afresh right after.
+    /// and beside it each problem solved afresh right before or after, in turn.
     pub leave_one_out: Vec<(Scope, Vec<Run>, Vec<Run>)>,
     /// The run with [`BenchmarkOptions::maps`] attached, one per problem (empty without maps).
     pub with_maps: Vec<Run>,
@@ -302,7 +302,7 @@ impl Benchmark {
                 .count();
             let _ = write!(
                 md,
-                "\nLeave-one-out experience, {}: each problem planned through the plain run's paths of every other problem of {} (never its own), RRT-Connect where they do not reach; {through} answered through them. Beside each problem solved afresh right after it (ratio = leave-one-out / fresh):\n\n{}",
+                "\nLeave-one-out experience, {}: each problem planned through the plain run's paths of every other problem of {} (never its own), RRT-Connect where they do not reach; {through} answered through them. Beside each problem solved afresh right before or after it, in turn (ratio = leave-one-out / fresh):\n\n{}",
                 match scope {
                     Scope::Family => "within the family",
                     Scope::Set => "across the set",
