@@ -11,39 +11,10 @@ use nalgebra::Isometry3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
-use trm_benches::random_configurations;
+use trm_benches::{random_configurations, sampled_table_scene, table_scene};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, Shape, World};
 use trm_kinematics::RobotModel;
-
-/// A table with a box on it and a shelf board above, in front of the Panda.
-fn primitives() -> World {
-    let mut world = World::new();
-    for (name, size, xyz) in [
-        ("table", [0.8, 1.2, 0.05], [0.6, 0.0, 0.2]),
-        ("box", [0.15, 0.1, 0.2], [0.5, 0.2, 0.325]),
-        ("board", [0.3, 0.8, 0.02], [0.55, 0.0, 0.8]),
-    ] {
-        let pose = Isometry3::translation(xyz[0], xyz[1], xyz[2]);
-        world.add(name, Shape::Box { size }, pose).expect("valid");
-    }
-    world
-}
-
-/// The same scene as a camera would give it: `per_object` points on each object's surface.
-fn sampled(per_object: usize) -> World {
-    let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let mut world = World::new();
-    for o in primitives().objects() {
-        let points = o.shape().surface_samples(per_object, &mut rng);
-        let cloud = Shape::Points {
-            points,
-            radius: 0.0025,
-        };
-        world.add(o.name(), cloud, *o.pose()).expect("valid");
-    }
-    world
-}
 
 /// A closed triangle mesh of a ball: `n` bands of latitude, `2n` of longitude.
 fn ball_mesh(radius: f64, n: u32) -> Shape {
@@ -112,7 +83,7 @@ fn clouds(c: &mut Criterion) {
     // the whole scene as one cloud, as MotionBenchMaker's --cloud makes it: 10 000 points on
     // each object, thinned to 2 cm (about 6 000 points over a metre)
     let mut scene_points = Vec::new();
-    for o in sampled(10_000).objects() {
+    for o in sampled_table_scene(10_000).objects() {
         if let Shape::Points { points, .. } = o.shape() {
             scene_points.extend(
                 points
@@ -143,7 +114,7 @@ fn clouds(c: &mut Criterion) {
     let mut busy = scene.clone();
     busy.add("bowl", bowl, Isometry3::translation(0.5, -0.3, 0.3))
         .expect("valid");
-    for (name, world) in primitives().objects().iter().map(|o| (o.name(), o)) {
+    for (name, world) in table_scene().objects().iter().map(|o| (o.name(), o)) {
         busy.add(
             &format!("{name}_solid"),
             world.shape().clone(),
@@ -170,9 +141,9 @@ fn clouds(c: &mut Criterion) {
     let qs: Vec<f64> = random_configurations(&active, 8 * 256, 3).concat();
     let d = active.len();
     for (name, world) in [
-        ("primitives", primitives()),
-        ("cloud_3x1000", sampled(1000)),
-        ("cloud_3x10000", sampled(10_000)),
+        ("primitives", table_scene()),
+        ("cloud_3x1000", sampled_table_scene(1000)),
+        ("cloud_3x10000", sampled_table_scene(10_000)),
     ] {
         let fast = checker.model().world(&world);
         let free = qs

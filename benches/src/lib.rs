@@ -1,9 +1,42 @@
 //! Shared inputs for trm's criterion benches (`cargo bench -p trm-benches`). The suites are in
 //! `benches/benches/`.
 
+use nalgebra::Isometry3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use trm_collision::{Shape, World};
 use trm_kinematics::ActiveSet;
+
+/// A table with a box on it and a shelf board above, in front of a Panda at the origin: the
+/// point-cloud benches' scene as primitives.
+pub fn table_scene() -> World {
+    let mut world = World::new();
+    for (name, size, xyz) in [
+        ("table", [0.8, 1.2, 0.05], [0.6, 0.0, 0.2]),
+        ("box", [0.15, 0.1, 0.2], [0.5, 0.2, 0.325]),
+        ("board", [0.3, 0.8, 0.02], [0.55, 0.0, 0.8]),
+    ] {
+        let pose = Isometry3::translation(xyz[0], xyz[1], xyz[2]);
+        world.add(name, Shape::Box { size }, pose).expect("valid");
+    }
+    world
+}
+
+/// [`table_scene`] as a camera would give it: `per_object` seeded points on each object's
+/// surface, points of 2.5 mm.
+pub fn sampled_table_scene(per_object: usize) -> World {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut world = World::new();
+    for o in table_scene().objects() {
+        let points = o.shape().surface_samples(per_object, &mut rng);
+        let cloud = Shape::Points {
+            points,
+            radius: 0.0025,
+        };
+        world.add(o.name(), cloud, *o.pose()).expect("valid");
+    }
+    world
+}
 
 /// `n` seeded uniform samples within the bounds of `active`.
 pub fn random_configurations(active: &ActiveSet, n: usize, seed: u64) -> Vec<Vec<f64>> {

@@ -7,10 +7,12 @@
 //! Most queries end before that, at their cell's clearance: near the points, the distance from
 //! the cell to the box about each nearby cell's points (a few cells about every occupied one,
 //! written row by row); farther, a distance transform of the occupied cells, truncated where
-//! no link's bounding sphere reaches. Building costs a sort of the points, a window of cells
-//! per occupied cell and a few passes over the cells — the difference from CAPT (Ramsey et
-//! al., RSS 2024), which stores, for every leaf of a k-d tree, every point its queries could
-//! reach.
+//! no link's bounding sphere reaches. Deep among the points a query ends at its cell's
+//! witness, a point near the cell: one within the sphere settles a collision. A walk that
+//! stops at the first collision leaves the remaining scans for its end, where most blocks
+//! never arrive. Building costs a sort of the points, a window of cells per occupied cell and
+//! a few passes over the cells — the difference from CAPT (Ramsey et al., RSS 2024), which
+//! stores, for every leaf of a k-d tree, every point its queries could reach.
 //!
 //! **Exact, as the other objects**: the scan finds the nearest point among all those within the
 //! query's range (its reach plus the margin, padded by a few units of rounding), so the
@@ -43,6 +45,10 @@ pub(super) struct CloudGrid {
     /// Per cell: no point of the cloud lies nearer than this to any place in the cell, m
     /// ([`near_clearances`]): most queries end at this one look-up.
     clear: Vec<f32>,
+    /// Per cell: a point of the cloud near it, coordinate by coordinate ([`witnesses`];
+    /// infinite where none is near): a query about a place in the cell that finds it within
+    /// its reach ends there.
+    witness: [Vec<f32>; 3],
     /// The points' coordinates, cell by cell.
     xyz: [Vec<f32>; 3],
     /// Added to every query's range: a few units of rounding of the largest coordinate, so
@@ -67,8 +73,8 @@ const MESH_SAMPLES: usize = 1 << 21;
 impl CloudGrid {
     /// The points in a grid of cells about `cell` wide (coarser when the cloud is sparse and
     /// wide; see [`CELLS_PER_POINT`]), each cell's clearance exact up to about `near` (see
-    /// [`near_clearances`]) and bounded up to about `far` ([`far_clearances`]). `points` must
-    /// be finite and not empty.
+    /// [`near_clearances`]) and bounded up to about `far` ([`far_clearances`]), and its
+    /// witness ([`witnesses`]). `points` must be finite and not empty.
     pub(super) fn new(points: &[[f32; 3]], cell: f32, near: f32, far: f32) -> CloudGrid {
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
@@ -122,6 +128,7 @@ impl CloudGrid {
         let far = far_clearances(&starts, dims, cell, far_cells);
         let cells_near = ((near / cell).ceil() as usize).clamp(1, NEAR_CELLS);
         let clear = near_clearances(&starts, &xyz, lo, dims, cell, cells_near, far);
+        let witness = witnesses(&starts, &xyz, lo, dims, cell, cells_near.min(WITNESS_CELLS));
 
         let largest = (0..3)
             .map(|k| lo[k].abs().max(hi[k].abs()))
@@ -133,6 +140,7 @@ impl CloudGrid {
             dims,
             starts,
             clear,
+            witness,
             xyz,
             slack: 16.0 * f32::EPSILON * (largest + cell),
             center: std::array::from_fn(|k| 0.5 * (lo[k] + hi[k])),
@@ -186,12 +194,18 @@ impl CloudGrid {
     /// place in the box is at least as near every point as `p`).
     #[inline(always)]
     pub(super) fn clearance(&self, p: [f32; 3]) -> f32 {
+        self.clear[self.cell_index(p)]
+    }
+
+    /// The index of the cell nearest `p`.
+    #[inline(always)]
+    fn cell_index(&self, p: [f32; 3]) -> usize {
         // truncation is the floor of what is not negative
         let i: [usize; 3] = std::array::from_fn(|k| {
             let v = (p[k] - self.origin[k]) * self.inv_cell;
             (v.max(0.0) as usize).min(self.dims[k] - 1)
         });
-        self.clear[i[0] + self.dims[0] * (i[1] + self.dims[1] * i[2])]
+        i[0] + self.dims[0] * (i[1] + self.dims[1] * i[2])
     }
 
     /// The lanes of `lanes` whose sphere at `c` of radius `reach` may touch a point's centre
@@ -209,30 +223,35 @@ impl CloudGrid {
             #[allow(unsafe_code)]
             return lanes & unsafe { self.may_touch_avx(c, reach + self.slack) };
         }
-        let mut out = 0;
-        for l in 0..FAST_LANES {
-            if lanes & (1 << l) == 0 {
-                continue;
-            }
-            let p = [c[0].0[l], c[1].0[l], c[2].0[l]];
-            if !p.iter().all(|v| v.is_finite()) || self.clearance(p) <= reach + self.slack {
-                out |= 1 << l;
-            }
-        }
-        out
+        lanes_where(c, lanes, true, |p| self.clearance(p) <= reach + self.slack)
     }
 
-    /// [`CloudGrid::may_touch`] in every lane at once: the cells' indices in vector
-    /// instructions, their clearances gathered (the same arithmetic as
-    /// [`CloudGrid::clearance`]), the lanes within `reach` or not finite.
+    /// [`CloudGrid::may_touch`] in every lane at once: the cells' clearances gathered.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     fn may_touch_avx(&self, c: &[F; 3], reach: f32) -> LaneMask {
         use std::arch::x86_64::{
-            _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_add_epi32, _mm256_and_ps, _mm256_andnot_ps,
-            _mm256_cmp_ps, _mm256_cvttps_epi32, _mm256_i32gather_ps, _mm256_load_ps, _mm256_max_ps,
-            _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_mullo_epi32,
-            _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
+            _CMP_NGT_UQ, _mm256_cmp_ps, _mm256_i32gather_ps, _mm256_movemask_ps, _mm256_set1_ps,
+        };
+        let (cell, finite) = self.cells_avx(c);
+        // SAFETY: every index lies in the grid, `clear` holds one value per cell
+        #[allow(unsafe_code)]
+        let clear = unsafe { _mm256_i32gather_ps::<4>(self.clear.as_ptr(), cell) };
+        let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(reach));
+        // (a mask's eight bits: one per lane)
+        (_mm256_movemask_ps(within) as LaneMask) | !(_mm256_movemask_ps(finite) as LaneMask)
+    }
+
+    /// Per lane, the index of the cell nearest `c` (the same arithmetic as
+    /// [`CloudGrid::cell_index`]: every index lies in the grid) and whether `c` is finite.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn cells_avx(&self, c: &[F; 3]) -> (std::arch::x86_64::__m256i, std::arch::x86_64::__m256) {
+        use std::arch::x86_64::{
+            _CMP_LT_OQ, _mm256_add_epi32, _mm256_and_ps, _mm256_andnot_ps, _mm256_cmp_ps,
+            _mm256_cvttps_epi32, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_mul_ps,
+            _mm256_mullo_epi32, _mm256_set1_epi32, _mm256_set1_ps, _mm256_setzero_ps,
+            _mm256_sub_ps,
         };
         let index = |k: usize| {
             // SAFETY: `F` is eight `f32` aligned to 32 bytes
@@ -251,7 +270,6 @@ impl CloudGrid {
             (_mm256_cvttps_epi32(v), ok)
         };
         let ((i, a), (j, b), (k, d)) = (index(0), index(1), index(2));
-        let finite = _mm256_and_ps(a, _mm256_and_ps(b, d));
         let (d0, d1) = (self.dims[0] as i32, self.dims[1] as i32);
         let cell = _mm256_add_epi32(
             i,
@@ -260,13 +278,64 @@ impl CloudGrid {
                 _mm256_add_epi32(j, _mm256_mullo_epi32(_mm256_set1_epi32(d1), k)),
             ),
         );
-        // SAFETY: every index lies in the grid (clamped to its cells), `clear` holds one
-        // value per cell
-        #[allow(unsafe_code)]
-        let clear = unsafe { _mm256_i32gather_ps::<4>(self.clear.as_ptr(), cell) };
-        let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(reach));
-        // (a mask's eight bits: one per lane)
-        (_mm256_movemask_ps(within) as LaneMask) | !(_mm256_movemask_ps(finite) as LaneMask)
+        (cell, _mm256_and_ps(a, _mm256_and_ps(b, d)))
+    }
+
+    /// The lanes of `lanes` whose cell's witness lies within `inside` of `c`: those whose sphere
+    /// at `c` of radius `inside` certainly holds a point's centre (NaN lanes never).
+    #[inline(always)]
+    pub(super) fn holding<const AVX: bool>(
+        &self,
+        c: &[F; 3],
+        inside: f32,
+        lanes: LaneMask,
+    ) -> LaneMask {
+        let inside = inside - self.slack;
+        if inside <= 0.0 {
+            return 0;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return lanes & unsafe { self.holding_avx(c, inside * inside) };
+        }
+        lanes_where(c, lanes, false, |p| {
+            let i = self.cell_index(p);
+            let d2: f32 = (0..3).map(|k| (self.witness[k][i] - p[k]).powi(2)).sum();
+            d2 < inside * inside
+        })
+    }
+
+    /// [`CloudGrid::holding`] in every lane at once: the cells' witnesses gathered.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn holding_avx(&self, c: &[F; 3], inside2: f32) -> LaneMask {
+        use std::arch::x86_64::{
+            _CMP_LT_OQ, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_i32gather_ps, _mm256_load_ps,
+            _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps,
+        };
+        let (cell, _) = self.cells_avx(c);
+        let mut d2 = _mm256_set1_ps(0.0);
+        for (k, witness) in self.witness.iter().enumerate() {
+            // SAFETY: `F` is eight `f32` aligned to 32 bytes; every index lies in the grid
+            // (clamped to its cells), `witness` holds one value per cell
+            #[allow(unsafe_code)]
+            let (p, w) = unsafe {
+                (
+                    _mm256_load_ps(c[k].0.as_ptr()),
+                    _mm256_i32gather_ps::<4>(witness.as_ptr(), cell),
+                )
+            };
+            let d = _mm256_sub_ps(w, p);
+            d2 = if k == 0 {
+                _mm256_mul_ps(d, d)
+            } else {
+                _mm256_fmadd_ps(d, d, d2)
+            };
+        }
+        // (NaN lanes fail the comparison)
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inside2))) as LaneMask
     }
 
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.
@@ -379,19 +448,32 @@ impl CloudGrid {
     }
 
     /// Per lane of `lanes`, [`CloudGrid::nearest2`] of the point at `c` (NaN where `c` is not
-    /// finite: never certainly clear); infinity in the other lanes, and with `first`, in the
-    /// lanes after the first one found below `stop2`.
+    /// finite: never certainly clear), −1 in the lanes of `certain` (known to hold a point
+    /// within `√stop2`: they are not scanned); infinity in the other lanes, and with `first`,
+    /// in the lanes after the first one found below `stop2` (all but `certain` when it has
+    /// any).
     pub(super) fn distance2(
         &self,
         c: &[F; 3],
         range: f32,
         stop2: f32,
         lanes: LaneMask,
+        certain: LaneMask,
         first: bool,
     ) -> F {
         let mut out = [f32::INFINITY; FAST_LANES];
+        if certain != 0 {
+            for (l, d2) in out.iter_mut().enumerate() {
+                if certain & (1 << l) != 0 {
+                    *d2 = -1.0;
+                }
+            }
+            if first {
+                return F(out);
+            }
+        }
         for (l, d2) in out.iter_mut().enumerate() {
-            if lanes & (1 << l) == 0 {
+            if (lanes & !certain) & (1 << l) == 0 {
                 continue;
             }
             let p = [c[0].0[l], c[1].0[l], c[2].0[l]];
@@ -406,6 +488,30 @@ impl CloudGrid {
         }
         F(out)
     }
+}
+
+/// The lanes of `lanes` whose place in `c` passes `test`, or is not finite and `not_finite`.
+#[inline(always)]
+fn lanes_where(
+    c: &[F; 3],
+    lanes: LaneMask,
+    not_finite: bool,
+    test: impl Fn([f32; 3]) -> bool,
+) -> LaneMask {
+    let mut out = 0;
+    for l in 0..FAST_LANES {
+        if lanes & (1 << l) == 0 {
+            continue;
+        }
+        let p = [c[0].0[l], c[1].0[l], c[2].0[l]];
+        let pass = if p.iter().all(|v| v.is_finite()) {
+            test(p)
+        } else {
+            not_finite
+        };
+        out |= LaneMask::from(pass) << l;
+    }
+    out
 }
 
 /// Per cell of a grid of `dims` cells of side `cell` whose points start at `starts`: a
@@ -472,6 +578,64 @@ fn min_plus(from: &[f32], to: &mut [f32], width: usize, n: usize, t: usize, cap:
 
 /// Most cells of [`far_clearances`]'s window along each axis.
 const FAR_CELLS: usize = 16;
+
+/// Most cells about an occupied cell that [`witnesses`] gives its point, along each axis.
+const WITNESS_CELLS: usize = 1;
+
+/// Per cell of a grid of `dims` cells of side `cell` from `lo` holding the points `xyz` (from
+/// `starts` per cell), a point near it, coordinate by coordinate: among the occupied cells
+/// within `k` cells along every axis, each represented by its point nearest its centre, the
+/// representative nearest the cell's centre (infinite coordinates where no cell is that
+/// near). Any point of the cloud bounds a query's distance from above; this one is near the
+/// nearest wherever the cloud is dense.
+fn witnesses(
+    starts: &[u32],
+    xyz: &[Vec<f32>; 3],
+    lo: [f32; 3],
+    dims: [usize; 3],
+    cell: f32,
+    k: usize,
+) -> [Vec<f32>; 3] {
+    let cells = dims[0] * dims[1] * dims[2];
+    let mut best = vec![f32::INFINITY; cells];
+    let mut which = vec![u32::MAX; cells];
+    let centre = |axis: usize, i: usize| lo[axis] + (i as f32 + 0.5) * cell;
+    let span = |axis: usize, i: usize| i.saturating_sub(k)..=(i + k).min(dims[axis] - 1);
+    for (c, run) in starts.windows(2).enumerate() {
+        let (from, to) = (run[0] as usize, run[1] as usize);
+        if from == to {
+            continue;
+        }
+        let home = [c % dims[0], c / dims[0] % dims[1], c / (dims[0] * dims[1])];
+        let d2 =
+            |i: usize, at: [f32; 3]| -> f32 { (0..3).map(|a| (xyz[a][i] - at[a]).powi(2)).sum() };
+        let here: [f32; 3] = std::array::from_fn(|a| centre(a, home[a]));
+        let chosen = (from..to)
+            .min_by(|&a, &b| d2(a, here).total_cmp(&d2(b, here)))
+            .expect("an occupied cell");
+        let p: [f32; 3] = std::array::from_fn(|a| xyz[a][chosen]);
+        for z in span(2, home[2]) {
+            let dz2 = (centre(2, z) - p[2]).powi(2);
+            for y in span(1, home[1]) {
+                let dyz2 = dz2 + (centre(1, y) - p[1]).powi(2);
+                let row = dims[0] * (y + dims[1] * z);
+                for x in span(0, home[0]) {
+                    let d = dyz2 + (centre(0, x) - p[0]).powi(2);
+                    if d < best[row + x] {
+                        best[row + x] = d;
+                        which[row + x] = chosen as u32;
+                    }
+                }
+            }
+        }
+    }
+    std::array::from_fn(|a| {
+        which
+            .iter()
+            .map(|&i| xyz[a].get(i as usize).copied().unwrap_or(f32::INFINITY))
+            .collect()
+    })
+}
 
 /// Most cells about a point whose clearances [`near_clearances`] makes exact, along each axis.
 const NEAR_CELLS: usize = 4;
@@ -677,6 +841,11 @@ mod tests {
                     .fold(f32::INFINITY, f32::min);
                 let found = grid.nearest2(p, range, 0.0);
                 let clearance = grid.clearance(p);
+                // a lane the witness settles has a point within its sphere
+                let c = p.map(|v| F([v; FAST_LANES]));
+                if grid.holding::<false>(&c, range, 1) != 0 {
+                    assert!(brute < range * range, "case {case}: {p:?} holds none");
+                }
                 assert!(
                     clearance * clearance <= brute,
                     "case {case}: clearance {clearance}, nearest {}",
@@ -733,6 +902,20 @@ mod tests {
             count > 500 && short < 0.75 * cell,
             "{count} near: {short} short on average"
         );
+        // within a cell of the board, a sphere of two cells holds a point by its cell's witness
+        // alone
+        let (mut held, mut tried) = (0, 0);
+        for _ in 0..1000 {
+            let p = [
+                rng.random_range(0.0..0.78),
+                rng.random_range(0.0..0.58),
+                0.5 + rng.random_range(-1.0..1.0) * cell,
+            ];
+            let c = p.map(|v| F([v; FAST_LANES]));
+            held += grid.holding::<false>(&c, 2.0 * cell, 1).count_ones();
+            tried += 1;
+        }
+        assert!(held * 10 > tried * 9, "{held} of {tried} held by a witness");
     }
 
     /// The vector instructions' lanes near a cloud (cells' indices, gathered clearances) are
@@ -767,6 +950,11 @@ mod tests {
             assert_eq!(
                 grid.may_touch::<true>(&c, reach, lanes),
                 plain,
+                "{c:?} {reach}"
+            );
+            assert_eq!(
+                grid.holding::<true>(&c, reach, lanes),
+                grid.holding::<false>(&c, reach, lanes),
                 "{c:?} {reach}"
             );
             flagged += plain.count_ones();

@@ -200,7 +200,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
                 return;
             }
         }
-        clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
+        clear_suspects::<AVX, _>(model, poses, world, scratch, verdict);
         return;
     }
     let steps = &model.steps;
@@ -235,7 +235,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         }
         i += 1;
     }
-    clear_suspects::<AVX, _>(model, poses, scratch, m, verdict);
+    clear_suspects::<AVX, _>(model, poses, world, scratch, verdict);
 }
 
 /// Whether a sphere at `c` of radius `reach` (in some lane of `live`) comes within object
@@ -309,19 +309,28 @@ pub(super) fn last_hit_again<const AVX: bool, O: Outcome>(
 }
 
 /// `verdict` without the link-pair suspects' lanes in which either link's spheres all lie
-/// beyond a slab of the other's k-DOP (when both are convex hulls): a second, tighter screen
-/// that only a block left uncertain pays for, before its lanes are checked exactly.
+/// beyond a slab of the other's k-DOP (when both are convex hulls), and with the point clouds'
+/// scans the walk left for its end ([`scan_clouds`]): a second, tighter screen that only a
+/// block left uncertain pays for, before its lanes are checked exactly.
 #[inline(always)]
 pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
     model: &FastModel,
     poses: &[PoseLanes32],
+    world: &FastWorld,
     scratch: &mut FastScratch,
-    m: f32,
     verdict: &mut O,
 ) {
-    if verdict.settled() || *verdict.uncertain() == 0 || model.exact {
+    if verdict.settled() || *verdict.uncertain() == 0 {
         return;
     }
+    if O::STOPS_AT_FIRST && model.exact {
+        scan_clouds::<AVX, O>(model, world, scratch, verdict);
+        return;
+    }
+    if model.exact {
+        return;
+    }
+    let m = world.margin;
     let mut suspects = std::mem::take(&mut scratch.suspects);
     let uncertain = verdict.uncertain();
     *uncertain = 0;
@@ -340,6 +349,52 @@ pub(super) fn clear_suspects<const AVX: bool, O: Outcome>(
         *uncertain |= *lanes;
     }
     suspects.retain(|&(_, lanes)| lanes != 0);
+    scratch.suspects = suspects;
+}
+
+/// The scans of the points of the clouds among the suspects (a walk that stops at the first
+/// certain collision leaves them for its end, see [`object_balls`]): each suspect link's
+/// spheres against the cloud's points in the suspect lanes; `verdict` and the suspects are
+/// left with the lanes that stay within the margin, or say which lane collides.
+fn scan_clouds<const AVX: bool, O: Outcome>(
+    model: &FastModel,
+    world: &FastWorld,
+    scratch: &mut FastScratch,
+    verdict: &mut O,
+) {
+    let mut suspects = std::mem::take(&mut scratch.suspects);
+    let m = world.margin;
+    let mut hit_at = None;
+    for (k, (suspect, lanes)) in suspects.iter_mut().enumerate() {
+        let Suspect::Object { object, group } = *suspect else {
+            continue;
+        };
+        let object = &world.objects[world.compiled_of[object as usize] as usize];
+        if !matches!(object, Object::Cloud { .. }) {
+            continue;
+        }
+        let mut contact = Contact::default();
+        for i in model.groups[group as usize].balls.clone() {
+            let r = model.balls[i].radius;
+            world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, *lanes, true);
+            if contact.hit.mask::<AVX>() != 0 {
+                break;
+            }
+        }
+        let (hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
+        if verdict.add(*lanes, hit, close).is_none() {
+            hit_at = Some(k);
+            break;
+        }
+        *lanes &= close;
+    }
+    if let Some(k) = hit_at {
+        scratch.last_hit = Some(suspects[k].0);
+    } else {
+        let uncertain = verdict.uncertain();
+        *uncertain = suspects.iter().fold(0, |all, &(_, lanes)| all | lanes);
+        suspects.retain(|&(_, lanes)| lanes != 0);
+    }
     scratch.suspects = suspects;
 }
 
@@ -530,16 +585,27 @@ fn object_balls<const AVX: bool>(
         let (inside, _) = against(&scratch.inner[inner.clone()], &model.inner[inner]);
         return (inside, close);
     }
-    let mut contact = Contact::default();
     // a point cloud costs per sphere and lane: where a certain collision ends the walk, the
-    // first one ends the link's spheres too (a sphere model's spheres are its bodies)
+    // first one ends the link's spheres too (a sphere model's spheres are its bodies), and
+    // the scans of its points wait for the end of the walk ([`scan_clouds`]): most blocks
+    // end before, at a collision that costs no scan
     let stop = stop_at_hit && model.exact && matches!(object, Object::Cloud { .. });
+    if stop {
+        let (mut hit, mut close) = (0, 0);
+        for i in group.balls.clone() {
+            let r = model.balls[i].radius;
+            let (h, c) = world.glance::<AVX>(object, &scratch.balls[i], r, m, near);
+            (hit, close) = (hit | h, close | c);
+            if hit != 0 {
+                break;
+            }
+        }
+        return (hit, close);
+    }
+    let mut contact = Contact::default();
     for i in group.balls.clone() {
         let r = model.balls[i].radius;
-        world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, near, stop);
-        if stop && contact.hit.mask::<AVX>() != 0 {
-            break;
-        }
+        world.test::<AVX>(object, &mut contact, &scratch.balls[i], r, m, near, false);
     }
     let (mut hit, close) = (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>());
     if !model.exact {

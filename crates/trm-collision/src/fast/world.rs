@@ -119,21 +119,50 @@ impl FastWorld {
         first: bool,
     ) {
         if let Object::Cloud { index, .. } = *object {
-            let reach = object.reach(r);
-            let near = lanes & object.near::<AVX>(c, r + m);
+            let (certain, near) = self.glance::<AVX>(object, c, r, m, lanes);
             if near != 0 {
                 let grid = &self.clouds[index as usize];
+                let reach = object.reach(r);
                 let outer = reach + grid.gap + m;
                 // a point certainly colliding settles the lane: the scan may stop there
                 let [inner2, _] = limits(reach, m);
-                // the lanes a cell's clearance does not settle, all at once
-                let near = grid.may_touch::<AVX>(c, outer, near);
-                let d2 = grid.distance2(c, outer, inner2, near, first);
+                let d2 = grid.distance2(c, outer, inner2, near, certain, first);
                 contact.add_within(d2, [inner2, outer * outer]);
             }
         } else {
             object.test::<AVX>(contact, c, r, m);
         }
+    }
+
+    /// What point cloud `object`'s cells say of the spheres of radius `r` at `c` in the lanes
+    /// of `lanes`, without a scan of its points: the lanes certainly touching a point (the
+    /// cell's witness within reach), and those a point may touch within the margin (the
+    /// cell's clearance within reach; NaN lanes and the certain ones included).
+    #[inline(always)]
+    pub(super) fn glance<const AVX: bool>(
+        &self,
+        object: &Object,
+        c: &[F; 3],
+        r: f32,
+        m: f32,
+        lanes: LaneMask,
+    ) -> (LaneMask, LaneMask) {
+        let Object::Cloud { index, .. } = *object else {
+            return (0, lanes);
+        };
+        let near = lanes & object.near::<AVX>(c, r + m);
+        if near == 0 {
+            return (0, 0);
+        }
+        let grid = &self.clouds[index as usize];
+        let reach = object.reach(r);
+        // the lanes a cell's clearance does not settle, all at once
+        let near = grid.may_touch::<AVX>(c, reach + grid.gap + m, near);
+        if near == 0 {
+            return (0, 0);
+        }
+        // and those a cell's witness settles
+        (grid.holding::<AVX>(c, (reach - m).max(0.0), near), near)
     }
 }
 
@@ -153,7 +182,7 @@ impl FastModel {
 
     fn compile_world(&self, world: &World, reuse: Option<(&World, &FastWorld)>) -> FastWorld {
         let mut farthest: f64 = 0.0;
-        // a point cloud's cells: as wide as the largest sphere's reach
+        // a point cloud's cells: sized by the largest sphere's reach
         let cloud_cell = (self.balls.iter().chain(&self.inner))
             .map(|b| b.radius)
             .fold(0.0, f32::max);
@@ -226,9 +255,11 @@ impl FastModel {
                             .iter()
                             .map(|p| to_f32((pose * Point3::from(*p)).coords))
                             .collect();
+                        // cells of 0.4 reach: finer ones cost more to build than their
+                        // tighter clearances save (0.25: twice the build, the same checks)
                         let reach = cloud_cell + *radius as f32;
                         let grid =
-                            CloudGrid::new(&points, 0.25 * reach, reach, far + *radius as f32);
+                            CloudGrid::new(&points, 0.4 * reach, reach, far + *radius as f32);
                         let object = Object::Cloud {
                             index: clouds.len() as u32,
                             center: grid.center,
