@@ -32,6 +32,9 @@ use trm_kinematics::PoseLanes32;
 /// this over a sparse, wide cloud is coarsened so that its cells stay cheap to build.
 const CELLS_PER_POINT: usize = 32;
 
+/// Most cells of a grid (their records' offsets, four values each, fit an `i32`).
+const MOST_CELLS: usize = 1 << 28;
+
 /// A point cloud in a uniform grid, in the world frame, single precision.
 #[derive(Debug, Clone)]
 pub(super) struct CloudGrid {
@@ -42,13 +45,12 @@ pub(super) struct CloudGrid {
     dims: [usize; 3],
     /// Per cell (x fastest), the index of its first point; one more entry at the end.
     starts: Vec<u32>,
-    /// Per cell: no point of the cloud lies nearer than this to any place in the cell, m
-    /// ([`near_clearances`]): most queries end at this one look-up.
-    clear: Vec<f32>,
-    /// Per cell: a point of the cloud near it, coordinate by coordinate ([`witnesses`];
-    /// infinite where none is near): a query about a place in the cell that finds it within
-    /// its reach ends there.
-    witness: [Vec<f32>; 3],
+    /// Per cell (one record: a query reads one cache line): its clearance — no point of the
+    /// cloud lies nearer than this to any place in the cell, m ([`near_clearances`]; most
+    /// queries end at this one look-up) — then its witness, a point of the cloud near it
+    /// ([`witnesses`]; infinite where none is near): a query about a place in the cell that
+    /// finds it within its reach ends there.
+    records: Vec<[f32; 4]>,
     /// The points' coordinates, cell by cell.
     xyz: [Vec<f32>; 3],
     /// Added to every query's range: a few units of rounding of the largest coordinate, so
@@ -85,7 +87,7 @@ impl CloudGrid {
             }
         }
         let extent: [f32; 3] = std::array::from_fn(|k| (hi[k] - lo[k]).max(0.0));
-        let budget = (CELLS_PER_POINT * points.len()).max(4096) as f64;
+        let budget = (CELLS_PER_POINT * points.len()).clamp(4096, MOST_CELLS) as f64;
         let count = |cell: f32| -> [usize; 3] {
             std::array::from_fn(|k| (extent[k] / cell).floor() as usize + 1)
         };
@@ -127,8 +129,15 @@ impl CloudGrid {
         let far_cells = ((far / cell).ceil() as usize + 2).clamp(1, FAR_CELLS);
         let far = far_clearances(&starts, dims, cell, far_cells);
         let cells_near = ((near / cell).ceil() as usize).clamp(1, NEAR_CELLS);
-        let clear = near_clearances(&starts, &xyz, lo, dims, cell, cells_near, far);
-        let witness = witnesses(&starts, &xyz, lo, dims, cell, cells_near.min(WITNESS_CELLS));
+        let sorted = Sorted {
+            starts: &starts,
+            xyz: &xyz,
+            lo,
+            dims,
+            cell,
+        };
+        let clear = near_clearances(&sorted, cells_near, far);
+        let records = witnesses(&sorted, cells_near.min(WITNESS_CELLS), clear);
 
         let largest = (0..3)
             .map(|k| lo[k].abs().max(hi[k].abs()))
@@ -139,8 +148,7 @@ impl CloudGrid {
             inv_cell,
             dims,
             starts,
-            clear,
-            witness,
+            records,
             xyz,
             slack: 16.0 * f32::EPSILON * (largest + cell),
             center: std::array::from_fn(|k| 0.5 * (lo[k] + hi[k])),
@@ -194,7 +202,7 @@ impl CloudGrid {
     /// place in the box is at least as near every point as `p`).
     #[inline(always)]
     pub(super) fn clearance(&self, p: [f32; 3]) -> f32 {
-        self.clear[self.cell_index(p)]
+        self.records[self.cell_index(p)][0]
     }
 
     /// The index of the cell nearest `p`.
@@ -230,16 +238,30 @@ impl CloudGrid {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     fn may_touch_avx(&self, c: &[F; 3], reach: f32) -> LaneMask {
-        use std::arch::x86_64::{
-            _CMP_NGT_UQ, _mm256_cmp_ps, _mm256_i32gather_ps, _mm256_movemask_ps, _mm256_set1_ps,
-        };
+        use std::arch::x86_64::{_CMP_NGT_UQ, _mm256_cmp_ps, _mm256_movemask_ps, _mm256_set1_ps};
         let (cell, finite) = self.cells_avx(c);
-        // SAFETY: every index lies in the grid, `clear` holds one value per cell
-        #[allow(unsafe_code)]
-        let clear = unsafe { _mm256_i32gather_ps::<4>(self.clear.as_ptr(), cell) };
+        let clear = self.gather_avx(cell, 0);
         let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(reach));
         // (a mask's eight bits: one per lane)
         (_mm256_movemask_ps(within) as LaneMask) | !(_mm256_movemask_ps(finite) as LaneMask)
+    }
+
+    /// Per lane, value `k` of the record of cell `cell` (0: the clearance, 1 to 3: the
+    /// witness).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn gather_avx(&self, cell: std::arch::x86_64::__m256i, k: usize) -> std::arch::x86_64::__m256 {
+        use std::arch::x86_64::{_mm256_i32gather_ps, _mm256_slli_epi32};
+        // SAFETY: every index lies in the grid, `records` holds one record of four values per
+        // cell (fewer than 2²⁸ cells: the offsets fit an `i32`), `k` < 4
+        #[allow(unsafe_code)]
+        unsafe {
+            _mm256_i32gather_ps::<4>(
+                self.records.as_ptr().cast::<f32>().add(k),
+                _mm256_slli_epi32::<2>(cell),
+            )
+        }
     }
 
     /// Per lane, the index of the cell nearest `c` (the same arithmetic as
@@ -302,7 +324,9 @@ impl CloudGrid {
         }
         lanes_where(c, lanes, false, |p| {
             let i = self.cell_index(p);
-            let d2: f32 = (0..3).map(|k| (self.witness[k][i] - p[k]).powi(2)).sum();
+            let d2: f32 = (0..3)
+                .map(|k| (self.records[i][k + 1] - p[k]).powi(2))
+                .sum();
             d2 < inside * inside
         })
     }
@@ -312,22 +336,16 @@ impl CloudGrid {
     #[target_feature(enable = "avx2,fma")]
     fn holding_avx(&self, c: &[F; 3], inside2: f32) -> LaneMask {
         use std::arch::x86_64::{
-            _CMP_LT_OQ, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_i32gather_ps, _mm256_load_ps,
-            _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps,
+            _CMP_LT_OQ, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_movemask_ps,
+            _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps,
         };
         let (cell, _) = self.cells_avx(c);
         let mut d2 = _mm256_set1_ps(0.0);
-        for (k, witness) in self.witness.iter().enumerate() {
-            // SAFETY: `F` is eight `f32` aligned to 32 bytes; every index lies in the grid
-            // (clamped to its cells), `witness` holds one value per cell
+        for k in 0..3 {
+            // SAFETY: `F` is eight `f32` aligned to 32 bytes
             #[allow(unsafe_code)]
-            let (p, w) = unsafe {
-                (
-                    _mm256_load_ps(c[k].0.as_ptr()),
-                    _mm256_i32gather_ps::<4>(witness.as_ptr(), cell),
-                )
-            };
-            let d = _mm256_sub_ps(w, p);
+            let p = unsafe { _mm256_load_ps(c[k].0.as_ptr()) };
+            let d = _mm256_sub_ps(self.gather_avx(cell, k + 1), p);
             d2 = if k == 0 {
                 _mm256_mul_ps(d, d)
             } else {
@@ -336,6 +354,85 @@ impl CloudGrid {
         }
         // (NaN lanes fail the comparison)
         _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inside2))) as LaneMask
+    }
+
+    /// [`super::world::FastWorld::glance`] for every sphere at `centres` (radii in `balls`)
+    /// in turn, for the cloud whose points' box has centre `center` and half sizes `half`
+    /// (points of radius `radius`): the lanes of `lanes` whose witness settles a collision,
+    /// and those the cells leave open (the certain ones included); it ends at the first sphere
+    /// with a certain lane. The box's and the grid's constants are broadcast once; most
+    /// spheres end at the box.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn glance_balls_avx(
+        &self,
+        center: [f32; 3],
+        half: [f32; 3],
+        radius: f32,
+        centres: &[[F; 3]],
+        balls: &[super::model::Ball],
+        m: f32,
+        lanes: LaneMask,
+    ) -> (LaneMask, LaneMask) {
+        use std::arch::x86_64::{
+            _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_fmadd_ps,
+            _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps, _mm256_set1_ps, _mm256_setzero_ps,
+            _mm256_sub_ps,
+        };
+        let sign = _mm256_set1_ps(-0.0);
+        let centre: [_; 3] = std::array::from_fn(|k| _mm256_set1_ps(center[k]));
+        let halves: [_; 3] = std::array::from_fn(|k| _mm256_set1_ps(half[k]));
+        let (mut hit, mut close) = (0, 0);
+        for (c, ball) in centres.iter().zip(balls) {
+            // SAFETY: `F` is eight `f32` aligned to 32 bytes
+            #[allow(unsafe_code)]
+            let p: [_; 3] = std::array::from_fn(|k| unsafe { _mm256_load_ps(c[k].0.as_ptr()) });
+            // the box about the points, as `Object::near` measures it
+            let reach = ball.radius + radius;
+            let mut d2 = _mm256_setzero_ps();
+            for k in 0..3 {
+                let d = _mm256_andnot_ps(sign, _mm256_sub_ps(p[k], centre[k]));
+                let out = _mm256_max_ps(_mm256_sub_ps(d, halves[k]), _mm256_setzero_ps());
+                d2 = _mm256_fmadd_ps(out, out, d2);
+            }
+            // (summed in `Object::near`'s order)
+            let outer = ball.radius + m + radius;
+            let near = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer));
+            let near = lanes & _mm256_movemask_ps(near) as LaneMask;
+            if near == 0 {
+                continue;
+            }
+            // the cells' clearances, then their witnesses ([`CloudGrid::may_touch`],
+            // [`CloudGrid::holding`])
+            let (cell, finite) = self.cells_avx(c);
+            let clear = self.gather_avx(cell, 0);
+            let limit = reach + self.gap + m + self.slack;
+            let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(limit));
+            let open = near
+                & ((_mm256_movemask_ps(within) as LaneMask)
+                    | !(_mm256_movemask_ps(finite) as LaneMask));
+            if open == 0 {
+                continue;
+            }
+            close |= open;
+            let inside = (reach - m).max(0.0) - self.slack;
+            if inside <= 0.0 {
+                continue;
+            }
+            let mut w2 = _mm256_setzero_ps();
+            for (k, &p) in p.iter().enumerate() {
+                let d = _mm256_sub_ps(self.gather_avx(cell, k + 1), p);
+                w2 = _mm256_fmadd_ps(d, d, w2);
+            }
+            // (NaN lanes fail the comparison)
+            let held = _mm256_cmp_ps::<_CMP_LT_OQ>(w2, _mm256_set1_ps(inside * inside));
+            hit |= open & _mm256_movemask_ps(held) as LaneMask;
+            if hit != 0 {
+                break;
+            }
+        }
+        (hit, close)
     }
 
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.
@@ -582,20 +679,32 @@ const FAR_CELLS: usize = 16;
 /// Most cells about an occupied cell that [`witnesses`] gives its point, along each axis.
 const WITNESS_CELLS: usize = 1;
 
-/// Per cell of a grid of `dims` cells of side `cell` from `lo` holding the points `xyz` (from
-/// `starts` per cell), a point near it, coordinate by coordinate: among the occupied cells
-/// within `k` cells along every axis, each represented by its point nearest its centre, the
-/// representative nearest the cell's centre (infinite coordinates where no cell is that
-/// near). Any point of the cloud bounds a query's distance from above; this one is near the
-/// nearest wherever the cloud is dense.
-fn witnesses(
-    starts: &[u32],
-    xyz: &[Vec<f32>; 3],
+/// The points of a cloud sorted into the cells of a grid.
+struct Sorted<'a> {
+    /// Per cell (x fastest), the index of its first point; one more entry at the end.
+    starts: &'a [u32],
+    /// The points' coordinates, cell by cell.
+    xyz: &'a [Vec<f32>; 3],
+    /// Corner of cell (0, 0, 0).
     lo: [f32; 3],
     dims: [usize; 3],
+    /// The cells' side, m.
     cell: f32,
-    k: usize,
-) -> [Vec<f32>; 3] {
+}
+
+/// Per cell of `sorted`, its record: its clearance from `clear`, then a point near it,
+/// coordinate by coordinate: among the occupied cells within `k` cells along every axis, each
+/// represented by its point nearest its centre, the representative nearest the cell's centre
+/// (infinite coordinates where no cell is that near). Any point of the cloud bounds a query's
+/// distance from above; this one is near the nearest wherever the cloud is dense.
+fn witnesses(sorted: &Sorted, k: usize, clear: Vec<f32>) -> Vec<[f32; 4]> {
+    let Sorted {
+        starts,
+        xyz,
+        lo,
+        dims,
+        cell,
+    } = *sorted;
     let cells = dims[0] * dims[1] * dims[2];
     let mut best = vec![f32::INFINITY; cells];
     let mut which = vec![u32::MAX; cells];
@@ -629,12 +738,10 @@ fn witnesses(
             }
         }
     }
-    std::array::from_fn(|a| {
-        which
-            .iter()
-            .map(|&i| xyz[a].get(i as usize).copied().unwrap_or(f32::INFINITY))
-            .collect()
-    })
+    let coordinate = |a: usize, i: u32| xyz[a].get(i as usize).copied().unwrap_or(f32::INFINITY);
+    (which.into_iter().zip(clear))
+        .map(|(i, c)| [c, coordinate(0, i), coordinate(1, i), coordinate(2, i)])
+        .collect()
 }
 
 /// Most cells about a point whose clearances [`near_clearances`] makes exact, along each axis.
@@ -643,8 +750,7 @@ const NEAR_CELLS: usize = 4;
 /// Cells in the window [`near_clearances`] updates about an occupied cell along x.
 const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
 
-/// Per cell of a grid of `dims` cells of side `cell` from `lo` holding the points `xyz` (from
-/// `starts` per cell): the distance from the cell to the nearest box about a cell's points
+/// Per cell of `sorted`: the distance from the cell to the nearest box about a cell's points
 /// where that is below `k` cells (a point farther away along some axis than `k` cells is at
 /// least `k` cells from the cell; a box about one point is the point), else `k` cells; the
 /// larger of that and the cell's `far` clearance, m. Near the points, where queries land, this
@@ -653,15 +759,14 @@ const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
 /// the window at a time.
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
-fn near_clearances(
-    starts: &[u32],
-    xyz: &[Vec<f32>; 3],
-    lo: [f32; 3],
-    dims: [usize; 3],
-    cell: f32,
-    k: usize,
-    far: Vec<f32>,
-) -> Vec<f32> {
+fn near_clearances(sorted: &Sorted, k: usize, far: Vec<f32>) -> Vec<f32> {
+    let Sorted {
+        starts,
+        xyz,
+        lo,
+        dims,
+        cell,
+    } = *sorted;
     let cap2 = (k as f32 * cell).powi(2);
     // squared, in rows padded by NEAR_CELLS cells each side: every window is NEAR_WINDOW wide
     let row_len = dims[0] + 2 * NEAR_CELLS;
@@ -805,165 +910,4 @@ pub(super) fn solids_against_cloud(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{RngExt, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
-
-    /// Every query finds the nearest point within its range, as a scan of all points does,
-    /// on clouds of every shape: a plane, a cluster, a line, a single point, wide and sparse.
-    #[test]
-    fn nearest_within_range_is_the_brute_force_nearest() {
-        let mut rng = ChaCha8Rng::seed_from_u64(11);
-        for case in 0..60 {
-            let n = [1, 7, 300, 5000][case % 4];
-            let spread: [f32; 3] = match case % 5 {
-                0 => [1.0, 1.0, 0.0],
-                1 => [0.1, 0.1, 0.1],
-                2 => [2.0, 0.0, 0.0],
-                3 => [30.0, 30.0, 5.0],
-                _ => [0.6, 0.8, 1.2],
-            };
-            let points: Vec<[f32; 3]> = (0..n)
-                .map(|_| std::array::from_fn(|k| rng.random_range(-0.5..=0.5) * spread[k] + 0.3))
-                .collect();
-            let cell = rng.random_range(0.005..0.2);
-            let (near, far) = (rng.random_range(0.0..4.0), rng.random_range(0.0..20.0));
-            let grid = CloudGrid::new(&points, cell, near * cell, far * cell);
-            assert_eq!(grid.len(), n);
-            for _ in 0..200 {
-                let p: [f32; 3] =
-                    std::array::from_fn(|k| rng.random_range(-0.7..=0.7) * (spread[k] + 0.2) + 0.3);
-                let range = rng.random_range(0.0..0.3);
-                let brute = points
-                    .iter()
-                    .map(|q| (0..3).map(|k| (q[k] - p[k]) * (q[k] - p[k])).sum::<f32>())
-                    .fold(f32::INFINITY, f32::min);
-                let found = grid.nearest2(p, range, 0.0);
-                let clearance = grid.clearance(p);
-                // a lane the witness settles has a point within its sphere
-                let c = p.map(|v| F([v; FAST_LANES]));
-                if grid.holding::<false>(&c, range, 1) != 0 {
-                    assert!(brute < range * range, "case {case}: {p:?} holds none");
-                }
-                assert!(
-                    clearance * clearance <= brute,
-                    "case {case}: clearance {clearance}, nearest {}",
-                    brute.sqrt()
-                );
-                if brute <= range * range {
-                    assert_eq!(found, brute, "case {case}: {p:?} range {range}");
-                } else {
-                    assert!(found >= brute, "case {case}: {found} < {brute}");
-                }
-            }
-        }
-    }
-
-    /// Near the points a cell's clearance is the distance from the cell to the points about
-    /// it (less than a cell short of a query's own distance, on average), and far from them it
-    /// still grows up to `far`: a transform of occupied cells alone is short by √3 cells.
-    #[test]
-    fn clearances_are_tight_near_the_points_and_reach_far() {
-        let mut rng = ChaCha8Rng::seed_from_u64(12);
-        // a board of points 2 cm apart, as a thinned camera cloud gives it, and a small cell
-        let points: Vec<[f32; 3]> = (0..40)
-            .flat_map(|i| (0..30).map(move |j| [0.02 * i as f32, 0.02 * j as f32, 0.5]))
-            .chain([[0.4, 0.3, 0.0], [0.4, 0.3, 1.0]])
-            .collect();
-        let (cell, near, far) = (0.02, 0.08, 0.3);
-        let grid = CloudGrid::new(&points, cell, near, far);
-        // the grid's own cell: coarser than asked where the cells would be too many
-        let (cell, diagonal) = (grid.cell, 3f32.sqrt() * grid.cell);
-        let (mut short, mut count) = (0.0, 0);
-        for _ in 0..4000 {
-            let p: [f32; 3] = [
-                rng.random_range(0.0..0.8),
-                rng.random_range(0.0..0.6),
-                rng.random_range(0.0..1.0),
-            ];
-            let nearest = points
-                .iter()
-                .map(|q| (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f32>())
-                .fold(f32::INFINITY, f32::min)
-                .sqrt();
-            let clearance = grid.clearance(p);
-            assert!(clearance <= nearest, "{p:?}: {clearance} > {nearest}");
-            if nearest < near {
-                short += nearest - clearance;
-                count += 1;
-            } else if nearest < far - 2.0 * diagonal {
-                let lost = nearest - clearance;
-                assert!(lost <= 2.0 * diagonal, "{p:?}: {clearance} for {nearest}");
-            }
-        }
-        let short = short / count as f32;
-        assert!(
-            count > 500 && short < 0.75 * cell,
-            "{count} near: {short} short on average"
-        );
-        // within a cell of the board, a sphere of two cells holds a point by its cell's witness
-        // alone
-        let (mut held, mut tried) = (0, 0);
-        for _ in 0..1000 {
-            let p = [
-                rng.random_range(0.0..0.78),
-                rng.random_range(0.0..0.58),
-                0.5 + rng.random_range(-1.0..1.0) * cell,
-            ];
-            let c = p.map(|v| F([v; FAST_LANES]));
-            held += grid.holding::<false>(&c, 2.0 * cell, 1).count_ones();
-            tried += 1;
-        }
-        assert!(held * 10 > tried * 9, "{held} of {tried} held by a witness");
-    }
-
-    /// The vector instructions' lanes near a cloud (cells' indices, gathered clearances) are
-    /// the plain loop's, for points inside the grid, outside it on every side, on cell
-    /// borders and not finite.
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn lanes_near_a_cloud_are_the_same_in_vector_instructions() {
-        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
-            return;
-        }
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let points: Vec<[f32; 3]> = (0..2000)
-            .map(|_| std::array::from_fn(|_| rng.random_range(-0.3..0.3f32)))
-            .collect();
-        let grid = CloudGrid::new(&points, 0.02, 0.08, 0.3);
-        let (mut flagged, mut total) = (0, 0);
-        for round in 0..2000 {
-            let c: [F; 3] = std::array::from_fn(|_| {
-                F(std::array::from_fn(|l| match (round + l) % 23 {
-                    0 => f32::NAN,
-                    1 => f32::INFINITY,
-                    2 => -f32::INFINITY,
-                    // a cell's border
-                    3 => grid.origin[0] + grid.cell * rng.random_range(0..40) as f32,
-                    _ => rng.random_range(-1.0..1.0f32),
-                }))
-            });
-            let reach = rng.random_range(0.0..0.05f32);
-            let lanes: LaneMask = rng.random();
-            let plain = grid.may_touch::<false>(&c, reach, lanes);
-            assert_eq!(
-                grid.may_touch::<true>(&c, reach, lanes),
-                plain,
-                "{c:?} {reach}"
-            );
-            assert_eq!(
-                grid.holding::<true>(&c, reach, lanes),
-                grid.holding::<false>(&c, reach, lanes),
-                "{c:?} {reach}"
-            );
-            flagged += plain.count_ones();
-            total += lanes.count_ones();
-        }
-        // both kinds of lanes were seen
-        assert!(
-            flagged > total / 20 && flagged < total * 19 / 20,
-            "{flagged} of {total}"
-        );
-    }
-}
+mod tests;

@@ -293,6 +293,15 @@ pub(super) fn box_distance2(
     x * x + y * y + z * z
 }
 
+/// Squared distance from the point in every lane to the box of half sizes `half` about
+/// `center` along the world's axes (0 inside).
+#[inline(always)]
+pub(super) fn aligned_box_distance2(c: &[F; 3], center: [f32; 3], half: [f32; 3]) -> F {
+    let out = |k: usize| c[k].map(|v| ((v - center[k]).abs() - half[k]).max(0.0));
+    let (x, y, z) = (out(0), out(1), out(2));
+    x * x + y * y + z * z
+}
+
 /// Squared distance from the point in every lane to the solid cylinder along the z axis of
 /// `axes` (0 inside).
 #[inline(always)]

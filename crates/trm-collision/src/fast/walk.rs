@@ -591,16 +591,14 @@ fn object_balls<const AVX: bool>(
     // end before, at a collision that costs no scan
     let stop = stop_at_hit && model.exact && matches!(object, Object::Cloud { .. });
     if stop {
-        let (mut hit, mut close) = (0, 0);
-        for i in group.balls.clone() {
-            let r = model.balls[i].radius;
-            let (h, c) = world.glance::<AVX>(object, &scratch.balls[i], r, m, near);
-            (hit, close) = (hit | h, close | c);
-            if hit != 0 {
-                break;
-            }
-        }
-        return (hit, close);
+        let balls = group.balls.clone();
+        return world.glance_balls::<AVX>(
+            object,
+            &scratch.balls[balls.clone()],
+            &model.balls[balls],
+            m,
+            near,
+        );
     }
     let mut contact = Contact::default();
     for i in group.balls.clone() {

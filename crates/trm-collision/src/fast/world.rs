@@ -3,18 +3,15 @@ use super::LaneMask;
 use super::avx;
 use super::cloud::{CloudGrid, MESH_SPACING};
 use super::lanes::{
-    F, PORTABLE, box_distance2, cylinder_distance2, distance2, inverse_axes, segment_distance2,
-    splat, to_f32,
+    F, PORTABLE, aligned_box_distance2, box_distance2, cylinder_distance2, distance2, inverse_axes,
+    segment_distance2, splat, to_f32,
 };
-use super::model::FastModel;
+use super::model::{Ball, FastModel};
 use super::outcome::Contact;
 use crate::shape::Shape;
 use crate::world::World;
 use nalgebra::{Point3, Vector3};
 use std::sync::Arc;
-
-/// The world's axes, as rows of a rotation.
-const IDENTITY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Rounding budget of the margin, m per metre of the largest coordinate per joint of the
 /// deepest chain (see [`FastWorld::margin`]).
@@ -132,6 +129,44 @@ impl FastWorld {
         } else {
             object.test::<AVX>(contact, c, r, m);
         }
+    }
+
+    /// [`FastWorld::glance`] for the spheres at `centres` (radii in `balls`) in turn, their
+    /// lanes gathered, ending at the first sphere with a certain lane.
+    #[inline(always)]
+    pub(super) fn glance_balls<const AVX: bool>(
+        &self,
+        object: &Object,
+        centres: &[[F; 3]],
+        balls: &[Ball],
+        m: f32,
+        lanes: LaneMask,
+    ) -> (LaneMask, LaneMask) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX
+            && let Object::Cloud {
+                index,
+                center,
+                half,
+                radius,
+            } = *object
+        {
+            let grid = &self.clouds[index as usize];
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return unsafe {
+                grid.glance_balls_avx(center, half, radius, centres, balls, m, lanes)
+            };
+        }
+        let (mut hit, mut close) = (0, 0);
+        for (c, ball) in centres.iter().zip(balls) {
+            let (h, o) = self.glance::<AVX>(object, c, ball.radius, m, lanes);
+            (hit, close) = (hit | h, close | o);
+            if hit != 0 {
+                break;
+            }
+        }
+        (hit, close)
     }
 
     /// What point cloud `object`'s cells say of the spheres of radius `r` at `c` in the lanes
@@ -406,7 +441,7 @@ impl Object {
                 half,
             } => cylinder_distance2(c, center, &axes, radius, half),
             Object::Bounded { center, .. } => distance2(c, &splat(center)),
-            Object::Cloud { center, half, .. } => box_distance2(c, center, &IDENTITY, half),
+            Object::Cloud { center, half, .. } => aligned_box_distance2(c, center, half),
         }
     }
 
