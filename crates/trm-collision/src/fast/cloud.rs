@@ -692,34 +692,37 @@ struct Sorted<'a> {
     cell: f32,
 }
 
+impl Sorted<'_> {
+    /// The cells holding points: each one's place in the grid along each axis and the range
+    /// of its points.
+    fn occupied(&self) -> impl Iterator<Item = ([usize; 3], std::ops::Range<usize>)> {
+        let dims = self.dims;
+        (self.starts.windows(2).enumerate())
+            .filter(|(_, run)| run[0] < run[1])
+            .map(move |(c, run)| {
+                let home = [c % dims[0], c / dims[0] % dims[1], c / (dims[0] * dims[1])];
+                (home, run[0] as usize..run[1] as usize)
+            })
+    }
+}
+
 /// Per cell of `sorted`, its record: its clearance from `clear`, then a point near it,
 /// coordinate by coordinate: among the occupied cells within `k` cells along every axis, each
 /// represented by its point nearest its centre, the representative nearest the cell's centre
 /// (infinite coordinates where no cell is that near). Any point of the cloud bounds a query's
 /// distance from above; this one is near the nearest wherever the cloud is dense.
 fn witnesses(sorted: &Sorted, k: usize, clear: Vec<f32>) -> Vec<[f32; 4]> {
-    let Sorted {
-        starts,
-        xyz,
-        lo,
-        dims,
-        cell,
-    } = *sorted;
+    let (xyz, lo, dims, cell) = (sorted.xyz, sorted.lo, sorted.dims, sorted.cell);
     let cells = dims[0] * dims[1] * dims[2];
     let mut best = vec![f32::INFINITY; cells];
     let mut which = vec![u32::MAX; cells];
     let centre = |axis: usize, i: usize| lo[axis] + (i as f32 + 0.5) * cell;
     let span = |axis: usize, i: usize| i.saturating_sub(k)..=(i + k).min(dims[axis] - 1);
-    for (c, run) in starts.windows(2).enumerate() {
-        let (from, to) = (run[0] as usize, run[1] as usize);
-        if from == to {
-            continue;
-        }
-        let home = [c % dims[0], c / dims[0] % dims[1], c / (dims[0] * dims[1])];
+    for (home, points) in sorted.occupied() {
         let d2 =
             |i: usize, at: [f32; 3]| -> f32 { (0..3).map(|a| (xyz[a][i] - at[a]).powi(2)).sum() };
         let here: [f32; 3] = std::array::from_fn(|a| centre(a, home[a]));
-        let chosen = (from..to)
+        let chosen = points
             .min_by(|&a, &b| d2(a, here).total_cmp(&d2(b, here)))
             .expect("an occupied cell");
         let p: [f32; 3] = std::array::from_fn(|a| xyz[a][chosen]);
@@ -760,13 +763,7 @@ const NEAR_WINDOW: usize = 2 * NEAR_CELLS + 1;
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
 fn near_clearances(sorted: &Sorted, k: usize, far: Vec<f32>) -> Vec<f32> {
-    let Sorted {
-        starts,
-        xyz,
-        lo,
-        dims,
-        cell,
-    } = *sorted;
+    let (xyz, lo, dims, cell) = (sorted.xyz, sorted.lo, sorted.dims, sorted.cell);
     let cap2 = (k as f32 * cell).powi(2);
     // squared, in rows padded by NEAR_CELLS cells each side: every window is NEAR_WINDOW wide
     let row_len = dims[0] + 2 * NEAR_CELLS;
@@ -777,19 +774,14 @@ fn near_clearances(sorted: &Sorted, k: usize, far: Vec<f32>) -> Vec<f32> {
         (a - v1).max(v0 - (a + cell)).max(0.0)
     };
     let span = |axis: usize, i: usize| (i.saturating_sub(k), (i + k).min(dims[axis] - 1));
-    for (c, run) in starts.windows(2).enumerate() {
-        let (from, to) = (run[0] as usize, run[1] as usize);
-        if from == to {
-            continue;
-        }
+    for ([hx, hy, hz], points) in sorted.occupied() {
         let bounds: [[f32; 2]; 3] = std::array::from_fn(|axis| {
-            let v = &xyz[axis][from..to];
+            let v = &xyz[axis][points.clone()];
             [
                 v.iter().fold(f32::INFINITY, |a, &b| a.min(b)),
                 v.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b)),
             ]
         });
-        let (hx, hy, hz) = (c % dims[0], c / dims[0] % dims[1], c / (dims[0] * dims[1]));
         let dx2: [f32; NEAR_WINDOW] = std::array::from_fn(|i| {
             let offset = i as isize - NEAR_CELLS as isize;
             if offset.unsigned_abs() > k {
