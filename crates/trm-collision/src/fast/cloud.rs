@@ -35,6 +35,12 @@ const CELLS_PER_POINT: usize = 32;
 /// Most cells of a grid (their records' offsets, four values each, fit an `i32`).
 const MOST_CELLS: usize = 1 << 28;
 
+/// A cell's clearance, then its witness's coordinates ([`CloudGrid`]), aligned so that it
+/// lies in one cache line.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(16))]
+struct Record([f32; 4]);
+
 /// A point cloud in a uniform grid, in the world frame, single precision.
 #[derive(Debug, Clone)]
 pub(super) struct CloudGrid {
@@ -50,7 +56,7 @@ pub(super) struct CloudGrid {
     /// queries end at this one look-up) — then its witness, a point of the cloud near it
     /// ([`witnesses`]; infinite where none is near): a query about a place in the cell that
     /// finds it within its reach ends there.
-    records: Vec<[f32; 4]>,
+    records: Vec<Record>,
     /// The points' coordinates, cell by cell.
     xyz: [Vec<f32>; 3],
     /// Added to every query's range: a few units of rounding of the largest coordinate, so
@@ -202,7 +208,7 @@ impl CloudGrid {
     /// place in the box is at least as near every point as `p`).
     #[inline(always)]
     pub(super) fn clearance(&self, p: [f32; 3]) -> f32 {
-        self.records[self.cell_index(p)][0]
+        self.records[self.cell_index(p)].0[0]
     }
 
     /// The index of the cell nearest `p`.
@@ -325,7 +331,7 @@ impl CloudGrid {
         lanes_where(c, lanes, false, |p| {
             let i = self.cell_index(p);
             let d2: f32 = (0..3)
-                .map(|k| (self.records[i][k + 1] - p[k]).powi(2))
+                .map(|k| (self.records[i].0[k + 1] - p[k]).powi(2))
                 .sum();
             d2 < inside * inside
         })
@@ -711,7 +717,7 @@ impl Sorted<'_> {
 /// represented by its point nearest its centre, the representative nearest the cell's centre
 /// (infinite coordinates where no cell is that near). Any point of the cloud bounds a query's
 /// distance from above; this one is near the nearest wherever the cloud is dense.
-fn witnesses(sorted: &Sorted, k: usize, clear: Vec<f32>) -> Vec<[f32; 4]> {
+fn witnesses(sorted: &Sorted, k: usize, clear: Vec<f32>) -> Vec<Record> {
     let (xyz, lo, dims, cell) = (sorted.xyz, sorted.lo, sorted.dims, sorted.cell);
     let cells = dims[0] * dims[1] * dims[2];
     let mut best = vec![f32::INFINITY; cells];
@@ -743,7 +749,7 @@ fn witnesses(sorted: &Sorted, k: usize, clear: Vec<f32>) -> Vec<[f32; 4]> {
     }
     let coordinate = |a: usize, i: u32| xyz[a].get(i as usize).copied().unwrap_or(f32::INFINITY);
     (which.into_iter().zip(clear))
-        .map(|(i, c)| [c, coordinate(0, i), coordinate(1, i), coordinate(2, i)])
+        .map(|(i, c)| Record([c, coordinate(0, i), coordinate(1, i), coordinate(2, i)]))
         .collect()
 }
 
