@@ -341,24 +341,33 @@ impl CloudGrid {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     fn holding_avx(&self, c: &[F; 3], inside2: f32) -> LaneMask {
-        use std::arch::x86_64::{
-            _CMP_LT_OQ, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_movemask_ps,
-            _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps,
-        };
+        use std::arch::x86_64::_mm256_load_ps;
         let (cell, _) = self.cells_avx(c);
-        let mut d2 = _mm256_set1_ps(0.0);
-        for k in 0..3 {
-            // SAFETY: `F` is eight `f32` aligned to 32 bytes
-            #[allow(unsafe_code)]
-            let p = unsafe { _mm256_load_ps(c[k].0.as_ptr()) };
+        // SAFETY: `F` is eight `f32` aligned to 32 bytes
+        #[allow(unsafe_code)]
+        let p: [_; 3] = std::array::from_fn(|k| unsafe { _mm256_load_ps(c[k].0.as_ptr()) });
+        self.held_avx(cell, &p, inside2)
+    }
+
+    /// The lanes whose cell `cell`'s witness lies within `√inside2` of `p` (NaN lanes never).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn held_avx(
+        &self,
+        cell: std::arch::x86_64::__m256i,
+        p: &[std::arch::x86_64::__m256; 3],
+        inside2: f32,
+    ) -> LaneMask {
+        use std::arch::x86_64::{
+            _CMP_LT_OQ, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_movemask_ps, _mm256_set1_ps,
+            _mm256_setzero_ps, _mm256_sub_ps,
+        };
+        let mut d2 = _mm256_setzero_ps();
+        for (k, &p) in p.iter().enumerate() {
             let d = _mm256_sub_ps(self.gather_avx(cell, k + 1), p);
-            d2 = if k == 0 {
-                _mm256_mul_ps(d, d)
-            } else {
-                _mm256_fmadd_ps(d, d, d2)
-            };
+            d2 = _mm256_fmadd_ps(d, d, d2);
         }
-        // (NaN lanes fail the comparison)
         _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inside2))) as LaneMask
     }
 
@@ -382,9 +391,8 @@ impl CloudGrid {
         lanes: LaneMask,
     ) -> (LaneMask, LaneMask) {
         use std::arch::x86_64::{
-            _CMP_LT_OQ, _CMP_NGT_UQ, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_fmadd_ps,
-            _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps, _mm256_set1_ps, _mm256_setzero_ps,
-            _mm256_sub_ps,
+            _CMP_NGT_UQ, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps,
+            _mm256_max_ps, _mm256_movemask_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
         };
         let sign = _mm256_set1_ps(-0.0);
         let centre: [_; 3] = std::array::from_fn(|k| _mm256_set1_ps(center[k]));
@@ -426,14 +434,7 @@ impl CloudGrid {
             if inside <= 0.0 {
                 continue;
             }
-            let mut w2 = _mm256_setzero_ps();
-            for (k, &p) in p.iter().enumerate() {
-                let d = _mm256_sub_ps(self.gather_avx(cell, k + 1), p);
-                w2 = _mm256_fmadd_ps(d, d, w2);
-            }
-            // (NaN lanes fail the comparison)
-            let held = _mm256_cmp_ps::<_CMP_LT_OQ>(w2, _mm256_set1_ps(inside * inside));
-            hit |= open & _mm256_movemask_ps(held) as LaneMask;
+            hit |= open & self.held_avx(cell, &p, inside * inside);
             if hit != 0 {
                 break;
             }
