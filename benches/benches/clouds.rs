@@ -3,7 +3,8 @@
 //! screen's grid, for 5 000 points on a board and for a whole thinned scene) and checking
 //! blocks of eight configurations among the cloud against the same scene as primitives.
 //! Targets: a 5 000-point cloud builds in ≤ 0.5 ms on one core; a block among the sampled
-//! scene costs no more than among its primitives. Also: one box moved in a world holding the
+//! scene costs no more than among its primitives. Also: the blocks' spheres as queries of
+//! eight spheres ([`FastWorld::spheres_touching`](trm_collision::fast::FastWorld::spheres_touching)), exact. Also: one box moved in a world holding the
 //! scene cloud and a mesh (the screen compiles again only what changed).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -156,6 +157,28 @@ fn clouds(c: &mut Criterion) {
                 qs.chunks(d * FAST_LANES)
                     .filter(|b| checker.all_free_unchecked(b, &world, &fast))
                     .count()
+            })
+        });
+    }
+    // the same blocks' spheres as queries of eight (one sphere in eight configurations),
+    // answered exactly
+    let queries = trm_benches::sphere_queries(
+        &collision,
+        &active,
+        &random_configurations(&active, 8 * 256, 3),
+    );
+    for (name, world) in [
+        ("primitives", table_scene()),
+        ("cloud_3x1000", sampled_table_scene(1000)),
+        ("cloud_3x10000", sampled_table_scene(10_000)),
+    ] {
+        let fast = checker.model().world(&world);
+        group.bench_function(BenchmarkId::new("sphere_queries", name), |b| {
+            b.iter(|| {
+                queries
+                    .iter()
+                    .map(|(centres, r)| fast.spheres_touching_unchecked(&world, centres, *r))
+                    .fold(0u32, |n, lanes| n + lanes.count_ones())
             })
         });
     }

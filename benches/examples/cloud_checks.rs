@@ -18,7 +18,9 @@ use std::time::Instant;
 use nalgebra::Isometry3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use trm_benches::{median, positive, random_configurations, sampled_table_scene, table_scene};
+use trm_benches::{
+    median, positive, random_configurations, sampled_table_scene, sphere_queries, table_scene,
+};
 use trm_collision::fast::{FAST_LANES, FastChecker};
 use trm_collision::{CollisionModel, Shape, World};
 use trm_kinematics::RobotModel;
@@ -61,8 +63,27 @@ fn run() -> Result<(), String> {
     board
         .add("cloud", cloud, Isometry3::identity())
         .map_err(|e| e.to_string())?;
+    // the same blocks' spheres, a query of eight at a time (one sphere, eight configurations)
+    let queries = sphere_queries(
+        &collision,
+        &active,
+        &random_configurations(&active, 8 * 256, 3),
+    );
     let (mut times, mut builds) = (vec![Vec::new(); worlds.len()], Vec::new());
+    let mut query_times = vec![Vec::new(); worlds.len()];
     for _ in 0..rounds {
+        for (k, (world, fast)) in worlds.iter().zip(&compiled).enumerate() {
+            let start = Instant::now();
+            for _ in 0..4 {
+                let touching: u32 = queries
+                    .iter()
+                    .map(|(centres, r)| fast.spheres_touching_unchecked(world, centres, *r))
+                    .map(u8::count_ones)
+                    .sum();
+                black_box(touching);
+            }
+            query_times[k].push(start.elapsed().as_secs_f64() / 4.0 / queries.len() as f64 * 1e9);
+        }
         for (k, (world, fast)) in worlds.iter().zip(&compiled).enumerate() {
             let start = Instant::now();
             for _ in 0..40 {
@@ -86,6 +107,27 @@ fn run() -> Result<(), String> {
         println!(
             "  {name:<18} {:7.1} µs  ({:.3}× the boxes)",
             median(&mut times[k].clone()),
+            median(&mut ratios)
+        );
+    }
+    println!(
+        "{} queries of {FAST_LANES} spheres (the blocks' spheres, one at a time), exact answers:",
+        queries.len()
+    );
+    for (k, name) in names.iter().enumerate() {
+        let mut ratios: Vec<f64> = query_times[k]
+            .iter()
+            .zip(&query_times[0])
+            .map(|(a, b)| a / b)
+            .collect();
+        let touching: u32 = queries
+            .iter()
+            .map(|(centres, r)| compiled[k].spheres_touching_unchecked(&worlds[k], centres, *r))
+            .map(u8::count_ones)
+            .sum();
+        println!(
+            "  {name:<18} {:7.1} ns  ({:.3}× the boxes; {touching} spheres touching)",
+            median(&mut query_times[k].clone()),
             median(&mut ratios)
         );
     }

@@ -4,7 +4,7 @@
 use nalgebra::Isometry3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use trm_collision::{Shape, World};
+use trm_collision::{CollisionModel, Shape, World};
 use trm_kinematics::ActiveSet;
 
 /// A table with a box on it and a shelf board above, in front of a Panda at the origin: the
@@ -42,6 +42,34 @@ pub fn sampled_table_scene(per_object: usize) -> World {
 pub fn random_configurations(active: &ActiveSet, n: usize, seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n).map(|_| active.random(&mut rng)).collect()
+}
+
+/// Queries of [`FAST_LANES`](trm_collision::fast::FAST_LANES) spheres, as a robot's spheres
+/// put them where they are in `configurations` (taken eight at a time): per block
+/// and sphere of `collision` (a sphere model), the sphere's centre in each configuration and
+/// its radius.
+pub fn sphere_queries(
+    collision: &CollisionModel,
+    active: &ActiveSet,
+    configurations: &[Vec<f64>],
+) -> Vec<(Vec<[f64; 3]>, f64)> {
+    let (mut pose, mut placed) = (active.model().pose_buffer(), collision.placed_bodies());
+    let mut queries = Vec::new();
+    for block in configurations.chunks(trm_collision::fast::FAST_LANES) {
+        let mut spheres: Vec<(Vec<[f64; 3]>, f64)> = Vec::new();
+        for q in block {
+            active.forward_unchecked(q, &mut pose);
+            collision.place(&pose, &mut placed);
+            for (b, aabb) in placed.body_boxes().enumerate() {
+                if spheres.len() <= b {
+                    spheres.push((Vec::new(), aabb.half_extents().x));
+                }
+                spheres[b].0.push(aabb.center().coords.into());
+            }
+        }
+        queries.extend(spheres);
+    }
+    queries
 }
 
 /// The median of `values` (the upper one of an even count), sorting them in place.

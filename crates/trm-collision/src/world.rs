@@ -140,6 +140,23 @@ fn check_pose(what: &str, pose: &Isometry3<f64>) -> Result<()> {
     }
 }
 
+/// An error for a sphere's centre or radius that is not finite, or a negative radius.
+pub(crate) fn check_sphere(centre: &[f64; 3], radius: f64) -> Result<()> {
+    if let Some(i) = centre.iter().position(|v| !v.is_finite()) {
+        return Err(CollisionError::InvalidValue {
+            what: format!("coordinate {i} of a sphere's centre"),
+            problem: format!("is {}, not a finite number", centre[i]),
+        });
+    }
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(CollisionError::InvalidValue {
+            what: "a sphere's radius".into(),
+            problem: format!("is {radius}; give a finite radius of 0 or more, in metres"),
+        });
+    }
+    Ok(())
+}
+
 impl World {
     /// An empty world.
     pub fn new() -> Self {
@@ -389,6 +406,32 @@ impl World {
     /// True when the world is empty.
     pub fn is_empty(&self) -> bool {
         self.objects.is_empty()
+    }
+
+    /// The first object (index) that a ball of radius `radius` at `centre` touches or
+    /// overlaps, measured exactly in `f64` (a point cloud's points as balls of its radius);
+    /// `None` when it touches none. A radius of 0 asks about a point. An error for a centre
+    /// or radius that is not finite, or a negative radius.
+    pub fn sphere_touches(&self, centre: [f64; 3], radius: f64) -> Result<Option<usize>> {
+        check_sphere(&centre, radius)?;
+        Ok(self.sphere_touches_unchecked(centre, radius))
+    }
+
+    /// [`World::sphere_touches`] without its checks: a centre or radius that is not finite
+    /// gives a meaningless answer (never a panic).
+    pub fn sphere_touches_unchecked(&self, centre: [f64; 3], radius: f64) -> Option<usize> {
+        let c = nalgebra::Point3::from(centre);
+        let ball = Compiled {
+            center: c,
+            bound: radius,
+            geometry: crate::shape::Geometry::Round { a: c, b: c, radius },
+        };
+        let mut placed = Placed::default();
+        ball.place(&Isometry3::identity(), &mut placed);
+        self.objects.iter().position(|o| {
+            !crate::shape::bounds_apart(&placed, &o.placed)
+                && crate::shape::intersects(&ball, &placed, &o.compiled, &o.placed)
+        })
     }
 }
 

@@ -390,56 +390,72 @@ impl CloudGrid {
         m: f32,
         lanes: LaneMask,
     ) -> (LaneMask, LaneMask) {
-        use std::arch::x86_64::{
-            _CMP_NGT_UQ, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps,
-            _mm256_max_ps, _mm256_movemask_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
-        };
-        let sign = _mm256_set1_ps(-0.0);
+        use std::arch::x86_64::_mm256_set1_ps;
         let centre: [_; 3] = std::array::from_fn(|k| _mm256_set1_ps(center[k]));
         let halves: [_; 3] = std::array::from_fn(|k| _mm256_set1_ps(half[k]));
         let (mut hit, mut close) = (0, 0);
         for (c, ball) in centres.iter().zip(balls) {
-            // SAFETY: `F` is eight `f32` aligned to 32 bytes
-            #[allow(unsafe_code)]
-            let p: [_; 3] = std::array::from_fn(|k| unsafe { _mm256_load_ps(c[k].0.as_ptr()) });
-            // the box about the points, as `Object::near` measures it
-            let reach = ball.radius + radius;
-            let mut d2 = _mm256_setzero_ps();
-            for k in 0..3 {
-                let d = _mm256_andnot_ps(sign, _mm256_sub_ps(p[k], centre[k]));
-                let out = _mm256_max_ps(_mm256_sub_ps(d, halves[k]), _mm256_setzero_ps());
-                d2 = _mm256_fmadd_ps(out, out, d2);
-            }
-            // (summed in `Object::near`'s order)
-            let outer = ball.radius + m + radius;
-            let near = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer));
-            let near = lanes & _mm256_movemask_ps(near) as LaneMask;
-            if near == 0 {
-                continue;
-            }
-            // the cells' clearances, then their witnesses ([`CloudGrid::may_touch`],
-            // [`CloudGrid::holding`])
-            let (cell, finite) = self.cells_avx(c);
-            let clear = self.gather_avx(cell, 0);
-            let limit = reach + self.gap + m + self.slack;
-            let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(limit));
-            let open = near
-                & ((_mm256_movemask_ps(within) as LaneMask)
-                    | !(_mm256_movemask_ps(finite) as LaneMask));
-            if open == 0 {
-                continue;
-            }
-            close |= open;
-            let inside = (reach - m).max(0.0) - self.slack;
-            if inside <= 0.0 {
-                continue;
-            }
-            hit |= open & self.held_avx(cell, &p, inside * inside);
+            let (h, open) = self.glance_avx(&centre, &halves, radius, c, ball.radius, m, lanes);
+            (hit, close) = (hit | h, close | open);
             if hit != 0 {
                 break;
             }
         }
         (hit, close)
+    }
+
+    /// [`super::world::FastWorld::glance`] of the sphere of radius `r` at `c`, for the cloud
+    /// whose points' box has centre `centre` and half sizes `halves` (broadcast to every lane),
+    /// points of radius `radius`: the box, then the cells' clearances, then their witnesses
+    /// ([`CloudGrid::may_touch`], [`CloudGrid::holding`]), each lane's cell found once.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn glance_avx(
+        &self,
+        centre: &[std::arch::x86_64::__m256; 3],
+        halves: &[std::arch::x86_64::__m256; 3],
+        radius: f32,
+        c: &[F; 3],
+        r: f32,
+        m: f32,
+        lanes: LaneMask,
+    ) -> (LaneMask, LaneMask) {
+        use std::arch::x86_64::{
+            _CMP_NGT_UQ, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps,
+            _mm256_max_ps, _mm256_movemask_ps, _mm256_set1_ps, _mm256_setzero_ps, _mm256_sub_ps,
+        };
+        // SAFETY: `F` is eight `f32` aligned to 32 bytes
+        #[allow(unsafe_code)]
+        let p: [_; 3] = std::array::from_fn(|k| unsafe { _mm256_load_ps(c[k].0.as_ptr()) });
+        // the box about the points, as `Object::near` measures it
+        let reach = r + radius;
+        let mut d2 = _mm256_setzero_ps();
+        for k in 0..3 {
+            let d = _mm256_andnot_ps(_mm256_set1_ps(-0.0), _mm256_sub_ps(p[k], centre[k]));
+            let out = _mm256_max_ps(_mm256_sub_ps(d, halves[k]), _mm256_setzero_ps());
+            d2 = _mm256_fmadd_ps(out, out, d2);
+        }
+        // (summed in `Object::near`'s order)
+        let outer = r + m + radius;
+        let near = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer * outer));
+        let near = lanes & _mm256_movemask_ps(near) as LaneMask;
+        if near == 0 {
+            return (0, 0);
+        }
+        let (cell, finite) = self.cells_avx(c);
+        let clear = self.gather_avx(cell, 0);
+        let limit = reach + self.gap + m + self.slack;
+        let within = _mm256_cmp_ps::<_CMP_NGT_UQ>(clear, _mm256_set1_ps(limit));
+        let open = near
+            & ((_mm256_movemask_ps(within) as LaneMask)
+                | !(_mm256_movemask_ps(finite) as LaneMask));
+        let inside = (reach - m).max(0.0) - self.slack;
+        if open == 0 || inside <= 0.0 {
+            return (0, open);
+        }
+        (open & self.held_avx(cell, &p, inside * inside), open)
     }
 
     /// The range of cells along axis `k` that `[a, b]` overlaps, `None` when it misses them.

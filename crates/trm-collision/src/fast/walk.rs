@@ -241,7 +241,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
 /// Whether a sphere at `c` of radius `reach` (in some lane of `live`) comes within object
 /// `k`'s enclosing sphere ([`FastWorld::enclosing`]): when not, it misses the object.
 #[inline(always)]
-fn enclosing_near<const AVX: bool>(
+pub(super) fn enclosing_near<const AVX: bool>(
     world: &FastWorld,
     k: usize,
     c: &[F; 3],

@@ -1,4 +1,3 @@
-use super::LaneMask;
 #[cfg(target_arch = "x86_64")]
 use super::avx;
 use super::cloud::{CloudGrid, MESH_SPACING};
@@ -8,6 +7,10 @@ use super::lanes::{
 };
 use super::model::{Ball, FastModel};
 use super::outcome::Contact;
+use super::outcome::Verdict;
+use super::walk::enclosing_near;
+use super::{ALL_LANES, FAST_LANES, LaneMask};
+use crate::error::{CollisionError, Result};
 use crate::shape::Shape;
 use crate::world::World;
 use nalgebra::{Point3, Vector3};
@@ -182,9 +185,27 @@ impl FastWorld {
         m: f32,
         lanes: LaneMask,
     ) -> (LaneMask, LaneMask) {
-        let Object::Cloud { index, .. } = *object else {
+        let Object::Cloud {
+            index,
+            center,
+            half,
+            radius,
+        } = *object
+        else {
             return (0, lanes);
         };
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            use std::arch::x86_64::_mm256_set1_ps;
+            let grid = &self.clouds[index as usize];
+            // SAFETY: as in `F::any_within`
+            #[allow(unsafe_code)]
+            return unsafe {
+                let centre = center.map(|v| _mm256_set1_ps(v));
+                let halves = half.map(|v| _mm256_set1_ps(v));
+                grid.glance_avx(&centre, &halves, radius, c, r, m, lanes)
+            };
+        }
         let near = lanes & object.near::<AVX>(c, r + m);
         if near == 0 {
             return (0, 0);
@@ -199,6 +220,101 @@ impl FastWorld {
         // and those a cell's witness settles
         (grid.holding::<AVX>(c, (reach - m).max(0.0), near), near)
     }
+}
+
+impl FastWorld {
+    /// Spheres of radius `radius` (m, 0 or more) at `centres`, one per lane (`centres[0]`
+    /// holds each lane's x, `centres[1]` its y, `centres[2]` its z), screened in single
+    /// precision against every object: `colliding` holds **every** lane certainly touching an
+    /// object, `uncertain` the lanes within the margin of contact and certain of none (check
+    /// those exactly, as [`FastWorld::spheres_touching`] does). Lanes that are not finite are
+    /// uncertain.
+    pub fn screen_spheres(&self, centres: &[[f32; FAST_LANES]; 3], radius: f32) -> Verdict {
+        let c = [F(centres[0]), F(centres[1]), F(centres[2])];
+        let (hit, close) = screen_spheres_in(self, &c, radius);
+        let unmeasured = (0..FAST_LANES)
+            .filter(|&l| !(radius.is_finite() && (0..3).all(|k| centres[k][l].is_finite())))
+            .fold(0, |lanes, l| lanes | 1 << l);
+        Verdict {
+            colliding: hit & !unmeasured,
+            uncertain: (close & !hit) | unmeasured,
+        }
+    }
+
+    /// The lanes (bit `l` for `centres[l]`) in which a sphere of radius `radius` at the centre
+    /// touches or overlaps an object of `world`, exactly: the single-precision screen
+    /// ([`FastWorld::screen_spheres`]), then its uncertain lanes in `f64`
+    /// ([`World::sphere_touches`]). `self` must be compiled from `world`. An error for more
+    /// than [`FAST_LANES`] centres, a value that is not finite, or a negative radius.
+    pub fn spheres_touching(
+        &self,
+        world: &World,
+        centres: &[[f64; 3]],
+        radius: f64,
+    ) -> Result<LaneMask> {
+        if centres.len() > FAST_LANES {
+            return Err(CollisionError::InvalidValue {
+                what: format!("{} sphere centres", centres.len()),
+                problem: format!("one query takes at most {FAST_LANES}; split them"),
+            });
+        }
+        for c in centres {
+            crate::world::check_sphere(c, radius)?;
+        }
+        Ok(self.spheres_touching_unchecked(world, centres, radius))
+    }
+
+    /// [`FastWorld::spheres_touching`] without its checks: up to [`FAST_LANES`] centres (more
+    /// panic); a lane whose centre or radius is not finite counts as touching.
+    pub fn spheres_touching_unchecked(
+        &self,
+        world: &World,
+        centres: &[[f64; 3]],
+        radius: f64,
+    ) -> LaneMask {
+        let mut lanes = [[f32::NAN; FAST_LANES]; 3];
+        for (l, c) in centres.iter().enumerate() {
+            for k in 0..3 {
+                lanes[k][l] = c[k] as f32;
+            }
+        }
+        let used = ((1u16 << centres.len()) - 1) as LaneMask;
+        let verdict = self.screen_spheres(&lanes, radius as f32);
+        let mut touching = verdict.colliding & used;
+        for (l, c) in centres.iter().enumerate() {
+            if verdict.uncertain & (1 << l) != 0 {
+                let finite = radius.is_finite() && c.iter().all(|v| v.is_finite());
+                if !finite || world.sphere_touches_unchecked(*c, radius).is_some() {
+                    touching |= 1 << l;
+                }
+            }
+        }
+        touching
+    }
+}
+
+/// [`FastWorld::screen_spheres`]: the lanes certainly touching an object, and those within the
+/// margin of contact with one (the certain ones among them). Each object's enclosing sphere
+/// first; a lane certain of one object is not tested against the later ones.
+#[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
+#[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
+fn screen_spheres_in(world: &FastWorld, c: &[F; 3], r: f32) -> (LaneMask, LaneMask) {
+    // the AVX code paths take AVX2 and FMA: the plain-AVX clone goes without them
+    const AVX: bool = multiversion::target::selected_target!().supports_feature_str("avx2")
+        && multiversion::target::selected_target!().supports_feature_str("fma");
+    let m = world.margin;
+    let (mut contact, mut open) = (Contact::default(), ALL_LANES);
+    for (k, object) in world.objects.iter().enumerate() {
+        if !enclosing_near::<AVX>(world, k, c, r + m, open) {
+            continue;
+        }
+        world.test::<AVX>(object, &mut contact, c, r, m, open, false);
+        open = !contact.hit.mask::<AVX>();
+        if open == 0 {
+            break;
+        }
+    }
+    (contact.hit.mask::<AVX>(), contact.close.mask::<AVX>())
 }
 
 impl FastModel {
@@ -486,3 +602,6 @@ pub(super) fn limits(r: f32, m: f32) -> [f32; 2] {
     let (inner, outer) = ((r - m).max(0.0), r + m);
     [inner * inner, outer * outer]
 }
+
+#[cfg(test)]
+mod tests;
