@@ -120,6 +120,35 @@ impl PyWorld {
         self.world.remove(name).map(drop).map_err(err)
     }
 
+    /// Per sphere of radius `radius` (m) centred on a row of `centres` (an (N, 3) array): the
+    /// name of an object it touches or overlaps, measured exactly (a point cloud's points as
+    /// balls of its radius), or None. A radius of 0 asks about points.
+    fn touching(
+        &self,
+        py: Python<'_>,
+        centres: &Bound<'_, PyAny>,
+        radius: f64,
+    ) -> PyResult<Vec<Option<String>>> {
+        let centres = rows3(centres, "centres")?;
+        let found = py.detach(|| {
+            centres
+                .iter()
+                .enumerate()
+                .map(|(row, c)| {
+                    self.world
+                        .sphere_touches(*c, radius)
+                        .map_err(|e| format!("centres row {row}: {e}"))
+                })
+                .collect::<Result<Vec<_>, _>>()
+        });
+        let objects = self.world.objects();
+        Ok(found
+            .map_err(err)?
+            .into_iter()
+            .map(|o| o.map(|i| objects[i].name().to_string()))
+            .collect())
+    }
+
     /// Object names.
     #[getter]
     fn names(&self) -> Vec<String> {

@@ -114,6 +114,14 @@ def test_point_clouds_and_meshes_are_obstacles(robot):
     assert col.is_colliding(home, world) is False
     world.set_pose("fold", [0.0, 0.0, -1.0])
     assert col.is_colliding(home, world) is True
+    # spheres alone: the hand's place touches the fold's plane, a point far off touches nothing
+    spheres = np.array([far + [0.1, 0.1, -0.995], far + [5.0, 0.0, 0.0], cloud[1] + [2.0, 0, 0]])
+    assert world.touching(spheres, 0.01) == ["fold", None, "scan"]
+    assert world.touching(spheres, 0.0) == [None, None, "scan"]
+    with pytest.raises(trm.TrmError, match="centres row 1: .*coordinate 2 of a sphere's centre"):
+        world.touching(np.array([far, [0.0, 0.0, np.nan]]), 0.01)
+    with pytest.raises(trm.TrmError, match="radius"):
+        world.touching(spheres, -0.01)
     with pytest.raises(trm.TrmError, match=r"expected \(N, 3\)"):
         world.add_points("flat", np.zeros((4, 2)), 0.01)
     with pytest.raises(trm.TrmError, match="beyond the 4 given"):
