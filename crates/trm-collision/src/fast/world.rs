@@ -232,9 +232,12 @@ impl FastWorld {
     pub fn screen_spheres(&self, centres: &[[f32; FAST_LANES]; 3], radius: f32) -> Verdict {
         let c = [F(centres[0]), F(centres[1]), F(centres[2])];
         let (hit, close) = screen_spheres_in(self, &c, radius);
-        let unmeasured = (0..FAST_LANES)
-            .filter(|&l| !(radius.is_finite() && (0..3).all(|k| centres[k][l].is_finite())))
-            .fold(0, |lanes, l| lanes | 1 << l);
+        // 0·x is 0 for a finite x, NaN otherwise
+        let mut unmeasured = if radius.is_finite() { 0 } else { ALL_LANES };
+        for l in 0..FAST_LANES {
+            let zero: f32 = (0..3).map(|k| 0.0 * centres[k][l]).sum();
+            unmeasured |= LaneMask::from(zero != 0.0) << l;
+        }
         Verdict {
             colliding: hit & !unmeasured,
             uncertain: (close & !hit) | unmeasured,
@@ -272,21 +275,19 @@ impl FastWorld {
         centres: &[[f64; 3]],
         radius: f64,
     ) -> LaneMask {
-        let mut lanes = [[f32::NAN; FAST_LANES]; 3];
-        for (l, c) in centres.iter().enumerate() {
-            for k in 0..3 {
-                lanes[k][l] = c[k] as f32;
-            }
-        }
+        let mut padded = [[f64::NAN; 3]; FAST_LANES];
+        padded[..centres.len()].copy_from_slice(centres);
+        let lanes = std::array::from_fn(|k| std::array::from_fn(|l| padded[l][k] as f32));
         let used = ((1u16 << centres.len()) - 1) as LaneMask;
         let verdict = self.screen_spheres(&lanes, radius as f32);
         let mut touching = verdict.colliding & used;
-        for (l, c) in centres.iter().enumerate() {
-            if verdict.uncertain & (1 << l) != 0 {
-                let finite = radius.is_finite() && c.iter().all(|v| v.is_finite());
-                if !finite || world.sphere_touches_unchecked(*c, radius).is_some() {
-                    touching |= 1 << l;
-                }
+        let mut uncertain = verdict.uncertain & used;
+        while uncertain != 0 {
+            let l = uncertain.trailing_zeros() as usize;
+            uncertain &= uncertain - 1;
+            let finite = radius.is_finite() && centres[l].iter().all(|v| v.is_finite());
+            if !finite || world.sphere_touches_unchecked(centres[l], radius).is_some() {
+                touching |= 1 << l;
             }
         }
         touching
