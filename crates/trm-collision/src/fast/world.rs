@@ -6,8 +6,7 @@ use super::lanes::{
     segment_distance2, splat, to_f32,
 };
 use super::model::{Ball, FastModel};
-use super::outcome::Contact;
-use super::outcome::Verdict;
+use super::outcome::{Contact, Verdict};
 use super::walk::enclosing_near;
 use super::{ALL_LANES, FAST_LANES, LaneMask};
 use crate::error::{CollisionError, Result};
@@ -220,9 +219,7 @@ impl FastWorld {
         // and those a cell's witness settles
         (grid.holding::<AVX>(c, (reach - m).max(0.0), near), near)
     }
-}
 
-impl FastWorld {
     /// Spheres of radius `radius` (m, 0 or more) at `centres`, one per lane (`centres[0]`
     /// holds each lane's x, `centres[1]` its y, `centres[2]` its z), screened in single
     /// precision against every object: `colliding` holds **every** lane certainly touching an
@@ -261,7 +258,11 @@ impl FastWorld {
                 problem: format!("one query takes at most {FAST_LANES}; split them"),
             });
         }
-        for c in centres {
+        // (the radius is checked with the first centre, or alone)
+        for c in centres
+            .iter()
+            .chain(centres.is_empty().then_some(&[0.0; 3]))
+        {
             crate::world::check_sphere(c, radius)?;
         }
         Ok(self.spheres_touching_unchecked(world, centres, radius))

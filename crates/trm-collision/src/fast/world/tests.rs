@@ -225,6 +225,7 @@ fn sphere_queries_refuse_bad_input() {
         0
     );
     assert_eq!(fast.spheres_touching(&world, &[], 0.1).unwrap(), 0);
+    assert!(fast.spheres_touching(&world, &[], -0.1).is_err());
     let unmeasured = [far, [f64::NAN, 0.0, 0.0], far];
     assert_eq!(
         fast.spheres_touching_unchecked(&world, &unmeasured, 0.1),
