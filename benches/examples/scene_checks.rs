@@ -1,35 +1,55 @@
 //! The check of free configurations in MotionBenchMaker's scenes, where the world part costs:
 //! random configurations of each problem's scene (seed = the problem's place in the set) kept
 //! where the exact model finds them free, checked by the single-precision screen in blocks of
-//! [`FAST_LANES`] (interleaved rounds, median of the rounds):
+//! [`FAST_LANES`] (interleaved rounds, median of the rounds), optionally beside VAMP on the same
+//! configurations in the same scenes:
 //!
 //! ```sh
 //! cargo run --release -p trm-benches --example scene_checks -- \
-//!     benches/mbm/fetch_problems.tar.bz2 models/fetch-mbm/fetch_spherized.ron 10
+//!     benches/mbm/fetch_problems.tar.bz2 models/fetch-mbm/fetch_spherized.ron 10 7 \
+//!     target/peers/vamp-mbm
 //! ```
 //!
-//! Arguments: the problem set, the model, the problems per family (default 10) and the rounds
-//! (default 7). Prints the time per free configuration per family and over the set, and
-//! whether the screen agreed with the exact model on every configuration.
+//! Arguments: the problem set, the model, the problems per family (default 10), the rounds
+//! (default 7) and VAMP's program (`benches/peers/vamp/build.sh`; the model's name and joints
+//! must be VAMP's robot's). Prints the time per free configuration per family and over the set,
+//! and whether the screen agreed with the exact model on every configuration. With VAMP, trm is
+//! also timed in the world as VAMP sees it ([`trm_mbm::vamp_world`]: cylinders as capsules, in
+//! the box family as boxes), and each round runs trm's passes and then VAMP's.
 
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use trm_benches::{median, positive, random_configurations};
-use trm_collision::CollisionModel;
-use trm_collision::fast::{FAST_LANES, FastChecker};
+use trm_collision::fast::{FAST_LANES, FastChecker, FastWorld};
+use trm_collision::{CollisionModel, World};
 use trm_kinematics::RobotModel;
-use trm_mbm::{LoadedProblem, ProblemSet};
+use trm_mbm::{LoadedProblem, ProblemSet, peer_objects, vamp_world};
 use trm_tasks::Objective;
 
 fn main() {
     trm_benches::exit_on_error(run);
 }
 
+/// One problem's scene: its family, checker, worlds (compiled and exact; as trm plans in it and
+/// as VAMP sees it) and free configurations (whole blocks).
+struct Scene {
+    family: String,
+    fast: FastChecker,
+    worlds: [(FastWorld, World); 2],
+    free: Vec<f64>,
+}
+
+/// Per family, each round's seconds and the configurations timed.
+type Times = BTreeMap<String, (Vec<f64>, usize)>;
+
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 2 {
-        return Err("usage: scene_checks PROBLEMS MODEL [PER_FAMILY] [ROUNDS]".into());
+        return Err("usage: scene_checks PROBLEMS MODEL [PER_FAMILY] [ROUNDS] [VAMP]".into());
     }
     let per_family = args.get(2).map_or(Ok(10), |r| positive(r, "PER_FAMILY"))?;
     let rounds = args.get(3).map_or(Ok(7), |r| positive(r, "ROUNDS"))?;
@@ -39,7 +59,8 @@ fn run() -> Result<(), String> {
     set.select(&[], Some(per_family))
         .map_err(|e| e.to_string())?;
     let loaded = LoadedProblem::load_all(&collision, &set.problems).map_err(|e| e.to_string())?;
-    // per scene: its checker, compiled world and free configurations in blocks
+    let d = robot.all_active().len();
+    let width = FAST_LANES * d;
     let mut scenes = Vec::new();
     let mut disagreements = 0;
     for (k, p) in loaded.iter().enumerate() {
@@ -56,78 +77,250 @@ fn run() -> Result<(), String> {
                 free.extend(q);
             }
         }
-        let width = FAST_LANES * objective.dim();
         free.truncate(free.len() / width * width);
-        scenes.push((
-            p.problem.family.clone(),
+        let seen = vamp_world(&p.world, &p.problem.family);
+        let worlds = [(world, p.world.clone()), (fast.model().world(&seen), seen)];
+        scenes.push(Scene {
+            family: p.problem.family.clone(),
             fast,
-            world,
-            p.world.clone(),
+            worlds,
             free,
-            width,
-        ));
+        });
     }
-    // the same configurations and checkers in an empty world: the self part alone
-    let empty_world = trm_collision::World::new();
-    let mut empty = Vec::new();
-    for _ in 0..rounds {
-        let began = Instant::now();
-        for (_, fast, _, _, free, width) in &mut scenes {
-            let compiled = fast.model().world(&empty_world);
-            for block in free.chunks(*width) {
-                std::hint::black_box(fast.all_free_unchecked(block, &empty_world, &compiled));
-            }
-        }
-        empty.push(began.elapsed().as_secs_f64());
-    }
-    let mut times: std::collections::BTreeMap<String, (Vec<f64>, usize)> = Default::default();
-    let mut all = Vec::new();
-    for _ in 0..rounds {
-        let mut round = std::collections::BTreeMap::<String, f64>::new();
-        for (family, fast, world, exact, free, width) in &mut scenes {
-            let began = Instant::now();
-            for block in free.chunks(*width) {
-                std::hint::black_box(fast.all_free_unchecked(block, exact, world));
-            }
-            *round.entry(family.clone()).or_default() += began.elapsed().as_secs_f64();
-        }
-        all.push(round.values().sum::<f64>());
-        for (family, t) in round {
-            times.entry(family).or_default().0.push(t);
-        }
-    }
-    for (family, _, _, _, free, width) in &scenes {
-        if let Some(entry) = times.get_mut(family) {
-            entry.1 += free.len() / width * FAST_LANES;
-        }
-    }
-    let total: usize = times.values().map(|(_, n)| n).sum();
+    let total: usize = scenes.iter().map(|s| s.free.len() / d).sum();
     if total == 0 {
         return Err(format!(
-            "{}: no block of free configurations in the scenes of {} problems (an empty set,              or scenes that fill the robot's reach)",
+            "{}: no block of free configurations in the scenes of {} problems (an empty set, \
+             or scenes that fill the robot's reach)",
             args[0],
             scenes.len()
         ));
     }
-    println!(
-        "{} with {}: free configurations of {per_family} problems per family, blocks of \
-         {FAST_LANES}, median of {rounds} rounds",
-        args[0], args[1]
-    );
-    for (family, (t, n)) in &mut times {
-        println!(
-            "  {family}: {:.1} ns per configuration ({n})",
-            median(t) / *n as f64 * 1e9
-        );
+    // the same configurations and checkers in an empty world: the self part alone
+    let empty_world = World::new();
+    let mut empty = Vec::new();
+    for _ in 0..rounds {
+        let began = Instant::now();
+        for scene in &mut scenes {
+            let compiled = scene.fast.model().world(&empty_world);
+            for block in scene.free.chunks(width) {
+                std::hint::black_box(
+                    scene
+                        .fast
+                        .all_free_unchecked(block, &empty_world, &compiled),
+                );
+            }
+        }
+        empty.push(began.elapsed().as_secs_f64());
+    }
+    let mut vamp = match args.get(4) {
+        Some(program) => Some(Vamp::start(program, &robot, &loaded, &scenes, d, rounds)?),
+        None => None,
+    };
+    // per world (trm's, VAMP's as trm checks it, VAMP's own): per family its rounds
+    let mut times: [Times; 3] = Default::default();
+    for round in 0..rounds {
+        for (w, family_times) in times.iter_mut().enumerate().take(2) {
+            if w == 1 && vamp.is_none() {
+                continue;
+            }
+            let mut this = BTreeMap::<String, f64>::new();
+            for scene in &mut scenes {
+                let (compiled, exact) = &scene.worlds[w];
+                let began = Instant::now();
+                for block in scene.free.chunks(width) {
+                    std::hint::black_box(scene.fast.all_free_unchecked(block, exact, compiled));
+                }
+                *this.entry(scene.family.clone()).or_default() += began.elapsed().as_secs_f64();
+            }
+            record(family_times, this);
+        }
+        if let Some(vamp) = &mut vamp {
+            let per_scene = vamp.round(round)?;
+            let mut this = BTreeMap::<String, f64>::new();
+            for (scene, ns) in scenes.iter().zip(per_scene) {
+                *this.entry(scene.family.clone()).or_default() +=
+                    ns * 1e-9 * (scene.free.len() / d) as f64;
+            }
+            record(&mut times[2], this);
+        }
+    }
+    for family_times in &mut times {
+        for scene in &scenes {
+            if let Some(entry) = family_times.get_mut(&scene.family) {
+                entry.1 += scene.free.len() / d;
+            }
+        }
     }
     println!(
-        "  all: {:.1} ns per configuration ({total}); the screen and the exact model differ on \
-         {disagreements} configurations",
-        median(&mut all) / total as f64 * 1e9
+        "{} with {}: free configurations of {per_family} problems per family, blocks of \
+         {FAST_LANES}, median of {rounds} rounds (ns per configuration{})",
+        args[0],
+        args[1],
+        if vamp.is_some() {
+            "; trm in its world, trm in the world as VAMP sees it, VAMP, ratio of the first to \
+             VAMP's"
+        } else {
+            ""
+        }
     );
+    let per_config = |entry: &mut (Vec<f64>, usize)| median(&mut entry.0) / entry.1 as f64 * 1e9;
+    let families: Vec<String> = times[0].keys().cloned().collect();
+    let mut rows: Vec<(String, [Option<f64>; 3])> = families
+        .iter()
+        .map(|f| {
+            (
+                f.clone(),
+                [0, 1, 2].map(|w| times[w].get_mut(f).map(per_config)),
+            )
+        })
+        .collect();
+    let all = |family_times: &Times| -> Option<f64> {
+        if family_times.is_empty() {
+            return None;
+        }
+        let mut sums: Vec<f64> = (0..rounds)
+            .map(|r| family_times.values().map(|(t, _)| t[r]).sum())
+            .collect();
+        Some(median(&mut sums) / total as f64 * 1e9)
+    };
+    rows.push(("all".into(), [0, 1, 2].map(|w| all(&times[w]))));
+    for (family, [ours, seen, theirs]) in &rows {
+        let n = times[0].get(family).map_or(total, |e| e.1);
+        match (ours, seen, theirs) {
+            (Some(ours), Some(seen), Some(theirs)) => println!(
+                "  {family}: {ours:.1}, {seen:.1}, {theirs:.1} ({:.2}×; {n} configurations)",
+                ours / theirs
+            ),
+            (Some(ours), ..) => println!("  {family}: {ours:.1} ns per configuration ({n})"),
+            _ => {}
+        }
+    }
     println!(
-        "  the same in an empty world: {:.1} ns per configuration",
+        "  the screen and the exact model differ on {disagreements} configurations; in an empty \
+         world: {:.1} ns per configuration",
         median(&mut empty) / total as f64 * 1e9
     );
+    if let Some(vamp) = vamp {
+        let free = vamp.finish()?;
+        println!(
+            "  VAMP finds {free} of the {total} configurations free (its spheres and its world: \
+             cylinders as capsules)"
+        );
+    }
     Ok(())
+}
+
+/// Adds one round's seconds per family.
+fn record(times: &mut Times, round: BTreeMap<String, f64>) {
+    for (family, t) in round {
+        times.entry(family).or_default().0.push(t);
+    }
+}
+
+/// VAMP's program in its `scenes` mode, a round at a time.
+struct Vamp {
+    child: std::process::Child,
+    input: std::process::ChildStdin,
+    output: std::io::Lines<BufReader<std::process::ChildStdout>>,
+    program: String,
+}
+
+impl Vamp {
+    /// Starts `program` and hands it every scene's objects and free configurations.
+    fn start(
+        program: &str,
+        robot: &RobotModel,
+        loaded: &[LoadedProblem],
+        scenes: &[Scene],
+        d: usize,
+        rounds: usize,
+    ) -> Result<Vamp, String> {
+        let active = robot.all_active();
+        let names: Vec<&str> = active.names().collect();
+        let mut text = format!(
+            "trm-mbm-problems 1\nrobot {}\nscenes\njoints {d} {}\n{}\n",
+            robot.name(),
+            names.join(" "),
+            scenes.len()
+        );
+        for (p, scene) in loaded.iter().zip(scenes) {
+            text.push_str(&format!("scene {}\n", scene.family));
+            text.push_str(&peer_objects(&p.scene).map_err(|e| e.to_string())?);
+            text.push_str(&format!("configurations {}\n", scene.free.len() / d));
+            for q in scene.free.chunks(d) {
+                let values: Vec<String> = q.iter().map(|v| v.to_string()).collect();
+                text.push_str(&values.join(" "));
+                text.push('\n');
+            }
+        }
+        text.push_str(&format!("rounds {rounds}\n"));
+        let mut child = Command::new(program)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .map_err(|e| format!("{program}: {e} (build it with benches/peers/vamp/build.sh)"))?;
+        let (Some(mut input), Some(output)) = (child.stdin.take(), child.stdout.take()) else {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!("{program}: no pipes"));
+        };
+        input
+            .write_all(text.as_bytes())
+            .and_then(|()| input.flush())
+            .map_err(|e| format!("{program}: {e}"))?;
+        Ok(Vamp {
+            child,
+            input,
+            output: BufReader::new(output).lines(),
+            program: program.into(),
+        })
+    }
+
+    /// The next line VAMP prints, which must start with `word`: the rest's fields.
+    fn line(&mut self, word: &str) -> Result<Vec<String>, String> {
+        let line = self
+            .output
+            .next()
+            .ok_or_else(|| format!("{}: ended before `{word}` (see its message)", self.program))?
+            .map_err(|e| format!("{}: {e}", self.program))?;
+        let mut fields = line.split_whitespace();
+        if fields.next() != Some(word) {
+            return Err(format!(
+                "{}: expected `{word} …`, read `{line}`",
+                self.program
+            ));
+        }
+        Ok(fields.map(str::to_owned).collect())
+    }
+
+    /// Round `round`'s times, ns per configuration, one per scene.
+    fn round(&mut self, round: usize) -> Result<Vec<f64>, String> {
+        if round > 0 {
+            writeln!(self.input, "next")
+                .and_then(|()| self.input.flush())
+                .map_err(|e| format!("{}: {e}", self.program))?;
+        }
+        let fields = self.line("round")?;
+        fields
+            .iter()
+            .map(|f| {
+                let ns = f.split('/').next().unwrap_or(f);
+                ns.parse::<f64>()
+                    .map_err(|e| format!("{}: `{f}` in a round: {e}", self.program))
+            })
+            .collect()
+    }
+
+    /// How many configurations VAMP finds free in all, then waits for it to end.
+    fn finish(mut self) -> Result<usize, String> {
+        let fields = self.line("free")?;
+        let free = fields
+            .iter()
+            .map(|f| f.parse::<usize>().map_err(|e| format!("`{f}`: {e}")))
+            .sum::<Result<usize, String>>()?;
+        drop(self.input);
+        let _ = self.child.wait();
+        Ok(free)
+    }
 }

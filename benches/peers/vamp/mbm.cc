@@ -2,7 +2,8 @@
 // (`cargo xtask benchmark-mbm SET --model M --vamp target/peers/vamp-mbm`), for the side-by-side
 // table. Reads the problems on stdin (the format `trm_plan::mbm::peer_problems` writes), prints
 // one line per problem on stdout (after `robot NAME`, `configurations N` instead of `joints`
-// times FK + self-collision of N configurations instead: see `configurations` below):
+// times FK + self-collision of N configurations instead, and `scenes` FK + collision in
+// scenes: see `configurations` and `scenes` below):
 //   result FAMILY INDEX VALID SOLVED PLAN_NS SIMPLIFY_NS COST SIMPLIFIED_COST ITERATIONS WAYPOINTS BUILD_NS
 //   path q1 … qd   (one line per waypoint of the simplified path)
 // Settings as VAMP's own evaluate_mbm.py: Halton sampler reset per problem, dynamic-domain
@@ -147,13 +148,10 @@ namespace
         return environment;
     }
 
+    // `N NAME…` after `joints`: VAMP's joints of the robot, in its order.
     template <typename Robot>
-    auto run(std::istream &in, float range) -> void
+    auto expect_joints(std::istream &in) -> void
     {
-        using Configuration = typename Robot::Configuration;
-        using Environment = vamp::collision::Environment<vamp::FloatVector<rake>>;
-        using RRTC = vamp::planning::RRTC<Robot, rake, Robot::resolution>;
-
         if (read<std::size_t>(in, "the joint count") != Robot::dimension)
         {
             fail(std::string("joint count differs from VAMP's ") + Robot::name);
@@ -167,6 +165,52 @@ namespace
                      std::string(Robot::joint_names[j]) + "`");
             }
         }
+    }
+
+    // `count` configurations of the robot, one per line, in VAMP's joint order.
+    template <typename Robot>
+    auto read_configurations(std::istream &in, std::size_t count)
+        -> std::vector<std::array<float, Robot::dimension>>
+    {
+        std::vector<std::array<float, Robot::dimension>> qs(count);
+        for (auto &q : qs)
+        {
+            for (auto &v : q)
+            {
+                v = read<float>(in, "a joint value");
+            }
+        }
+        return qs;
+    }
+
+    // Blocks of `rake` configurations (lane l: configuration first + l, the last repeated
+    // past the end; with `broadcast`, configuration `first` in every lane).
+    template <typename Robot>
+    auto block_of(const std::vector<std::array<float, Robot::dimension>> &qs, std::size_t first, bool broadcast)
+        -> typename Robot::template ConfigurationBlock<rake>
+    {
+        typename Robot::template ConfigurationBlock<rake> block;
+        for (std::size_t j = 0; j < Robot::dimension; ++j)
+        {
+            std::array<float, rake> lane{};
+            for (std::size_t l = 0; l < rake; ++l)
+            {
+                const auto k = broadcast ? first : std::min(first + l, qs.size() - 1);
+                lane[l] = qs[k][j];
+            }
+            block[j] = vamp::FloatVector<rake>(lane);
+        }
+        return block;
+    }
+
+    template <typename Robot>
+    auto run(std::istream &in, float range) -> void
+    {
+        using Configuration = typename Robot::Configuration;
+        using Environment = vamp::collision::Environment<vamp::FloatVector<rake>>;
+        using RRTC = vamp::planning::RRTC<Robot, rake, Robot::resolution>;
+
+        expect_joints<Robot>(in);
         expect(in, "problems");
         const auto count = read<std::size_t>(in, "the problem count");
 
@@ -247,33 +291,11 @@ namespace
         using Block = typename Robot::template ConfigurationBlock<rake>;
         const vamp::collision::Environment<vamp::FloatVector<rake>> empty{};
         const auto n = read<std::size_t>(in, "the configuration count");
-        std::vector<std::array<float, Robot::dimension>> qs(n);
-        for (auto &q : qs)
-        {
-            for (auto &v : q)
-            {
-                v = read<float>(in, "a joint value");
-            }
-        }
-        const auto block_of = [&](std::size_t first, bool broadcast)
-        {
-            Block block;
-            for (std::size_t j = 0; j < Robot::dimension; ++j)
-            {
-                std::array<float, rake> lane{};
-                for (std::size_t l = 0; l < rake; ++l)
-                {
-                    const auto k = broadcast ? first : std::min(first + l, n - 1);
-                    lane[l] = qs[k][j];
-                }
-                block[j] = vamp::FloatVector<rake>(lane);
-            }
-            return block;
-        };
+        const auto qs = read_configurations<Robot>(in, n);
         std::vector<Block> blocks;
         for (std::size_t first = 0; first < n; first += rake)
         {
-            blocks.push_back(block_of(first, false));
+            blocks.push_back(block_of<Robot>(qs, first, false));
         }
         const auto repeats = read<std::size_t>(in, "the repeat count");
         for (std::size_t r = 0; r < repeats; ++r)
@@ -295,9 +317,83 @@ namespace
         }
         for (std::size_t k = 0; k < n; ++k)
         {
-            auto block = block_of(k, true);
+            auto block = block_of<Robot>(qs, k, true);
             std::printf("valid %d\n", Robot::template fkcc<rake>(empty, block) ? 1 : 0);
         }
+    }
+
+    // Scenes mode: FK + collision (self and world) of configurations in several scenes, each
+    // scene's blocks of `rake` timed apart, round by round (`next` starts each round after the
+    // first), then how many of each scene's configurations VAMP finds free, one at a time:
+    //   scenes, joints N NAME…, K, then K times: scene FAMILY, objects … (as a problem's),
+    //   configurations N and N lines; then rounds R. Prints `round T1/B1 … TK/BK` (ns per
+    //   configuration / free blocks) per round and `free F1 … FK` (free configurations).
+    template <typename Robot>
+    auto scenes(std::istream &in) -> void
+    {
+        using Block = typename Robot::template ConfigurationBlock<rake>;
+        using Environment = vamp::collision::Environment<vamp::FloatVector<rake>>;
+        expect(in, "joints");
+        expect_joints<Robot>(in);
+        const auto count = read<std::size_t>(in, "the scene count");
+        std::vector<Environment> environments;
+        std::vector<std::vector<std::array<float, Robot::dimension>>> configurations;
+        std::vector<std::vector<Block>> blocks(count);
+        for (std::size_t k = 0; k < count; ++k)
+        {
+            expect(in, "scene");
+            const auto family = read<std::string>(in, "a family");
+            const bool box_family = family.rfind("box_", 0) == 0 or family == "box";
+            std::size_t build_ns = 0;
+            environments.emplace_back(
+                read_environment(in, box_family, Robot::min_radius, Robot::max_radius, build_ns));
+            expect(in, "configurations");
+            const auto n = read<std::size_t>(in, "the configuration count");
+            configurations.push_back(read_configurations<Robot>(in, n));
+            for (std::size_t first = 0; first < n; first += rake)
+            {
+                blocks[k].push_back(block_of<Robot>(configurations[k], first, false));
+            }
+        }
+        expect(in, "rounds");
+        const auto rounds = read<std::size_t>(in, "the round count");
+        for (std::size_t r = 0; r < rounds; ++r)
+        {
+            if (r > 0)
+            {
+                expect(in, "next");
+            }
+            std::printf("round");
+            for (std::size_t k = 0; k < count; ++k)
+            {
+                std::size_t valid = 0;
+                const auto began = std::chrono::steady_clock::now();
+                for (auto &block : blocks[k])
+                {
+                    valid += Robot::template fkcc<rake>(environments[k], block) ? 1 : 0;
+                }
+                const auto ns =
+                    std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - began).count();
+                const auto n = std::max<std::size_t>(configurations[k].size(), 1);
+                // (the count of free blocks is printed so that no compiler drops the checks)
+                std::printf(" %.3f/%zu", ns / static_cast<double>(n), valid);
+            }
+            std::printf("\n");
+            std::fflush(stdout);
+        }
+        std::printf("free");
+        for (std::size_t k = 0; k < count; ++k)
+        {
+            std::size_t free = 0;
+            for (std::size_t i = 0; i < configurations[k].size(); ++i)
+            {
+                auto block = block_of<Robot>(configurations[k], i, true);
+                free += Robot::template fkcc<rake>(environments[k], block) ? 1 : 0;
+            }
+            std::printf(" %zu", free);
+        }
+        std::printf("\n");
+        std::fflush(stdout);
     }
 }  // namespace
 
@@ -316,9 +412,13 @@ namespace
         {
             configurations<Robot>(in);
         }
+        else if (mode == "scenes")
+        {
+            scenes<Robot>(in);
+        }
         else
         {
-            fail("expected `joints` or `configurations`, read `" + mode + "`");
+            fail("expected `joints`, `configurations` or `scenes`, read `" + mode + "`");
         }
     }
 }  // namespace

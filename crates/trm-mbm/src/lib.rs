@@ -25,7 +25,7 @@ pub use experience::{LeaveOneOut, Scope, solve_leave_one_out, solve_with_experie
 pub use loaded::LoadedProblem;
 pub use peers::{
     CLOUD_POINT_RADIUS, CLOUD_SPACING, CloudBuild, Obstacles, cloud_world, parse_peer_results,
-    peer_problems, vamp_world,
+    peer_objects, peer_problems, vamp_world,
 };
 pub use problems::{Problem, ProblemSet, find_problems, rrt_options_for};
 pub use report::{Summary, markdown_table, quantile, runs_csv, side_by_side};

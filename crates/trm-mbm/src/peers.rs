@@ -70,36 +70,7 @@ pub fn peer_problems(
             }
             continue;
         }
-        let primitives: Vec<_> = scene.objects.iter().flat_map(|o| &o.primitives).collect();
-        let _ = writeln!(body, "objects {}", primitives.len());
-        for primitive in primitives {
-            let t = primitive.pose.translation.vector;
-            let q = primitive.pose.rotation;
-            let pose = format!("{} {} {} {} {} {} {}", t.x, t.y, t.z, q.w, q.i, q.j, q.k);
-            let _ = match &primitive.shape {
-                trm_collision::Shape::Sphere { radius } => {
-                    writeln!(body, "sphere {} {} {} {radius}", t.x, t.y, t.z)
-                }
-                trm_collision::Shape::Box { size } => writeln!(
-                    body,
-                    "box {pose} {} {} {}",
-                    size[0] / 2.0,
-                    size[1] / 2.0,
-                    size[2] / 2.0
-                ),
-                trm_collision::Shape::Cylinder { radius, length } => {
-                    writeln!(body, "cylinder {pose} {radius} {length}")
-                }
-                other => {
-                    return Err(MbmError::Invalid {
-                        path: scene.origin.clone(),
-                        line: 0,
-                        problem: format!("a {other:?} has no peer-file form"),
-                        fix: "give boxes, spheres and cylinders (MoveIt's primitives)".into(),
-                    });
-                }
-            };
-        }
+        body.push_str(&peer_objects(&scene)?);
     }
     let joints = joints.unwrap_or_default();
     Ok(format!(
@@ -108,6 +79,44 @@ pub fn peer_problems(
         joints.join(" "),
         problems.len()
     ))
+}
+
+/// A scene's primitives as peer planners read them (the `objects` part of [`peer_problems`]'s
+/// format): `objects N`, then a line per box, cylinder or sphere with its world pose.
+pub fn peer_objects(scene: &PlanningScene) -> Result<String, MbmError> {
+    use std::fmt::Write as _;
+    let mut body = String::new();
+    let primitives: Vec<_> = scene.objects.iter().flat_map(|o| &o.primitives).collect();
+    let _ = writeln!(body, "objects {}", primitives.len());
+    for primitive in primitives {
+        let t = primitive.pose.translation.vector;
+        let q = primitive.pose.rotation;
+        let pose = format!("{} {} {} {} {} {} {}", t.x, t.y, t.z, q.w, q.i, q.j, q.k);
+        let _ = match &primitive.shape {
+            trm_collision::Shape::Sphere { radius } => {
+                writeln!(body, "sphere {} {} {} {radius}", t.x, t.y, t.z)
+            }
+            trm_collision::Shape::Box { size } => writeln!(
+                body,
+                "box {pose} {} {} {}",
+                size[0] / 2.0,
+                size[1] / 2.0,
+                size[2] / 2.0
+            ),
+            trm_collision::Shape::Cylinder { radius, length } => {
+                writeln!(body, "cylinder {pose} {radius} {length}")
+            }
+            other => {
+                return Err(MbmError::Invalid {
+                    path: scene.origin.clone(),
+                    line: 0,
+                    problem: format!("a {other:?} has no peer-file form"),
+                    fix: "give boxes, spheres and cylinders (MoveIt's primitives)".into(),
+                });
+            }
+        };
+    }
+    Ok(body)
 }
 
 /// One problem as a peer planner reported it (`result` lines of `benches/peers/vamp/mbm.cc`):
