@@ -119,7 +119,7 @@ fn run() -> Result<(), String> {
     };
     // per world (trm's, VAMP's as trm checks it, VAMP's own): per family its rounds
     let mut times: [Times; 3] = Default::default();
-    for round in 0..rounds {
+    for _ in 0..rounds {
         for (w, family_times) in times.iter_mut().enumerate().take(2) {
             if w == 1 && vamp.is_none() {
                 continue;
@@ -136,7 +136,7 @@ fn run() -> Result<(), String> {
             record(family_times, this);
         }
         if let Some(vamp) = &mut vamp {
-            let per_scene = vamp.round(round)?;
+            let per_scene = vamp.round()?;
             let mut this = BTreeMap::<String, f64>::new();
             for (scene, ns) in scenes.iter().zip(per_scene) {
                 *this.entry(scene.family.clone()).or_default() +=
@@ -158,20 +158,21 @@ fn run() -> Result<(), String> {
         args[0],
         args[1],
         if vamp.is_some() {
-            "; trm in its world, trm in the world as VAMP sees it, VAMP, ratio of the first to \
-             VAMP's"
+            "; trm in its world, trm in the world as VAMP sees it, VAMP, and the median over \
+             the rounds of the first's ratio to VAMP's"
         } else {
             ""
         }
     );
-    let per_config = |entry: &mut (Vec<f64>, usize)| median(&mut entry.0) / entry.1 as f64 * 1e9;
+    let per_config =
+        |entry: &(Vec<f64>, usize)| median(&mut entry.0.clone()) / entry.1 as f64 * 1e9;
     let families: Vec<String> = times[0].keys().cloned().collect();
     let mut rows: Vec<(String, [Option<f64>; 3])> = families
         .iter()
         .map(|f| {
             (
                 f.clone(),
-                [0, 1, 2].map(|w| times[w].get_mut(f).map(per_config)),
+                [0, 1, 2].map(|w| times[w].get(f).map(per_config)),
             )
         })
         .collect();
@@ -185,12 +186,24 @@ fn run() -> Result<(), String> {
         Some(median(&mut sums) / total as f64 * 1e9)
     };
     rows.push(("all".into(), [0, 1, 2].map(|w| all(&times[w]))));
+    // the ratio round by round (both sides ran in the same round), the median of those: the
+    // machine's speed drifts between rounds
+    let ratio = |family: &str| -> f64 {
+        let side = |w: usize, r: usize| -> f64 {
+            match times[w].get(family) {
+                Some((t, _)) => t[r],
+                None => times[w].values().map(|(t, _)| t[r]).sum(),
+            }
+        };
+        let mut ratios: Vec<f64> = (0..rounds).map(|r| side(0, r) / side(2, r)).collect();
+        median(&mut ratios)
+    };
     for (family, [ours, seen, theirs]) in &rows {
         let n = times[0].get(family).map_or(total, |e| e.1);
         match (ours, seen, theirs) {
             (Some(ours), Some(seen), Some(theirs)) => println!(
                 "  {family}: {ours:.1}, {seen:.1}, {theirs:.1} ({:.2}×; {n} configurations)",
-                ours / theirs
+                ratio(family)
             ),
             (Some(ours), ..) => println!("  {family}: {ours:.1} ns per configuration ({n})"),
             _ => {}
@@ -294,13 +307,12 @@ impl Vamp {
         Ok(fields.map(str::to_owned).collect())
     }
 
-    /// Round `round`'s times, ns per configuration, one per scene.
-    fn round(&mut self, round: usize) -> Result<Vec<f64>, String> {
-        if round > 0 {
-            writeln!(self.input, "next")
-                .and_then(|()| self.input.flush())
-                .map_err(|e| format!("{}: {e}", self.program))?;
-        }
+    /// The next round's times, ns per configuration, one per scene (VAMP runs it while this
+    /// process waits).
+    fn round(&mut self) -> Result<Vec<f64>, String> {
+        writeln!(self.input, "next")
+            .and_then(|()| self.input.flush())
+            .map_err(|e| format!("{}: {e}", self.program))?;
         let fields = self.line("round")?;
         fields
             .iter()

@@ -323,8 +323,7 @@ namespace
     }
 
     // Scenes mode: FK + collision (self and world) of configurations in several scenes, each
-    // scene's blocks of `rake` timed apart, round by round (`next` starts each round after the
-    // first), then how many of each scene's configurations VAMP finds free, one at a time:
+    // scene's blocks of `rake` timed apart, round by round (`next` starts each round), then how many of each scene's configurations VAMP finds free, one at a time:
     //   scenes, joints N NAME…, K, then K times: scene FAMILY, objects … (as a problem's),
     //   configurations N and N lines; then rounds R. Prints `round T1/B1 … TK/BK` (ns per
     //   configuration / free blocks) per round and `free F1 … FK` (free configurations).
@@ -359,10 +358,8 @@ namespace
         const auto rounds = read<std::size_t>(in, "the round count");
         for (std::size_t r = 0; r < rounds; ++r)
         {
-            if (r > 0)
-            {
-                expect(in, "next");
-            }
+            // each round when the caller says so: never while the caller times its own
+            expect(in, "next");
             std::printf("round");
             for (std::size_t k = 0; k < count; ++k)
             {

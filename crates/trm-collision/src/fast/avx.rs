@@ -77,85 +77,134 @@ pub(super) fn abs(v: __m256) -> __m256 {
 }
 
 /// [`Object::distance2`] written out: the compiler vectorises it badly where lane masks
-/// follow (measured: 0.40 → 0.37 ms median on the MBM Panda with mesh hulls).
+/// follow (measured: 0.40 → 0.37 ms median on the MBM Panda with mesh hulls). Each kind of
+/// object is its own small function, so that the callers that match on the kind (the walk's
+/// tests of a link's bounding sphere, [`near`]) take its few instructions inline rather than
+/// a call of the whole match.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(super) fn distance2(object: &Object, c: &[F; 3]) -> __m256 {
-    let norm2 = |v: [__m256; 3]| {
-        _mm256_fmadd_ps(
-            v[2],
-            v[2],
-            _mm256_fmadd_ps(v[1], v[1], _mm256_mul_ps(v[0], v[0])),
-        )
+    object_distance2!(object, c)
+}
+
+/// The match of [`distance2`], written where it is used: a function holding it is too large
+/// for the compiler to take inline, and [`near`] is on the walk's hottest path.
+macro_rules! object_distance2 {
+    ($object:expr, $c:expr) => {
+        match *$object {
+            Object::Round { a, b, .. } => round_distance2($c, a, b),
+            Object::Box { center, axes, half } => box_distance2($c, center, &axes, half),
+            Object::Cylinder {
+                center,
+                axes,
+                radius,
+                half,
+            } => cylinder_distance2($c, center, &axes, radius, half),
+            Object::Cloud { center, half, .. } => aligned_box_distance2($c, center, half),
+            Object::Bounded { center, .. } => point_distance2($c, center),
+        }
     };
-    match *object {
-        Object::Round { a, b, .. } => {
-            let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
-            let inv = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
-            let p = [
-                _mm256_sub_ps(load(&c[0]), _mm256_set1_ps(a[0])),
-                _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(a[1])),
-                _mm256_sub_ps(load(&c[2]), _mm256_set1_ps(a[2])),
-            ];
-            let ab = [
-                _mm256_set1_ps(ab[0]),
-                _mm256_set1_ps(ab[1]),
-                _mm256_set1_ps(ab[2]),
-            ];
-            let along = _mm256_fmadd_ps(
-                p[2],
-                ab[2],
-                _mm256_fmadd_ps(p[1], ab[1], _mm256_mul_ps(p[0], ab[0])),
-            );
-            let t = _mm256_mul_ps(along, _mm256_set1_ps(inv));
-            let t = _mm256_max_ps(_mm256_min_ps(t, _mm256_set1_ps(1.0)), _mm256_setzero_ps());
-            norm2([
-                _mm256_fnmadd_ps(t, ab[0], p[0]),
-                _mm256_fnmadd_ps(t, ab[1], p[1]),
-                _mm256_fnmadd_ps(t, ab[2], p[2]),
-            ])
-        }
-        Object::Box { center, axes, half } => {
-            let p = local(c, center, &axes);
-            norm2([
-                beyond(abs(p[0]), half[0]),
-                beyond(abs(p[1]), half[1]),
-                beyond(abs(p[2]), half[2]),
-            ])
-        }
-        Object::Cylinder {
-            center,
-            axes,
-            radius,
-            half,
-        } => {
-            let [x, y, z] = local(c, center, &axes);
-            let radial = _mm256_sqrt_ps(_mm256_fmadd_ps(y, y, _mm256_mul_ps(x, x)));
-            let radial = beyond(radial, radius);
-            let axial = beyond(abs(z), half);
-            _mm256_fmadd_ps(axial, axial, _mm256_mul_ps(radial, radial))
-        }
-        Object::Cloud { center, half, .. } => {
-            let out = |k: usize| {
-                let d = _mm256_sub_ps(load(&c[k]), _mm256_set1_ps(center[k]));
-                beyond(abs(d), half[k])
-            };
-            norm2([out(0), out(1), out(2)])
-        }
-        Object::Bounded { center, .. } => norm2([
-            _mm256_sub_ps(load(&c[0]), _mm256_set1_ps(center[0])),
-            _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(center[1])),
-            _mm256_sub_ps(load(&c[2]), _mm256_set1_ps(center[2])),
-        ]),
-    }
+}
+use object_distance2;
+
+/// `|v|²` in every lane.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn norm2(v: [__m256; 3]) -> __m256 {
+    _mm256_fmadd_ps(
+        v[2],
+        v[2],
+        _mm256_fmadd_ps(v[1], v[1], _mm256_mul_ps(v[0], v[0])),
+    )
+}
+
+/// Squared distance from `c` to the segment `a`–`b` (a point when they are equal).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn round_distance2(c: &[F; 3], a: [f32; 3], b: [f32; 3]) -> __m256 {
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+    let inv = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
+    let p = [
+        _mm256_sub_ps(load(&c[0]), _mm256_set1_ps(a[0])),
+        _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(a[1])),
+        _mm256_sub_ps(load(&c[2]), _mm256_set1_ps(a[2])),
+    ];
+    let ab = [
+        _mm256_set1_ps(ab[0]),
+        _mm256_set1_ps(ab[1]),
+        _mm256_set1_ps(ab[2]),
+    ];
+    let along = _mm256_fmadd_ps(
+        p[2],
+        ab[2],
+        _mm256_fmadd_ps(p[1], ab[1], _mm256_mul_ps(p[0], ab[0])),
+    );
+    let t = _mm256_mul_ps(along, _mm256_set1_ps(inv));
+    let t = _mm256_max_ps(_mm256_min_ps(t, _mm256_set1_ps(1.0)), _mm256_setzero_ps());
+    norm2([
+        _mm256_fnmadd_ps(t, ab[0], p[0]),
+        _mm256_fnmadd_ps(t, ab[1], p[1]),
+        _mm256_fnmadd_ps(t, ab[2], p[2]),
+    ])
+}
+
+/// Squared distance from `c` to a box (centre, rows of the world → box rotation, half sizes).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn box_distance2(c: &[F; 3], center: [f32; 3], axes: &[[f32; 3]; 3], half: [f32; 3]) -> __m256 {
+    let p = local(c, center, axes);
+    norm2([
+        beyond(abs(p[0]), half[0]),
+        beyond(abs(p[1]), half[1]),
+        beyond(abs(p[2]), half[2]),
+    ])
+}
+
+/// Squared distance from `c` to a cylinder along its z axis.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn cylinder_distance2(
+    c: &[F; 3],
+    center: [f32; 3],
+    axes: &[[f32; 3]; 3],
+    radius: f32,
+    half: f32,
+) -> __m256 {
+    let [x, y, z] = local(c, center, axes);
+    let radial = _mm256_sqrt_ps(_mm256_fmadd_ps(y, y, _mm256_mul_ps(x, x)));
+    let radial = beyond(radial, radius);
+    let axial = beyond(abs(z), half);
+    _mm256_fmadd_ps(axial, axial, _mm256_mul_ps(radial, radial))
+}
+
+/// Squared distance from `c` to a box along the world's axes (centre, half sizes).
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn aligned_box_distance2(c: &[F; 3], center: [f32; 3], half: [f32; 3]) -> __m256 {
+    let out = |k: usize| {
+        let d = _mm256_sub_ps(load(&c[k]), _mm256_set1_ps(center[k]));
+        beyond(abs(d), half[k])
+    };
+    norm2([out(0), out(1), out(2)])
+}
+
+/// Squared distance from `c` to a point.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+fn point_distance2(c: &[F; 3], p: [f32; 3]) -> __m256 {
+    norm2([
+        _mm256_sub_ps(load(&c[0]), _mm256_set1_ps(p[0])),
+        _mm256_sub_ps(load(&c[1]), _mm256_set1_ps(p[1])),
+        _mm256_sub_ps(load(&c[2]), _mm256_set1_ps(p[2])),
+    ])
 }
 
 /// [`Object::near`]: the lanes whose squared distance is within `reach2` (NaN included).
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(super) fn near(object: &Object, c: &[F; 3], reach2: f32) -> LaneMask {
-    let flags = _mm256_cmp_ps::<_CMP_NGT_UQ>(distance2(object, c), _mm256_set1_ps(reach2));
+    let flags = _mm256_cmp_ps::<_CMP_NGT_UQ>(object_distance2!(object, c), _mm256_set1_ps(reach2));
     _mm256_movemask_ps(flags) as LaneMask
 }
 

@@ -92,19 +92,31 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
         for g in (0..model.groups.len()).rev() {
             let within = farthest(&scratch.bounds[g]) + model.groups[g].bound.radius + m;
             let reach = model.groups[g].bound.radius + m;
-            for (k, (&o, object)) in world.original.iter().zip(&world.objects).enumerate() {
-                if world.from_origin[k] > within {
-                    // the link's bounding sphere lies nearer the origin than this object and
-                    // every later one
-                    break;
+            // the objects nearer the origin than the link's bounding sphere reaches (they are
+            // sorted: their count is where the first beyond is, found without a branch), 64 at
+            // a time: first which of them the sphere comes near in some lane (no branch per
+            // object: whether one passes is hard to predict), then those
+            let upto: usize = world
+                .from_origin
+                .iter()
+                .map(|&d| usize::from(!(d > within)))
+                .sum();
+            for start in (0..upto).step_by(64) {
+                let end = (start + 64).min(upto);
+                let mut near = 0u64;
+                for k in start..end {
+                    let passes = enclosing_near::<AVX>(world, k, &scratch.bounds[g], reach, live);
+                    near |= u64::from(passes) << (k - start);
                 }
-                if !enclosing_near::<AVX>(world, k, &scratch.bounds[g], reach, live) {
-                    continue;
-                }
-                let o = o as usize;
-                if object_link::<AVX, _>(model, poses, o, object, g, live, world, scratch, verdict)
-                {
-                    return;
+                while near != 0 {
+                    let k = start + near.trailing_zeros() as usize;
+                    near &= near - 1;
+                    let (o, object) = (world.original[k] as usize, &world.objects[k]);
+                    if object_link::<AVX, _>(
+                        model, poses, o, object, g, live, world, scratch, verdict,
+                    ) {
+                        return;
+                    }
                 }
             }
         }
@@ -195,9 +207,28 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
     // self: the culling spheres of the kinematic tree (one test clears a hand against the
     // other hand), then each link pair's bounding spheres and spheres
     if !model.culls {
-        for (k, gp) in model.group_pairs.iter().enumerate() {
-            if link_pair::<AVX>(model, poses, gp, k, live, world, scratch, verdict) {
-                return;
+        // 64 link pairs at a time: first which of them come near in some lane by their
+        // bounding spheres (no branch per pair: whether one does is hard to predict), then
+        // those
+        let pairs = &model.group_pairs;
+        for start in (0..pairs.len()).step_by(64) {
+            let end = (start + 64).min(pairs.len());
+            let mut lanes = [0 as LaneMask; 64];
+            let mut near = 0u64;
+            for k in start..end {
+                let mask = bounds_near::<AVX>(model, &pairs[k], live, scratch, m);
+                lanes[k - start] = mask;
+                near |= u64::from(mask != 0) << (k - start);
+            }
+            while near != 0 {
+                let j = near.trailing_zeros() as usize;
+                near &= near - 1;
+                let k = start + j;
+                if near_link_pair::<AVX, _>(
+                    model, poses, &pairs[k], k, lanes[j], world, scratch, verdict,
+                ) {
+                    return;
+                }
             }
         }
         clear_suspects::<AVX, _>(model, poses, world, scratch, verdict);
@@ -636,14 +667,23 @@ pub(super) fn link_pair<const AVX: bool>(
     scratch: &mut FastScratch,
     verdict: &mut impl Outcome,
 ) -> bool {
-    let m = world.margin;
-    let (ga, gb) = (&model.groups[gp.a], &model.groups[gp.b]);
-    let reach = ga.bound.radius + gb.bound.radius + m;
-    let near = live
-        & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
-            .within(reach * reach)
-            .mask::<AVX>();
+    let near = bounds_near::<AVX>(model, gp, live, scratch, world.margin);
     near != 0 && near_link_pair::<AVX, _>(model, poses, gp, k, near, world, scratch, verdict)
+}
+
+/// The lanes of `live` where the bounding spheres of `gp`'s links come within the margin `m`.
+#[inline(always)]
+fn bounds_near<const AVX: bool>(
+    model: &FastModel,
+    gp: &GroupPair,
+    live: LaneMask,
+    scratch: &FastScratch,
+    m: f32,
+) -> LaneMask {
+    let reach = model.groups[gp.a].bound.radius + model.groups[gp.b].bound.radius + m;
+    live & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
+        .within(reach * reach)
+        .mask::<AVX>()
 }
 
 /// [`link_pair`] in the lanes of `near`, where the links' bounding spheres come near.
