@@ -18,9 +18,8 @@
 //! the box family as boxes), and each round runs trm's passes and then VAMP's.
 
 use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufReader, Write};
 use std::path::Path;
-use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use trm_benches::{median, positive, random_configurations};
@@ -268,16 +267,7 @@ impl Vamp {
             }
         }
         text.push_str(&format!("rounds {rounds}\n"));
-        let mut child = Command::new(program)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .map_err(|e| format!("{program}: {e} (build it with benches/peers/vamp/build.sh)"))?;
-        let (Some(mut input), Some(output)) = (child.stdin.take(), child.stdout.take()) else {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(format!("{program}: no pipes"));
-        };
+        let (child, mut input, output) = trm_benches::start_vamp(program)?;
         input
             .write_all(text.as_bytes())
             .and_then(|()| input.flush())
@@ -285,7 +275,7 @@ impl Vamp {
         Ok(Vamp {
             child,
             input,
-            output: BufReader::new(output).lines(),
+            output,
             program: program.into(),
         })
     }

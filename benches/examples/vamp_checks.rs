@@ -16,8 +16,7 @@
 //! configurations (trm [`trm_kinematics::LANES`], VAMP its float lanes), stopping a block at
 //! its first collision, in an empty world.
 
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
+use std::io::Write;
 use std::time::Instant;
 
 use trm_benches::{median, positive, random_configurations};
@@ -176,17 +175,7 @@ fn exchange(
         input.push('\n');
     }
     input.push_str(&format!("{rounds}\n"));
-    let mut vamp = Command::new(program)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("{program}: {e} (build it with benches/peers/vamp/build.sh)"))?;
-    let (Some(mut to_vamp), Some(out)) = (vamp.stdin.take(), vamp.stdout.take()) else {
-        let _ = vamp.kill();
-        let _ = vamp.wait();
-        return Err("no pipes to VAMP".into());
-    };
-    let mut from_vamp = BufReader::new(out).lines();
+    let (mut vamp, mut to_vamp, mut from_vamp) = trm_benches::start_vamp(program)?;
     let lost = |e: std::io::Error| format!("{program}: {e}");
     let flat: Vec<f64> = qs.iter().flatten().copied().collect();
     let d = timed.dim();

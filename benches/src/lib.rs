@@ -89,6 +89,31 @@ pub fn positive(text: &str, what: &str) -> Result<usize, String> {
     }
 }
 
+/// A peer's program (`benches/peers/vamp`'s) started with piped input and output: the child,
+/// its input and its output's lines.
+pub type Peer = (
+    std::process::Child,
+    std::process::ChildStdin,
+    std::io::Lines<std::io::BufReader<std::process::ChildStdout>>,
+);
+
+/// Starts VAMP's program `program` ([`Peer`]), or says how to build it.
+pub fn start_vamp(program: &str) -> Result<Peer, String> {
+    use std::io::BufRead;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(program)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("{program}: {e} (build it with benches/peers/vamp/build.sh)"))?;
+    let (Some(input), Some(output)) = (child.stdin.take(), child.stdout.take()) else {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(format!("{program}: no pipes"));
+    };
+    Ok((child, input, std::io::BufReader::new(output).lines()))
+}
+
 /// Runs an example's `run`, printing its error and exiting with status 2 when it fails.
 pub fn exit_on_error(run: impl FnOnce() -> Result<(), String>) {
     if let Err(e) = run() {
