@@ -15,7 +15,9 @@
 //! must be VAMP's robot's). Prints the time per free configuration per family and over the set,
 //! and whether the screen agreed with the exact model on every configuration. With VAMP, trm is
 //! also timed in the world as VAMP sees it ([`trm_mbm::vamp_world`]: cylinders as capsules, in
-//! the box family as boxes), and each round runs trm's passes and then VAMP's.
+//! the box family as boxes), and each round runs trm's passes and then VAMP's. Every round also
+//! times both with the robot alone (the same configurations in an empty world: FK and
+//! self-collision), so that the world's part and the robot's are compared apart.
 
 use std::collections::BTreeMap;
 use std::io::{BufReader, Write};
@@ -33,14 +35,25 @@ fn main() {
     trm_benches::exit_on_error(run);
 }
 
-/// One problem's scene: its family, checker, worlds (compiled and exact; as trm plans in it and
-/// as VAMP sees it) and free configurations (whole blocks).
+/// One problem's scene: its family, checker, worlds (compiled and exact; as trm plans in it,
+/// as VAMP sees it, and empty: the robot alone) and free configurations (whole blocks).
 struct Scene {
     family: String,
     fast: FastChecker,
-    worlds: [(FastWorld, World); 2],
+    worlds: [(FastWorld, World); 3],
     free: Vec<f64>,
 }
+
+/// What each round times, in [`Times`]' order: trm in its world, trm in the world as VAMP sees
+/// it, VAMP, trm with the robot alone, VAMP with the robot alone.
+const PASSES: usize = 5;
+
+/// [`PASSES`]' indices.
+const TRM: usize = 0;
+const TRM_SEEN: usize = 1;
+const VAMP: usize = 2;
+const TRM_ALONE: usize = 3;
+const VAMP_ALONE: usize = 4;
 
 /// Per family, each round's seconds and the configurations timed.
 type Times = BTreeMap<String, (Vec<f64>, usize)>;
@@ -78,7 +91,12 @@ fn run() -> Result<(), String> {
         }
         free.truncate(free.len() / width * width);
         let seen = vamp_world(&p.world, &p.problem.family);
-        let worlds = [(world, p.world.clone()), (fast.model().world(&seen), seen)];
+        let (seen_fast, empty) = (fast.model().world(&seen), World::new());
+        let worlds = [
+            (world, p.world.clone()),
+            (seen_fast, seen),
+            (fast.model().world(&empty), empty),
+        ];
         scenes.push(Scene {
             family: p.problem.family.clone(),
             fast,
@@ -95,32 +113,15 @@ fn run() -> Result<(), String> {
             scenes.len()
         ));
     }
-    // the same configurations and checkers in an empty world: the self part alone
-    let empty_world = World::new();
-    let mut empty = Vec::new();
-    for _ in 0..rounds {
-        let began = Instant::now();
-        for scene in &mut scenes {
-            let compiled = scene.fast.model().world(&empty_world);
-            for block in scene.free.chunks(width) {
-                std::hint::black_box(
-                    scene
-                        .fast
-                        .all_free_unchecked(block, &empty_world, &compiled),
-                );
-            }
-        }
-        empty.push(began.elapsed().as_secs_f64());
-    }
     let mut vamp = match args.get(4) {
         Some(program) => Some(Vamp::start(program, &robot, &loaded, &scenes, d, rounds)?),
         None => None,
     };
-    // per world (trm's, VAMP's as trm checks it, VAMP's own): per family its rounds
-    let mut times: [Times; 3] = Default::default();
+    // per pass (PASSES): per family its rounds
+    let mut times: [Times; PASSES] = Default::default();
     for _ in 0..rounds {
-        for (w, family_times) in times.iter_mut().enumerate().take(2) {
-            if w == 1 && vamp.is_none() {
+        for (pass, w) in [(TRM, 0), (TRM_SEEN, 1), (TRM_ALONE, 2)] {
+            if pass == TRM_SEEN && vamp.is_none() {
                 continue;
             }
             let mut this = BTreeMap::<String, f64>::new();
@@ -132,16 +133,20 @@ fn run() -> Result<(), String> {
                 }
                 *this.entry(scene.family.clone()).or_default() += began.elapsed().as_secs_f64();
             }
-            record(family_times, this);
+            record(&mut times[pass], this);
         }
         if let Some(vamp) = &mut vamp {
+            // the scenes with their objects, then the same scenes empty
             let per_scene = vamp.round()?;
-            let mut this = BTreeMap::<String, f64>::new();
-            for (scene, ns) in scenes.iter().zip(per_scene) {
-                *this.entry(scene.family.clone()).or_default() +=
-                    ns * 1e-9 * (scene.free.len() / d) as f64;
+            let (full, alone) = per_scene.split_at(scenes.len());
+            for (pass, part) in [(VAMP, full), (VAMP_ALONE, alone)] {
+                let mut this = BTreeMap::<String, f64>::new();
+                for (scene, ns) in scenes.iter().zip(part) {
+                    *this.entry(scene.family.clone()).or_default() +=
+                        ns * 1e-9 * (scene.free.len() / d) as f64;
+                }
+                record(&mut times[pass], this);
             }
-            record(&mut times[2], this);
         }
     }
     for family_times in &mut times {
@@ -158,20 +163,21 @@ fn run() -> Result<(), String> {
         args[1],
         if vamp.is_some() {
             "; trm in its world, trm in the world as VAMP sees it, VAMP, and the median over \
-             the rounds of the first's ratio to VAMP's"
+             the rounds of the first's ratio to VAMP's; then the robot alone, in an empty world, \
+             trm and VAMP; and the world's part, each round's difference of the two"
         } else {
-            ""
+            "; then the robot alone, in an empty world"
         }
     );
     let per_config =
         |entry: &(Vec<f64>, usize)| median(&mut entry.0.clone()) / entry.1 as f64 * 1e9;
     let families: Vec<String> = times[0].keys().cloned().collect();
-    let mut rows: Vec<(String, [Option<f64>; 3])> = families
+    let mut rows: Vec<(String, [Option<f64>; PASSES])> = families
         .iter()
         .map(|f| {
             (
                 f.clone(),
-                [0, 1, 2].map(|w| times[w].get(f).map(per_config)),
+                std::array::from_fn(|w| times[w].get(f).map(per_config)),
             )
         })
         .collect();
@@ -184,37 +190,58 @@ fn run() -> Result<(), String> {
             .collect();
         Some(median(&mut sums) / total as f64 * 1e9)
     };
-    rows.push(("all".into(), [0, 1, 2].map(|w| all(&times[w]))));
-    // the ratio round by round (both sides ran in the same round), the median of those: the
+    rows.push(("all".into(), std::array::from_fn(|w| all(&times[w]))));
+    // a pass's seconds in round r (the family's, or all of them)
+    let side = |family: &str, w: usize, r: usize| -> f64 {
+        match times[w].get(family) {
+            Some((t, _)) => t[r],
+            None => times[w].values().map(|(t, _)| t[r]).sum(),
+        }
+    };
+    // ratios round by round (both sides ran in the same round), the median of those: the
     // machine's speed drifts between rounds
-    let ratio = |family: &str| -> f64 {
-        let side = |w: usize, r: usize| -> f64 {
-            match times[w].get(family) {
-                Some((t, _)) => t[r],
-                None => times[w].values().map(|(t, _)| t[r]).sum(),
-            }
-        };
-        let mut ratios: Vec<f64> = (0..rounds).map(|r| side(0, r) / side(2, r)).collect();
+    let ratio = |ours: &dyn Fn(usize) -> f64, theirs: &dyn Fn(usize) -> f64| {
+        let mut ratios: Vec<f64> = (0..rounds).map(|r| ours(r) / theirs(r)).collect();
         median(&mut ratios)
     };
-    for (family, [ours, seen, theirs]) in &rows {
-        let n = times[0].get(family).map_or(total, |e| e.1);
-        match (ours, seen, theirs) {
-            (Some(ours), Some(seen), Some(theirs)) => println!(
-                "  {family}: {ours:.1}, {seen:.1}, {theirs:.1} ({:.2}×; {n} configurations)",
-                ratio(family)
-            ),
-            (Some(ours), ..) => println!("  {family}: {ours:.1} ns per configuration ({n})"),
+    for (family, row) in &rows {
+        let n = times[TRM].get(family).map_or(total, |e| e.1);
+        let per = |seconds: f64| seconds / n as f64 * 1e9;
+        match row {
+            [
+                Some(ours),
+                Some(seen),
+                Some(theirs),
+                Some(alone),
+                Some(vamp_alone),
+            ] => {
+                let whole = ratio(&|r| side(family, TRM, r), &|r| side(family, VAMP, r));
+                let robot = ratio(&|r| side(family, TRM_ALONE, r), &|r| {
+                    side(family, VAMP_ALONE, r)
+                });
+                let world = |w: usize, alone: usize| {
+                    let mut parts: Vec<f64> = (0..rounds)
+                        .map(|r| per(side(family, w, r) - side(family, alone, r)))
+                        .collect();
+                    median(&mut parts)
+                };
+                println!(
+                    "  {family}: {ours:.1}, {seen:.1}, {theirs:.1} ({whole:.2}×); alone \
+                     {alone:.1}, {vamp_alone:.1} ({robot:.2}×); the world's part {:.1}, {:.1} \
+                     ({n} configurations)",
+                    world(TRM, TRM_ALONE),
+                    world(VAMP, VAMP_ALONE),
+                );
+            }
+            [Some(ours), _, _, Some(alone), _] => {
+                println!("  {family}: {ours:.1}; alone {alone:.1} ns per configuration ({n})")
+            }
             _ => {}
         }
     }
-    println!(
-        "  the screen and the exact model differ on {disagreements} configurations; in an empty \
-         world: {:.1} ns per configuration",
-        median(&mut empty) / total as f64 * 1e9
-    );
+    println!("  the screen and the exact model differ on {disagreements} configurations");
     if let Some(vamp) = vamp {
-        let free = vamp.finish()?;
+        let free = vamp.finish(scenes.len())?;
         println!(
             "  VAMP finds {free} of the {total} configurations free (its spheres and its world: \
              cylinders as capsules)"
@@ -250,20 +277,27 @@ impl Vamp {
     ) -> Result<Vamp, String> {
         let active = robot.all_active();
         let names: Vec<&str> = active.names().collect();
+        // every scene twice: with its objects, then empty (the robot alone)
         let mut text = format!(
             "trm-mbm-problems 1\nrobot {}\nscenes\njoints {d} {}\n{}\n",
             robot.name(),
             names.join(" "),
-            scenes.len()
+            2 * scenes.len()
         );
-        for (p, scene) in loaded.iter().zip(scenes) {
-            text.push_str(&format!("scene {}\n", scene.family));
-            text.push_str(&peer_objects(&p.scene).map_err(|e| e.to_string())?);
-            text.push_str(&format!("configurations {}\n", scene.free.len() / d));
-            for q in scene.free.chunks(d) {
-                let values: Vec<String> = q.iter().map(|v| v.to_string()).collect();
-                text.push_str(&values.join(" "));
-                text.push('\n');
+        for alone in [false, true] {
+            for (p, scene) in loaded.iter().zip(scenes) {
+                text.push_str(&format!("scene {}\n", scene.family));
+                if alone {
+                    text.push_str("objects 0\n");
+                } else {
+                    text.push_str(&peer_objects(&p.scene).map_err(|e| e.to_string())?);
+                }
+                text.push_str(&format!("configurations {}\n", scene.free.len() / d));
+                for q in scene.free.chunks(d) {
+                    let values: Vec<String> = q.iter().map(|v| v.to_string()).collect();
+                    text.push_str(&values.join(" "));
+                    text.push('\n');
+                }
             }
         }
         text.push_str(&format!("rounds {rounds}\n"));
@@ -297,8 +331,8 @@ impl Vamp {
         Ok(fields.map(str::to_owned).collect())
     }
 
-    /// The next round's times, ns per configuration, one per scene (VAMP runs it while this
-    /// process waits).
+    /// The next round's times, ns per configuration, one per scene handed to it (VAMP runs
+    /// it while this process waits).
     fn round(&mut self) -> Result<Vec<f64>, String> {
         writeln!(self.input, "next")
             .and_then(|()| self.input.flush())
@@ -314,11 +348,13 @@ impl Vamp {
             .collect()
     }
 
-    /// How many configurations VAMP finds free in all, then waits for it to end.
-    fn finish(mut self) -> Result<usize, String> {
+    /// How many configurations VAMP finds free in the first `scenes` scenes handed to it
+    /// (those with their objects), then waits for it to end.
+    fn finish(mut self, scenes: usize) -> Result<usize, String> {
         let fields = self.line("free")?;
         let free = fields
             .iter()
+            .take(scenes)
             .map(|f| f.parse::<usize>().map_err(|e| format!("`{f}`: {e}")))
             .sum::<Result<usize, String>>()?;
         drop(self.input);
