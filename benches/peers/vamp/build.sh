@@ -7,7 +7,8 @@
 # no CMake); PDQSORT_DIR: https://github.com/orlp/pdqsort. Needs g++ ≥ 10 and Eigen 3
 # (Debian: libeigen3-dev). Nigh, VAMP's nearest-neighbour library, is replaced by the exhaustive
 # scan in nigh-shim/ (see README.md). Compiled as VAMP compiles itself: -O3, the host's vector
-# instructions.
+# instructions. VAMP_MARCH sets another -march (`haswell`: AVX2 without AVX-512, for valgrind)
+# and VAMP_OUT another program path.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../../.." && pwd)
@@ -17,9 +18,9 @@ if [ $# -ne 2 ] || [ ! -f "$1/src/impl/vamp/robots/panda.hh" ] || [ ! -f "$2/pdq
 fi
 eigen=${EIGEN_DIR:-/usr/include/eigen3}
 [ -f "$eigen/Eigen/Dense" ] || { echo "no Eigen at $eigen: apt install libeigen3-dev, or set EIGEN_DIR" >&2; exit 2; }
-mkdir -p "$root/target/peers"
-out="$root/target/peers/vamp-mbm"
-${CXX:-g++} -std=c++17 -O3 -march=native -DNDEBUG -w \
+out=${VAMP_OUT:-$root/target/peers/vamp-mbm}
+mkdir -p "$(dirname "$out")"
+${CXX:-g++} -std=c++17 -O3 -march="${VAMP_MARCH:-native}" -DNDEBUG -w \
   -I"$1/src/impl" -I"$here/nigh-shim" -I"$2" -I"$eigen" \
   "$here/mbm.cc" -o "$out.tmp"
 mv "$out.tmp" "$out"

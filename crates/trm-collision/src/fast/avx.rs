@@ -382,12 +382,19 @@ pub(super) fn pair_contacts(
 ) -> (LaneMask, LaneMask) {
     let m = world.margin;
     let (balls, bounds) = (&scratch.balls, &scratch.bounds);
+    // what the unchecked reads below rest on: the model's pairs and runs index its balls and
+    // its pairs (as compiled), and the scratch and the world are this model's
+    assert!(
+        balls.len() == model.balls.len() && world.limits.len() == model.pairs.len(),
+        "a scratch or a world of another model"
+    );
     let bound_b = load3(&bounds[gp.b]);
-    let bound_radius = model.groups[gp.b].bound.radius;
     let (mut hit, mut close) = (_mm256_setzero_ps(), _mm256_setzero_ps());
-    for (a, run) in &gp.runs {
-        let ball = load3(&balls[*a as usize]);
-        let reach = model.balls[*a as usize].radius + bound_radius + m;
+    for run in &gp.runs {
+        // SAFETY: a run's ball is one of the model's balls (asserted above)
+        #[allow(unsafe_code)]
+        let ball = load3(unsafe { balls.get_unchecked(run.ball as usize) });
+        let reach = run.reach + m;
         let near = _mm256_cmp_ps::<_CMP_NGT_UQ>(
             distance2_between(&ball, &bound_b),
             _mm256_set1_ps(reach * reach),
@@ -395,11 +402,18 @@ pub(super) fn pair_contacts(
         if _mm256_testz_ps(near, near) != 0 {
             continue;
         }
-        let pairs = model.pairs[run.clone()]
-            .iter()
-            .zip(&world.limits[run.clone()]);
+        let range = run.start as usize..run.end as usize;
+        // SAFETY: a run's pairs are a range of the model's pairs, and the world holds their
+        // limits (asserted above)
+        #[allow(unsafe_code)]
+        let pairs = unsafe {
+            (model.pairs.get_unchecked(range.clone()).iter()).zip(world.limits.get_unchecked(range))
+        };
         for (&(_, b, _), &[inner2, outer2]) in pairs {
-            let d2 = distance2_between(&ball, &load3(&balls[b as usize]));
+            // SAFETY: a pair's balls are the model's (asserted above)
+            #[allow(unsafe_code)]
+            let other = unsafe { balls.get_unchecked(b as usize) };
+            let d2 = distance2_between(&ball, &load3(other));
             let h = _mm256_cmp_ps::<_CMP_LT_OQ>(d2, _mm256_set1_ps(inner2));
             let c = _mm256_cmp_ps::<_CMP_NGT_UQ>(d2, _mm256_set1_ps(outer2));
             hit = _mm256_or_ps(hit, h);
@@ -570,8 +584,13 @@ pub(super) fn place_balls(model: &FastModel, g: usize, scratch: &mut FastScratch
     }
     let (rot, t) = (m, load3(t));
     let group = &model.groups[g];
-    for i in group.balls.clone() {
-        scratch.balls[i] = store3(transform(&rot, &t, model.balls[i].center));
+    // (one check for the group's balls: the loop reads and writes without one per ball)
+    let (placed, balls) = (
+        &mut scratch.balls[group.balls.clone()],
+        &model.balls[group.balls.clone()],
+    );
+    for (out, ball) in placed.iter_mut().zip(balls) {
+        *out = store3(transform(&rot, &t, ball.center));
     }
     for i in group.inner.clone() {
         scratch.inner[i] = store3(transform(&rot, &t, model.inner[i].center));

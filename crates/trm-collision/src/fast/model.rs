@@ -64,9 +64,10 @@ pub(super) type LinkPairTests = (Vec<BallPair>, Vec<(u32, u32)>);
 pub(super) struct GroupPair {
     pub(super) a: usize,
     pub(super) b: usize,
-    /// Per ball of link `a`: the ball and its pairs with link `b`'s balls, a range of
-    /// [`FastModel::pairs`].
-    pub(super) runs: Vec<(u32, std::ops::Range<usize>)>,
+    /// The two links' bounding spheres' radii summed.
+    pub(super) reach: f32,
+    /// Per ball of link `a`: the ball and its pairs with link `b`'s balls.
+    pub(super) runs: Vec<Run>,
     /// The checked body pairs of the two links (indices into [`CollisionModel::bodies`]).
     pub(super) bodies: Vec<(u32, u32)>,
     /// Pairs of spheres inside the two links' checked bodies (indices into
@@ -82,6 +83,19 @@ pub(super) struct GroupPair {
     /// When one or two revolute joints alone move the two links relative to each other: the
     /// pair's clearance table (an index into [`FastModel::tables`]), consulted first.
     pub(super) table: Option<u32>,
+}
+
+/// A ball of one link of a [`GroupPair`] and its pairs with the other link's balls.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Run {
+    /// The ball (an index into [`FastModel::balls`]).
+    pub(super) ball: u32,
+    /// Its radius plus the other link's bounding sphere's: farther from that sphere's centre,
+    /// the ball misses every ball of the other link.
+    pub(super) reach: f32,
+    /// Its pairs, `start..end` of [`FastModel::pairs`].
+    pub(super) start: u32,
+    pub(super) end: u32,
 }
 
 /// One step of the self-collision walk, in the order of [`crate::cull`]'s steps.
@@ -461,11 +475,17 @@ impl Spheres {
         let (mut pairs, mut group_pairs) = (Vec::new(), Vec::new());
         for ((a, b), (mut list, bodies)) in by_pair {
             list.sort_by_key(|&(x, y, _)| (x, y));
-            let mut runs: Vec<(u32, std::ops::Range<usize>)> = Vec::new();
+            let mut runs: Vec<Run> = Vec::new();
             for pair in list {
+                let at = pairs.len() as u32;
                 match runs.last_mut() {
-                    Some((x, range)) if *x == pair.0 => range.end += 1,
-                    _ => runs.push((pair.0, pairs.len()..pairs.len() + 1)),
+                    Some(run) if run.ball == pair.0 => run.end += 1,
+                    _ => runs.push(Run {
+                        ball: pair.0,
+                        reach: balls[pair.0 as usize].radius + groups[b].bound.radius,
+                        start: at,
+                        end: at + 1,
+                    }),
                 }
                 pairs.push(pair);
             }
@@ -498,6 +518,7 @@ impl Spheres {
                 solid_pairs,
                 a,
                 b,
+                reach: groups[a].bound.radius + groups[b].bound.radius,
                 runs,
                 bodies,
                 inner: inner_pairs,

@@ -216,7 +216,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
             let mut lanes = [0 as LaneMask; 64];
             let mut near = 0u64;
             for k in start..end {
-                let mask = bounds_near::<AVX>(model, &pairs[k], live, scratch, m);
+                let mask = bounds_near::<AVX>(&pairs[k], live, scratch, m);
                 lanes[k - start] = mask;
                 near |= u64::from(mask != 0) << (k - start);
             }
@@ -667,20 +667,19 @@ pub(super) fn link_pair<const AVX: bool>(
     scratch: &mut FastScratch,
     verdict: &mut impl Outcome,
 ) -> bool {
-    let near = bounds_near::<AVX>(model, gp, live, scratch, world.margin);
+    let near = bounds_near::<AVX>(gp, live, scratch, world.margin);
     near != 0 && near_link_pair::<AVX, _>(model, poses, gp, k, near, world, scratch, verdict)
 }
 
 /// The lanes of `live` where the bounding spheres of `gp`'s links come within the margin `m`.
 #[inline(always)]
 fn bounds_near<const AVX: bool>(
-    model: &FastModel,
     gp: &GroupPair,
     live: LaneMask,
     scratch: &FastScratch,
     m: f32,
 ) -> LaneMask {
-    let reach = model.groups[gp.a].bound.radius + model.groups[gp.b].bound.radius + m;
+    let reach = gp.reach + m;
     live & distance2(&scratch.bounds[gp.a], &scratch.bounds[gp.b])
         .within(reach * reach)
         .mask::<AVX>()
@@ -889,17 +888,15 @@ pub(super) fn pair_contacts<const AVX: bool>(
     }
     let m = world.margin;
     let (balls, bounds) = (&scratch.balls, &scratch.bounds);
-    let bound_b = model.groups[gp.b].bound.radius;
     let mut contact = Contact::default();
-    for (a, run) in &gp.runs {
-        let ball = &balls[*a as usize];
-        let reach = model.balls[*a as usize].radius + bound_b + m;
+    for run in &gp.runs {
+        let ball = &balls[run.ball as usize];
+        let reach = run.reach + m;
         if !distance2(ball, &bounds[gp.b]).any_within::<PORTABLE>(reach * reach) {
             continue;
         }
-        let pairs = model.pairs[run.clone()]
-            .iter()
-            .zip(&world.limits[run.clone()]);
+        let range = run.start as usize..run.end as usize;
+        let pairs = model.pairs[range.clone()].iter().zip(&world.limits[range]);
         for (&(_, b, _), &limits) in pairs {
             contact.add_within(distance2(ball, &balls[b as usize]), limits);
         }
