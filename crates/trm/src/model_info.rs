@@ -176,10 +176,70 @@ pub fn run(args: &Args) -> Result<()> {
         println!("\npostures: {}", postures.join(", "));
     }
     match args.meshes.collision_model(&model) {
-        Ok(collision) => print_collision(&collision, args.collisions),
+        Ok(collision) => {
+            print_collision(&collision, args.collisions);
+            print_planning(&model, &collision);
+        }
         Err(e) => println!("\ncollision bodies: cannot be built: {e:#}"),
     }
     Ok(())
+}
+
+/// RRT-Connect's settings when planning for all motors and for each group (what `trm plan`,
+/// `benchmark-mbm` and Python's planner use unless told otherwise): the model description's
+/// `planning` where it gives them, else sized by the bodies' lever arms
+/// ([`RrtOptions::for_robot`]).
+fn print_planning(model: &RobotModel, collision: &CollisionModel) {
+    use trm_plan::rrt::{CHECK_TRAVEL, DOMAIN_RADIUS, RrtOptions, STEP_MOTORS, STEP_TRAVEL};
+    let mut sets = vec![("all motors".to_string(), Ok(model.all_active()))];
+    for (name, _) in model.groups() {
+        sets.push((
+            name.into(),
+            model.active_set(&[name], &model.neutral_motors()),
+        ));
+    }
+    let width = sets.iter().map(|(name, _)| name.len()).max().unwrap_or(0);
+    let own = model.planning();
+    println!(
+        "\nplanning (RRT-Connect's step, its edges' resolution and first dynamic-domain radius; \
+         the largest lever: the farthest a body point moves per unit step of the motors):"
+    );
+    for (name, active) in sets {
+        let sized = active.map_err(anyhow::Error::from).and_then(|active| {
+            let levers = trm_collision::Levers::new(collision, &active)?;
+            let options = RrtOptions::for_robot(collision, &active)?;
+            Ok((active.len(), levers.max_reach(), options))
+        });
+        match sized {
+            Ok((motors, lever, o)) => println!(
+                "  {name:<width$} ({motors:>2}) range {:.3} rad, resolution 1/{:.1} rad, domains \
+                 {:.2} rad; largest lever {lever:.2} m/rad",
+                o.range,
+                1.0 / o.resolution,
+                o.domain_radius
+            ),
+            Err(e) => println!("  {name:<width$} cannot be sized: {e:#}"),
+        }
+    }
+    let given: Vec<&str> = [
+        ("range", own.range.is_some()),
+        ("resolution", own.resolution.is_some()),
+        ("domain_radius", own.domain_radius.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, set)| set.then_some(name))
+    .collect();
+    if !given.is_empty() {
+        println!("  (the model description sets {})", given.join(", "));
+    }
+    if given.len() < 3 {
+        println!(
+            "  (sized by the lever arms: range {STEP_TRAVEL} m / lever · √({STEP_MOTORS} / \
+             motors), resolution {CHECK_TRAVEL} m / lever, domains {DOMAIN_RADIUS} rad · √(motors / \
+             {STEP_MOTORS}); fix them in the model description: `planning: (range: Some(…), \
+             resolution: Some(…), domain_radius: Some(…))`)"
+        );
+    }
 }
 
 /// The motors, their limits and the joints each drives.

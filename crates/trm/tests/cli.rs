@@ -436,3 +436,46 @@ fn plan_through_a_map_holds_what_the_scene_holds() {
     assert!(stderr.contains("plank"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn model_info_shows_the_planner_settings_sized_or_given() {
+    let dir = std::env::temp_dir().join(format!("trm-cli-planning-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/panda");
+    let text = std::fs::read_to_string(models.join("panda.ron")).unwrap();
+    let urdf = models.join("panda_fitted.urdf");
+    let text = text.replace(
+        "urdf: \"panda_fitted.urdf\"",
+        &format!("urdf: {:?}", urdf.display().to_string()),
+    );
+    let end = text.rfind(')').unwrap();
+    let given = format!("{}    planning: (range: Some(1.25)),\n)\n", &text[..end]);
+    std::fs::write(dir.join("panda.ron"), given).unwrap();
+    let info = trm(&["model-info", "panda.ron"], &dir);
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    let out = String::from_utf8_lossy(&info.stdout);
+    // the range given, the rest sized as the planner sizes it for the group
+    let robot = trm_kinematics::RobotModel::load(dir.join("panda.ron")).unwrap();
+    let collision = trm_collision::CollisionModel::new(&robot).unwrap();
+    let arm = robot.active_set(&["arm"], &robot.neutral_motors()).unwrap();
+    let sized = trm_plan::rrt::RrtOptions::for_robot(&collision, &arm).unwrap();
+    assert_eq!(sized.range, 1.25);
+    let planning = &out[out.find("\nplanning (").expect("a planning section")..];
+    let line = planning
+        .lines()
+        .find(|l| l.trim_start().starts_with("arm "))
+        .unwrap_or_else(|| panic!("no line for the arm group:\n{out}"));
+    assert!(
+        line.contains("range 1.250 rad")
+            && line.contains(&format!("resolution 1/{:.1} rad", 1.0 / sized.resolution))
+            && line.contains(&format!("domains {:.2} rad", sized.domain_radius)),
+        "{line}"
+    );
+    assert!(out.contains("(the model description sets range)"), "{out}");
+    assert!(out.contains("sized by the lever arms"), "{out}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
