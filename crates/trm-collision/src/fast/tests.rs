@@ -901,11 +901,11 @@ fn objects_lie_no_nearer_the_origin_than_their_walk_takes_them() {
     }
 }
 
-/// Each compiled object's enclosing sphere, the world walk's first test of a link against it,
-/// holds the object's farthest point (exact, nalgebra, `f64`) and is within 0.1 mm of it, for
-/// boxes, cylinders, capsules and spheres in random poses.
+/// Each compiled object's enclosing box, the world walk's first test of a link against it,
+/// holds the object (its extent along each world axis, exact in `f64`) and is within 0.1 mm of
+/// it, for boxes, cylinders, capsules and spheres in random poses.
 #[test]
-fn enclosing_spheres_hold_their_objects() {
+fn enclosing_boxes_hold_their_objects() {
     use nalgebra::{Isometry3, UnitQuaternion};
     let (_, _, model) = shipped("panda-mbm/panda_spherized.ron");
     let mut rng = ChaCha8Rng::seed_from_u64(12);
@@ -939,26 +939,27 @@ fn enclosing_spheres_hold_their_objects() {
     }
     let compiled = model.world(&world);
     for (k, &o) in compiled.original.iter().enumerate() {
-        let (centre, radius) = compiled.enclosing[k];
+        let (centre, half) = compiled.boxes[k];
         let (pose, [a, b, c]) = poses[o as usize];
-        let centre = Point3::new(centre[0], centre[1], centre[2]).cast::<f64>();
-        // the sphere's centre in the object's frame
-        let p = pose.inverse_transform_point(&centre).coords;
-        let farthest = match o % 4 {
-            0 => (p.abs() + Vector3::new(a, b, c)).norm(),
-            1 => (p.x.hypot(p.y) + a).hypot(p.z.abs() + b),
-            2 => {
-                (p - Vector3::new(0.0, 0.0, b))
-                    .norm()
-                    .max((p + Vector3::new(0.0, 0.0, b)).norm())
-                    + a
+        let r = pose.rotation.to_rotation_matrix();
+        let r = r.matrix();
+        // the object's half extent along world axis i
+        let extent = |i: usize| -> f64 {
+            let z = r[(i, 2)].abs();
+            match o % 4 {
+                0 => r[(i, 0)].abs() * a + r[(i, 1)].abs() * b + z * c,
+                1 => z * b + a * (1.0 - z * z).max(0.0).sqrt(),
+                2 => z * b + a,
+                _ => a,
             }
-            _ => p.norm() + a,
         };
-        let radius = f64::from(radius);
-        assert!(
-            radius >= farthest && radius <= farthest + 1e-4,
-            "object {o}: {radius} against {farthest}"
-        );
+        for i in 0..3 {
+            let (exact, half) = (extent(i), f64::from(half[i]));
+            let off = (f64::from(centre[i]) - pose.translation.vector[i]).abs();
+            assert!(
+                off + exact <= half && half <= exact + 1e-4,
+                "object {o}, axis {i}: half {half} off by {off} against {exact}"
+            );
+        }
     }
 }

@@ -4,8 +4,8 @@ use super::avx;
 use super::cloud::solids_against_cloud;
 use super::kdop::kdop_clear;
 use super::lanes::{
-    F, PORTABLE, compiled_per_isa, distance2, inverse_transform, pose_point, rotation, splat,
-    transform,
+    F, PORTABLE, aligned_box_distance2, compiled_per_isa, distance2, inverse_transform, pose_point,
+    rotation, splat, transform,
 };
 use super::model::{CullStep, FastModel, GroupPair, Suspect, WorldStep};
 use super::outcome::{Contact, Outcome};
@@ -270,7 +270,7 @@ pub(super) fn walk<const AVX: bool, O: Outcome>(
 }
 
 /// Whether a sphere at `c` of radius `reach` (in some lane of `live`) comes within object
-/// `k`'s enclosing sphere ([`FastWorld::enclosing`]): when not, it misses the object.
+/// `k`'s enclosing box ([`FastWorld::boxes`]): when not, it misses the object.
 #[inline(always)]
 pub(super) fn enclosing_near<const AVX: bool>(
     world: &FastWorld,
@@ -279,10 +279,9 @@ pub(super) fn enclosing_near<const AVX: bool>(
     reach: f32,
     live: LaneMask,
 ) -> bool {
-    let (center, radius) = world.enclosing[k];
-    let limit = reach + radius;
-    live & distance2(c, &splat(center))
-        .within(limit * limit)
+    let (center, half) = world.boxes[k];
+    live & aligned_box_distance2(c, center, half)
+        .within(reach * reach)
         .mask::<AVX>()
         != 0
 }

@@ -66,9 +66,9 @@ pub struct FastWorld {
     /// Per object of `objects` (ascending): a lower bound of its distance from the world's
     /// origin ([`Object::origin_distance`]).
     pub(super) from_origin: Vec<f32>,
-    /// Per object of `objects`: a sphere enclosing it (centre, radius; [`Object::enclosing`]),
-    /// the first and cheapest test of a link against it.
-    pub(super) enclosing: Vec<([f32; 3], f32)>,
+    /// Per object of `objects`: an axis-aligned box enclosing it (centre, half sizes;
+    /// [`Object::enclosing_box`]), the first and cheapest test of a link against it.
+    pub(super) boxes: Vec<([f32; 3], [f32; 3])>,
     /// The index in `objects` of each of the world's objects.
     pub(super) compiled_of: Vec<u32>,
     pub(super) margin: f32,
@@ -296,7 +296,7 @@ impl FastWorld {
 }
 
 /// [`FastWorld::screen_spheres`]: the lanes certainly touching an object, and those within the
-/// margin of contact with one (the certain ones among them). Each object's enclosing sphere
+/// margin of contact with one (the certain ones among them). Each object's enclosing box
 /// first; a lane certain of one object is not tested against the later ones.
 #[allow(unsafe_code)] // multiversion's run-time CPU-feature dispatch
 #[multiversion::multiversion(targets("x86_64+avx2+fma", "x86_64+avx", "aarch64+neon"))]
@@ -470,9 +470,9 @@ impl FastModel {
         FastWorld {
             objects: sorted,
             from_origin: order.iter().map(|&o| from_origin[o as usize]).collect(),
-            enclosing: order
+            boxes: order
                 .iter()
-                .map(|&o| objects[o as usize].enclosing())
+                .map(|&o| objects[o as usize].enclosing_box())
                 .collect(),
             original: order,
             compiled_of,
@@ -497,40 +497,52 @@ impl Object {
         (d - 1e-6 * (1.0 + d.abs())).max(0.0) as f32
     }
 
-    /// A sphere enclosing the object (its geometry widened by its radius): centre and radius,
-    /// the radius measured in `f64` and widened by 1 µm per metre, so that a point farther
-    /// from the centre than the radius is outside the object.
-    pub(super) fn enclosing(&self) -> ([f32; 3], f32) {
-        let norm = |v: [f32; 3]| v.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>().sqrt();
-        let (center, radius) = match *self {
+    /// An axis-aligned box enclosing the object (its geometry widened by its radius): centre
+    /// and half sizes, measured in `f64` from the single-precision geometry and widened by
+    /// 1 µm per metre, so that a point outside the box is outside the object.
+    pub(super) fn enclosing_box(&self) -> ([f32; 3], [f32; 3]) {
+        let f = |v: [f32; 3]| v.map(f64::from);
+        // the half sizes along the world's axes of a box with half sizes `h` along the rows
+        // of `axes` (each row: one of the box's axes in world coordinates)
+        let turned = |axes: &[[f32; 3]; 3], h: [f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|k| (0..3).map(|j| f64::from(axes[j][k]).abs() * h[j]).sum())
+        };
+        let (center, half): ([f64; 3], [f64; 3]) = match *self {
             Object::Round { a, b, radius } => {
-                let half = [
-                    (b[0] - a[0]) / 2.0,
-                    (b[1] - a[1]) / 2.0,
-                    (b[2] - a[2]) / 2.0,
-                ];
-                let c = [a[0] + half[0], a[1] + half[1], a[2] + half[2]];
-                // the centre's rounding: its distance to both ends, not half the length
-                let ends = norm([c[0] - a[0], c[1] - a[1], c[2] - a[2]]).max(norm([
-                    c[0] - b[0],
-                    c[1] - b[1],
-                    c[2] - b[2],
-                ]));
-                (c, ends + f64::from(radius))
+                let (a, b) = (f(a), f(b));
+                (
+                    std::array::from_fn(|k| 0.5 * (a[k] + b[k])),
+                    std::array::from_fn(|k| 0.5 * (a[k] - b[k]).abs() + f64::from(radius)),
+                )
             }
-            Object::Box { center, half, .. } | Object::Cloud { center, half, .. } => {
-                (center, norm(half) + f64::from(self.reach(0.0)))
-            }
+            Object::Box { center, axes, half } => (f(center), turned(&axes, f(half))),
             Object::Cylinder {
                 center,
+                axes,
                 radius,
                 half,
+            } => {
+                // the disc's extent along k is r·√(1 − z_k²), its axis's |z_k|·half
+                let z = f(axes[2]);
+                (
+                    f(center),
+                    std::array::from_fn(|k| {
+                        f64::from(half) * z[k].abs()
+                            + f64::from(radius) * (1.0 - z[k] * z[k]).max(0.0).sqrt()
+                    }),
+                )
+            }
+            Object::Cloud {
+                center,
+                half,
+                radius,
                 ..
-            } => (center, f64::from(radius).hypot(f64::from(half))),
-            Object::Bounded { center, radius } => (center, f64::from(radius)),
+            } => (f(center), f(half).map(|h| h + f64::from(radius))),
+            Object::Bounded { center, radius } => (f(center), [f64::from(radius); 3]),
         };
-        let far = radius + norm(center);
-        (center, (radius + 1e-6 * (1.0 + far)) as f32)
+        let far: f64 = (0..3).map(|k| center[k].abs() + half[k]).sum();
+        let widen = 1e-6 * (1.0 + far);
+        (center.map(|v| v as f32), half.map(|h| (h + widen) as f32))
     }
 
     /// The reach of a sphere of radius `r` from the object's own geometry: the sum of the radii
