@@ -19,6 +19,7 @@ fi
 eigen=${EIGEN_DIR:-/usr/include/eigen3}
 [ -f "$eigen/Eigen/Dense" ] || { echo "no Eigen at $eigen: apt install libeigen3-dev, or set EIGEN_DIR" >&2; exit 2; }
 out=${VAMP_OUT:-$root/target/peers/vamp-mbm}
+[ ! -d "$out" ] || { echo "VAMP_OUT=$out is a directory: give the program's file path (e.g. $out/vamp-mbm)" >&2; exit 2; }
 mkdir -p "$(dirname "$out")"
 ${CXX:-g++} -std=c++17 -O3 -march="${VAMP_MARCH:-native}" -DNDEBUG -w \
   -I"$1/src/impl" -I"$here/nigh-shim" -I"$2" -I"$eigen" \

@@ -213,10 +213,15 @@ fn print_planning(model: &RobotModel, collision: &CollisionModel) {
         match sized {
             Ok((motors, lever, o)) => println!(
                 "  {name:<width$} ({motors:>2}) range {:.3} rad, resolution 1/{:.1} rad, domains \
-                 {:.2} rad; largest lever {lever:.2} m/rad",
+                 {:.2} rad; largest lever {lever:.2} m/rad{}",
                 o.range,
                 1.0 / o.resolution,
-                o.domain_radius
+                o.domain_radius,
+                if lever > 0.0 {
+                    ""
+                } else {
+                    " (no body moves: the defaults)"
+                }
             ),
             Err(e) => println!("  {name:<width$} cannot be sized: {e:#}"),
         }
